@@ -1,0 +1,48 @@
+# Two user-facing targets: `make demo` and `make test`. Both set up what they
+# need (a local .venv with the package installed editable, the C build) and are
+# quick when nothing changed: the install re-runs only when pyproject.toml or the
+# C sources change, and CMake rebuilds only what changed.
+
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+CBUILD := build/c
+C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h)
+C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in) CMakeLists.txt $(wildcard fmu_src/*/CMakeLists.txt)
+# System cmake, not the one fmpy's dependencies put in the venv.
+CMAKE  ?= cmake
+
+.PHONY: demo test pytest ctest cbuild bench clean
+
+$(PY):
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+
+$(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
+	$(PY) -m pip install -q -e '.[dev]'
+	touch $@
+
+$(CBUILD)/.built: $(C_ALL) | $(PY)
+	$(CMAKE) -S . -B $(CBUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(abspath $(PY)) > $(CBUILD).log 2>&1 || (cat $(CBUILD).log; exit 1)
+	$(CMAKE) --build $(CBUILD) -j 2 >> $(CBUILD).log 2>&1 || (cat $(CBUILD).log; exit 1)
+	touch $@
+
+cbuild: $(CBUILD)/.built
+
+ctest: cbuild
+	cd $(CBUILD) && ctest --output-on-failure
+
+pytest: $(STAMP) cbuild
+	OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
+
+test: ctest pytest
+
+demo: $(STAMP)
+	$(PY) examples/demo.py --out out
+
+bench: $(STAMP) cbuild
+	$(PY) examples/benchmarks.py
+
+clean:
+	rm -rf build out .damper_cache

@@ -1,0 +1,143 @@
+/*
+ * iwan.h -- the Masing/Iwan friction element: one plain C99 implementation.
+ *
+ * A concave piecewise-linear virgin curve T(u) (the tangential force-displacement
+ * curve of a contact, loaded monotonically from zero) is represented exactly by
+ * m parallel Jenkins elements (spring k_j in series with a Coulomb slider of
+ * strength fs_j) plus a residual spring k_res (Iwan). For slopes
+ * s_1 > s_2 > ... > s_(m+1) >= 0 between breakpoints u_1 < ... < u_m:
+ *     k_j = s_j - s_(j+1),  fs_j = k_j u_j,  k_res = s_(m+1).
+ * Such a parallel model obeys Masing's rules exactly for any load history with
+ * nested loops (branch after a reversal at (u_r, F_r): F = F_r + 2 g((u-u_r)/2)).
+ *
+ * Normal load N: every slip strength scales with N / n_ref (same curve shape),
+ * so F(u; cN) = c F(u/c; N). N <= 0 is lift-off: force zero, memory released,
+ * reloading restarts on the virgin curve from the displacement of re-contact.
+ * When u and N change together within one update, each slider is advanced
+ * exactly along the straight path (u, N)(s), 0 <= s <= 1 (its stick/slip
+ * switches located in closed form), so results do not depend on the step size.
+ *
+ * Conventions: SI units (u in m, F and N in N, k in N/m, energies in J).
+ * No heap use, no global state; model and state are flat fixed-size structs
+ * without pointers, so a state is saved and restored by copying it.
+ * Every function returns an iwan_status; on failure nothing is written to the
+ * committed state.
+ */
+#ifndef IWAN_H
+#define IWAN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IWAN_MAX_SLIDERS 256   /* largest number of Jenkins elements (table segments) */
+#define IWAN_STATE_VERSION 1   /* bump when iwan_state changes layout */
+
+typedef enum {
+    IWAN_OK = 0,
+    IWAN_ERR_NONFINITE = 1,     /* NaN or infinite input */
+    IWAN_ERR_BAD_TABLE = 2,     /* empty, too long, not starting at (0,0), u not increasing */
+    IWAN_ERR_NOT_CONCAVE = 3,   /* slopes not non-increasing (and no fit requested) */
+    IWAN_ERR_BAD_PARAM = 4,     /* n_ref <= 0, scale < 0, null pointer, size 0, ... */
+    IWAN_ERR_NOT_CONVERGED = 5, /* periodic loop did not close within max_periods */
+    IWAN_ERR_BAD_STATE = 6      /* state of another version or corrupted */
+} iwan_status;
+
+/* Model built from a virgin curve (immutable after iwan_model_init). */
+typedef struct {
+    int32_t n;                    /* number of Jenkins elements */
+    double k[IWAN_MAX_SLIDERS];   /* slider spring stiffnesses [N/m] */
+    double fs[IWAN_MAX_SLIDERS];  /* slip strengths at N = n_ref [N] */
+    double k_res;                 /* residual (never slipping) spring [N/m] */
+    double n_ref;                 /* normal load the curve was computed at [N] */
+    double scale;                 /* friction scale: multiplies every fs (1 = as tabulated) */
+} iwan_model;
+
+/* History of one element (flat, copyable, versioned). */
+typedef struct {
+    int32_t version;              /* IWAN_STATE_VERSION */
+    int32_t in_contact;           /* 0 after lift-off (N <= 0), 1 otherwise */
+    double u;                     /* last committed displacement [m] */
+    double N;                     /* last committed normal load [N] */
+    double u_contact;             /* displacement at (re-)contact: residual spring rest point [m] */
+    double w_diss;                /* cumulative dissipated energy [J], never decreasing */
+    double z[IWAN_MAX_SLIDERS];   /* slider positions; slider force = k_j (u - z_j) [m] */
+    double dir;                   /* sign of the last nonzero increment of u (+1/-1), for tangents */
+} iwan_state;
+
+/* Outputs at one point of the history. */
+typedef struct {
+    double F;      /* friction force [N] */
+    double kt;     /* tangent stiffness dF/du for continued motion in direction `dir` [N/m] */
+    double dFdN;   /* dF/dN at fixed u (slipping sliders only) [-] */
+    double W;      /* cumulative dissipated energy [J] */
+    double E;      /* stored elastic energy [J] */
+    double slip;   /* slip fraction: slipping strength / total strength, in [0, 1] */
+} iwan_output;
+
+/* Curve-table handling for iwan_model_init. */
+typedef enum {
+    IWAN_FIT_REJECT = 0,  /* a non-concave table is an error (IWAN_ERR_NOT_CONCAVE) */
+    IWAN_FIT_CONCAVE = 1  /* replace the table by its least concave majorant (upper hull) */
+} iwan_fit;
+
+/* Build a model from a virgin-curve table u[0..m-1], T[0..m-1], u[0] = T[0] = 0,
+ * u strictly increasing. The last segment's slope continues as the residual spring
+ * unless the table ends flat (gross slip). */
+iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T, size_t m,
+                            double n_ref, iwan_fit fit);
+
+/* Build a model directly from sliders (k_j, fs_j at n_ref) and a residual spring. */
+iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const double *fs,
+                                    size_t n, double k_res, double n_ref);
+
+/* Virgin state at u = 0 with normal load N (pass model->n_ref for the curve's own load). */
+iwan_status iwan_state_init(const iwan_model *model, iwan_state *state, double N);
+
+/* Trial update: advance a copy of `committed` along the straight path to (u, N) and
+ * report the outputs there. `committed` is not modified; `trial` may be NULL (outputs
+ * only) and must not alias `committed` (iwan_step updates in place). */
+iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, double u, double N,
+                      iwan_state *trial, iwan_output *out);
+
+/* In-place update of `state` to (u, N); `out` may be NULL. */
+iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, double N,
+                      iwan_output *out);
+
+/* Whole history in one call: n samples of u (and N, or NULL for constant model->n_ref).
+ * Any output pointer may be NULL. `state` is advanced to the last sample. */
+iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
+                        const double *u, const double *N,
+                        double *F, double *kt, double *dFdN, double *W);
+
+/* Converged periodic loop of a periodic input sampled at n points per period
+ * (sample n would equal sample 0). With constant N (N == NULL or all equal) the loop
+ * is exact in one pass (the sweep starts at the maximum of u); otherwise periods are
+ * repeated until the loop closes to `tol` (relative to the force range), at most
+ * `max_periods`. Outputs per sample; W_cycle = energy dissipated per period [J];
+ * periods_used may be NULL. */
+iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, const double *N,
+                          double *F, double *kt, double *dFdN, double *W_cycle,
+                          int max_periods, double tol, int *periods_used);
+
+/* Periodic loop plus its exact sensitivities with respect to basis coefficients:
+ * u[t] = sum_c Eu[t*nb + c] X[c] (and N[t] = sum_c EN[t*nb + c] XN[c] when EN != NULL).
+ * Writes dFdX[t*nb + c] = dF[t]/dX[c], including the dependence of every sticking
+ * slider on the sample where it last stuck (its reversal point), and, when EN and
+ * dFdXN are not NULL, dFdXN[t*nb + c] = dF[t]/dXN[c]. Same F, W_cycle as iwan_periodic. */
+iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
+                              const double *Eu, const double *EN, size_t nb,
+                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
+                              int max_periods, double tol, int *periods_used);
+
+/* Human-readable text of a status code (static string). */
+const char *iwan_status_text(iwan_status status);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* IWAN_H */
