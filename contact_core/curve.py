@@ -1,0 +1,182 @@
+"""The virgin curve: a contact's tangential force-displacement curve as plain data.
+
+The virgin curve T(u) is the tangential force T [N] of a contact loaded
+monotonically from zero, against the rigid tangential displacement u [m] of the
+distant faces, at a fixed normal load N [N] and friction coefficient mu [-].
+Its initial slope is the tangential contact stiffness k_t [N/m]; it ends at
+gross slip, T = mu N. Later stages (the hysteresis element, the FMU, harmonic
+balance) read it.
+
+File format (JSON, ``schema`` = ``SCHEMA``)::
+
+    {
+      "schema": "damper-virgin-curve/1",
+      "u": [0.0, ...],          # m, strictly increasing, u[0] = 0
+      "T": [0.0, ...],          # N, T[0] = 0, finite, non-negative
+      "N": 200.0,               # normal load [N] (optional)
+      "mu": 0.5,                # friction coefficient (optional)
+      "k_t": 1.2e8,             # initial tangential stiffness [N/m] (optional)
+      "k_n": 3.4e8,             # normal contact stiffness at N [N/m] (optional)
+      "load_case": "CNF",       # CNF (constant normal force) or CND (optional)
+      "geometry": {...}, "materials": {...}, "grid": {...},   # optional
+      "provenance": {"code_version": "...", "date": "...", "command": "..."}
+    }
+
+Only ``u`` and ``T`` are required, so a hand-made table works too. Unknown
+keys are kept in ``extra`` and written back unchanged.
+"""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from contact_core.fileio import atomic_write
+
+#: Schema tag written to every curve file.
+SCHEMA = "damper-virgin-curve/1"
+_KNOWN_SCALARS = ("N", "mu", "k_t", "k_n")
+_KNOWN_TEXT = ("load_case",)
+_KNOWN_DICTS = ("geometry", "materials", "grid", "provenance")
+
+
+@dataclass(frozen=True)
+class VirginCurve:
+    """A validated virgin curve.
+
+    Attributes
+    ----------
+    u : ndarray, shape (m,)
+        Tangential displacement [m], strictly increasing, ``u[0] = 0``.
+    T : ndarray, shape (m,)
+        Tangential force [N], ``T[0] = 0``, non-negative.
+    N, mu, k_t, k_n : float or None
+        Normal load [N], friction coefficient [-], initial tangential and
+        normal contact stiffness [N/m].
+    load_case : str or None
+        ``"CNF"`` or ``"CND"``.
+    geometry, materials, grid, provenance, extra : dict
+        Descriptive metadata, written back unchanged.
+    """
+
+    u: np.ndarray
+    T: np.ndarray
+    N: float | None = None
+    mu: float | None = None
+    k_t: float | None = None
+    k_n: float | None = None
+    load_case: str | None = None
+    geometry: dict = field(default_factory=dict)
+    materials: dict = field(default_factory=dict)
+    grid: dict = field(default_factory=dict)
+    provenance: dict = field(default_factory=dict)
+    extra: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        u = np.array(self.u, dtype=float)
+        T = np.array(self.T, dtype=float)
+        _check_table(u, T)
+        u.setflags(write=False)
+        T.setflags(write=False)
+        object.__setattr__(self, "u", u)
+        object.__setattr__(self, "T", T)
+        for name in _KNOWN_SCALARS:
+            value = getattr(self, name)
+            if value is not None:
+                value = float(value)
+                if not math.isfinite(value):
+                    raise ValueError(f"curve: {name} must be finite, got {value}")
+                object.__setattr__(self, name, value)
+        if self.N is not None and self.N <= 0:
+            raise ValueError(f"curve: normal load N must be > 0, got {self.N}")
+        if self.mu is not None and self.mu < 0:
+            raise ValueError(f"curve: friction coefficient mu must be >= 0, got {self.mu}")
+        if self.load_case not in (None, "CNF", "CND"):
+            raise ValueError(f"curve: load_case must be CNF or CND, got {self.load_case!r}")
+
+    def to_dict(self) -> dict:
+        """The file's JSON object (plain Python types)."""
+        out = {"schema": SCHEMA, "u": self.u.tolist(), "T": self.T.tolist()}
+        for name in _KNOWN_SCALARS + _KNOWN_TEXT:
+            if getattr(self, name) is not None:
+                out[name] = getattr(self, name)
+        for name in _KNOWN_DICTS:
+            if getattr(self, name):
+                out[name] = getattr(self, name)
+        out.update(self.extra)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "curve") -> "VirginCurve":
+        """Validate a JSON object and build the curve; ValueError names what is wrong."""
+        if not isinstance(data, dict):
+            raise ValueError(f"{source}: expected a JSON object, got {type(data).__name__}")
+        schema = data.get("schema", SCHEMA)
+        if not str(schema).startswith("damper-virgin-curve/"):
+            raise ValueError(f"{source}: unknown schema {schema!r} (expected {SCHEMA!r})")
+        if schema != SCHEMA:
+            raise ValueError(f"{source}: schema {schema!r} is newer than this code reads ({SCHEMA!r})")
+        for key in ("u", "T"):
+            if key not in data:
+                raise ValueError(f"{source}: missing required array {key!r}")
+            if not isinstance(data[key], list) or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in data[key]
+            ):
+                raise ValueError(f"{source}: {key!r} must be a list of numbers")
+        kwargs = {"u": data["u"], "T": data["T"]}
+        for name in _KNOWN_SCALARS + _KNOWN_TEXT + _KNOWN_DICTS:
+            if name in data:
+                kwargs[name] = data[name]
+        known = {"schema", "u", "T", *_KNOWN_SCALARS, *_KNOWN_TEXT, *_KNOWN_DICTS}
+        kwargs["extra"] = {k: v for k, v in data.items() if k not in known}
+        try:
+            return cls(**kwargs)
+        except (TypeError, ValueError) as err:
+            raise ValueError(f"{source}: {err}") from None
+
+
+def _check_table(u: np.ndarray, T: np.ndarray) -> None:
+    """Raise ValueError unless (u, T) is a usable virgin-curve table."""
+    if u.ndim != 1 or T.ndim != 1:
+        raise ValueError("u and T must be one-dimensional arrays")
+    if u.size != T.size:
+        raise ValueError(f"u and T differ in length ({u.size} vs {T.size})")
+    if u.size < 2:
+        raise ValueError(f"a virgin curve needs at least 2 points, got {u.size}")
+    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(T))):
+        raise ValueError("u and T must be finite (no NaN or infinity)")
+    if u[0] != 0.0 or T[0] != 0.0:
+        raise ValueError(f"a virgin curve starts at (0, 0), got ({u[0]}, {T[0]})")
+    if np.any(np.diff(u) <= 0.0):
+        raise ValueError("u must be strictly increasing")
+    if np.any(T < 0.0):
+        raise ValueError("T must be non-negative")
+
+
+def read_curve(path: str | Path) -> VirginCurve:
+    """Read and validate a curve file.
+
+    Raises
+    ------
+    ValueError
+        Malformed, truncated or invalid file (the message names the file and
+        the problem).
+    OSError
+        The file cannot be read.
+    """
+    path = Path(path)
+    text = path.read_text()
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise ValueError(f"{path}: not valid JSON (truncated?): {err}") from None
+    return VirginCurve.from_dict(data, source=str(path))
+
+
+def write_curve(curve: VirginCurve, path: str | Path) -> Path:
+    """Write ``curve`` to ``path`` (JSON; all or nothing)."""
+    text = json.dumps(curve.to_dict(), indent=1, allow_nan=False)
+    return atomic_write(path, text + "\n")
