@@ -24,8 +24,9 @@ $(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
 	touch $@
 
 $(CBUILD)/.built: $(C_ALL) | $(PY)
-	$(CMAKE) -S . -B $(CBUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(abspath $(PY)) > $(CBUILD).log 2>&1 || (cat $(CBUILD).log; exit 1)
-	$(CMAKE) --build $(CBUILD) -j 2 >> $(CBUILD).log 2>&1 || (cat $(CBUILD).log; exit 1)
+	mkdir -p $(CBUILD)
+	$(CMAKE) -S . -B $(CBUILD) -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=$(abspath $(PY)) > $(CBUILD)/build.log 2>&1 || (cat $(CBUILD)/build.log; exit 1)
+	$(CMAKE) --build $(CBUILD) -j 2 >> $(CBUILD)/build.log 2>&1 || (cat $(CBUILD)/build.log; exit 1)
 	touch $@
 
 cbuild: $(CBUILD)/.built
