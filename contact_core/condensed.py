@@ -44,12 +44,19 @@ class ContactGrid:
         Tributary area of each node inside the modelled part [m^2] (a node on a
         symmetry plane owns only its half inside the part).
     mult : ndarray, shape (n,)
-        Number of copies of the node in the full model: its symmetry images
-        (4, 2 or 1 for a quarter model, 2 or 1 for a half model, 1 for a full
-        model). A full-model total is ``sum(mult * f)``.
+        Weight of the node's modelled share in full-model totals:
+        ``sum(mult * f)`` is the full-model force and ``sum(mult * area)`` the
+        full-model area. With symmetry boundary conditions the modelled part
+        carries 1/4 (quarter) or 1/2 (half) of every load, including at nodes
+        on a symmetry plane (their other half lies in the image part), so
+        ``mult`` is 4 for every node of a quarter model, 2 for a half model and
+        1 for a full model. ``copies`` counts the distinct nodes instead.
     h : ndarray, shape (n,)
         Initial normal gap from the geometry [m] (>= 0, zero at the first
         touching point).
+    copies : ndarray of int, shape (n,), optional
+        Number of distinct nodes of the full model the node stands for (its
+        symmetry images: 4, 2 or 1 in a quarter model); for node counts only.
     """
 
     x: np.ndarray
@@ -57,6 +64,7 @@ class ContactGrid:
     area: np.ndarray
     mult: np.ndarray
     h: np.ndarray
+    copies: np.ndarray | None = None
 
     @property
     def n(self) -> int:
