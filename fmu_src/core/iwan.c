@@ -1,5 +1,55 @@
-/* iwan.c -- implementation of iwan.h (in progress: see issue "The Masing/Iwan hysteresis element"). */
+/*
+ * iwan.c -- the Masing/Iwan friction element (implementation of iwan.h).
+ *
+ * Symbols (SI): u tangential displacement [m], N normal load [N], F force [N].
+ * Slider j: spring k_j in series with a Coulomb slider of strength
+ *     g_j(N) = fs_j * f(N),   f(N) = scale * N / n_ref          (strength factor)
+ * position z_j, elastic stretch e_j = u - z_j, force k_j e_j, |e_j| <= r_j,
+ *     r_j(N) = g_j(N) / k_j                                       (slip radius)
+ * The residual spring carries k_res (u - u_contact) and never slips.
+ *
+ * Exact straight-path update (README of issue 3): between two committed points
+ * (u0, N0) -> (u1, N1) both u and r_j are linear in the path parameter s, so the
+ * trial stretch e0 + s du and the limits +-r_j(s) are linear too. A slider that
+ * ends outside its limit crossed it once, at s* = (r0 - e0) / (du - dr) (upper
+ * limit; mirror for the lower), and slips from s* to 1 at the limit; one that
+ * ends inside never left it (a linear function inside at both ends stays
+ * inside). The friction work of the slip phase, integral of g(s) dz, is exact by
+ * the trapezoid rule because g is linear in s and dz/ds is constant:
+ *     dW_j = k_j * slip * (r_j(s*) + r_j(1)) / 2,   slip = |e_trial(1)| - r_j(1).
+ * Hence results do not depend on how a piecewise-linear (u, N) path is sampled.
+ *
+ * Lift-off (N <= 0): the path is followed up to N = 0 (every slider has then
+ * slipped down to zero force), then the element is released: F = 0, z_j = u,
+ * u_contact = u. The stored energy of the residual spring is released, not
+ * counted as friction work. Re-contact at N = 0 (inside a step, by the same
+ * straight path) restarts the element virgin at the re-contact displacement.
+ */
 #include "iwan.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Concavity check of a table in IWAN_FIT_REJECT mode: a slope may exceed the
+ * previous one by this fraction of the largest slope (round-off in slopes of
+ * collinear points computed from a curve), not more. */
+#define IWAN_CONCAVE_RTOL 1e-9
+
+/* Anchor codes for the exact periodic Jacobian (see iwan_periodic_jac). A slider
+ * stuck since sample a (>= 0) has force k (u(t) - u(a)) + sg * g(N(aN)). */
+#define ANCHOR_ORIGIN (-1)               /* stuck since the virgin state at u = 0 */
+#define ANCHOR_RECONTACT(t) (-2 - (int32_t)(t)) /* stuck since re-contact in the step to t */
+#define ANCHOR_IS_RECONTACT(a) ((a) <= -2)
+#define ANCHOR_RECONTACT_STEP(a) ((size_t)(-2 - (a)))
+
+typedef struct {
+    int32_t au[IWAN_MAX_SLIDERS];   /* sample fixing the slider position (or code above) */
+    int32_t aN[IWAN_MAX_SLIDERS];   /* sample fixing the slip force at the anchor */
+    int8_t sg[IWAN_MAX_SLIDERS];    /* sign of the slip force at the anchor */
+    int8_t slip[IWAN_MAX_SLIDERS];  /* 1 if the slider slipped in the step just made */
+    int32_t res;                    /* residual-spring anchor: ANCHOR_ORIGIN or re-contact */
+    int32_t t;                      /* index of the sample being reached */
+} anchors;
 
 const char *iwan_status_text(iwan_status status)
 {
@@ -13,4 +63,538 @@ const char *iwan_status_text(iwan_status status)
     case IWAN_ERR_BAD_STATE: return "bad state";
     }
     return "unknown status";
+}
+
+/* ------------------------------------------------------------------ checks */
+
+static iwan_status check_model(const iwan_model *m)
+{
+    if (!m || m->n < 0 || m->n > IWAN_MAX_SLIDERS) return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(m->n_ref) || !isfinite(m->scale) || !isfinite(m->k_res))
+        return IWAN_ERR_NONFINITE;
+    if (!(m->n_ref > 0.0) || !(m->scale >= 0.0) || !(m->k_res >= 0.0)) return IWAN_ERR_BAD_PARAM;
+    if (m->n == 0 && m->k_res == 0.0) return IWAN_ERR_BAD_PARAM;
+    return IWAN_OK;
+}
+
+static iwan_status check_state(const iwan_state *s)
+{
+    if (!s) return IWAN_ERR_BAD_PARAM;
+    if (s->version != IWAN_STATE_VERSION || (s->in_contact != 0 && s->in_contact != 1))
+        return IWAN_ERR_BAD_STATE;
+    if (!isfinite(s->u) || !isfinite(s->N) || !isfinite(s->u_contact) || !isfinite(s->w_diss))
+        return IWAN_ERR_BAD_STATE;
+    if ((s->in_contact == 1) != (s->N > 0.0) || s->w_diss < 0.0) return IWAN_ERR_BAD_STATE;
+    if (s->dir != 1.0 && s->dir != -1.0) return IWAN_ERR_BAD_STATE;
+    return IWAN_OK;
+}
+
+static iwan_status check_finite(const double *x, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i])) return IWAN_ERR_NONFINITE;
+    return IWAN_OK;
+}
+
+/* ------------------------------------------------------------- model build */
+
+static iwan_status slopes_check(const double *u, const double *T, size_t m, iwan_fit fit)
+{
+    double smax = 0.0;
+    for (size_t i = 0; i + 1 < m; ++i) {
+        double s = (T[i + 1] - T[i]) / (u[i + 1] - u[i]);
+        if (fabs(s) > smax) smax = fabs(s);
+    }
+    if (fit == IWAN_FIT_CONCAVE) return IWAN_OK;
+    double prev = INFINITY;
+    for (size_t i = 0; i + 1 < m; ++i) {
+        double s = (T[i + 1] - T[i]) / (u[i + 1] - u[i]);
+        if (s < 0.0) return IWAN_ERR_BAD_TABLE;  /* T decreasing: negative stiffness */
+        if (s > prev + IWAN_CONCAVE_RTOL * smax) return IWAN_ERR_NOT_CONCAVE;
+        prev = s;
+    }
+    return IWAN_OK;
+}
+
+/* Largest slope from point i to any later point (upper-hull edge by gift
+ * wrapping, O(m) per vertex and no scratch memory); *next = farthest point
+ * attaining it, so collinear points are dropped. */
+static double hull_edge(const double *u, const double *T, size_t m, size_t i, size_t *next)
+{
+    double best = -INFINITY;
+    for (size_t j = i + 1; j < m; ++j) {
+        double s = (T[j] - T[i]) / (u[j] - u[i]);
+        if (s >= best) { best = s; *next = j; }
+    }
+    return best;
+}
+
+/* Sliders of the least concave non-decreasing majorant of the table: its upper
+ * hull, made flat after the first vertex from which no later point is higher
+ * (so a noisy plateau at gross slip gives k_res = 0). For a concave table this is
+ * the table itself (collinear points merged). */
+static iwan_status hull_sliders(iwan_model *md, const double *u, const double *T, size_t m)
+{
+    size_t i = 0, next = 0;
+    double s_prev = hull_edge(u, T, m, 0, &next);
+    if (!(s_prev > 0.0)) return IWAN_ERR_BAD_TABLE;  /* no stiffness at all */
+    md->n = 0;
+    for (i = next; i + 1 < m; i = next) {
+        double s = hull_edge(u, T, m, i, &next);
+        if (s < 0.0) s = 0.0;                     /* flat after the maximum */
+        double k = s_prev - s;
+        if (k > 0.0) {                            /* k <= 0 only by round-off: merge */
+            if (md->n >= IWAN_MAX_SLIDERS) return IWAN_ERR_BAD_TABLE;
+            md->k[md->n] = k;
+            md->fs[md->n] = k * u[i];             /* Iwan: fs_j = k_j u_j */
+            md->n++;
+            s_prev = s;
+        }
+        if (s == 0.0) break;
+    }
+    md->k_res = s_prev;
+    return IWAN_OK;
+}
+
+iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T, size_t m,
+                            double n_ref, iwan_fit fit)
+{
+    if (!model || !u || !T || (fit != IWAN_FIT_REJECT && fit != IWAN_FIT_CONCAVE))
+        return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(n_ref)) return IWAN_ERR_NONFINITE;
+    if (!(n_ref > 0.0)) return IWAN_ERR_BAD_PARAM;
+    if (m < 2) return IWAN_ERR_BAD_TABLE;
+    if (check_finite(u, m) || check_finite(T, m)) return IWAN_ERR_NONFINITE;
+    if (u[0] != 0.0 || T[0] != 0.0) return IWAN_ERR_BAD_TABLE;
+    for (size_t i = 1; i < m; ++i)
+        if (!(u[i] > u[i - 1])) return IWAN_ERR_BAD_TABLE;
+    iwan_status st = slopes_check(u, T, m, fit);
+    if (st != IWAN_OK) return st;
+    iwan_model md;
+    memset(&md, 0, sizeof md);
+    st = hull_sliders(&md, u, T, m);
+    if (st != IWAN_OK) return st;
+    md.n_ref = n_ref;
+    md.scale = 1.0;
+    *model = md;
+    return IWAN_OK;
+}
+
+iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const double *fs,
+                                    size_t n, double k_res, double n_ref)
+{
+    if (!model || (n > 0 && (!k || !fs)) || n > IWAN_MAX_SLIDERS) return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(k_res) || !isfinite(n_ref)) return IWAN_ERR_NONFINITE;
+    if (n > 0 && (check_finite(k, n) || check_finite(fs, n))) return IWAN_ERR_NONFINITE;
+    for (size_t j = 0; j < n; ++j)
+        if (!(k[j] > 0.0) || !(fs[j] >= 0.0)) return IWAN_ERR_BAD_PARAM;
+    iwan_model md;
+    memset(&md, 0, sizeof md);
+    md.n = (int32_t)n;
+    for (size_t j = 0; j < n; ++j) { md.k[j] = k[j]; md.fs[j] = fs[j]; }
+    md.k_res = k_res;
+    md.n_ref = n_ref;
+    md.scale = 1.0;
+    iwan_status st = check_model(&md);
+    if (st != IWAN_OK) return st;
+    *model = md;
+    return IWAN_OK;
+}
+
+iwan_status iwan_state_init(const iwan_model *model, iwan_state *state, double N)
+{
+    iwan_status st = check_model(model);
+    if (st != IWAN_OK) return st;
+    if (!state) return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(N)) return IWAN_ERR_NONFINITE;
+    memset(state, 0, sizeof *state);
+    state->version = IWAN_STATE_VERSION;
+    state->in_contact = N > 0.0;
+    state->N = N;
+    state->dir = 1.0;
+    return IWAN_OK;
+}
+
+/* ------------------------------------------------------------------ update */
+
+static double strength_factor(const iwan_model *m, double N)
+{
+    return m->scale * (N / m->n_ref);
+}
+
+/* Advance every slider along the straight path (u0, f0) -> (u1, f1) of
+ * displacement and strength factor (f0, f1 >= 0); return the friction work. */
+static double sliders_path(const iwan_model *m, double *z, double u0, double f0,
+                           double u1, double f1, anchors *an)
+{
+    const double du = u1 - u0;
+    double dw = 0.0;
+    for (int32_t j = 0; j < m->n; ++j) {
+        const double k = m->k[j];
+        const double r0 = m->fs[j] * f0 / k, r1 = m->fs[j] * f1 / k, dr = r1 - r0;
+        double e0 = u0 - z[j];
+        if (e0 > r0 || e0 < -r0) {        /* outside only by round-off: project */
+            e0 = e0 > r0 ? r0 : -r0;
+            z[j] = u0 - e0;
+        }
+        const double e1 = e0 + du;
+        int8_t sg = 0;
+        if (e1 > r1) {                    /* stick to s*, slip at +r to s = 1 */
+            const double s = (r0 - e0) / (du - dr);
+            dw += k * (e1 - r1) * 0.5 * (r0 + s * dr + r1);
+            z[j] = u1 - r1;
+            sg = 1;
+        } else if (e1 < -r1) {            /* mirror: lower limit */
+            const double s = (r0 + e0) / (-(du + dr));
+            dw += k * (-r1 - e1) * 0.5 * (r0 + s * dr + r1);
+            z[j] = u1 + r1;
+            sg = -1;
+        }
+        if (an) {
+            an->slip[j] = sg != 0;
+            if (sg) { an->au[j] = an->t; an->aN[j] = an->t; an->sg[j] = sg; }
+        }
+    }
+    return dw;
+}
+
+static void release(const iwan_model *m, iwan_state *s, double u)
+{
+    for (int32_t j = 0; j < m->n; ++j) s->z[j] = u;
+    s->u_contact = u;
+    s->in_contact = 0;
+}
+
+/* Exact update of s along the straight path to (u1, N1), with lift-off and
+ * re-contact at the point where N crosses zero. */
+static void advance(const iwan_model *m, iwan_state *s, double u1, double N1, anchors *an)
+{
+    const double u0 = s->u, N0 = s->N, du = u1 - u0;
+    if (N0 > 0.0 && N1 > 0.0) {
+        s->w_diss += sliders_path(m, s->z, u0, strength_factor(m, N0), u1,
+                                  strength_factor(m, N1), an);
+    } else if (N0 > 0.0) {                 /* lift-off where N = 0 */
+        const double sl = N0 / (N0 - N1);
+        s->w_diss += sliders_path(m, s->z, u0, strength_factor(m, N0), u0 + sl * du, 0.0, an);
+        release(m, s, u1);
+    } else if (N1 > 0.0) {                 /* re-contact where N = 0: virgin there */
+        const double sc = -N0 / (N1 - N0);
+        const double uc = u0 + sc * du;
+        for (int32_t j = 0; j < m->n; ++j) s->z[j] = uc;
+        s->u_contact = uc;
+        s->in_contact = 1;
+        if (an) {
+            for (int32_t j = 0; j < m->n; ++j) an->au[j] = ANCHOR_RECONTACT(an->t);
+            an->res = ANCHOR_RECONTACT(an->t);
+        }
+        s->w_diss += sliders_path(m, s->z, uc, 0.0, u1, strength_factor(m, N1), an);
+    } else {
+        release(m, s, u1);
+    }
+    if (du > 0.0) s->dir = 1.0;
+    else if (du < 0.0) s->dir = -1.0;
+    s->u = u1;
+    s->N = N1;
+}
+
+/* Outputs of a state. A slider counts as slipping when it sits at its limit on
+ * the side of the last motion (it would slip on continued motion): it adds
+ * nothing to kt and +-dg/dN to dF/dN. */
+static void outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
+{
+    o->W = s->w_diss;
+    if (!s->in_contact) {
+        o->F = o->kt = o->dFdN = o->E = 0.0;
+        o->slip = 1.0;
+        return;
+    }
+    const double f = strength_factor(m, s->N), u = s->u, ur = u - s->u_contact;
+    const double dgdN = m->scale / m->n_ref;
+    double F = m->k_res * ur, kt = m->k_res, dfdn = 0.0, E = 0.5 * m->k_res * ur * ur;
+    double g_slip = 0.0, g_all = 0.0;
+    for (int32_t j = 0; j < m->n; ++j) {
+        const double k = m->k[j], r = m->fs[j] * f / k, e = u - s->z[j];
+        const int slipping = s->dir > 0.0 ? s->z[j] <= u - r : s->z[j] >= u + r;
+        F += k * e;
+        E += 0.5 * k * e * e;
+        g_all += m->fs[j];
+        if (slipping) {
+            dfdn += s->dir * m->fs[j] * dgdN;
+            g_slip += m->fs[j];
+        } else {
+            kt += k;
+        }
+    }
+    o->F = F;
+    o->kt = kt;
+    o->dFdN = dfdn;
+    o->E = E;
+    o->slip = (g_all > 0.0 && f > 0.0) ? g_slip / g_all : 1.0;
+}
+
+iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, double u, double N,
+                      iwan_state *trial, iwan_output *out)
+{
+    iwan_status st = check_model(model);
+    if (st != IWAN_OK) return st;
+    st = check_state(committed);
+    if (st != IWAN_OK) return st;
+    if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
+    if (trial == committed) return IWAN_ERR_BAD_PARAM;
+    iwan_state s = *committed;
+    advance(model, &s, u, N, NULL);
+    if (out) outputs(model, &s, out);
+    if (trial) *trial = s;
+    return IWAN_OK;
+}
+
+iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, double N,
+                      iwan_output *out)
+{
+    iwan_status st = check_model(model);
+    if (st != IWAN_OK) return st;
+    st = check_state(state);
+    if (st != IWAN_OK) return st;
+    if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
+    advance(model, state, u, N, NULL);
+    if (out) outputs(model, state, out);
+    return IWAN_OK;
+}
+
+
+/* ------------------------------------------------------------- time series */
+
+/* One sweep of samples at constant committed N > 0. For constant N the exact
+ * update reduces to the play operator z <- clamp(z, u - r, u + r), and the
+ * friction work to g |dz|. `up` is a compile-time constant after inlining, so
+ * the slip test has no branch on the direction. */
+static inline void sweep_const(const iwan_model *m, double *z, const double *r,
+                               const double *g, double u, int up, double *F, double *kslip,
+                               double *fslip, double *dw)
+{
+    double Fa = 0.0, ks = 0.0, fsl = 0.0, w = 0.0;
+    for (int32_t j = 0; j < m->n; ++j) {
+        const double z0 = z[j], lo = u - r[j], hi = u + r[j];
+        double zn = z0 < lo ? lo : z0;
+        zn = zn > hi ? hi : zn;
+        w += g[j] * fabs(zn - z0);
+        z[j] = zn;
+        Fa += m->k[j] * (u - zn);
+        const int slipping = up ? zn <= lo : zn >= hi;
+        ks += slipping ? m->k[j] : 0.0;
+        fsl += slipping ? m->fs[j] : 0.0;
+    }
+    *F = Fa;
+    *kslip = ks;
+    *fslip = fsl;
+    *dw = w;
+}
+
+static void run_const(const iwan_model *m, iwan_state *s, size_t n, const double *u,
+                      double *F, double *kt, double *dFdN, double *W)
+{
+    double r[IWAN_MAX_SLIDERS], g[IWAN_MAX_SLIDERS];
+    const double f = strength_factor(m, s->N), dgdN = m->scale / m->n_ref;
+    double ktot = m->k_res;
+    for (int32_t j = 0; j < m->n; ++j) {
+        r[j] = m->fs[j] * f / m->k[j];   /* same expression as outputs(): same limits */
+        g[j] = m->fs[j] * f;
+        ktot += m->k[j];
+    }
+    for (size_t i = 0; i < n; ++i) {
+        const double ui = u[i];
+        double Fs, ks, fsl, dw;
+        if (ui > s->u) s->dir = 1.0;
+        else if (ui < s->u) s->dir = -1.0;
+        if (s->dir > 0.0) sweep_const(m, s->z, r, g, ui, 1, &Fs, &ks, &fsl, &dw);
+        else sweep_const(m, s->z, r, g, ui, 0, &Fs, &ks, &fsl, &dw);
+        s->u = ui;
+        s->w_diss += dw;
+        if (F) F[i] = Fs + m->k_res * (ui - s->u_contact);
+        if (kt) kt[i] = ktot - ks;
+        if (dFdN) dFdN[i] = s->dir * fsl * dgdN;
+        if (W) W[i] = s->w_diss;
+    }
+}
+
+static void store(const iwan_output *o, size_t i, double *F, double *kt, double *dFdN, double *W)
+{
+    if (F) F[i] = o->F;
+    if (kt) kt[i] = o->kt;
+    if (dFdN) dFdN[i] = o->dFdN;
+    if (W) W[i] = o->W;
+}
+
+iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
+                        const double *u, const double *N,
+                        double *F, double *kt, double *dFdN, double *W)
+{
+    iwan_status st = check_model(model);
+    if (st != IWAN_OK) return st;
+    st = check_state(state);
+    if (st != IWAN_OK) return st;
+    if (!u || n == 0) return IWAN_ERR_BAD_PARAM;
+    if (check_finite(u, n) || (N && check_finite(N, n))) return IWAN_ERR_NONFINITE;
+    size_t i = 0;
+    while (i < n) {
+        const double Ni = N ? N[i] : model->n_ref;
+        if (state->in_contact && Ni == state->N) {   /* run of constant N: fast sweep */
+            size_t j = i + 1;
+            if (N) while (j < n && N[j] == Ni) ++j;
+            else j = n;
+            run_const(model, state, j - i, u + i, F ? F + i : NULL, kt ? kt + i : NULL,
+                      dFdN ? dFdN + i : NULL, W ? W + i : NULL);
+            i = j;
+        } else {
+            iwan_output o;
+            advance(model, state, u[i], Ni, NULL);
+            outputs(model, state, &o);
+            store(&o, i, F, kt, dFdN, W);
+            ++i;
+        }
+    }
+    return IWAN_OK;
+}
+
+/* ------------------------------------------------------------ periodic loop */
+
+/* Start of the periodic sweep, at the first maximum tM of u (index of the first
+ * minimum tm). Convention for the loop's static state (non-unique for sliders
+ * that never slip): the element is virgin at u = 0 (residual spring and sliders
+ * at rest there) and every slider is shifted by the least amount that keeps it
+ * stuck between the loop's extremes, z_j = clamp(0, M - r_j, m + r_j); a slider
+ * with M - m >= 2 r_j slips in every cycle and sits at its upper limit at M,
+ * z_j = M - r_j, whatever the history. With constant N this state is exactly
+ * periodic, so one pass gives the loop (play operator). */
+static void periodic_start(const iwan_model *m, size_t n, const double *u, const double *N,
+                           iwan_state *s, anchors *an, size_t *tMo)
+{
+    size_t tM = 0, tm = 0;
+    for (size_t i = 1; i < n; ++i) {
+        if (u[i] > u[tM]) tM = i;
+        if (u[i] < u[tm]) tm = i;
+    }
+    const double M = u[tM], mn = u[tm], NM = N ? N[tM] : m->n_ref;
+    memset(s, 0, sizeof *s);
+    memset(an, 0, sizeof *an);
+    s->version = IWAN_STATE_VERSION;
+    s->u = M;
+    s->N = NM;
+    s->dir = 1.0;
+    an->res = ANCHOR_ORIGIN;
+    *tMo = tM;
+    if (!(NM > 0.0)) {
+        release(m, s, M);
+        for (int32_t j = 0; j < m->n; ++j) an->au[j] = ANCHOR_ORIGIN;
+        return;
+    }
+    s->in_contact = 1;
+    const double f = strength_factor(m, NM);
+    for (int32_t j = 0; j < m->n; ++j) {
+        const double r = m->fs[j] * f / m->k[j];
+        an->aN[j] = (int32_t)tM;
+        if (M - mn >= 2.0 * r || 0.0 < M - r) {
+            s->z[j] = M - r;
+            an->au[j] = (int32_t)tM;
+            an->sg[j] = 1;
+        } else if (0.0 > mn + r) {
+            s->z[j] = mn + r;
+            an->au[j] = (int32_t)tm;
+            an->sg[j] = -1;
+        } else {
+            s->z[j] = 0.0;
+            an->au[j] = ANCHOR_ORIGIN;
+        }
+    }
+}
+
+/* Force-weighted distance of two states: bounds the change of F over a period. */
+static double state_distance(const iwan_model *m, const iwan_state *a, const iwan_state *b)
+{
+    if (a->in_contact != b->in_contact) return INFINITY;
+    double d = m->k_res * fabs(a->u_contact - b->u_contact);
+    for (int32_t j = 0; j < m->n; ++j) d += m->k[j] * fabs(a->z[j] - b->z[j]);
+    return d;
+}
+
+/* Repeat periods from the state s at sample tM until the state at tM recurs
+ * within tol times the force range of the period. */
+static iwan_status march(const iwan_model *m, size_t n, const double *u, const double *N,
+                         size_t tM, iwan_state *s, anchors *an, int max_periods, double tol,
+                         double *F, double *kt, double *dFdN, double *W_cycle, int *periods)
+{
+    for (int p = 1; p <= max_periods; ++p) {
+        const iwan_state s0 = *s;
+        double fmin = INFINITY, fmax = -INFINITY;
+        for (size_t k = 1; k <= n; ++k) {
+            const size_t t = (tM + k) % n;
+            iwan_output o;
+            if (an) an->t = (int32_t)t;
+            advance(m, s, u[t], N ? N[t] : m->n_ref, an);
+            outputs(m, s, &o);
+            store(&o, t, F, kt, dFdN, NULL);
+            if (o.F < fmin) fmin = o.F;
+            if (o.F > fmax) fmax = o.F;
+        }
+        *W_cycle = s->w_diss - s0.w_diss;
+        *periods = p;
+        if (state_distance(m, &s0, s) <= tol * (fmax - fmin)) return IWAN_OK;
+    }
+    return IWAN_ERR_NOT_CONVERGED;
+}
+
+static int all_equal(const double *x, size_t n)
+{
+    for (size_t i = 1; i < n; ++i)
+        if (x[i] != x[0]) return 0;
+    return 1;
+}
+
+static iwan_status check_periodic(const iwan_model *model, size_t n, const double *u,
+                                  const double *N, int max_periods, double tol)
+{
+    iwan_status st = check_model(model);
+    if (st != IWAN_OK) return st;
+    if (!u || n == 0 || max_periods < 1) return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(tol)) return IWAN_ERR_NONFINITE;
+    if (!(tol >= 0.0)) return IWAN_ERR_BAD_PARAM;
+    if (check_finite(u, n) || (N && check_finite(N, n))) return IWAN_ERR_NONFINITE;
+    return IWAN_OK;
+}
+
+iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, const double *N,
+                          double *F, double *kt, double *dFdN, double *W_cycle,
+                          int max_periods, double tol, int *periods_used)
+{
+    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
+    if (st != IWAN_OK) return st;
+    iwan_state s;
+    anchors an;
+    size_t tM;
+    double w = 0.0;
+    int p = 0;
+    periodic_start(model, n, u, N, &s, &an, &tM);
+    if (s.in_contact && (!N || all_equal(N, n))) {
+        /* exact in one pass: tM+1 .. n-1, then 0 .. tM (closing the period) */
+        run_const(model, &s, n - 1 - tM, u + tM + 1, F ? F + tM + 1 : NULL,
+                  kt ? kt + tM + 1 : NULL, dFdN ? dFdN + tM + 1 : NULL, NULL);
+        run_const(model, &s, tM + 1, u, F, kt, dFdN, NULL);
+        w = s.w_diss;
+        p = 1;
+    } else {
+        st = march(model, n, u, N, tM, &s, NULL, max_periods, tol, F, kt, dFdN, &w, &p);
+    }
+    if (W_cycle) *W_cycle = w;
+    if (periods_used) *periods_used = p;
+    return st;
+}
+
+iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
+                              const double *Eu, const double *EN, size_t nb,
+                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
+                              int max_periods, double tol, int *periods_used)
+{
+    (void)model; (void)n; (void)u; (void)N; (void)Eu; (void)EN; (void)nb; (void)F; (void)dFdX;
+    (void)dFdXN; (void)W_cycle; (void)max_periods; (void)tol; (void)periods_used;
+    return IWAN_ERR_BAD_PARAM;  /* TEMP: being written */
 }

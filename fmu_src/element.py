@@ -1,0 +1,386 @@
+"""The Masing/Iwan friction element from Python: a thin ctypes layer over the C core.
+
+The law itself lives once, in ``fmu_src/core/iwan.c`` (see ``iwan.h``); this
+module only validates and converts numpy arrays, calls one C function per time
+series, and turns a bad status into an exception.
+
+Symbols (SI units)
+------------------
+u : tangential displacement [m];  N : normal load [N];  F : friction force [N]
+k_j, fs_j : stiffness [N/m] and slip strength at ``N_ref`` [N] of Jenkins slider j
+k_res : residual spring [N/m];  N_ref : normal load of the virgin curve [N]
+scale : friction scale multiplying every fs_j;  W : dissipated energy [J]
+kt = dF/du [N/m] (for continued motion in the direction of the last increment);
+dFdN = dF/dN at fixed u [-];  E : stored elastic energy [J]
+
+Slip strengths are ``fs_j * scale * N / N_ref`` (same curve shape at every N);
+``N <= 0`` is lift-off (F = 0, memory released, virgin again at re-contact).
+"""
+from __future__ import annotations
+
+import ctypes as ct
+import importlib.machinery
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
+           "MAX_SLIDERS"]
+
+MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
+_STATE_VERSION = 1         # IWAN_STATE_VERSION in iwan.h
+_FITS = {"reject": 0, "concave": 1}
+_STATUS = {1: "NaN or infinite input", 2: "bad curve table (fewer than 2 points, "
+           "not starting at (0, 0), u not strictly increasing, T decreasing, no "
+           f"stiffness, or more than {MAX_SLIDERS} slope changes)",
+           3: "curve table is not concave (a slope exceeds the previous one); pass "
+           "fit='concave' to use its least concave majorant",
+           4: "bad parameter (k <= 0, fs < 0, k_res < 0, N_ref <= 0, scale < 0, "
+           "empty array, ...)",
+           5: "periodic loop did not close within max_periods",
+           6: "bad state (other version or corrupted)"}
+
+
+class IwanInputError(ValueError):
+    """Bad input to the element (NaN, bad table, bad parameter or state)."""
+
+
+class IwanNotConvergedError(RuntimeError):
+    """The periodic loop did not close within the allowed number of periods."""
+
+
+class _Model(ct.Structure):
+    _fields_ = [("n", ct.c_int32), ("k", ct.c_double * MAX_SLIDERS),
+                ("fs", ct.c_double * MAX_SLIDERS), ("k_res", ct.c_double),
+                ("n_ref", ct.c_double), ("scale", ct.c_double)]
+
+
+class _State(ct.Structure):
+    _fields_ = [("version", ct.c_int32), ("in_contact", ct.c_int32), ("u", ct.c_double),
+                ("N", ct.c_double), ("u_contact", ct.c_double), ("w_diss", ct.c_double),
+                ("z", ct.c_double * MAX_SLIDERS), ("dir", ct.c_double)]
+
+
+class _Output(ct.Structure):
+    _fields_ = [(name, ct.c_double) for name in ("F", "kt", "dFdN", "W", "E", "slip")]
+
+
+def _load_library() -> ct.CDLL:
+    here = Path(__file__).resolve().parent
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = here / f"_iwan{suffix}"
+        if path.exists():
+            return ct.CDLL(str(path))
+    raise ImportError(f"fmu_src/_iwan*.so not found in {here}: run `pip install -e .`")
+
+
+_lib = _load_library()
+_P = ct.c_void_p          # raw double* / int* (numpy .ctypes.data): the fastest call path
+_S = ct.c_size_t
+_D = ct.c_double
+_I = ct.c_int
+
+
+def _declare(name, *argtypes):
+    fn = getattr(_lib, name)
+    fn.argtypes = list(argtypes)
+    fn.restype = ct.c_int
+    return fn
+
+
+_model_init = _declare("iwan_model_init", ct.POINTER(_Model), _P, _P, _S, _D, _I)
+_model_from_sliders = _declare("iwan_model_from_sliders", ct.POINTER(_Model), _P, _P, _S, _D, _D)
+_state_init = _declare("iwan_state_init", ct.POINTER(_Model), ct.POINTER(_State), _D)
+_step = _declare("iwan_step", ct.POINTER(_Model), ct.POINTER(_State), _D, _D,
+                 ct.POINTER(_Output))
+_series = _declare("iwan_series", _P, _P, _S, _P, _P, _P, _P, _P, _P)
+_periodic = _declare("iwan_periodic", _P, _S, _P, _P, _P, _P, _P, _P, _I, _D, _P)
+_periodic_jac = _declare("iwan_periodic_jac", _P, _S, _P, _P, _P, _P, _S, _P, _P, _P, _P,
+                         _I, _D, _P)
+_lib.iwan_status_text.argtypes = [ct.c_int]
+_lib.iwan_status_text.restype = ct.c_char_p
+
+
+def _check(status: int, where: str) -> None:
+    if status == 0:
+        return
+    text = _STATUS.get(status, _lib.iwan_status_text(status).decode())
+    if status == 5:
+        raise IwanNotConvergedError(f"{where}: {text}")
+    raise IwanInputError(f"{where}: {text}")
+
+
+def _vec(x, name: str, n: int | None = None) -> np.ndarray:
+    """Contiguous float64 1-D copy-free view of ``x`` (shape (n,) when n is given)."""
+    a = np.ascontiguousarray(x, dtype=np.float64)
+    if a.ndim != 1 or a.size == 0 or (n is not None and a.size != n):
+        want = f"({n},)" if n is not None else "(n,) with n >= 1"
+        raise IwanInputError(f"{name} must have shape {want}, got {a.shape}")
+    return a
+
+
+def _normal(N, n: int, default: float) -> np.ndarray:
+    """Normal-load samples: None -> ``default`` everywhere, scalar -> constant."""
+    if N is None:
+        return np.full(n, float(default))
+    if np.ndim(N) == 0:
+        return np.full(n, float(N))
+    return _vec(N, "N", n)
+
+
+class IwanState:
+    """A copy of the element's flat C state (save/restore by copying).
+
+    Attributes
+    ----------
+    u, N : float
+        Last committed displacement [m] and normal load [N].
+    W : float
+        Cumulative dissipated energy [J].
+    in_contact : bool
+    z : ndarray, shape (n_sliders,)
+        Slider positions [m]; slider force k_j (u - z_j).
+    """
+
+    def __init__(self, raw: _State, n_sliders: int):
+        self._raw = raw
+        self._n = n_sliders
+
+    def copy(self) -> "IwanState":
+        raw = _State()
+        ct.pointer(raw)[0] = self._raw
+        return IwanState(raw, self._n)
+
+    u = property(lambda self: self._raw.u)
+    N = property(lambda self: self._raw.N)
+    W = property(lambda self: self._raw.w_diss)
+    in_contact = property(lambda self: bool(self._raw.in_contact))
+    z = property(lambda self: np.array(self._raw.z[: self._n]))
+
+    def __repr__(self):
+        return f"IwanState(u={self.u!r}, N={self.N!r}, W={self.W!r}, in_contact={self.in_contact})"
+
+
+@dataclass(frozen=True)
+class StepOutput:
+    """Outputs at one point: F [N], kt [N/m], dFdN [-], W [J], E [J], slip [-]."""
+    F: float
+    kt: float
+    dFdN: float
+    W: float
+    E: float
+    slip: float
+
+
+@dataclass(frozen=True)
+class SeriesResult:
+    """Per-sample outputs, arrays of shape (n,), and the advanced state."""
+    F: np.ndarray
+    kt: np.ndarray
+    dFdN: np.ndarray
+    W: np.ndarray
+    state: IwanState
+
+
+@dataclass(frozen=True)
+class PeriodicResult:
+    """The converged loop: F, kt, dFdN of shape (n,); energy per period [J]; periods used."""
+    F: np.ndarray
+    kt: np.ndarray
+    dFdN: np.ndarray
+    W_cycle: float
+    periods: int
+
+
+class IwanElement:
+    """Masing/Iwan element: parallel Jenkins sliders plus a residual spring.
+
+    Build it with :meth:`from_curve`, :meth:`from_sliders` or :meth:`jenkins`.
+    """
+
+    def __init__(self, model: _Model):
+        self._model = model
+        self._mp = ct.addressof(model)
+
+    # ------------------------------------------------------------ construction
+    @classmethod
+    def from_curve(cls, u, T, N_ref, fit: str = "reject", scale: float = 1.0) -> "IwanElement":
+        """Element reproducing a concave piecewise-linear virgin curve exactly (Iwan).
+
+        Parameters
+        ----------
+        u, T : array_like, shape (m,)
+            Virgin curve: displacement [m] strictly increasing from 0, force [N] from 0.
+            The last segment's slope continues as the residual spring.
+        N_ref : float
+            Normal load [N] at which the curve was computed.
+        fit : {"reject", "concave"}
+            "reject": a non-concave table raises ``IwanInputError``. "concave": use the
+            least concave non-decreasing majorant (upper hull, flat after the maximum).
+        scale : float
+            Friction scale multiplying every slip strength (>= 0).
+        """
+        if fit not in _FITS:
+            raise IwanInputError(f"fit must be one of {sorted(_FITS)}, got {fit!r}")
+        u = _vec(u, "u")
+        T = _vec(T, "T", u.size)
+        model = _Model()
+        _check(_model_init(ct.byref(model), u.ctypes.data, T.ctypes.data, u.size,
+                           float(N_ref), _FITS[fit]), "IwanElement.from_curve")
+        return cls._scaled(model, scale)
+
+    @classmethod
+    def from_sliders(cls, k, fs, k_res: float = 0.0, N_ref: float = 1.0) -> "IwanElement":
+        """Element from slider stiffnesses ``k`` [N/m] and strengths ``fs`` [N] (shape (n,))."""
+        k = np.atleast_1d(np.asarray(k, dtype=np.float64)).copy()
+        fs = np.atleast_1d(np.asarray(fs, dtype=np.float64)).copy()
+        if k.ndim != 1 or k.shape != fs.shape or k.size > MAX_SLIDERS:
+            raise IwanInputError(f"k and fs must have the same shape (n,), n <= {MAX_SLIDERS}")
+        model = _Model()
+        _check(_model_from_sliders(ct.byref(model), k.ctypes.data, fs.ctypes.data, k.size,
+                                   float(k_res), float(N_ref)), "IwanElement.from_sliders")
+        return cls(model)
+
+    @classmethod
+    def jenkins(cls, k: float, fs: float) -> "IwanElement":
+        """One Jenkins element (spring k [N/m] in series with a slider fs [N]), N_ref = 1."""
+        return cls.from_sliders([k], [fs], 0.0, 1.0)
+
+    @classmethod
+    def _scaled(cls, model: _Model, scale: float) -> "IwanElement":
+        scale = float(scale)
+        if not np.isfinite(scale) or scale < 0.0:
+            raise IwanInputError(f"scale must be finite and >= 0, got {scale!r}")
+        model.scale = scale
+        return cls(model)
+
+    # ------------------------------------------------------------ parameters
+    n_sliders = property(lambda self: int(self._model.n))
+    k = property(lambda self: np.array(self._model.k[: self._model.n]))
+    fs = property(lambda self: np.array(self._model.fs[: self._model.n]))
+    k_res = property(lambda self: float(self._model.k_res))
+    N_ref = property(lambda self: float(self._model.n_ref))
+    scale = property(lambda self: float(self._model.scale))
+
+    def __repr__(self):
+        return (f"IwanElement(n_sliders={self.n_sliders}, k_res={self.k_res!r}, "
+                f"N_ref={self.N_ref!r}, scale={self.scale!r})")
+
+    # ------------------------------------------------------------ evaluation
+    def initial_state(self, N: float | None = None) -> IwanState:
+        """Virgin state at u = 0 under normal load N [N] (default ``N_ref``)."""
+        raw = _State()
+        _check(_state_init(ct.byref(self._model), ct.byref(raw),
+                           self.N_ref if N is None else float(N)), "IwanElement.initial_state")
+        return IwanState(raw, self.n_sliders)
+
+    def step(self, state: IwanState, u: float, N: float | None = None) -> StepOutput:
+        """Advance ``state`` in place along the straight path to (u, N); N defaults to N_ref."""
+        out = _Output()
+        _check(_step(ct.byref(self._model), ct.byref(state._raw), float(u),
+                     self.N_ref if N is None else float(N), ct.byref(out)), "IwanElement.step")
+        return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
+
+    def series(self, u, N=None, state: IwanState | None = None) -> SeriesResult:
+        """Whole history in one C call.
+
+        Parameters
+        ----------
+        u : array_like, shape (n,)
+            Displacement samples [m], joined by straight paths (with N).
+        N : None, float or array_like shape (n,)
+            Normal load [N]; None means ``N_ref``.
+        state : IwanState, optional
+            Start state (not modified); default virgin at u = 0 and N[0].
+
+        Returns
+        -------
+        SeriesResult
+            F, kt, dFdN, W of shape (n,) and the state after the last sample.
+        """
+        u = _vec(u, "u")
+        n = u.size
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        if state is None:
+            st = self.initial_state(None if Nv is None else Nv[0])
+        else:
+            st = state.copy()
+        out = np.empty((4, n))
+        _check(_series(self._mp, ct.addressof(st._raw), n, u.ctypes.data,
+                       None if Nv is None else Nv.ctypes.data, out[0].ctypes.data,
+                       out[1].ctypes.data, out[2].ctypes.data, out[3].ctypes.data),
+               "IwanElement.series")
+        return SeriesResult(out[0], out[1], out[2], out[3], st)
+
+    def periodic(self, u, N=None, max_periods: int = 100, tol: float = 1e-12) -> PeriodicResult:
+        """Converged loop of a periodic input, u shape (n,) (sample n = sample 0).
+
+        Constant N: exact in one pass. Varying N: periods are repeated until the
+        state recurs within ``tol`` times the force range (``IwanNotConvergedError``
+        after ``max_periods``).
+        """
+        u = _vec(u, "u")
+        n = u.size
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        out = np.empty((3, n))
+        w = ct.c_double()
+        p = ct.c_int()
+        _check(_periodic(self._mp, n, u.ctypes.data, None if Nv is None else Nv.ctypes.data,
+                         out[0].ctypes.data, out[1].ctypes.data, out[2].ctypes.data,
+                         ct.addressof(w), int(max_periods), float(tol), ct.addressof(p)),
+               "IwanElement.periodic")
+        return PeriodicResult(out[0], out[1], out[2], w.value, p.value)
+
+    def periodic_jac(self, u, Eu, N=None, EN=None, max_periods: int = 100,
+                     tol: float = 1e-12):
+        """Periodic loop and its exact derivatives for u = Eu X (and N = EN XN).
+
+        Parameters
+        ----------
+        u : array_like, shape (n,)
+            Displacement samples [m] over one period (u = Eu @ X).
+        Eu : array_like, shape (n, nb)
+            Basis (e.g. the inverse DFT) mapping coefficients X to u.
+        N : None, float or array_like shape (n,)
+            Normal load [N] (N = EN @ XN when EN is given).
+        EN : array_like, shape (n, nb), optional
+            Basis of the normal load.
+
+        Returns
+        -------
+        F : ndarray (n,);  dFdX : ndarray (n, nb);  dFdXN : ndarray (n, nb) or None;
+        W_cycle : float
+        """
+        u = _vec(u, "u")
+        n = u.size
+        Eu = np.ascontiguousarray(Eu, dtype=np.float64)
+        if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
+            raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
+        nb = Eu.shape[1]
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        ENa = None
+        if EN is not None:
+            ENa = np.ascontiguousarray(EN, dtype=np.float64)
+            if ENa.shape != Eu.shape:
+                raise IwanInputError(f"EN must have shape {Eu.shape}, got {ENa.shape}")
+        F = np.empty(n)
+        dFdX = np.empty((n, nb))
+        dFdXN = None if ENa is None else np.empty((n, nb))
+        w = ct.c_double()
+        p = ct.c_int()
+        _check(_periodic_jac(self._mp, n, u.ctypes.data,
+                             None if Nv is None else Nv.ctypes.data, Eu.ctypes.data,
+                             None if ENa is None else ENa.ctypes.data, nb, F.ctypes.data,
+                             dFdX.ctypes.data, None if dFdXN is None else dFdXN.ctypes.data,
+                             ct.addressof(w), int(max_periods), float(tol), ct.addressof(p)),
+               "IwanElement.periodic_jac")
+        return F, dFdX, dFdXN, w.value
+
+    def virgin(self, u) -> np.ndarray:
+        """Virgin-curve force [N] at N_ref for displacements u (odd extension), shape (n,)."""
+        u = _vec(u, "u")
+        order = np.argsort(np.abs(u), kind="stable")
+        F = np.empty_like(u)
+        F[order] = self.series(np.abs(u)[order]).F
+        return np.sign(u) * F
