@@ -589,12 +589,99 @@ iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, co
     return st;
 }
 
+/* ------------------------------------------------- periodic loop Jacobian */
+
+/* d u_c / dX and d u_c / dXN of the re-contact point in the step p -> tc,
+ * u_c = u_p + s_c (u_tc - u_p), s_c = -N_p / (N_tc - N_p) (see advance()). */
+static void recontact_grad(size_t n, size_t nb, const double *u, const double *N,
+                           const double *Eu, const double *EN, size_t tc, double w,
+                           double *rX, double *rXN)
+{
+    const size_t p = (tc + n - 1) % n;
+    const double N0 = N[p], N1 = N[tc], D = N1 - N0, sc = -N0 / D, du = u[tc] - u[p];
+    const double ds0 = -N1 / (D * D), ds1 = N0 / (D * D);
+    for (size_t c = 0; c < nb; ++c) {
+        rX[c] -= w * ((1.0 - sc) * Eu[p * nb + c] + sc * Eu[tc * nb + c]);
+        if (rXN) rXN[c] -= w * du * (ds0 * EN[p * nb + c] + ds1 * EN[tc * nb + c]);
+    }
+}
+
+/* Row t of dF/dX (and dF/dXN): a slider that slipped into t carries
+ * sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) + sg g(N(aN));
+ * one stuck since the virgin state k u(t); one stuck since re-contact
+ * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy. */
+static void jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
+                    size_t nb, const double *u, const double *N, const double *Eu,
+                    const double *EN, double *rX, double *rXN)
+{
+    const size_t t = (size_t)an->t;
+    const double dgdN = m->scale / m->n_ref;
+    for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
+    if (!s->in_contact) return;
+    double kst = m->k_res, krc = ANCHOR_IS_RECONTACT(an->res) ? m->k_res : 0.0, cnow = 0.0;
+    double gk = 0.0, gc = 0.0;
+    int32_t ga = ANCHOR_ORIGIN, gn = 0;
+    for (int32_t j = 0; j <= m->n; ++j) {
+        const int last = j == m->n;
+        const int32_t a = last ? ANCHOR_ORIGIN : an->au[j];
+        if (!last && an->slip[j]) { cnow += an->sg[j] * m->fs[j] * dgdN; continue; }
+        if (!last) kst += m->k[j];
+        if (!last && ANCHOR_IS_RECONTACT(a)) { krc += m->k[j]; continue; }
+        if (ga >= 0 && (last || a != ga || an->aN[j] != gn)) {   /* flush the group */
+            for (size_t c = 0; c < nb; ++c) {
+                rX[c] -= gk * Eu[(size_t)ga * nb + c];
+                if (rXN) rXN[c] += gc * EN[(size_t)gn * nb + c];
+            }
+            gk = gc = 0.0;
+        }
+        if (last) break;
+        ga = a;
+        gn = an->aN[j];
+        if (a >= 0) { gk += m->k[j]; gc += an->sg[j] * m->fs[j] * dgdN; }
+    }
+    for (size_t c = 0; c < nb; ++c) {
+        rX[c] += kst * Eu[t * nb + c];
+        if (rXN) rXN[c] += cnow * EN[t * nb + c];
+    }
+    if (krc > 0.0) recontact_grad(n, nb, u, N, Eu, EN, ANCHOR_RECONTACT_STEP(an->res), krc, rX, rXN);
+}
+
 iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
                               const double *Eu, const double *EN, size_t nb,
                               double *F, double *dFdX, double *dFdXN, double *W_cycle,
                               int max_periods, double tol, int *periods_used)
 {
-    (void)model; (void)n; (void)u; (void)N; (void)Eu; (void)EN; (void)nb; (void)F; (void)dFdX;
-    (void)dFdXN; (void)W_cycle; (void)max_periods; (void)tol; (void)periods_used;
-    return IWAN_ERR_BAD_PARAM;  /* TEMP: being written */
+    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
+    if (st != IWAN_OK) return st;
+    if (!Eu || nb == 0) return IWAN_ERR_BAD_PARAM;
+    if (check_finite(Eu, n * nb) || (EN && check_finite(EN, n * nb))) return IWAN_ERR_NONFINITE;
+    iwan_state s;
+    anchors an;
+    size_t tM;
+    double w = 0.0;
+    int p = 0;
+    periodic_start(model, n, u, N, &s, &an, &tM);
+    if (N && !all_equal(N, n)) {
+        st = march(model, n, u, N, tM, &s, &an, max_periods, tol, NULL, NULL, NULL, &w, &p);
+        if (st != IWAN_OK) {
+            if (periods_used) *periods_used = p;
+            return st;
+        }
+    }
+    const double w0 = s.w_diss;
+    for (size_t k = 1; k <= n; ++k) {       /* final pass from the closed state */
+        const size_t t = (tM + k) % n;
+        iwan_output o;
+        an.t = (int32_t)t;
+        advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
+        outputs(model, &s, &o);
+        if (F) F[t] = o.F;
+        if (dFdX) {
+            jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + t * nb,
+                    (EN && dFdXN) ? dFdXN + t * nb : NULL);
+        }
+    }
+    if (W_cycle) *W_cycle = s.w_diss - w0;
+    if (periods_used) *periods_used = p + 1;
+    return IWAN_OK;
 }
