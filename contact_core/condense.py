@@ -1,0 +1,172 @@
+"""Static (Guyan) condensation of the two FE bodies onto their contact nodes.
+
+With the distant face of each body clamped (its rigid motion imposed, thesis
+Appendix A.1.2) the condensed contact compliance of a body is the block of
+K_ff^-1 on the contact DOFs (K_ff: stiffness on the free DOFs). Its z-z block
+with the tangential contact DOFs left free and unloaded is exactly the inverse of
+the thesis's reduced stiffness K~zz (eqs A.10-A.11), so no stiffness inverse is
+ever formed: one sparse Cholesky factorisation per body and direction, one block
+of unit right-hand sides per contact node (``linsolve.compliance_block``).
+
+Symmetry (quarter model for sphere and cylinder, half model for the flat face):
+
+* z (normal) load, even in x and y: u_x = 0 on x = 0, u_y = 0 on y = 0.
+* x (tangential) load: u_x even in x, so u_y, u_z odd in x -> u_y = u_z = 0 on
+  x = 0; even in y -> u_y = 0 on y = 0.
+
+The rigid motion of a distant face carries the unloaded body with it, so the
+closing of the gap per unit approach is 1 at every contact node, and per unit
+rotation theta about the y axis (flat face) it is x.
+"""
+from __future__ import annotations
+
+import hashlib
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import assembly, linsolve, mesh
+from .cache import DiskCache, make_key
+from .condensed import CondensedContact, ContactGrid
+from .spec import ContactSpec
+
+_SOURCES = ("mesh.py", "assembly.py", "condense.py", "spec.py", "linsolve.py")
+DIRECTIONS = ("z", "x")
+
+
+def code_version() -> str:
+    """Hash of the sources that shape the condensed matrices (part of the cache key)."""
+    h = hashlib.sha256()
+    for name in _SOURCES:
+        h.update((Path(__file__).parent / name).read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _fixed_dofs(body: mesh.BodyMesh, direction: str, symmetry: str) -> np.ndarray:
+    """Clamped DOFs (distant face) plus the symmetry conditions of the load direction."""
+    fixed = [3 * body.distant + c for c in range(3)]
+    fixed.append(3 * body.sym_y0 + 1)
+    if symmetry == "quarter":
+        comps = (0,) if direction == "z" else (1, 2)
+        fixed += [3 * body.sym_x0 + c for c in comps]
+    return np.unique(np.concatenate(fixed))
+
+
+def body_compliance(K, body: mesh.BodyMesh, direction: str, symmetry: str) -> np.ndarray:
+    """Compliance (n, n) [m/N] of one body at its contact nodes in ``direction``."""
+    ndof = K.shape[0]
+    free = np.setdiff1d(np.arange(ndof), _fixed_dofs(body, direction, symmetry))
+    local = np.full(ndof, -1)
+    local[free] = np.arange(free.size)
+    dofs = local[3 * body.contact + "xyz".index(direction)]
+    if np.any(dofs < 0):
+        raise ValueError("a contact DOF is constrained: the contact zone touches a clamped face")
+    Kff = K[free][:, free]
+    return linsolve.compliance_block(Kff, dofs)
+
+
+def _tributary(u: np.ndarray, on_symmetry_plane: bool) -> np.ndarray:
+    """1D tributary lengths of zone nodes u; the end nodes own half a cell inside."""
+    mid = 0.5 * (u[1:] + u[:-1])
+    lo = np.concatenate([[u[0]], mid])
+    hi = np.concatenate([mid, [u[-1]]])
+    return hi - lo
+
+
+def make_grid(spec: ContactSpec, b1: mesh.BodyMesh, b2: mesh.BodyMesh, symmetry: str) -> ContactGrid:
+    """Contact grid (positions, areas, weights, initial gap) of the modelled part."""
+    x, y = b2.p[0, b2.contact], b2.p[1, b2.contact]
+    ux, uy = np.unique(x), np.unique(y)
+    area = np.outer(_tributary(ux, True), _tributary(uy, True)).ravel()
+    if spec.model == "real" and spec.body != "flat":
+        h = b1.p[2, b1.contact] - b2.p[2, b2.contact]   # the true surface z_s(x, y)
+    elif spec.body == "sphere":
+        h = (x**2 + y**2) / (2.0 * spec.radius)           # h = r^2 / (2R)
+    elif spec.body == "cylinder":
+        h = x**2 / (2.0 * spec.radius)
+    else:
+        h = np.zeros_like(x)
+    tol = 1e-9 * (ux[1] - ux[0])
+    copies = 1 + (np.abs(y) > tol).astype(int)
+    if symmetry == "quarter":
+        copies *= 1 + (np.abs(x) > tol).astype(int)
+    weight = 4.0 if symmetry == "quarter" else 2.0
+    return ContactGrid(x=x, y=y, area=area, mult=np.full(x.size, weight), h=h, copies=copies)
+
+
+def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
+    """Run the FE stages; return the arrays and meta of a CondensedContact."""
+    timings = {"mesh": 0.0, "assembly": 0.0, "condensation": 0.0}
+    t0 = time.perf_counter()
+    b1, b2, meta = mesh.build(spec)
+    timings["mesh"] = time.perf_counter() - t0
+    sym = meta["symmetry"]
+    grid = make_grid(spec, b1, b2, sym)
+    arrays = {"x": grid.x, "y": grid.y, "area": grid.area, "mult": grid.mult, "h": grid.h,
+              "copies": grid.copies}
+    mats = ((spec.E1, spec.nu1), (spec.E2, spec.nu2))
+    dofs = []
+    for ib, (body, (E, nu)) in enumerate(zip((b1, b2), mats), start=1):
+        t0 = time.perf_counter()
+        K = assembly.stiffness(body.p, body.t, E, nu)
+        timings["assembly"] += time.perf_counter() - t0
+        dofs.append(K.shape[0])
+        for d in directions:
+            t0 = time.perf_counter()
+            arrays[f"C{d}{d}_{ib}"] = body_compliance(K, body, d, sym)
+            timings["condensation"] += time.perf_counter() - t0
+        del K
+    rigid = [np.ones_like(grid.x)] + ([grid.x] if spec.body == "flat" else [])
+    arrays["rigid"] = np.stack(rigid, axis=1)
+    meta.update({"spec": spec.key_dict(), "directions": list(directions), "dofs": dofs,
+                 "solver": linsolve.backend(), "timings": timings})
+    return arrays, meta
+
+
+def _assemble_result(arrays: dict, meta: dict) -> CondensedContact:
+    grid = ContactGrid(x=arrays["x"], y=arrays["y"], area=arrays["area"], mult=arrays["mult"],
+                       h=arrays["h"], copies=arrays["copies"])
+    z = (arrays["Czz_1"], arrays["Czz_2"])
+    x = (arrays["Cxx_1"], arrays["Cxx_2"]) if "Cxx_1" in arrays else None
+    return CondensedContact(grid=grid, Czz=z[0] + z[1], rigid=arrays["rigid"], Czz_bodies=z,
+                            Cxx=None if x is None else x[0] + x[1], Cxx_bodies=x, meta=meta)
+
+
+def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedContact:
+    """Condensed contact compliance of the pair ``spec``.
+
+    Parameters
+    ----------
+    spec : ContactSpec
+    directions : sequence of {"z", "x"}
+        Compliance blocks to compute; "z" is always included (the normal solve).
+    cache : None, False, str, Path or DiskCache
+        None: the default cache folder (``DAMPER_CACHE_DIR`` or ``.damper_cache``);
+        False: no cache; a folder or a DiskCache: that cache.
+
+    Returns
+    -------
+    CondensedContact
+        ``meta["timings"]`` holds the seconds per stage (mesh, assembly,
+        condensation) or the cache load time; ``meta["cache"]`` the key and hit.
+    """
+    bad = set(directions) - set(DIRECTIONS)
+    if bad:
+        raise ValueError(f"unknown direction(s) {sorted(bad)}; use 'z' and/or 'x'")
+    directions = tuple(d for d in DIRECTIONS if d in set(directions) | {"z"})
+    store = None if cache is False else cache if isinstance(cache, DiskCache) else DiskCache(cache)
+    key = make_key(spec.key_dict(), directions, code_version())
+    t0 = time.perf_counter()
+    hit = store.get(key) if store is not None else None
+    if hit is not None:
+        arrays, meta = hit
+        meta["build_timings"] = meta.get("timings")
+        meta["timings"] = {"cache_load": time.perf_counter() - t0}
+    else:
+        arrays, meta = _build(spec, directions)
+        if store is not None:
+            store.put(key, arrays, meta)
+    meta["cache"] = {"key": key, "hit": hit is not None,
+                     "path": None if store is None else str(store.path(key))}
+    return _assemble_result(arrays, meta)

@@ -1,0 +1,236 @@
+"""Structured, graded hexahedral meshes of the two bodies (thesis section 2.1).
+
+Every body is a logically structured block of trilinear hexahedra, node (i, j, k)
+at ``X[i, j, k]``, mapped where needed onto the real geometry. The potential
+contact faces of both bodies carry nodes at the same x-y positions (the thesis's
+"hard points projection", Appendix B.1.2): a uniform grid of spacing s over the
+potential contact zone, then element sizes growing by the grading ratio q.
+
+Body 1 (curved body or damper face) lies above z = 0 (real geometry: above the
+surface z_s(x, y) >= 0), body 2 (the plane) below. Symmetry: a quarter model
+(x >= 0, y >= 0) for the sphere and the cylinder, a half model (y >= 0) for the
+flat face. Element local node order is scikit-fem's ``MeshHex``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .spec import ContactSpec
+
+#: scikit-fem MeshHex local vertex offsets (i, j, k) of the 8 nodes.
+HEX_OFFSETS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0],
+                        [0, 1, 1], [1, 0, 1], [1, 1, 0], [1, 1, 1]])
+#: Largest angular step [rad] along a curved surface, so the polygonal surface
+#: stays within 0.2 % of the arc.
+MAX_ARC_STEP = math.pi / 24
+
+
+@dataclass(frozen=True)
+class BodyMesh:
+    """A meshed body.
+
+    Attributes
+    ----------
+    p : ndarray, shape (3, N)   node coordinates [m]
+    t : ndarray, shape (8, nel) element connectivity (scikit-fem order)
+    contact : ndarray, shape (n,)  node index of each contact-grid node
+    distant : ndarray        nodes of the distant face (clamped: rigid motion imposed)
+    sym_x0, sym_y0 : ndarray nodes on the symmetry planes x = 0 and y = 0
+    """
+
+    p: np.ndarray
+    t: np.ndarray
+    contact: np.ndarray
+    distant: np.ndarray
+    sym_x0: np.ndarray
+    sym_y0: np.ndarray
+
+
+def graded(start: float, end: float, s0: float, q: float, cap: float = np.inf) -> np.ndarray:
+    """Points after ``start`` up to ``end`` with steps s0*q, s0*q^2, ... (capped).
+
+    The steps are scaled by one common factor so that the last point is ``end``.
+    Returns shape (m,), excluding ``start``; empty if ``end <= start``.
+    """
+    span = end - start
+    if span <= 1e-12 * max(abs(end), 1.0):
+        return np.empty(0)
+    steps, step, total = [], s0, 0.0
+    while total < span * (1.0 - 1e-9):
+        step = min(step * q, cap)
+        steps.append(step)
+        total += step
+    steps = np.asarray(steps) * (span / total)
+    return start + np.cumsum(steps)
+
+
+def zone_points(extent: float, n_side: int, symmetric_half: bool) -> np.ndarray:
+    """Uniform contact-zone coordinates: [0, extent] (quarter/half axis, n_side odd
+    nodes over [-extent, extent] in the full model) or the full [-extent, extent]."""
+    full = np.linspace(-extent, extent, n_side)
+    full[n_side // 2] = 0.0  # exactly on the symmetry plane
+    return full[full >= -1e-15 * extent] if symmetric_half else full
+
+
+def _arc_points(x_zone: np.ndarray, R: float, q: float) -> np.ndarray:
+    """Zone points, then points x = R sin(theta) graded in theta up to the rim x = R."""
+    s = x_zone[1] - x_zone[0]
+    th0 = math.asin(min(x_zone[-1] / R, 1.0))
+    th = graded(th0, 0.5 * math.pi, s / R, q, MAX_ARC_STEP)
+    return np.concatenate([x_zone, R * np.sin(th)])
+
+
+def structured(X: np.ndarray, Y: np.ndarray, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes and hexahedra of a logically structured block.
+
+    Parameters
+    ----------
+    X, Y, Z : ndarray, shape (nx, ny, nz)
+        Node coordinates [m], right-handed in (i, j, k).
+
+    Returns
+    -------
+    p : ndarray, shape (3, nx*ny*nz); t : ndarray, shape (8, (nx-1)(ny-1)(nz-1))
+    """
+    nx, ny, nz = X.shape
+    idx = np.arange(nx * ny * nz).reshape(nx, ny, nz)
+    t = np.stack([idx[o[0]:nx - 1 + o[0], o[1]:ny - 1 + o[1], o[2]:nz - 1 + o[2]].ravel()
+                  for o in HEX_OFFSETS])
+    return np.stack([X.ravel(), Y.ravel(), Z.ravel()]), t
+
+
+def _body(X, Y, Z, nzx: int, nzy: int, contact_k: int, distant: np.ndarray) -> BodyMesh:
+    """Assemble a BodyMesh; the contact grid is nzx x nzy nodes at level contact_k:
+    i < nzx on a quarter model (x >= 0), the nzx lines centred on x = 0 otherwise."""
+    p, t = structured(X, Y, Z)
+    idx = np.arange(X.size).reshape(X.shape)
+    xline = X[:, 0, contact_k]
+    ii = np.arange(nzx) if xline[0] >= 0 else _centered(xline, nzx)
+    contact = idx[np.ix_(ii, np.arange(nzy), [contact_k])].ravel()
+    tol = 1e-12 * np.max(np.abs(p))
+    return BodyMesh(p=p, t=t, contact=contact, distant=distant,
+                    sym_x0=np.flatnonzero(np.abs(p[0]) <= tol),
+                    sym_y0=np.flatnonzero(np.abs(p[1]) <= tol))
+
+
+def _centered(xline: np.ndarray, nzx: int) -> np.ndarray:
+    """Indices of the nzx zone nodes centred on x = 0 in a full x-line."""
+    c = int(np.argmin(np.abs(xline)))
+    return np.arange(c - nzx // 2, c + nzx // 2 + 1)
+
+
+def plane_block(xs, ys, depth: float, s: float, q: float, nzx: int, nzy: int) -> BodyMesh:
+    """Body 2: the block below z = 0 on x-y lines ``xs``, ``ys``, graded in depth."""
+    zs = -graded(0.0, depth, s, q)[::-1]
+    zs = np.concatenate([zs, [0.0]])
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    nz = zs.size
+    idx = np.arange(X.size).reshape(X.shape)
+    return _body(X, Y, Z, nzx, nzy, nz - 1, idx[:, :, 0].ravel())
+
+
+def upper_block(xs, ys, height: float, s: float, q: float, nzx: int, nzy: int) -> BodyMesh:
+    """Body 1 as a block above z = 0 (half-space variant, flat face)."""
+    zs = np.concatenate([[0.0], graded(0.0, height, s, q)])
+    X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
+    idx = np.arange(X.size).reshape(X.shape)
+    return _body(X, Y, Z, nzx, nzy, 0, idx[:, :, -1].ravel())
+
+
+def _lift(X2, Y2, zsurf, R, s, q):
+    """Columns from the curved surface z_s up to the flat distant face z = R."""
+    phi = np.concatenate([[0.0], graded(0.0, 1.0, s / R, q)])
+    Z = zsurf[:, :, None] + (R - zsurf)[:, :, None] * phi[None, None, :]
+    X = np.repeat(X2[:, :, None], phi.size, axis=2)
+    Y = np.repeat(Y2[:, :, None], phi.size, axis=2)
+    return X, Y, Z
+
+
+def half_sphere(R: float, xz: np.ndarray, q: float) -> BodyMesh:
+    """Quarter of a real half-sphere (radius R, flat face z = R, pole at the origin).
+
+    A graded square [0, R]^2 is mapped onto the quarter disk r <= R: identity in
+    the contact zone (so its nodes keep the plane's x-y), blending smoothly into
+    the square-to-disk map x = xi * max(xi, eta) / |(xi, eta)| at the rim; then
+    each column is lifted from the sphere z_s = R - sqrt(R^2 - r^2) to z = R.
+    The rim nodes collapse onto the flat face, where they are clamped anyway.
+    """
+    xi = _arc_points(xz, R, q)
+    XI, ETA = np.meshgrid(xi, xi, indexing="ij")
+    m = np.maximum(XI, ETA)
+    rho = np.hypot(XI, ETA)
+    w = np.clip((m - xz[-1]) / (R - xz[-1]), 0.0, 1.0) ** 2
+    g = 1.0 + w * (np.divide(m, rho, out=np.ones_like(m), where=rho > 0) - 1.0)
+    X2, Y2 = XI * g, ETA * g
+    r2 = np.minimum(X2**2 + Y2**2, R**2)
+    X, Y, Z = _lift(X2, Y2, R - np.sqrt(R**2 - r2), R, xz[1] - xz[0], q)
+    idx = np.arange(X.size).reshape(X.shape)
+    distant = np.union1d(idx[:, :, -1].ravel(), np.flatnonzero(Z.ravel() >= R * (1 - 1e-12)))
+    return _body(X, Y, Z, xz.size, xz.size, 0, distant)
+
+
+def half_cylinder(R: float, xz: np.ndarray, ys: np.ndarray, q: float) -> BodyMesh:
+    """Quarter of a real half-cylinder (radius R, axis along y at z = R, x >= 0,
+    0 <= y <= L/2 on the lines ``ys``), its cut face z = R the distant face."""
+    xi = _arc_points(xz, R, q)
+    X2, Y2 = np.meshgrid(xi, ys, indexing="ij")
+    X, Y, Z = _lift(X2, Y2, R - np.sqrt(np.maximum(R**2 - X2**2, 0.0)), R, xz[1] - xz[0], q)
+    idx = np.arange(X.size).reshape(X.shape)
+    distant = np.union1d(idx[:, :, -1].ravel(), np.flatnonzero(Z.ravel() >= R * (1 - 1e-12)))
+    return _body(X, Y, Z, xz.size, ys.size, 0, distant)
+
+
+def build(spec: ContactSpec) -> tuple[BodyMesh, BodyMesh, dict]:
+    """Meshes of body 1 and body 2 for ``spec`` and a description (``meta``)."""
+    q, R = spec.grading, spec.radius
+    zx, zy = spec.zone()
+    n = spec.n_side
+    if spec.body == "sphere":
+        xz = zone_points(zx, n, True)
+        s = xz[1] - xz[0]
+        size = R if spec.model == "real" else max(R, 60.0 * zx)
+        xs = np.concatenate([xz, graded(zx, size, s, q)])
+        b2 = plane_block(xs, xs, size, s, q, xz.size, xz.size)
+        b1 = (half_sphere(R, xz, q) if spec.model == "real"
+              else upper_block(xs, xs, size, s, q, xz.size, xz.size))
+        sym = "quarter"
+    elif spec.body == "cylinder":
+        xz = zone_points(zx, n, True)
+        s = xz[1] - xz[0]
+        yz = _cylinder_y(zy, s)
+        size = R
+        xs = np.concatenate([xz, graded(zx, size, s, q)])
+        ys = np.concatenate([yz, graded(zy, zy + size, yz[-1] - yz[-2], q)])
+        b2 = plane_block(xs, ys, size, s, q, xz.size, yz.size)
+        b1 = (half_cylinder(R, xz, yz, q) if spec.model == "real"
+              else upper_block(xs, yz, size, s, q, xz.size, yz.size))
+        sym = "quarter"
+    else:
+        xz = zone_points(zx, n, False)
+        s = xz[1] - xz[0]
+        ny = max(3, int(round(zy / s)) + 1)
+        yz = np.linspace(0.0, zy, ny)
+        size = max(2.0 * zx, zy)
+        xr = graded(zx, zx + size, s, q)
+        xs = np.concatenate([-xr[::-1], xz, xr])
+        ys = np.concatenate([yz, graded(zy, zy + size, yz[1] - yz[0], q)])
+        b2 = plane_block(xs, ys, size, s, q, xz.size, yz.size)
+        b1 = upper_block(xz, yz, size, s, q, xz.size, yz.size)
+        sym = "half"
+    meta = {"symmetry": sym, "zone": [zx, zy], "spacing": float(s), "n_side": n,
+            "nodes": [b1.p.shape[1], b2.p.shape[1]], "elements": [b1.t.shape[1], b2.t.shape[1]]}
+    return b1, b2, meta
+
+
+def _cylinder_y(zy: float, s: float) -> np.ndarray:
+    """Lines along the cylinder, 0 <= y <= L/2: spacing 2s in the middle, refined
+    to s/2 towards the end y = L/2 where the edge pressure peak sits."""
+    fine = s / 2.0
+    tail = zy - graded(0.0, min(zy, 12.0 * s), fine, 1.25, 2.0 * s)[::-1]
+    head_end = tail[0]
+    nh = max(1, int(math.ceil(head_end / (2.0 * s))))
+    head = np.linspace(0.0, head_end, nh + 1)
+    return np.unique(np.round(np.concatenate([head, tail, [zy]]) / (1e-9 * s)) * (1e-9 * s))

@@ -1,0 +1,206 @@
+"""Normal contact solve on condensed compliances (thesis Appendix A.1).
+
+Symbols (SI units): n contact nodes of the modelled part; C (n, n) combined
+normal compliance [m/N]; h (n,) initial gap [m]; R_q (n, r) closing per rigid DOF;
+q (r,) rigid DOFs (approach delta [m], rotation theta [rad]); f (n,) compressive
+nodal forces [N]; g = h - R_q q + C f (n,) gap [m]; m (n,) full-model weights.
+
+For given q the contact problem is the linear complementarity problem
+
+    g = C f + (h - R_q q) >= 0,  f >= 0,  f g = 0,
+
+equivalently the strictly convex QP  min 1/2 f'Cf + f'(h - R_q q), f >= 0 (C is
+symmetric positive definite). It is solved by the thesis's active-set idea
+(nodes in tension leave the contact, penetrating nodes re-enter) organised as a
+Lawson-Hanson primal active-set method: every outer iteration ends on the exact
+minimiser over its active set with f > 0 there and strictly lowers the QP
+objective, so no active set can repeat and the iteration cannot cycle. Several
+penetrating nodes enter at once; a node that would enter with a non-positive
+force is held back (the guard), and if none is left the single most penetrating
+node enters, for which Lawson-Hanson guarantees progress.
+
+Tolerances: penetration <= ``GAP_RTOL`` * max|h - R_q q| (no tension holds
+exactly: f = 0 off the active set, f > 0 on it); force control meets its
+targets to ``FORCE_RTOL``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from .condensed import CondensedContact
+
+#: Allowed penetration relative to the largest effective gap magnitude.
+GAP_RTOL = 1e-10
+#: Relative accuracy of force control (force and moment).
+FORCE_RTOL = 1e-9
+#: Newton steps allowed in force control.
+MAX_NEWTON = 60
+
+
+@dataclass
+class NormalSolution:
+    """One solved normal contact state.
+
+    Attributes
+    ----------
+    f : ndarray (n,)      nodal compressive forces of the modelled part [N]
+    g : ndarray (n,)      gaps [m]
+    q : ndarray (r,)      rigid DOFs: approach [m] (and rotation [rad])
+    active : ndarray (n,) bool, nodes in contact
+    iterations : int      active-set iterations (summed over Newton steps)
+    newton : int          force-control Newton steps (0 in displacement control)
+    """
+
+    f: np.ndarray
+    g: np.ndarray
+    q: np.ndarray
+    active: np.ndarray
+    iterations: int
+    newton: int = 0
+
+
+def _solve_sub(C, rhs, P):
+    """Solution s (n,) of C_PP s_P = rhs_P, zero off P."""
+    s = np.zeros(rhs.size)
+    if P.any():
+        s[P] = sla.solve(C[np.ix_(P, P)], rhs[P], assume_a="pos", check_finite=False)
+    return s
+
+
+def _enter(C, b, f, P, cand):
+    """Lawson-Hanson inner loop after ``cand`` nodes enter; None if all are held back."""
+    Pn = P | cand
+    while True:
+        s = _solve_sub(C, -b, Pn)
+        held = Pn & ~P & (f <= 0) & (s <= 0)        # entering with a non-positive force
+        if held.any():
+            Pn &= ~held
+            if not (Pn & ~P).any():
+                return None
+            continue
+        bad = Pn & (s <= 0)
+        if not bad.any():
+            return s, Pn
+        alpha = np.min(f[bad] / (f[bad] - s[bad]))  # step to the first node reaching f = 0
+        f = f + alpha * (s - f)
+        Pn &= f > 1e-300
+        P = P & Pn
+
+
+def lcp(C: np.ndarray, b: np.ndarray, P0: np.ndarray | None = None, max_iter: int | None = None):
+    """Solve g = C f + b >= 0, f >= 0, f g = 0 for SPD C.
+
+    Parameters
+    ----------
+    C : ndarray (n, n) SPD; b : ndarray (n,) the effective gap h - R_q q [m]
+    P0 : ndarray (n,) bool, optional, a guess of the contact set (warm start)
+
+    Returns
+    -------
+    f : ndarray (n,); active : ndarray (n,) bool; iterations : int
+
+    Raises
+    ------
+    RuntimeError
+        If the iteration limit (default 3 n + 10) is reached.
+    """
+    n = b.size
+    max_iter = 3 * n + 10 if max_iter is None else max_iter
+    tol = GAP_RTOL * max(np.max(np.abs(b)), 1e-300)
+    P = (b < 0) if P0 is None else P0.copy()
+    it = 0
+    while True:  # start: drop tensile nodes from the guess (thesis A.1.4-A.1.5)
+        s = _solve_sub(C, -b, P)
+        it += 1
+        if not (P & (s <= 0)).any():
+            break
+        P &= s > 0
+    f = s
+    while True:
+        w = C @ f + b
+        viol = ~P & (w < -tol)
+        if not viol.any():
+            return f, P, it
+        if it >= max_iter:
+            raise RuntimeError(f"normal contact active set did not converge in {max_iter} iterations "
+                               f"(max penetration {-w[viol].min():.3e} m)")
+        it += 1
+        step = _enter(C, b, f, P, viol)
+        if step is None:
+            one = np.zeros(n, bool)
+            one[np.argmin(np.where(viol, w, np.inf))] = True
+            step = _enter(C, b, f, P, one)
+            if step is None:
+                raise RuntimeError("normal contact active set stalled (ill-conditioned compliance)")
+        f, P = step
+
+
+def solve_displacement(cc: CondensedContact, q, P0=None) -> NormalSolution:
+    """Contact state for imposed rigid DOFs q (approach [m] and, flat face, rotation [rad])."""
+    q = np.atleast_1d(np.asarray(q, float))
+    q = np.concatenate([q, np.zeros(cc.rigid.shape[1] - q.size)])
+    b = cc.grid.h - cc.rigid @ q
+    f, P, it = lcp(cc.Czz, b, P0)
+    return NormalSolution(f=f, g=cc.Czz @ f + b, q=q, active=P, iterations=it)
+
+
+def tangent(cc: CondensedContact, active: np.ndarray) -> np.ndarray:
+    """Exact d(resultants)/dq for a fixed active set, shape (r, r).
+
+    Resultants are the full-model force sum(m f) and (flat face) moment
+    sum(m f x); f_P = C_PP^-1 (R_q q - h)_P is linear in q for a fixed set.
+    """
+    R = cc.rigid[active]
+    if not active.any():
+        return np.zeros((cc.rigid.shape[1],) * 2)
+    X = sla.solve(cc.Czz[np.ix_(active, active)], R, assume_a="pos")
+    W = (cc.grid.mult[:, None] * cc.rigid)[active]
+    return W.T @ X
+
+
+def resultants(cc: CondensedContact, f: np.ndarray) -> np.ndarray:
+    """Full-model force [N] (and moment about y [N m] if r = 2)."""
+    return (cc.grid.mult * f) @ cc.rigid
+
+
+def solve_force(cc: CondensedContact, force: float, eccentricity: float | None = None) -> NormalSolution:
+    """Contact state for a target full-model force [N] (flat face: and eccentricity [m]).
+
+    Newton on the rigid DOFs with the exact tangent of the current active set
+    (piecewise linear resultants, so it ends exactly once the set settles),
+    bracketed by bisection on the approach when there is one rigid DOF.
+    """
+    if not (np.isfinite(force) and force > 0):
+        raise ValueError(f"force must be positive, got {force!r}")
+    r = cc.rigid.shape[1]
+    target = np.array([force] if r == 1 else [force, force * (eccentricity or 0.0)])
+    h0 = cc.grid.h.min()
+    # one node carrying all the force closes at least as much as the true contact
+    q = np.zeros(r)
+    q[0] = h0 + np.max(np.diag(cc.Czz)) * force / cc.grid.mult.max()
+    lo, hi, its, sol = h0, None, 0, None
+    for k in range(1, MAX_NEWTON + 1):
+        sol = solve_displacement(cc, q, None if sol is None else sol.active)
+        its += sol.iterations
+        res = resultants(cc, sol.f)[:r]
+        err = target - res
+        if np.all(np.abs(err) <= FORCE_RTOL * force * np.array([1.0, _arm(cc)][:r])):
+            sol.iterations, sol.newton = its, k
+            return sol
+        if r == 1:
+            lo, hi = (q[0], hi) if err[0] > 0 else (lo, q[0])
+        T = tangent(cc, sol.active)
+        dq = np.linalg.lstsq(T, err, rcond=None)[0] if sol.active.any() else np.array([q[0] - h0] + [0] * (r - 1))
+        q = q + dq
+        if r == 1 and (q[0] <= lo or (hi is not None and q[0] >= hi)):
+            q[0] = 0.5 * (lo + (hi if hi is not None else 2 * q[0] - lo))
+    raise RuntimeError(f"force control did not converge in {MAX_NEWTON} Newton steps "
+                       f"(target {target}, reached {res})")
+
+
+def _arm(cc: CondensedContact) -> float:
+    """Moment scale [m] for the moment tolerance: the half-width of the grid."""
+    return max(np.max(np.abs(cc.grid.x)), 1e-300)

@@ -1,0 +1,141 @@
+"""Specification of a contact pair: geometry, materials, model variant, grid.
+
+Body 1 is the curved body (sphere, cylinder) or the damper's flat face, body 2
+the plane. Axes: z normal to the contact plane (body 1 above), a cylinder's axis
+and a flat face's length L along y, the face width W along x.
+
+The potential contact zone is sized as in the thesis (Appendix A.1.2): the Hertz
+contact for a design peak pressure (``p_design``, 2000 MPa), enlarged by
+``zone_margin``, or the Hertz contact of ``load_hint`` if that is larger.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from . import hertz
+
+#: Steel, the default for both bodies.
+STEEL_E = 200e9
+STEEL_NU = 0.3
+BODIES = ("sphere", "cylinder", "flat")
+MODELS = ("real", "halfspace")
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """A contact pair (SI units).
+
+    Parameters
+    ----------
+    body : {"sphere", "cylinder", "flat"}
+    radius : float
+        Sphere or cylinder radius R [m] (cylinder: D/2).
+    length : float
+        Cylinder length or flat-face length L along y [m].
+    width : float
+        Flat-face width W along x [m].
+    E1, nu1, E2, nu2 : float
+        Young's modulus [Pa] and Poisson ratio of body 1 (curved/face) and 2 (plane).
+    model : {"real", "halfspace"}
+        "real": a true half-sphere / half-cylinder on a block; "halfspace": block
+        on block with the curvature only in the gap h = r^2 / (2R).
+    grid : int
+        Contact-zone nodes per side of the full model (an even value is raised
+        by one so that a node sits on each symmetry plane).
+    p_design : float
+        Design peak pressure sizing the potential contact zone [Pa].
+    load_hint : float
+        A normal force [N] the zone must hold (0: none).
+    zone_margin : float
+        Potential zone / Hertz contact size at ``p_design``.
+    grading : float
+        Growth ratio of element sizes away from the contact zone.
+    """
+
+    body: str = "sphere"
+    radius: float = 0.01
+    length: float = 0.0
+    width: float = 0.0
+    E1: float = STEEL_E
+    nu1: float = STEEL_NU
+    E2: float = STEEL_E
+    nu2: float = STEEL_NU
+    model: str = "real"
+    grid: int = 21
+    p_design: float = 2000e6
+    load_hint: float = 0.0
+    zone_margin: float = 1.15
+    grading: float = 1.45
+
+    def __post_init__(self):
+        validate(self)
+
+    @property
+    def Estar(self) -> float:
+        """Contact modulus E* [Pa]."""
+        return hertz.contact_modulus(self.E1, self.nu1, self.E2, self.nu2)
+
+    @property
+    def n_side(self) -> int:
+        """Contact-zone nodes per side actually used (odd)."""
+        return self.grid + 1 - self.grid % 2
+
+    def zone(self) -> tuple[float, float]:
+        """Half-extents (zx, zy) [m] of the potential contact zone of the full model."""
+        Es, R = self.Estar, self.radius
+        if self.body == "sphere":
+            a = hertz.sphere_radius_for_peak(self.p_design, R, Es)
+            if self.load_hint > 0:
+                a = max(a, hertz.sphere(self.load_hint, R, Es)["a"])
+            return self.zone_margin * a, self.zone_margin * a
+        if self.body == "cylinder":
+            b = hertz.cylinder_halfwidth_for_peak(self.p_design, R, Es)
+            if self.load_hint > 0:
+                b = max(b, hertz.cylinder(self.load_hint, self.length, R, Es)["b"])
+            # the edge effect widens the contact at the ends (thesis Fig. 5)
+            return min(1.5 * self.zone_margin * b, 0.5 * R), 0.5 * self.length
+        return 0.5 * self.width, 0.5 * self.length
+
+    def key_dict(self) -> dict:
+        """Fields that define the FE model (for the cache key)."""
+        d = asdict(self)
+        if self.body == "flat":
+            d["model"] = "halfspace"  # a flat face has no curvature to model
+        return d
+
+
+def _positive(name: str, value: float) -> None:
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+
+
+def validate(spec: ContactSpec) -> None:
+    """Raise ValueError with a clear message for an inconsistent specification."""
+    if spec.body not in BODIES:
+        raise ValueError(f"body must be one of {BODIES}, got {spec.body!r}")
+    if spec.model not in MODELS:
+        raise ValueError(f"model must be one of {MODELS}, got {spec.model!r}")
+    for name in ("E1", "E2"):
+        _positive(name, getattr(spec, name))
+    for name in ("nu1", "nu2"):
+        nu = getattr(spec, name)
+        if not (-1.0 < nu < 0.5):
+            raise ValueError(f"{name} must lie in (-1, 0.5) (0.5 is incompressible), got {nu!r}")
+    if spec.body in ("sphere", "cylinder"):
+        _positive("radius", spec.radius)
+    if spec.body in ("cylinder", "flat"):
+        _positive("length", spec.length)
+    if spec.body == "flat":
+        _positive("width", spec.width)
+    if not isinstance(spec.grid, int) or spec.grid < 3:
+        raise ValueError(f"grid must be an integer >= 3, got {spec.grid!r}")
+    if spec.grid > 201:
+        raise ValueError(f"grid {spec.grid} is beyond what this machine can condense (max 201)")
+    _positive("p_design", spec.p_design)
+    if spec.load_hint < 0:
+        raise ValueError(f"load_hint must be >= 0, got {spec.load_hint!r}")
+    if not spec.zone_margin >= 1.0:
+        raise ValueError("zone_margin must be >= 1")
+    if not 1.0 < spec.grading <= 3.0:
+        raise ValueError("grading must lie in (1, 3]")
