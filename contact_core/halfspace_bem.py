@@ -1,0 +1,227 @@
+"""Half-space influence-coefficient (boundary-element) contact model.
+
+A fast, independent oracle for the FE contact models and a fast option for
+users: both bodies are elastic half-spaces, the curvature enters only through
+the initial gap ``h = r^2 / (2 R)`` (sphere) or ``h = x^2 / (2 R)`` (cylinder
+with its axis along y, cut off at its ends ``|y| <= L/2``). It cannot see
+finite bodies (their extra compliance, the cylinder's body compression).
+
+The potential contact zone is a regular grid of ``nx * ny`` rectangular cells
+of size ``dx * dy``; node i sits at the centre of cell i. A nodal force f_j
+[N] is a uniform traction f_j / (dx dy) over cell j, and displacements are
+collocated at the nodes. The surface displacement of a half-space (modulus E,
+Poisson's ratio nu, shear modulus G = E / (2 (1 + nu))) under a point force at
+distance rho = sqrt(X^2 + Y^2) is (Johnson, Contact Mechanics, eqs. 3.19a and
+3.22; Love 1929 for the uniform rectangle)
+
+    normal force P (Boussinesq):       u_z = (1 - nu^2) / (pi E) * P / rho
+    tangential force Q_x (Cerruti):    u_x = Q_x / (2 pi G) * [(1 - nu) / rho + nu X^2 / rho^3]
+
+Integrated over a rectangle these have closed forms (``_rect_inv_rho``,
+``_rect_x2_rho3``). The combined (relative) compliance of the pair is the sum
+over the two bodies; the coupling of normal and tangential displacements
+(Johnson's constant beta) is neglected, exactly so for like materials and as
+the thesis does (Appendix A.2, decoupled problems).
+
+Symbols: n number of nodes, E [Pa], nu [-], G [Pa], R radius [m], L cylinder
+length [m], C compliance [m/N].
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Default material: steel.
+STEEL = (200e9, 0.3)
+
+
+@dataclass(frozen=True)
+class HalfspaceGrid:
+    """A regular grid of contact cells (cell-centred nodes).
+
+    Attributes
+    ----------
+    x, y : ndarray, shape (n,)
+        Node (cell centre) coordinates [m], x fastest.
+    dx, dy : float
+        Cell size [m].
+    nx, ny : int
+        Cells along x and y.
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    dx: float
+    dy: float
+    nx: int
+    ny: int
+
+    @property
+    def area(self) -> np.ndarray:
+        """Cell areas [m^2], shape (n,)."""
+        return np.full(self.x.size, self.dx * self.dy)
+
+
+def regular_grid(half_x: float, half_y: float, nx: int, ny: int) -> HalfspaceGrid:
+    """Cells covering ``[-half_x, half_x] x [-half_y, half_y]``; node i at cell centre."""
+    for name, v in (("half_x", half_x), ("half_y", half_y)):
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"halfspace grid: {name} must be positive and finite, got {v}")
+    if int(nx) < 3 or int(ny) < 1:
+        raise ValueError(f"halfspace grid: need nx >= 3 and ny >= 1 cells, got {nx}, {ny}")
+    dx, dy = 2.0 * half_x / nx, 2.0 * half_y / ny
+    xc = -half_x + dx * (np.arange(nx) + 0.5)
+    yc = -half_y + dy * (np.arange(ny) + 0.5)
+    X, Y = np.meshgrid(xc, yc, indexing="xy")
+    return HalfspaceGrid(X.ravel(), Y.ravel(), dx, dy, int(nx), int(ny))
+
+
+def _xlog(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a * asinh(b / |a|)``, continuous with limit 0 at a = 0."""
+    out = np.zeros(np.broadcast(a, b).shape)
+    nz = a != 0.0
+    a_, b_ = np.broadcast_to(a, out.shape)[nz], np.broadcast_to(b, out.shape)[nz]
+    out[nz] = a_ * np.arcsinh(b_ / np.abs(a_))
+    return out
+
+
+def _corner_sum(F, X1, X2, Y1, Y2):
+    """Double integral over [X1, X2] x [Y1, Y2] from an antiderivative F(X, Y)."""
+    return F(X2, Y2) - F(X1, Y2) - F(X2, Y1) + F(X1, Y1)
+
+
+def _rect_inv_rho(X1, X2, Y1, Y2):
+    """Integral of 1/rho over the rectangle [X1, X2] x [Y1, Y2] (rho from the origin).
+
+    Antiderivative X asinh(Y/|X|) + Y asinh(X/|Y|): its mixed derivative is
+    1/rho; the terms X ln|X| dropped against the log form cancel between corners.
+    """
+    return _corner_sum(lambda X, Y: _xlog(X, Y) + _xlog(Y, X), X1, X2, Y1, Y2)
+
+
+def _rect_x2_rho3(X1, X2, Y1, Y2):
+    """Integral of X^2/rho^3 over the rectangle (antiderivative Y asinh(X/|Y|))."""
+    return _corner_sum(lambda X, Y: _xlog(Y, X), X1, X2, Y1, Y2)
+
+
+def cell_integrals(grid: HalfspaceGrid) -> tuple[np.ndarray, np.ndarray]:
+    """Kernel integrals between every node i and every cell j.
+
+    Returns
+    -------
+    I1, I2 : ndarray, shape (n, n)
+        ``I1[i, j]`` = integral over cell j of 1/rho, ``I2[i, j]`` of
+        X^2/rho^3, with (X, Y) the vector from the source point to node i [m].
+    Notes
+    -----
+    The grid is regular, so each integral depends only on the index offset:
+    it is evaluated once per offset (block-Toeplitz) and gathered.
+    """
+    ox = np.arange(-(grid.nx - 1), grid.nx) * grid.dx
+    oy = np.arange(-(grid.ny - 1), grid.ny) * grid.dy
+    OX, OY = np.meshgrid(ox, oy, indexing="xy")
+    hx, hy = 0.5 * grid.dx, 0.5 * grid.dy
+    k1 = _rect_inv_rho(OX - hx, OX + hx, OY - hy, OY + hy)
+    k2 = _rect_x2_rho3(OX - hx, OX + hx, OY - hy, OY + hy)
+    ix = np.tile(np.arange(grid.nx), grid.ny)
+    iy = np.repeat(np.arange(grid.ny), grid.nx)
+    di = ix[:, None] - ix[None, :] + grid.nx - 1
+    dj = iy[:, None] - iy[None, :] + grid.ny - 1
+    return k1[dj, di], k2[dj, di]
+
+
+def body_compliances(I1, I2, area, E: float, nu: float) -> tuple[np.ndarray, np.ndarray]:
+    """Normal and tangential-x compliance of one half-space [m/N], shape (n, n).
+
+    ``C[i, j]`` is the displacement at node i per unit nodal force at node j
+    (Boussinesq and Cerruti, module docstring), the force spread over cell j.
+    """
+    if not (np.isfinite(E) and E > 0):
+        raise ValueError(f"halfspace: Young's modulus must be positive, got {E}")
+    if not (np.isfinite(nu) and -1.0 < nu < 0.5):
+        raise ValueError(f"halfspace: Poisson's ratio must be in (-1, 0.5), got {nu}")
+    G = E / (2.0 * (1.0 + nu))
+    Czz = (1.0 - nu**2) / (np.pi * E) * I1 / area[None, :]
+    Cxx = ((1.0 - nu) * I1 + nu * I2) / (2.0 * np.pi * G) / area[None, :]
+    return Czz, Cxx
+
+
+def gap_sphere(grid: HalfspaceGrid, radius: float) -> np.ndarray:
+    """Initial gap h = r^2 / (2 R) of a sphere over a plane [m], shape (n,)."""
+    return (grid.x**2 + grid.y**2) / (2.0 * radius)
+
+
+def gap_cylinder(grid: HalfspaceGrid, radius: float) -> np.ndarray:
+    """Initial gap h = x^2 / (2 R) of a cylinder (axis along y) over a plane [m]."""
+    return grid.x**2 / (2.0 * radius)
+
+
+def condense_grid(grid: HalfspaceGrid, h: np.ndarray, materials=(STEEL, STEEL),
+                  directions=("z", "x"), meta: dict | None = None):
+    """The half-space pair on ``grid`` as a ``CondensedContact`` (full grid, mult = 1).
+
+    Parameters
+    ----------
+    grid : HalfspaceGrid
+        Contact cells.
+    h : ndarray, shape (n,)
+        Initial gap [m].
+    materials : ((E1, nu1), (E2, nu2))
+        Body 1 (curved) and body 2 (plane) [Pa, -].
+    directions : tuple of str
+        ``"x"`` adds the tangential compliance ``Cxx``.
+    meta : dict, optional
+        Extra metadata (geometry) stored in ``meta``.
+
+    Returns
+    -------
+    contact_core.condensed.CondensedContact
+        ``rigid`` is a column of ones (the approach); no rotation DOF.
+    """
+    from contact_core.condensed import CondensedContact, ContactGrid
+
+    area = grid.area
+    I1, I2 = cell_integrals(grid)
+    (E1, nu1), (E2, nu2) = materials
+    z1, x1 = body_compliances(I1, I2, area, E1, nu1)
+    z2, x2 = body_compliances(I1, I2, area, E2, nu2)
+    n = grid.x.size
+    cgrid = ContactGrid(x=grid.x, y=grid.y, area=area, mult=np.ones(n),
+                        h=np.asarray(h, float), copies=np.ones(n, dtype=int))
+    info = {"model": "bem", "materials": {"E1": E1, "nu1": nu1, "E2": E2, "nu2": nu2},
+            "grid": {"nx": grid.nx, "ny": grid.ny, "dx": grid.dx, "dy": grid.dy,
+                     "symmetry": "none"}}
+    info.update(meta or {})
+    tangential = "x" in directions
+    return CondensedContact(grid=cgrid, Czz=z1 + z2, rigid=np.ones((n, 1)), Czz_bodies=(z1, z2),
+                            Cxx=(x1 + x2) if tangential else None,
+                            Cxx_bodies=(x1, x2) if tangential else None, meta=info)
+
+
+def sphere(radius: float, half_width: float, n: int, materials=(STEEL, STEEL),
+           directions=("z", "x")):
+    """Sphere (radius R [m]) on a plane: an ``n x n`` grid over ``|x|, |y| <= half_width``."""
+    _check_positive(radius=radius, half_width=half_width)
+    grid = regular_grid(half_width, half_width, n, n)
+    geometry = {"geometry": {"body": "sphere", "radius": float(radius)}}
+    return condense_grid(grid, gap_sphere(grid, radius), materials, directions, geometry)
+
+
+def cylinder(radius: float, length: float, half_width: float, nx: int, ny: int,
+             materials=(STEEL, STEEL), directions=("z", "x")):
+    """Cylinder (radius R, length L [m], axis along y) on a plane.
+
+    ``nx`` cells over ``|x| <= half_width`` and ``ny`` cells over the length
+    ``|y| <= L/2``; the ends of the cylinder are the ends of the grid.
+    """
+    _check_positive(radius=radius, length=length, half_width=half_width)
+    grid = regular_grid(half_width, 0.5 * length, nx, ny)
+    geometry = {"geometry": {"body": "cylinder", "radius": float(radius), "length": float(length)}}
+    return condense_grid(grid, gap_cylinder(grid, radius), materials, directions, geometry)
+
+
+def _check_positive(**values) -> None:
+    for name, v in values.items():
+        if not (np.isfinite(v) and v > 0):
+            raise ValueError(f"halfspace: {name} must be positive and finite, got {v}")

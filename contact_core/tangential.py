@@ -1,0 +1,317 @@
+"""Tangential stick/slip contact solve (thesis Appendix A.2, compliance form).
+
+The normal solution is fixed (decoupled problems, thesis A.2.1: the normal
+forces do not change with the tangential load; exact for like materials, whose
+Johnson coupling constant beta vanishes). The distant faces are moved by a rigid
+tangential displacement ``delta`` [m] along x.
+
+Symbols (SI units; n_c contact nodes, those with a normal force f_i > 0):
+
+f      (n_c,) nodal normal forces of the modelled part [N] (fixed)
+mu     friction coefficient [-]
+q      (n_c,) nodal tangential forces [N]: the force the contact exerts on the
+       plane (body 2) along +x, and on the curved body along -x
+C      (n_c, n_c) combined tangential compliance ``Cxx`` [m/N]
+w      (n_c,) full-model weights ``mult``; T = sum(w q) is the full tangential force
+s      (n_c,) relative slip of body 1 over body 2 [m]
+
+Kinematics: the surfaces' relative x displacement at node i is
+``s = delta - C q``: the rigid motion minus the elastic give of both bodies.
+
+Incremental problem (from a state ``s_prev`` to a new ``delta``): find q with
+
+    |q_i| <= mu f_i,
+    ds_i = (delta - s_prev_i) - (C q)_i = 0          where |q_i| < mu f_i   (stick)
+    ds_i * q_i >= 0, q_i = mu f_i sign(ds_i)          where ds_i != 0       (slip)
+
+(Amontons-Coulomb, thesis eq. A.24, with the friction force opposing the
+slip increment). These are exactly the optimality (KKT) conditions of the
+convex quadratic programme with box constraints
+
+    min_q  1/2 q^T W C q - q^T W (delta - s_prev)   s.t.  -mu f <= q <= mu f,
+
+W = diag(w) (W C is symmetric by reciprocity), whose gradient is ``-W ds``.
+It has one solution (W C is positive definite). It is solved by a
+primal-dual active-set iteration (Hintermueller, Ito, Kunisch, SIAM J. Optim.
+13, 2003), which is the thesis's stick/slip iteration (A.2.3-A.2.6) with a
+rule that also lets slip nodes return to stick; each iteration solves the stick
+set exactly (a dense Cholesky solve), and the iteration ends when the sets
+repeat, which is an exact KKT point. Should a set ever recur without
+convergence (cycling), the QP is handed to scipy's bounded-variable least
+squares (``lsq_linear``, method ``bvls``), a finite active-set method. The
+result is then checked against the KKT conditions with ``KKT_TOL``.
+
+Full stick (all |q_i| < mu f_i) is linear: ``q = delta C^-1 1``, so the
+initial tangential stiffness is exactly ``k_t = w^T C^-1 1``. Gross slip
+(q = mu f at every node) is reached at ``delta_gs = max_i (s_prev_i + (C mu f)_i)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import linalg, optimize
+
+#: Relative tolerance of the KKT check of every solution: force bounds
+#: relative to mu max(f), stick slip increments relative to the displacement
+#: scale (C mu f). Round-off of a dense solve is ~1e-13; 1e-8 leaves room for
+#: ill-conditioned FE compliances while still catching any wrong stick/slip set.
+KKT_TOL = 1e-8
+#: Convergence of the projected Newton iteration: slip increments of stick
+#: nodes (and wrong-way slips) below this fraction of the displacement scale.
+SOLVE_TOL = 1e-11
+#: A force within this fraction of its bound mu f counts as at the bound.
+SNAP_TOL = 1e-12
+#: Iteration cap of the active-set loop (it typically needs 1-5 warm started).
+MAX_ITER = 200
+#: A compliance with relative asymmetry of W C above this is rejected.
+SYMMETRY_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class TangentialState:
+    """Slip history carried from step to step (arrays over the contact nodes).
+
+    Attributes
+    ----------
+    delta : float
+        Rigid tangential displacement of the last step [m].
+    s : ndarray, shape (n_c,)
+        Accumulated relative slip [m].
+    q : ndarray, shape (n_c,)
+        Nodal tangential forces [N] (warm start of the next step).
+    """
+
+    delta: float
+    s: np.ndarray
+    q: np.ndarray
+
+
+@dataclass(frozen=True)
+class TangentialSolution:
+    """One solved point (arrays over all n nodes of the grid; zero off contact).
+
+    Attributes
+    ----------
+    delta : float
+        Rigid tangential displacement [m].
+    T : float
+        Full-model tangential force sum(mult q) [N].
+    q, s : ndarray, shape (n,)
+        Nodal tangential force [N], accumulated slip [m].
+    stick, slip : ndarray of bool, shape (n,)
+        Contact nodes in stick / in slip (|q| = mu f); both False off contact.
+    stick_fraction : float
+        Stick share of the contact area (mult- and area-weighted).
+    k_tan : float
+        Tangent stiffness dT/d(delta) with the current stick set [N/m].
+    iterations : int
+        Active-set iterations of this step.
+    """
+
+    delta: float
+    T: float
+    q: np.ndarray
+    s: np.ndarray
+    stick: np.ndarray
+    slip: np.ndarray
+    stick_fraction: float
+    k_tan: float
+    iterations: int
+    info: dict = field(default_factory=dict)
+
+
+class TangentialProblem:
+    """The tangential problem of a contact with fixed nodal normal forces.
+
+    Parameters
+    ----------
+    contact : contact_core.condensed.CondensedContact
+        Needs ``Cxx`` (condense with direction ``"x"``).
+    f_n : ndarray, shape (n,)
+        Nodal normal forces of the normal solution [N], >= 0.
+    mu : float
+        Friction coefficient, >= 0.
+    """
+
+    def __init__(self, contact, f_n, mu: float):
+        if contact.Cxx is None:
+            raise ValueError("tangential solve needs the tangential compliance Cxx "
+                             "(condense with directions including 'x')")
+        mu = float(mu)
+        if not np.isfinite(mu) or mu < 0:
+            raise ValueError(f"friction coefficient mu must be finite and >= 0, got {mu}")
+        f_n = np.asarray(f_n, dtype=float)
+        if f_n.shape != (contact.n,) or not np.all(np.isfinite(f_n)):
+            raise ValueError(f"normal forces must be a finite array of shape ({contact.n},)")
+        if np.any(f_n < 0):
+            raise ValueError("normal forces must be compressive (>= 0)")
+        self.contact, self.mu, self.f_n = contact, mu, f_n
+        self.idx = np.flatnonzero(f_n > 0)
+        if self.idx.size == 0:
+            raise ValueError("no node carries a normal force: nothing to load tangentially")
+        w = np.asarray(contact.grid.mult, float)[self.idx]
+        C = np.asarray(contact.Cxx, float)[np.ix_(self.idx, self.idx)]
+        K = w[:, None] * C
+        asym = np.abs(K - K.T).max() / np.abs(K).max()
+        if asym > SYMMETRY_TOL:
+            raise ValueError(f"weighted tangential compliance is not symmetric (relative "
+                             f"asymmetry {asym:.2e}): not a reciprocal elastic model")
+        self.w, self.C, self.K = w, C, 0.5 * (K + K.T)
+        self.bound = mu * f_n[self.idx]
+        self.N = float(np.sum(np.asarray(contact.grid.mult, float) * f_n))
+        cho = linalg.cho_factor(self.K)
+        self.k_t = float(w @ linalg.cho_solve(cho, w))  # w^T C^-1 1 (module docstring)
+        self.u_scale = float(np.max(np.abs(C @ self.bound))) or 1.0
+
+    @property
+    def n_c(self) -> int:
+        """Number of contact nodes."""
+        return int(self.idx.size)
+
+    def initial_state(self) -> TangentialState:
+        """The virgin state: no slip, no tangential force."""
+        z = np.zeros(self.n_c)
+        return TangentialState(0.0, z, z.copy())
+
+    def gross_slip_displacement(self, state: TangentialState, sign: float = 1.0) -> float:
+        """Smallest displacement, from ``state`` moving in direction ``sign``, at full slip [m]."""
+        if sign > 0:
+            return float(np.max(state.s + self.C @ self.bound))
+        return float(np.min(state.s - self.C @ self.bound))
+
+    def solve(self, state: TangentialState, delta: float):
+        """Solve one increment from ``state`` to the rigid displacement ``delta``.
+
+        Returns
+        -------
+        (TangentialSolution, TangentialState)
+            The solution and the state to carry to the next step.
+        """
+        delta = float(delta)
+        if not np.isfinite(delta):
+            raise ValueError(f"tangential displacement must be finite, got {delta}")
+        r = delta - state.s
+        if self.mu == 0.0:  # frictionless: every node slides freely, q = 0
+            q, it, free, cho = np.zeros(self.n_c), 0, np.zeros(self.n_c, bool), None
+        else:
+            q, it, free, cho = _active_set(self.K, self.w * r, self.bound, state.q,
+                                            self.u_scale * self.w.max())
+        # a node reaching its bound to round-off is at the bound: snap it, so
+        # the stick/slip split does not depend on the last bit (gross slip)
+        at = np.abs(q) >= self.bound * (1.0 - SNAP_TOL)
+        q = np.where(at, np.sign(q) * self.bound, q)
+        if cho is not None and np.any(at & free):
+            cho = None
+        free = free & ~at
+        ds = r - self.C @ q
+        _check_kkt(q, ds, self.bound, free, self.u_scale, self.mu)
+        k_tan = _tangent_stiffness(self.K, self.w, free, cho)
+        new = TangentialState(delta, state.s + np.where(free, 0.0, ds), q)
+        return self._expand(delta, q, new.s, free, k_tan, it), new
+
+    def _expand(self, delta, q_c, s_c, free_c, k_tan, it) -> TangentialSolution:
+        n = self.contact.n
+        q, s = np.zeros(n), np.zeros(n)
+        stick, slip = np.zeros(n, bool), np.zeros(n, bool)
+        q[self.idx], s[self.idx] = q_c, s_c
+        stick[self.idx], slip[self.idx] = free_c, ~free_c
+        weight = np.asarray(self.contact.grid.mult, float) * np.asarray(self.contact.grid.area, float)
+        frac = float(weight[stick].sum() / weight[self.idx].sum())
+        return TangentialSolution(delta, float(self.w @ q_c), q, s, stick, slip, frac, k_tan, it)
+
+
+def _active_set(K, b, bound, q0, u_scale):
+    """Projected Newton solve of min 1/2 q^T K q - q^T b subject to |q| <= bound.
+
+    Bertsekas' projected Newton method (SIAM J. Control Optim. 20, 1982): the
+    nodes at a bound whose gradient pushes outwards are held (binding set); on
+    the others a Newton step (an exact Cholesky solve, the thesis's stick-set
+    solve A.40) is taken, projected onto the box and shortened by an Armijo
+    rule on the QP objective. The objective falls at every iteration, so it
+    cannot cycle (the plain stick/slip exchange of the thesis, or a
+    primal-dual active-set method, does cycle on dense half-space compliances);
+    on a QP the full Newton step lands exactly on the solution once the sets
+    are right, typically in 1-3 iterations when warm started.
+
+    Returns q, iterations, the stick mask and the Cholesky factor of K on the
+    stick set (or None).
+    """
+    dinv = 1.0 / np.diag(K)
+    q = np.clip(q0, -bound, bound)
+    g = K @ q - b
+    gtol = SOLVE_TOL * u_scale  # g = W (C q - r): weighted slip increment [m]
+    for it in range(1, MAX_ITER + 1):
+        free = _kkt_free(q, g, bound, gtol)
+        if free is not None:
+            return q, it - 1, free, None
+        pg = np.abs(q - np.clip(q - dinv * g, -bound, bound))
+        eps = min(1e-3 * bound.max(), float(pg.max()))
+        held = ((q <= -bound + eps) & (g > 0)) | ((q >= bound - eps) & (g < 0))
+        step = -dinv * g
+        F = ~held
+        if F.any():
+            cho = linalg.cho_factor(K[np.ix_(F, F)])
+            step[F] = -linalg.cho_solve(cho, g[F])
+        q, g = _armijo(K, b, bound, q, g, step, F)
+    return _bvls(K, b, bound) + (None,)
+
+
+def _armijo(K, b, bound, q, g, step, F, sigma=1e-4):
+    """Projected step with Armijo backtracking (Bertsekas' condition)."""
+    f0 = 0.5 * q @ (K @ q) - b @ q
+    alpha = 1.0
+    for _ in range(60):
+        qa = np.clip(q + alpha * step, -bound, bound)
+        Kqa = K @ qa
+        fa = 0.5 * qa @ Kqa - b @ qa
+        predicted = -alpha * (g[F] @ step[F]) + g[~F] @ (q[~F] - qa[~F])
+        if f0 - fa >= sigma * predicted:
+            return qa, Kqa - b
+        alpha *= 0.5
+    return qa, Kqa - b  # the step has become negligible; the caller re-checks KKT
+
+
+def _kkt_free(q, g, bound, gtol):
+    """The stick mask if (q, g) is a KKT point within ``gtol``, else None."""
+    at_up = q >= bound
+    at_lo = q <= -bound
+    free = ~(at_up | at_lo)
+    ok = (np.all(np.abs(g[free]) <= gtol) and np.all(g[at_up] <= gtol)
+          and np.all(g[at_lo] >= -gtol))
+    return free if ok else None
+
+
+def _bvls(K, b, bound):
+    """Bounded-variable least squares fallback (finite active-set method)."""
+    L = linalg.cholesky(K, lower=True)
+    rhs = linalg.solve_triangular(L, b, lower=True)
+    res = optimize.lsq_linear(L.T, rhs, bounds=(-bound, bound), method="bvls", tol=1e-14)
+    if not res.success:
+        raise RuntimeError(f"tangential solve did not converge (BVLS: {res.message})")
+    q = res.x
+    free = np.abs(q) < bound * (1.0 - 1e-12)
+    return q, MAX_ITER + int(res.nit), free
+
+
+def _check_kkt(q, ds, bound, free, u_scale, mu) -> None:
+    """Raise RuntimeError unless (q, ds) meets Coulomb's law within KKT_TOL."""
+    ftol = KKT_TOL * max(float(bound.max()), 1e-300)
+    utol = KKT_TOL * u_scale
+    over = np.abs(q) - bound
+    if over.max() > ftol:
+        raise RuntimeError(f"tangential solve: |q| exceeds mu f by {over.max():.3e} N")
+    if free.any() and np.abs(ds[free]).max() > utol:
+        raise RuntimeError("tangential solve: a stick node slipped (KKT check failed)")
+    wrong = (~free) & (ds * np.sign(q) < -utol)
+    if mu > 0 and wrong.any():
+        raise RuntimeError("tangential solve: friction does not oppose the slip (KKT check failed)")
+
+
+def _tangent_stiffness(K, w, free, cho) -> float:
+    """dT/d(delta) with the stick set frozen: w_F^T (C_FF)^-1 1 = w_F^T K_FF^-1 w_F."""
+    if cho is None:
+        if not free.any():
+            return 0.0
+        cho = linalg.cho_factor(K[np.ix_(free, free)])
+    return float(w[free] @ linalg.cho_solve(cho, w[free]))
