@@ -1,0 +1,117 @@
+"""Alternating frequency-time (AFT) evaluation of the friction elements.
+
+One friction link joins DOF ``a`` to DOF ``b`` (or to the ground); its relative
+displacement is ``u = x_a - x_b`` and its force ``F(u)`` enters the internal force
+vector (left-hand side of the equation of motion) as ``+F`` at ``a`` and ``-F`` at ``b``.
+
+For harmonics ``U`` (n_b,) of ``u`` the AFT is (symbols in :mod:`fourier`)::
+
+    u = E U  (n_t samples)  ->  F(t), dF/dU  (C core, one call)  ->  F_h = D F,
+    dF_h/dU = D (dF/dU)
+
+The C core returns dF/dU exactly, including the dependence of each sticking slider
+on the sample where it last stuck (its reversal point), so the Jacobian is exact for
+the sampled loop (not a tangent-stiffness approximation).
+
+Zeroth-harmonic convention for a fully stuck element
+----------------------------------------------------
+A loop that never slips over the period has no memory of where the sliders stuck:
+any constant offset of the force is a periodic solution, so the mean force (the
+zeroth harmonic) is not unique. We fix it physically: a fully stuck element (no
+energy dissipated over the cycle) is taken to have stuck since its virgin state at
+the contact's reference position ``u = 0`` (the damper was pressed in without a
+tangential preload), so it acts as its initial linear spring, ``F = k_0 u``. With
+no static load (mean displacement zero) this joins continuously to the slipping
+loops, whose mean force is unique. It only matters when harmonic 0 is retained.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .fourier import FourierBasis
+
+
+@dataclass
+class FrictionLink:
+    """A friction element between two DOFs, or a DOF and the ground.
+
+    Parameters
+    ----------
+    element : object
+        Has ``periodic_jac(u, Eu) -> (F, dFdX, dFdXN, W_cycle)`` (``fmu_src.element.IwanElement``).
+    dof_a : int
+        DOF where the force acts with + sign (u = x_a - x_b).
+    dof_b : int or None
+        Second DOF, or None for the ground.
+    name : str
+        Label used in messages.
+    """
+
+    element: object
+    dof_a: int
+    dof_b: int | None = None
+    name: str = ""
+    _k0: float | None = field(default=None, repr=False)
+
+    @property
+    def k0(self) -> float:
+        """Initial (fully stuck) stiffness of the element [N/m]."""
+        if self._k0 is None:
+            self._k0 = initial_stiffness(self.element)
+        return self._k0
+
+    @property
+    def dofs(self) -> tuple[int, ...]:
+        return (self.dof_a,) if self.dof_b is None else (self.dof_a, self.dof_b)
+
+
+def initial_stiffness(element) -> float:
+    """Stuck stiffness k_0 [N/m] of an Iwan element: its slider springs plus the residual one."""
+    k, k_res = getattr(element, "k", None), getattr(element, "k_res", None)
+    if k is None or k_res is None:
+        raise TypeError(f"{type(element).__name__} has no slider stiffnesses k and k_res")
+    return float(np.sum(k) + k_res)
+
+
+def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis):
+    """Harmonics of one link's force and their exact Jacobian.
+
+    Parameters
+    ----------
+    link : FrictionLink
+    U : (n_b,) array
+        Harmonics of the relative displacement u = x_a - x_b [m].
+    basis : FourierBasis
+
+    Returns
+    -------
+    Fh : (n_b,) array      harmonics of the force [N]
+    dFh : (n_b, n_b) array dFh / dU [N/m]
+    W : float              energy dissipated per cycle by the sampled loop [J]
+    F : (n_t,) array       force samples [N]
+    """
+    u = basis.E @ U
+    F, dF, _, W = link.element.periodic_jac(u, basis.E)
+    F = np.asarray(F, dtype=float)
+    dF = np.asarray(dF, dtype=float)
+    if basis.harmonics[0] == 0 and W <= 0.0 and _stuck(F, u, link.k0):
+        # Fully stuck: apply the virgin-state convention of the module docstring.
+        F = link.k0 * u
+        dF = link.k0 * basis.E
+    return basis.D @ F, basis.D @ dF, float(W), F
+
+
+#: Relative round-off allowance when deciding that a loop is a straight stuck line.
+STUCK_RTOL = 1e-12
+
+
+def _stuck(F, u, k0) -> bool:
+    """True when the loop is the stuck line F = k0 u + const (no slip anywhere).
+
+    W = 0 alone is not enough: a slider of zero strength slips freely without
+    dissipating (the free limit, F = 0).
+    """
+    dev = np.ptp(F - k0 * u)
+    return bool(dev <= STUCK_RTOL * (k0 * np.ptp(u) + np.abs(F).max() + 1e-300))

@@ -1,0 +1,257 @@
+"""Predictor-corrector pseudo-arclength continuation of R(x, lam) = 0.
+
+Knows nothing about mechanics: ``fun(x, lam) -> (R (N,), dR/dx (N, N), dR/dlam (N,))``.
+
+Scaling: the arclength is measured in scaled variables ``x / s_x`` and
+``lam / s_lam``, with ``s_lam`` the length of the parameter range and ``s_x`` the
+largest RMS of x met so far on the branch (grows with the response, so a resonance
+peak is resolved by more points and the step never lets lam run away: without it a
+50-DOF case wandered to negative frequency, performance.md).
+
+Step (Allgower & Georg, Numerical Continuation Methods, ch. 6): tangent t from
+``[R_x R_lam; t_prev^T] t = [0; 1]``; predictor ``y + ds t``; corrector Newton on R = 0
+and ``t . (y - y_pred) = 0`` (the pseudo-arclength plane), which passes turning points.
+Step control: the step grows or shrinks with the corrector's iteration count
+(target :data:`TARGET_ITER`), is halved on failure or when the tangent turns by more
+than :data:`MAX_TURN` (so a sharp peak is not jumped over).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.optimize import minimize_scalar
+
+from .newton import NewtonError, newton
+
+#: Corrector iterations the step control aims at.
+TARGET_ITER = 4
+#: Largest angle between successive tangents in scaled variables [rad].
+MAX_TURN = 0.35
+#: Scaled step below which a large tangent turn is accepted as a kink of the branch.
+KINK_STEP = 2e-4
+#: Corrector iteration limit inside the continuation (a step is retried smaller).
+CORRECTOR_ITER = 12
+
+
+class ContinuationError(RuntimeError):
+    """Continuation stopped early; ``branch`` holds the points computed so far."""
+
+    def __init__(self, message: str, branch: "Branch"):
+        super().__init__(message)
+        self.branch = branch
+
+
+@dataclass
+class Branch:
+    """Solution points of a continuation run.
+
+    Attributes
+    ----------
+    x : list of (N,) arrays
+    lam : list of float
+    iterations : list of int   corrector iterations per point
+    status : str               'complete', or why it stopped
+    """
+
+    x: list = field(default_factory=list)
+    lam: list = field(default_factory=list)
+    iterations: list = field(default_factory=list)
+    status: str = "running"
+
+    def append(self, x, lam, it):
+        self.x.append(np.array(x))
+        self.lam.append(float(lam))
+        self.iterations.append(int(it))
+
+
+class _Scaled:
+    """The scaled augmented problem around fixed scales (s_x, s_lam)."""
+
+    def __init__(self, fun, s_x, s_lam, tol):
+        self.fun, self.s_x, self.s_lam, self.tol = fun, s_x, s_lam, tol
+
+    def jac(self, y):
+        R, Jx, Jl = self.fun(y[:-1] * self.s_x, y[-1] * self.s_lam)
+        return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
+
+    def tangent(self, J, t_prev):
+        A = np.vstack([J, t_prev])
+        rhs = np.zeros(A.shape[0])
+        rhs[-1] = 1.0
+        t = sla.solve(A, rhs)
+        return t / np.linalg.norm(t)
+
+    def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
+        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred."""
+        def aug(y):
+            R, J = self.jac(y)
+            return np.append(R, normal @ (y - y_pred)), np.vstack([J, normal])
+        return newton(aug, y_pred, self.tol, max_iter)
+
+
+def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
+                 ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000) -> Branch:
+    """Trace the branch through (x0, lam0) until lam reaches lam_end.
+
+    Parameters
+    ----------
+    fun : callable (x, lam) -> (R, dR/dx, dR/dlam)
+    x0 : (N,) array, initial guess at lam0 (corrected first at fixed lam0)
+    lam0, lam_end : float, parameter range (either order)
+    tol : float, absolute tolerance on |R|_2
+    ds, ds_min, ds_max : float, initial / smallest / largest step in scaled arclength
+        (lam scaled by |lam_end - lam0|, so ds_max = 0.02 means >= 50 points on a flat branch)
+    max_points : int
+
+    Returns
+    -------
+    Branch (status 'complete'); the last point is exactly at lam_end.
+
+    Raises
+    ------
+    ContinuationError (a RuntimeError) with the parameter reached and ``.branch``.
+    """
+    branch = Branch()
+    first = _solve_fixed(fun, x0, lam0, tol, branch)
+    branch.append(first.x, lam0, first.iterations)
+    sign = 1.0 if lam_end >= lam0 else -1.0
+    s_lam = abs(lam_end - lam0)
+    if s_lam == 0:
+        raise ValueError("empty parameter range")
+    s_x = max(_rms(first.x), 1e-300)
+    t_prev = np.zeros(len(x0) + 1)
+    t_prev[-1] = sign
+    while len(branch.lam) < max_points:
+        sc = _Scaled(fun, s_x, s_lam, tol)
+        y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
+        R, J = sc.jac(y)
+        try:
+            t = sc.tangent(J, t_prev)
+        except (np.linalg.LinAlgError, ValueError):
+            raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
+        if t @ t_prev < 0:
+            t = -t
+        y_new, it, ds = _step(sc, y, t, t_prev, ds, ds_min, branch)
+        lam_new = y_new[-1] * s_lam
+        if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
+            x_end = _interpolate(branch, y_new[:-1] * s_x, lam_new, lam_end)
+            res = _solve_fixed(fun, x_end, lam_end, tol, branch)
+            branch.append(res.x, lam_end, res.iterations)
+            branch.status = "complete"
+            return branch
+        if sign * (lam_new - lam0) < 0:
+            branch.append(y_new[:-1] * s_x, lam_new, it)
+            raise _stop("the branch turned back out of the parameter range", branch)
+        branch.append(y_new[:-1] * s_x, lam_new, it)
+        s_x = max(s_x, _rms(branch.x[-1]))
+        # Tangent expressed in the (possibly updated) scaling, for the next orientation.
+        t_prev = t * np.append(np.full(len(x0), sc.s_x / s_x), 1.0)
+        t_prev /= np.linalg.norm(t_prev)
+        ds = min(ds_max, ds * np.clip(TARGET_ITER / max(it, 1), 0.5, 2.0))
+    raise _stop(f"point limit {max_points} reached", branch)
+
+
+def _step(sc, y, t, t_prev, ds, ds_min, branch):
+    """One accepted predictor-corrector step; shrinks ds until it succeeds."""
+    while True:
+        try:
+            res = sc.correct(y + ds * t, t)
+            # A kink of the branch (stick-slip onset: the describing function is only
+            # C0 in the Jacobian) keeps its turn at any step, so the turn limit only
+            # applies to steps above KINK_STEP.
+            if ds <= KINK_STEP or _turn_ok(sc, res, t):
+                return res.x, res.iterations, ds
+            reason = "tangent turned too much"
+        except NewtonError as err:
+            reason = err.reason
+        ds *= 0.5
+        if ds < ds_min:
+            raise _stop(f"step below minimum ({reason})", branch)
+
+
+def _turn_ok(sc, res, t) -> bool:
+    """The tangent at the new point stays within MAX_TURN of t."""
+    try:
+        t_new = sc.tangent(res.J[:-1], t)
+    except (np.linalg.LinAlgError, ValueError):
+        return False
+    return abs(t_new @ t) >= np.cos(MAX_TURN)
+
+
+def _solve_fixed(fun, x, lam, tol, branch):
+    try:
+        return newton(lambda z: fun(z, lam)[:2], x, tol)
+    except NewtonError as err:
+        raise _stop(f"no solution at fixed parameter {lam:.6g}: {err}", branch) from None
+
+
+def _interpolate(branch, x_new, lam_new, lam_end):
+    lam_old = branch.lam[-1]
+    f = (lam_end - lam_old) / (lam_new - lam_old)
+    return branch.x[-1] + f * (x_new - branch.x[-1])
+
+
+def _stop(message, branch):
+    lam = branch.lam[-1] if branch.lam else float("nan")
+    branch.status = message
+    return ContinuationError(f"continuation stopped at parameter {lam:.6g} after "
+                             f"{len(branch.lam)} points: {message}", branch)
+
+
+def _rms(x):
+    return float(np.sqrt(np.mean(np.square(x))))
+
+
+def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: float):
+    """Locate the local maximum of ``amplitude(x, lam)`` on the branch near point i.
+
+    The branch between points i-1 and i+1 is parameterised by tau in [0, 2]: a
+    point on the chord of segment k = floor(tau), corrected onto the branch in the
+    plane normal to that chord (so it works through turning points). Brent's
+    bounded search maximises the amplitude in tau until the bracket is below the
+    tau equivalent of ``tol_lam`` (parameter tolerance); the amplitude error is then
+    second order, ~ A'' tol_lam^2 / 2.
+
+    Parameters
+    ----------
+    fun : callable (x, lam) -> (R, dR/dx, dR/dlam)
+    branch : Branch
+    i : int, index of a point whose amplitude is not below its neighbours'
+    amplitude : callable (x, lam) -> float
+    tol : float, corrector tolerance on |R|_2
+    tol_lam : float, tolerance on the peak's parameter
+
+    Returns
+    -------
+    x : (N,) array, lam : float, amp : float, evaluations : int
+    """
+    if not 0 < i < len(branch.lam) - 1:
+        raise ValueError("refinement needs a point with neighbours on both sides")
+    pts = [np.append(branch.x[j], branch.lam[j]) for j in (i - 1, i, i + 1)]
+    scale = np.append(np.full(len(branch.x[i]), max(_rms(branch.x[i]), 1e-300)),
+                      max(abs(branch.lam[i + 1] - branch.lam[i - 1]), 1e-300))
+    pts = [p / scale for p in pts]
+    cache = {}
+
+    def point(tau):
+        k = min(int(tau), 1)
+        a, b = pts[k], pts[k + 1]
+        chord = (b - a) / np.linalg.norm(b - a)
+        y_pred = a + (tau - k) * (b - a)
+        sc = _Scaled(fun, scale[:-1], scale[-1], tol)
+        res = sc.correct(y_pred, chord, max_iter=30)
+        y = res.x * scale
+        cache[tau] = y
+        return -amplitude(y[:-1], y[-1])
+
+    dlam = max(abs(branch.lam[i] - branch.lam[i - 1]), abs(branch.lam[i + 1] - branch.lam[i]))
+    xatol = max(tol_lam / max(dlam, 1e-300), 1e-12)
+    opt = minimize_scalar(point, bounds=(0.0, 2.0), method="bounded",
+                          options={"xatol": xatol, "maxiter": 200})
+    y = cache.get(opt.x)
+    if y is None:
+        point(opt.x)
+        y = cache[opt.x]
+    return y[:-1], float(y[-1]), float(-opt.fun), int(opt.nfev)

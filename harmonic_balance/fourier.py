@@ -1,0 +1,219 @@
+"""Real Fourier representation of periodic signals and the AFT time grid.
+
+Symbols (used in the whole package)
+-----------------------------------
+theta = omega t          phase [rad], one period is 0 <= theta < 2 pi
+H                        highest retained harmonic
+h                        a retained harmonic index (0 = mean)
+n_b                      number of real basis coefficients per DOF
+n_t                      number of time samples per period in the AFT
+
+Ordering (defined here once, used everywhere)
+---------------------------------------------
+A signal ``u(theta) = a_0 + sum_h (a_h cos(h theta) + b_h sin(h theta))`` is stored as
+the coefficient vector ``[a_0, a_h1, b_h1, a_h2, b_h2, ...]`` for the retained
+harmonics in increasing order (``a_0`` only when 0 is retained). A model with ``n``
+DOFs stores its harmonics as an array ``X`` of shape ``(n_b, n)``: row = coefficient,
+column = DOF; flattened row-major (``X.ravel()``), coefficient ``c`` of DOF ``d`` sits at
+``c * n + d``.
+
+The complex amplitude of harmonic h is ``U_h = a_h - i b_h`` so that
+``u = Re(U_h exp(i h theta))``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Fewest AFT samples per period. A stick-slip loop sampled at n_t points has its
+#: kinks (reversal, slip onset) located only to 2 pi / n_t in phase, so its harmonics
+#: carry an O(n_t^-2) error: measured on the Jenkins describing function, 0.27 % at
+#: 64, 0.068 % at 128, 0.017 % at 256, 0.0045 % at 512; 256 keeps a 6x margin on 0.1 %.
+MIN_SAMPLES = 256
+#: Samples per retained harmonic coefficient: keeps harmonics that alias onto the
+#: retained band (those above n_t - H) far above H, where the friction force's
+#: spectrum has decayed (it falls like 1/h^2 for a force with kinks).
+SAMPLES_PER_HARMONIC = 16
+
+
+def parse_harmonics(spec) -> tuple[int, ...]:
+    """Retained harmonics from an int H (0..H), 'odd:H' / 'all:H', or a sequence.
+
+    Parameters
+    ----------
+    spec : int, str or sequence of int
+        ``7`` -> 0..7; ``"odd:7"`` -> 1, 3, 5, 7; ``"all:7"`` -> 0..7; ``[1, 3]`` as given.
+
+    Returns
+    -------
+    tuple of int, sorted, unique, non-negative.
+    """
+    if isinstance(spec, str):
+        kind, _, num = spec.partition(":")
+        if not num:
+            kind, num = "all", kind
+        try:
+            H = int(num)
+        except ValueError:
+            raise ValueError(f"bad harmonic spec {spec!r}: use H, 'odd:H' or 'all:H'") from None
+        if kind not in ("odd", "all"):
+            raise ValueError(f"bad harmonic spec {spec!r}: use H, 'odd:H' or 'all:H'")
+        if H < 1:
+            raise ValueError(f"highest harmonic must be >= 1, got {H}")
+        return tuple(range(1, H + 1, 2)) if kind == "odd" else tuple(range(H + 1))
+    if isinstance(spec, (int, np.integer)):
+        return parse_harmonics(f"all:{int(spec)}")
+    hs = sorted({int(h) for h in spec})
+    if not hs or hs[0] < 0 or hs[-1] < 1:
+        raise ValueError(f"harmonics must be >= 0 with at least one >= 1, got {list(spec)}")
+    return tuple(hs)
+
+
+def default_samples(H: int) -> int:
+    """Number of AFT samples for highest harmonic H: a power of two >= 16 (2H + 1), >= 256."""
+    need = max(MIN_SAMPLES, SAMPLES_PER_HARMONIC * (2 * H + 1))
+    return int(2 ** np.ceil(np.log2(need)))
+
+
+@dataclass(frozen=True)
+class FourierBasis:
+    """Real Fourier basis with its sampling and (inverse) DFT matrices.
+
+    Parameters
+    ----------
+    harmonics : tuple of int
+        Retained harmonics (see :func:`parse_harmonics`).
+    n_t : int, optional
+        Samples per period; default :func:`default_samples`. Must exceed 2 H (Nyquist),
+        otherwise the highest harmonic aliases onto lower ones (ValueError).
+
+    Attributes
+    ----------
+    E : (n_t, n_b) array      inverse DFT: u(theta_j) = E @ coefficients
+    D : (n_b, n_t) array      forward DFT: coefficients = D @ samples (D @ E = I)
+    dtheta : (n_b, n_b) array d/dtheta in coefficient space
+    order : (n_b,) int        harmonic of each coefficient
+    """
+
+    harmonics: tuple
+    n_t: int = 0
+    E: np.ndarray = field(init=False, repr=False)
+    D: np.ndarray = field(init=False, repr=False)
+    dtheta: np.ndarray = field(init=False, repr=False)
+    order: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self):
+        hs = parse_harmonics(self.harmonics)
+        object.__setattr__(self, "harmonics", hs)
+        n_t = int(self.n_t) or default_samples(hs[-1])
+        if n_t <= 2 * hs[-1]:
+            raise ValueError(f"n_t = {n_t} samples alias harmonic {hs[-1]} (need n_t > {2 * hs[-1]})")
+        object.__setattr__(self, "n_t", n_t)
+        theta = 2.0 * np.pi * np.arange(n_t) / n_t
+        cols, order = [], []
+        for h in hs:
+            if h == 0:
+                cols.append(np.ones(n_t))
+                order.append(0)
+            else:
+                cols += [np.cos(h * theta), np.sin(h * theta)]
+                order += [h, h]
+        E = np.column_stack(cols)
+        # Discrete orthogonality on the uniform grid (h < n_t / 2): the mean weighs
+        # 1/n_t, cosine and sine 2/n_t.
+        w = np.where(np.asarray(order) == 0, 1.0, 2.0) / n_t
+        object.__setattr__(self, "E", E)
+        object.__setattr__(self, "D", E.T * w[:, None])
+        object.__setattr__(self, "order", np.asarray(order))
+        object.__setattr__(self, "dtheta", self._derivative(hs))
+
+    @staticmethod
+    def _derivative(hs) -> np.ndarray:
+        """d/dtheta of (a cos h theta + b sin h theta) = h b cos - h a sin."""
+        nb = sum(1 if h == 0 else 2 for h in hs)
+        Dm = np.zeros((nb, nb))
+        i = 0
+        for h in hs:
+            if h == 0:
+                i += 1
+                continue
+            Dm[i, i + 1] = h
+            Dm[i + 1, i] = -h
+            i += 2
+        return Dm
+
+    @property
+    def nb(self) -> int:
+        """Number of real coefficients per DOF."""
+        return self.E.shape[1]
+
+    @property
+    def H(self) -> int:
+        """Highest retained harmonic."""
+        return self.harmonics[-1]
+
+    def index(self, h: int) -> tuple[int, int | None]:
+        """Coefficient indices (cos, sin) of harmonic h (sin is None for h = 0)."""
+        if h not in self.harmonics:
+            raise ValueError(f"harmonic {h} is not retained ({self.harmonics})")
+        i = 0
+        for g in self.harmonics:
+            if g == h:
+                return (i, None) if h == 0 else (i, i + 1)
+            i += 1 if g == 0 else 2
+        raise AssertionError  # unreachable
+
+    def magnitude(self, coeffs: np.ndarray, h: int) -> np.ndarray:
+        """|U_h| = sqrt(a_h^2 + b_h^2) of coefficient rows ``coeffs`` (n_b, ...)."""
+        ic, isn = self.index(h)
+        c = np.asarray(coeffs)
+        return np.abs(c[ic]) if isn is None else np.hypot(c[ic], c[isn])
+
+    def peak_abs(self, coeffs: np.ndarray, oversample: int = 8) -> float:
+        """max over the period of |u(theta)| for one DOF's coefficients (n_b,).
+
+        Located on a grid of ``oversample * n_t`` points, then polished by Newton's
+        method on du/dtheta = 0, so it is exact to round-off, not grid-limited.
+        """
+        c = np.asarray(coeffs, dtype=float)
+        n = oversample * self.n_t
+        th = 2.0 * np.pi * np.arange(n) / n
+        u = self.evaluate(c, th)
+        j = int(np.argmax(np.abs(u)))
+        t = th[j]
+        d1, d2 = self.dtheta @ c, self.dtheta @ (self.dtheta @ c)
+        for _ in range(8):
+            g1, g2 = self.evaluate(d1, t), self.evaluate(d2, t)
+            if g2 == 0.0:
+                break
+            step = -g1 / g2
+            if abs(step) > 2.0 * np.pi / n:  # left the grid cell: keep the grid value
+                break
+            t += step
+        return float(max(abs(self.evaluate(c, t)), abs(u[j])))
+
+    def evaluate(self, coeffs: np.ndarray, theta) -> np.ndarray:
+        """u(theta) for coefficients (n_b,) or (n_b, n) at arbitrary phases."""
+        th = np.atleast_1d(np.asarray(theta, dtype=float))
+        cols = []
+        for h in self.harmonics:
+            if h == 0:
+                cols.append(np.ones_like(th))
+            else:
+                cols += [np.cos(h * th), np.sin(h * th)]
+        out = np.column_stack(cols) @ np.asarray(coeffs)
+        return out[0] if np.ndim(theta) == 0 else out
+
+    def alias_ratio(self, samples: np.ndarray) -> float:
+        """Aliasing indicator of a sampled periodic signal (n_t,) or (n_t, k).
+
+        Ratio of the signal's spectral amplitude in the top half of the DFT band
+        (harmonics n_t/4 .. n_t/2, which alias onto harmonics near n_t - H and
+        show how much of the tail the grid cannot see) to its amplitude in the
+        retained harmonics. Small (< 1e-3) means the grid resolves the force.
+        """
+        S = np.abs(np.fft.rfft(np.asarray(samples), axis=0))
+        top = S[self.n_t // 4:].max() if S.ndim == 1 else S[self.n_t // 4:].max()
+        kept = S[list(h for h in self.harmonics)].max()
+        return float(top / kept) if kept > 0 else 0.0

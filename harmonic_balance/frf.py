@@ -1,0 +1,180 @@
+"""Forced-response curves: continuation of the HB residual over frequency + peak refinement.
+
+``compute_frf(model, harmonics, (omega_start, omega_end))`` traces the branch with
+:func:`continuation.continuation`, reports for the response DOF the peak absolute
+displacement over the period (``amplitude``) and the first-harmonic magnitude
+(``amplitude_h1``), and refines the highest peak of ``amplitude`` to
+:data:`PEAK_TOL_REL` in frequency (:func:`continuation.refine_max`).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .continuation import ContinuationError, continuation, refine_max
+from .fourier import FourierBasis, parse_harmonics
+from .model import Model
+from .residual import FullResidual, energy_per_cycle, make_residual
+
+#: Newton tolerance relative to the residual's reference size (|F_ext| for the
+#: full residual, |X| of the stuck linear response for the condensed one).
+TOL_REL = 1e-10
+#: Peak frequency located to this relative tolerance (the amplitude error is second
+#: order in it, ~1e-12 relative).
+PEAK_TOL_REL = 1e-6
+
+
+class FRFError(RuntimeError):
+    """The curve could not be completed; ``result`` holds the points computed so far."""
+
+    def __init__(self, message: str, result: "FRFResult"):
+        super().__init__(message)
+        self.result = result
+
+
+@dataclass
+class FRFResult:
+    """One forced-response curve (SI units: omega [rad/s], amplitudes [m])."""
+
+    omega: np.ndarray
+    amplitude: np.ndarray
+    amplitude_h1: np.ndarray
+    response: np.ndarray          # (points, n_b) harmonics of the response DOF
+    solutions: list               # raw unknowns per point
+    newton_iterations: int
+    evaluations: int
+    time_s: float
+    harmonics: tuple
+    n_t: int
+    peak_omega: float = float("nan")
+    peak_amplitude: float = float("nan")
+    peak_amplitude_h1: float = float("nan")
+    peak_solution: np.ndarray | None = None
+    peak_interior: bool = False
+    status: str = "complete"
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def points(self) -> int:
+        return len(self.omega)
+
+    def summary(self) -> dict:
+        """JSON-able dictionary (the CLI's output)."""
+        return {
+            "omega": self.omega, "amplitude": self.amplitude, "amplitude_h1": self.amplitude_h1,
+            "peak_omega": self.peak_omega, "peak_amplitude": self.peak_amplitude,
+            "peak_amplitude_h1": self.peak_amplitude_h1, "peak_interior": self.peak_interior,
+            "points": self.points, "newton_iterations": self.newton_iterations,
+            "residual_evaluations": self.evaluations, "time_s": self.time_s,
+            "harmonics": list(self.harmonics), "n_t": self.n_t, "status": self.status,
+        }
+
+
+class FRFProblem:
+    """Residual, basis and response extraction for one model and harmonic set."""
+
+    def __init__(self, model: Model, harmonics, n_t: int = 0, condensed: bool | None = None):
+        self.model = model
+        self.basis = FourierBasis(parse_harmonics(harmonics), n_t)
+        self.residual = make_residual(model, self.basis, condensed)
+        self.evaluations = 0
+
+    def __call__(self, x, omega):
+        self.evaluations += 1
+        return self.residual(x, omega)
+
+    def response(self, x, omega) -> np.ndarray:
+        """Harmonics (n_b,) of the response DOF."""
+        r = self.model.response_dof
+        res = self.residual
+        if isinstance(res, FullResidual):
+            return x.reshape(self.basis.nb, res.m)[:, r]
+        pos = np.flatnonzero(res.dofs == r)
+        if pos.size:
+            return x.reshape(self.basis.nb, res.m)[:, pos[0]]
+        return res.displacements(x, omega, [r])[:, 0]
+
+    def amplitude(self, x, omega) -> float:
+        return self.basis.peak_abs(self.response(x, omega))
+
+    def reference(self, omega0) -> float:
+        """Size the Newton tolerance refers to."""
+        if isinstance(self.residual, FullResidual):
+            return float(np.linalg.norm(self.residual.Fext))
+        return float(np.linalg.norm(self.residual.linear_guess(omega0)))
+
+    def energy(self, x, omega) -> dict:
+        """Energy per cycle [J]: excitation, viscous, friction (sampled loops), and the
+        friction work of the retained force harmonics (equal to W_ext - W_visc exactly)."""
+        X = self.residual.displacements(x, omega)
+        out = energy_per_cycle(self.model, self.basis, X, omega)
+        loops = self.residual.link_samples(x)
+        out["W_friction"] = float(sum(w for _, _, w in loops))
+        out["links"] = [w for _, _, w in loops]
+        return out
+
+
+def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
+                ds_max: float = 0.02, max_points: int = 2000, refine: bool = True) -> FRFResult:
+    """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
+
+    Raises
+    ------
+    ValueError for bad input; FRFError (a RuntimeError) when the continuation or the
+    peak refinement fails, carrying the points computed so far and the frequency reached.
+    """
+    w0, w1 = (float(w) for w in omega_range)
+    if not (np.isfinite(w0) and np.isfinite(w1)) or w0 <= 0 or w1 <= 0 or w0 == w1:
+        raise ValueError(f"omega range must be two different positive numbers, got {omega_range}")
+    t0 = time.perf_counter()
+    prob = FRFProblem(model, harmonics, n_t, condensed)
+    tol = TOL_REL * max(prob.reference(w0), 1e-300)
+    x0 = prob.residual.linear_guess(w0)
+    try:
+        branch = continuation(prob, x0, w0, w1, tol, ds_max=ds_max, max_points=max_points)
+    except ContinuationError as err:
+        result = _collect(prob, err.branch, t0)
+        result.status = str(err)
+        raise FRFError(str(err), result) from None
+    result = _collect(prob, branch, t0)
+    if refine:
+        _refine_peak(prob, branch, result, tol)
+    result.evaluations = prob.evaluations
+    result.time_s = time.perf_counter() - t0
+    return result
+
+
+def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
+    om = np.asarray(branch.lam)
+    resp = np.array([prob.response(x, w) for x, w in zip(branch.x, om)])
+    b = prob.basis
+    h1 = b.magnitude(resp.T, 1) if 1 in b.harmonics else np.full(len(om), np.nan)
+    amp = np.array([b.peak_abs(r) for r in resp])
+    i = int(np.argmax(amp)) if len(amp) else 0
+    return FRFResult(om, amp, np.asarray(h1), resp, list(branch.x), int(sum(branch.iterations)),
+                     prob.evaluations, time.perf_counter() - t0, b.harmonics, b.n_t,
+                     peak_omega=float(om[i]) if len(om) else float("nan"),
+                     peak_amplitude=float(amp[i]) if len(amp) else float("nan"),
+                     peak_amplitude_h1=float(h1[i]) if len(amp) else float("nan"),
+                     peak_solution=branch.x[i] if len(amp) else None,
+                     status=branch.status)
+
+
+def _refine_peak(prob, branch, result, tol):
+    """Refine the highest interior maximum of the amplitude in place."""
+    i = int(np.argmax(result.amplitude))
+    if not 0 < i < result.points - 1:
+        return  # the maximum is at an end of the range: no interior peak to refine
+    try:
+        x, w, amp, nfev = refine_max(prob, branch, i, prob.amplitude, tol,
+                                     PEAK_TOL_REL * abs(result.omega[i]))
+    except RuntimeError as err:
+        raise FRFError(f"peak refinement near omega = {result.omega[i]:.6g} rad/s failed: {err}",
+                       result) from None
+    r = prob.response(x, w)
+    result.peak_omega, result.peak_amplitude, result.peak_solution = w, amp, x
+    result.peak_amplitude_h1 = float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics else float("nan")
+    result.peak_interior = True
+    result.extra["peak_refinement_evaluations"] = nfev

@@ -1,0 +1,62 @@
+"""Newton and arc-length continuation on plain residuals (no mechanics)."""
+import numpy as np
+import pytest
+
+from harmonic_balance.continuation import ContinuationError, continuation, refine_max
+from harmonic_balance.newton import NewtonError, newton
+
+TOL = 1e-12
+
+
+def s_curve(x, lam):
+    """lam = x^3 - 3x: two turning points, at (x, lam) = (-1, 2) and (1, -2)."""
+    return np.array([x[0] ** 3 - 3 * x[0] - lam]), np.array([[3 * x[0] ** 2 - 3]]), np.array([-1.0])
+
+
+def test_continuation_passes_two_turning_points():
+    br = continuation(s_curve, np.array([-2.2]), -4.0, 4.0, TOL)
+    x, lam = np.array(br.x)[:, 0], np.array(br.lam)
+    assert br.status == "complete" and lam[-1] == 4.0
+    np.testing.assert_allclose(x**3 - 3 * x, lam, atol=1e-10)
+    assert x[-1] > 2.0  # reached the upper sheet through both folds
+    assert np.all(np.diff(x) > 0)  # followed the branch, did not jump across the S
+    assert lam[x < 0].max() > 1.99 and lam[(x > 0) & (x < 1.5)].min() < -1.99  # both folds
+
+
+def test_continuation_failure_keeps_the_points_and_names_the_parameter():
+    def fold(x, lam):  # x^2 = lam: from lam = 1 toward -1 the branch turns back at 0
+        return np.array([x[0] ** 2 - lam]), np.array([[2 * x[0]]]), np.array([-1.0])
+
+    with pytest.raises(ContinuationError, match="parameter") as info:
+        continuation(fold, np.array([1.0]), 1.0, -1.0, TOL)
+    br = info.value.branch
+    assert len(br.lam) > 5 and min(br.lam) < 0.01
+    assert isinstance(info.value, RuntimeError)
+
+
+def test_refine_max_locates_the_peak_to_tolerance():
+    def hump(x, lam):  # x = 1 - (lam - 0.3)^2 + 0.1 lam^3
+        r = x[0] - (1 - (lam - 0.3) ** 2 + 0.1 * lam**3)
+        return np.array([r]), np.array([[1.0]]), np.array([2 * (lam - 0.3) - 0.3 * lam**2])
+
+    br = continuation(hump, np.array([0.0]), -1.0, 1.0, TOL, ds_max=0.2)
+    i = int(np.argmax([x[0] for x in br.x]))
+    x, lam, amp, _ = refine_max(hump, br, i, lambda x, l: x[0], TOL, 1e-9)
+    # d/dlam: -2 (lam - 0.3) + 0.3 lam^2 = 0
+    lam_true = (2 - np.sqrt(4 - 4 * 0.3 * 0.6)) / 0.6
+    assert abs(lam - lam_true) < 1e-8
+    assert abs(amp - (1 - (lam_true - 0.3) ** 2 + 0.1 * lam_true**3)) < 2 * TOL  # corrector tol
+
+
+def test_newton_reports_why_it_failed():
+    with pytest.raises(NewtonError, match="line search") as info:
+        newton(lambda x: (x**2 + 1.0, np.diag(2 * x)), np.array([0.5]), TOL)
+    assert isinstance(info.value, RuntimeError) and info.value.iterations >= 0
+    with pytest.raises(NewtonError, match="singular"):
+        newton(lambda x: (x**2 + 1.0, np.diag(2 * x)), np.array([0.0]), TOL)
+
+
+def test_newton_converges_quadratically():
+    res = newton(lambda x: (np.array([np.exp(x[0]) - 2.0]), np.array([[np.exp(x[0])]])),
+                 np.array([0.0]), 1e-14)
+    assert abs(res.x[0] - np.log(2)) < 1e-14 and res.iterations <= 6

@@ -1,0 +1,58 @@
+"""Fourier basis: DFT pair, derivative, peak search, sampling checks."""
+import numpy as np
+import pytest
+
+from harmonic_balance.fourier import FourierBasis, default_samples, parse_harmonics
+from hbcases import SEED
+
+#: Round-off level of a DFT of a few hundred samples.
+DFT_TOL = 1e-12
+
+
+@pytest.mark.parametrize("spec", ["all:5", "odd:7", [0, 2, 3]])
+def test_forward_dft_inverts_the_sampling(spec):
+    b = FourierBasis(parse_harmonics(spec))
+    np.testing.assert_allclose(b.D @ b.E, np.eye(b.nb), atol=DFT_TOL)
+
+
+def test_ordering_is_mean_then_cos_sin_pairs():
+    b = FourierBasis((0, 1, 3))
+    assert b.nb == 5 and list(b.order) == [0, 1, 1, 3, 3]
+    assert b.index(3) == (3, 4) and b.index(0) == (0, None)
+    th = 0.7
+    np.testing.assert_allclose(b.evaluate(np.array([0, 0, 0, 1.0, 0]), th), np.cos(3 * th))
+    np.testing.assert_allclose(b.evaluate(np.array([0, 0, 0, 0, 1.0]), th), np.sin(3 * th))
+
+
+def test_derivative_matrix_matches_finite_difference():
+    b = FourierBasis("all:4")
+    c = np.random.default_rng(SEED).normal(size=b.nb)
+    th, h = 1.234, 1e-6
+    fd = (b.evaluate(c, th + h) - b.evaluate(c, th - h)) / (2 * h)
+    assert abs(b.evaluate(b.dtheta @ c, th) - fd) < 1e-8
+
+
+def test_peak_abs_is_exact_not_grid_limited():
+    b = FourierBasis("odd:5", n_t=32)
+    c = np.random.default_rng(SEED).normal(size=b.nb)
+    dense = np.abs(b.evaluate(c, np.linspace(0, 2 * np.pi, 400001))).max()
+    assert abs(b.peak_abs(c) - dense) < 1e-9 * dense  # dense grid error ~ (2pi/4e5)^2
+
+
+def test_too_few_samples_alias_and_are_refused():
+    with pytest.raises(ValueError, match="alias"):
+        FourierBasis("all:8", n_t=16)
+    assert all(default_samples(H) > 8 * (2 * H + 1) for H in (1, 5, 9, 20))
+
+
+@pytest.mark.parametrize("bad", ["odd:0", "even:3", "x", [], [-1, 1], [0]])
+def test_bad_harmonic_specs_are_refused(bad):
+    with pytest.raises(ValueError):
+        parse_harmonics(bad)
+
+
+def test_alias_ratio_flags_an_unresolved_signal():
+    b = FourierBasis("all:3", n_t=64)
+    th = 2 * np.pi * np.arange(64) / 64
+    assert b.alias_ratio(np.cos(th)) < 1e-12
+    assert b.alias_ratio(np.sign(np.cos(th))) > 1e-2  # square wave: 1/h tail
