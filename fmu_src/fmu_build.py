@@ -1,0 +1,242 @@
+"""Package the friction element as an FMI 2.0 or 3.0 co-simulation FMU.
+
+An FMU holds: ``modelDescription.xml`` (from the variable table in
+:mod:`fmu_src.fmu_xml`), the virgin curve as ``resources/curve.txt``, the C
+sources (the FMI wrapper of ``fmu_src/fmi`` and the core ``fmu_src/core/iwan.c``,
+so ``fmpy compile`` can rebuild it: FMI 2 ``<SourceFiles>``, FMI 3
+``sources/buildDescription.xml``) and a Linux binary compiled from those very
+sources (``binaries/linux64/damper.so`` or ``binaries/x86_64-linux/damper.so``).
+
+The curve is checked by building the element through :mod:`fmu_src.element`
+(the same C code the FMU runs), so a curve the FMU would refuse is refused here
+with a ``ValueError`` and no file is written. The ``.fmu`` is written through a
+temporary file and a rename: never half-written.
+
+Run ``python -m fmu_src.fmu_build --write-header`` after changing the variable
+table to regenerate ``fmu_src/fmi/damper_vr.h``.
+"""
+from __future__ import annotations
+
+import argparse
+import io
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from contact_core.fileio import atomic_write
+from fmu_src import fmu_xml
+
+FMI_DIR = Path(__file__).resolve().parent / "fmi"
+CORE_DIR = Path(__file__).resolve().parent / "core"
+HEADER_PATH = FMI_DIR / "damper_vr.h"
+
+#: Model hooks available to the wrapper (model.h): the element and a baseline.
+MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c"}
+#: Binary folder of each FMI version on 64-bit Linux.
+PLATFORM = {2: "linux64", 3: "x86_64-linux"}
+#: How a curve table that is not concave is handled (iwan.h iwan_fit).
+FIT_MODES = ("reject", "concave")
+_FMI_HEADERS = {
+    2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
+    3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
+}
+_WRAPPER_HEADERS = ("fmu_instance.h", "model.h", "damper_vr.h")
+#: Flags of the binary inside the FMU (the same as the CMake build's).
+CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
+          "-Wall", "-Wextra", "-Werror", "-Wl,--no-undefined")
+
+
+def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
+    """Names of the C files compiled into the FMU (all flat in ``sources/``)."""
+    _check_version(fmi_version)
+    if model not in MODELS:
+        raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", MODELS[model], "iwan.c"]
+
+
+def _check_version(fmi_version: int) -> None:
+    if fmi_version not in PLATFORM:
+        raise ValueError(f"--fmi-version must be 2 or 3, not {fmi_version!r}")
+
+
+def check_curve(u, T, n_ref: float, fit: str = "reject"):
+    """Validate a virgin curve by building the element from it.
+
+    Parameters
+    ----------
+    u, T : array_like, shape (m,)
+        Virgin curve: displacement [m] and tangential force [N].
+    n_ref : float
+        Normal load the curve was computed at [N], > 0.
+    fit : {"reject", "concave"}
+        A non-concave table is an error, or is replaced by its concave majorant.
+
+    Returns
+    -------
+    (u, T) : tuple of ndarray, shape (m,)
+        The table as float arrays.
+
+    Raises
+    ------
+    ValueError
+        Non-finite, non-positive load, bad table, or not concave with ``fit="reject"``.
+    """
+    from fmu_src.element import IwanElement  # the FMU's own C core, via ctypes
+
+    if fit not in FIT_MODES:
+        raise ValueError(f"fit must be one of {FIT_MODES}, not {fit!r}")
+    u = np.asarray(u, dtype=float).ravel()
+    T = np.asarray(T, dtype=float).ravel()
+    if u.shape != T.shape or u.size < 2:
+        raise ValueError(f"curve needs u and T of equal length >= 2, got {u.size}, {T.size}")
+    if u.size > 4096:  # FMU_MAX_CURVE_POINTS in fmu_instance.h
+        raise ValueError(f"curve has {u.size} points; the FMU reads at most 4096")
+    if not (np.isfinite(n_ref) and n_ref > 0):
+        raise ValueError(f"reference normal load must be finite and > 0, got {n_ref!r}")
+    IwanElement.from_curve(u, T, float(n_ref), fit=fit)
+    return u, T
+
+
+def curve_resource_text(u, T, n_ref: float, fit: str) -> str:
+    """Text of ``resources/curve.txt``, read by ``read_curve`` in fmu_instance.c.
+
+    Numbers are written with ``repr`` (17 significant digits at most), which
+    ``strtod`` reads back to the identical double.
+    """
+    lines = ["damper-curve 1", f"n_ref {float(n_ref)!r}", f"fit {FIT_MODES.index(fit)}",
+             f"points {len(u)}"]
+    lines += [f"{float(a)!r} {float(b)!r}" for a, b in zip(u, T)]
+    return "\n".join(lines) + "\n"
+
+
+def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
+    """Copy the C sources and headers flat into ``dest``; return the .c names."""
+    dest.mkdir(parents=True)
+    names = c_sources(fmi_version, model)
+    for name in names[:-1] + list(_WRAPPER_HEADERS):
+        shutil.copy(FMI_DIR / name, dest / name)
+    for name in ("iwan.c", "iwan.h"):
+        shutil.copy(CORE_DIR / name, dest / name)
+    for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
+        shutil.copy(FMI_DIR / "headers" / name,
+                    dest / ("FMI_HEADERS_LICENSE.txt" if name == "LICENSE.txt" else name))
+    return names
+
+
+def compile_binary(source_dir: Path, names: list[str], out: Path,
+                   compiler: str | None = None) -> None:
+    """Compile ``names`` from ``source_dir`` into the shared library ``out``.
+
+    Raises
+    ------
+    RuntimeError
+        The compiler failed (its message is included).
+    """
+    cc = compiler or os.environ.get("CC", "cc")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    cmd = [cc, *CFLAGS, f"-I{source_dir}", *[str(source_dir / n) for n in names],
+           "-o", str(out), "-lm"]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"compiling the FMU binary failed:\n{' '.join(cmd)}\n{proc.stderr}")
+
+
+def _documentation() -> str:
+    rows = "".join(f"<tr><td>{v.name}</td><td>{v.causality}</td><td>{v.unit}</td>"
+                   f"<td>{v.description}</td></tr>" for v in fmu_xml.VARIABLES)
+    return ("<html><body><h1>damper friction element</h1><p>Masing/Iwan friction element "
+            "built from a contact's virgin curve (resources/curve.txt). Outputs follow the "
+            "current inputs (direct feedthrough); the history is committed in doStep only. "
+            "The input is taken as a straight line between communication points (FMI 2: "
+            "with the input derivatives), which the element follows exactly at any step "
+            "size.</p><table><tr><th>name</th><th>causality</th><th>unit</th>"
+            f"<th>description</th></tr>{rows}</table></body></html>\n")
+
+
+def _zip_dir(root: Path) -> bytes:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        for path in sorted(root.rglob("*")):
+            if path.is_file():
+                zf.write(path, path.relative_to(root).as_posix())
+    return buf.getvalue()
+
+
+def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
+              fit: str = "reject", model: str = "iwan", description: str = "",
+              compiler: str | None = None) -> Path:
+    """Write a co-simulation FMU of the friction element for one contact.
+
+    Parameters
+    ----------
+    u, T : array_like, shape (m,)
+        Virgin curve [m], [N].
+    n_ref : float
+        Normal load of the curve [N]: start of the input ``N`` and parameter ``N_ref``.
+    out : path
+        The ``.fmu`` file (written atomically).
+    fmi_version : {2, 3}
+    fit : {"reject", "concave"}
+        Handling of a non-concave table (see :func:`check_curve`).
+    model : {"iwan", "passthrough"}
+        ``"passthrough"`` (F = u) is the benchmark's baseline, same wrapper.
+    description : str
+        Text for the model description (e.g. the curve's source).
+    compiler : str, optional
+        C compiler (default ``$CC`` or ``cc``).
+
+    Returns
+    -------
+    Path of the written FMU.
+    """
+    _check_version(fmi_version)
+    u, T = check_curve(u, T, n_ref, fit)
+    with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
+        root = Path(tmp) / "fmu"
+        names = _copy_sources(root / "sources", fmi_version, model)
+        (root / "resources").mkdir()
+        (root / "resources" / "curve.txt").write_text(curve_resource_text(u, T, n_ref, fit))
+        (root / "documentation").mkdir()
+        (root / "documentation" / "index.html").write_text(_documentation())
+        text = fmu_xml.render_model_description(fmi_version, n_ref, names, description)
+        (root / "modelDescription.xml").write_text(text)
+        if fmi_version == 3:
+            (root / "sources" / "buildDescription.xml").write_text(
+                fmu_xml.render_build_description(names))
+        binary = root / "binaries" / PLATFORM[fmi_version] / f"{fmu_xml.MODEL_IDENTIFIER}.so"
+        compile_binary(root / "sources", names, binary, compiler)
+        return atomic_write(out, _zip_dir(root))
+
+
+def header_is_current() -> bool:
+    """Whether the committed ``damper_vr.h`` equals the generated text."""
+    return HEADER_PATH.read_text() == fmu_xml.render_vr_header()
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m fmu_src.fmu_build --write-header | --check-header``."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    group = parser.add_mutually_exclusive_group(required=True)
+    group.add_argument("--write-header", action="store_true",
+                       help=f"regenerate {HEADER_PATH.name} from the variable table")
+    group.add_argument("--check-header", action="store_true",
+                       help="exit 1 if the committed header is out of date")
+    args = parser.parse_args(argv)
+    if args.write_header:
+        atomic_write(HEADER_PATH, fmu_xml.render_vr_header())
+        return 0
+    if header_is_current():
+        return 0
+    print(f"{HEADER_PATH} is out of date: run python -m fmu_src.fmu_build --write-header",
+          file=sys.stderr)
+    return 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,115 @@
+"""Packaging: one source of truth for the interface, our own model-description checks
+(what fmpy's validator misses), the CLI's handling of bad curves."""
+import xml.etree.ElementTree as ET
+import zipfile
+
+import numpy as np
+import pytest
+from fmu_helpers import N_CURVE, VR, Slave, curve_table
+
+from contact_core.curve import VirginCurve, write_curve
+from fmu_src import fmu_build, fmu_xml
+from fmu_src.element import IwanElement
+from harmonic_balance.cli import main as damper_main
+
+
+def _model_description(path) -> ET.Element:
+    with zipfile.ZipFile(path) as zf:
+        return ET.fromstring(zf.read("modelDescription.xml"))
+
+
+def test_committed_vr_header_is_the_generated_one():
+    assert fmu_build.header_is_current(), "run python -m fmu_src.fmu_build --write-header"
+
+
+def test_test_value_references_match_the_table():
+    assert VR == {v.name: v.vr for v in fmu_xml.VARIABLES}
+
+
+def _variables(root, version):
+    """(name, vr, causality, unit) per variable, in ModelVariables order."""
+    out = []
+    for sv in root.find("ModelVariables"):
+        if sv.tag is ET.Comment:
+            continue
+        unit = sv.find("Real").get("unit") if version == 2 else sv.get("unit")
+        out.append((sv.get("name"), int(sv.get("valueReference")), sv.get("causality"), unit))
+    return out
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_model_description_references_are_consistent(fmus, version):
+    """Unique value references, units defined, outputs depending on the inputs only."""
+    root = _model_description(fmus[version])
+    variables = _variables(root, version)
+    vrs = [v[1] for v in variables]
+    assert len(set(vrs)) == len(vrs)
+    defined = {u.get("name") for u in root.find("UnitDefinitions")}
+    assert all(v[3] and v[3] in defined for v in variables)
+    structure = root.find("ModelStructure")
+    if version == 2:
+        inputs = {i for i, v in enumerate(variables, 1) if v[2] == "input"}
+        outputs = {i for i, v in enumerate(variables, 1) if v[2] == "output"}
+        rows = list(structure.find("Outputs")) + list(structure.find("InitialUnknowns"))
+        keys = [int(r.get("index")) for r in rows]
+    else:
+        inputs = {v[1] for v in variables if v[2] == "input"}
+        outputs = {v[1] for v in variables if v[2] == "output"}
+        rows = list(structure)
+        keys = [int(r.get("valueReference")) for r in rows]
+    assert set(keys) == outputs and len(keys) == 2 * len(outputs)
+    for row in rows:
+        deps = {int(d) for d in row.get("dependencies").split()}
+        assert deps == inputs  # direct feedthrough from u and N, nothing else
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_fmu_carries_curve_sources_and_binary(fmus, version):
+    with zipfile.ZipFile(fmus[version]) as zf:
+        names = set(zf.namelist())
+        curve = zf.read("resources/curve.txt").decode().split("\n")
+    platform = fmu_build.PLATFORM[version]
+    assert f"binaries/{platform}/damper.so" in names
+    assert {f"sources/{n}" for n in fmu_build.c_sources(version)} <= names
+    u, T = curve_table()
+    table = np.array([[float(x) for x in line.split()] for line in curve[4:] if line])
+    assert np.array_equal(table[:, 0], u) and np.array_equal(table[:, 1], T)
+
+
+def test_cli_writes_an_fmu(tmp_path, capsys):
+    u, T = curve_table(11)
+    write_curve(VirginCurve(u=u, T=T, N=N_CURVE, mu=0.5), tmp_path / "c.json")
+    out = tmp_path / "x.fmu"
+    assert damper_main(["fmu", "--curve", str(tmp_path / "c.json"), "--fmi-version", "3",
+                        "-o", str(out)]) == 0
+    assert _model_description(out).get("fmiVersion") == "3.0"
+
+
+@pytest.mark.parametrize("change", ["not_concave", "no_N", "truncated"])
+def test_cli_refuses_a_bad_curve_and_writes_nothing(tmp_path, capsys, change):
+    u, T = curve_table(11)
+    path = tmp_path / "c.json"
+    if change == "not_concave":
+        T = T.copy()
+        T[5] = 0.5 * T[5]  # a dent: slopes no longer non-increasing
+    write_curve(VirginCurve(u=u, T=T, N=None if change == "no_N" else N_CURVE), path)
+    if change == "truncated":
+        path.write_text(path.read_text()[:40])
+    out = tmp_path / "x.fmu"
+    assert damper_main(["fmu", "--curve", str(path), "-o", str(out)]) == 2
+    assert "error" in capsys.readouterr().err
+    assert list(tmp_path.glob("*.fmu*")) == [] and not any(tmp_path.glob(".x.fmu*"))
+
+
+def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
+    """--fit concave: the FMU runs the same majorant as the array API with fit="concave"."""
+    u, T = curve_table(11)
+    T[5] *= 0.5
+    out = fmu_build.build_fmu(u, T, N_CURVE, tmp_path / "fit.fmu", fit="concave")
+    hist = np.array([0.0, 0.4, 1.2, -0.7, 0.9]) * u[-1]
+    ref = IwanElement.from_curve(u, T, N_CURVE, fit="concave").series(hist)
+    s = Slave(out, 2).initialize()
+    F = s.run(hist)[0]
+    s.close()
+    # same C core; iwan_step and iwan_series may differ in the last bit
+    assert np.max(np.abs(F - ref.F)) <= 1e-12 * np.max(np.abs(ref.F))
