@@ -1,0 +1,85 @@
+"""iwan_periodic_jac: exact derivatives of the periodic loop vs finite differences."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from elcases import N_SPHERE, SEED, cattaneo_table
+from fmu_src.element import IwanElement
+
+#: Central differences with step 1e-7 of the coefficient scale: truncation is zero
+#: for this piecewise-linear map away from kinks, round-off ~1e-16/1e-7 ~ 1e-9.
+FD_STEP, FD_RTOL = 1e-7, 1e-6
+N_T, H = 64, 3
+
+
+def basis(n=N_T, h=H):
+    """Inverse real DFT: columns 1, cos(t), sin(t), ..., shape (n, 2h+1)."""
+    th = 2 * np.pi * np.arange(n) / n
+    cols = [np.ones(n)]
+    for j in range(1, h + 1):
+        cols += [np.cos(j * th), np.sin(j * th)]
+    return np.column_stack(cols)
+
+
+def fd_jac(fun, X):
+    step = FD_STEP * np.abs(X).max()
+    cols = []
+    for e in np.eye(X.size):
+        cols.append((fun(X + step * e) - fun(X - step * e)) / (2 * step))
+    return np.column_stack(cols)
+
+
+@pytest.fixture(scope="module")
+def el():
+    return IwanElement.from_curve(*cattaneo_table(24), N_ref=N_SPHERE)
+
+
+CASES = {
+    "slipping": (np.array([1e-6, 6e-6, 1e-6, 1.5e-6, 0, 0, 0.4e-6]), None),
+    "mostly stuck, offset": (np.array([2e-6, 0.4e-6, 0.1e-6, 0, 0.05e-6, 0, 0]), None),
+    "varying N": (np.array([1e-6, 6e-6, 1e-6, 1.5e-6, 0, 0, 0.4e-6]),
+                  np.array([N_SPHERE, 30, 0, 0, 10, 5, 0])),
+    "lift-off": (np.array([1e-6, 6e-6, 1e-6, 1.5e-6, 0, 0, 0.4e-6]),
+                 np.array([N_SPHERE, 120, 0, 0, 10, 5, 0])),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_periodic_jacobian_matches_finite_differences(el, case):
+    X, XN = CASES[case]
+    E = basis()
+    N = None if XN is None else E @ XN
+    F, J, JN, W = el.periodic_jac(E @ X, E, N, None if XN is None else E)
+    loop = el.periodic(E @ X, N)
+    np.testing.assert_allclose(F, loop.F, rtol=0, atol=1e-12 * np.ptp(F))
+    assert W == pytest.approx(loop.W_cycle, rel=1e-10)
+    J_fd = fd_jac(lambda Y: el.periodic(E @ Y, N).F, X)
+    np.testing.assert_allclose(J, J_fd, rtol=0, atol=FD_RTOL * np.abs(J).max())
+    if XN is not None:
+        JN_fd = fd_jac(lambda Y: el.periodic(E @ X, E @ Y).F, XN)
+        np.testing.assert_allclose(JN, JN_fd, rtol=0, atol=FD_RTOL * np.abs(JN).max())
+
+
+def test_jacobian_of_random_multiharmonic_loops(el):
+    rng = np.random.default_rng(SEED)
+    E = basis()
+    for _ in range(5):
+        X = rng.normal(0.0, 2e-6, E.shape[1])
+        F, J, _, _ = el.periodic_jac(E @ X, E)
+        J_fd = fd_jac(lambda Y: el.periodic(E @ Y).F, X)
+        np.testing.assert_allclose(J, J_fd, rtol=0, atol=FD_RTOL * np.abs(J).max())
+
+
+def test_jenkins_first_harmonic_matches_the_describing_function():
+    # references.md: a1 = (k a / pi)(th* - sin(2 th*)/2), b1 = -(k a / pi) sin(th*)^2
+    k, fs, a = 2e6, 3.0, 4e-6
+    E = basis(256, 1)
+    F, J, _, W = IwanElement.jenkins(k, fs).periodic_jac(E @ np.array([0, a, 0]), E)
+    th = np.arccos(1 - 2 * fs / (k * a))
+    a1 = k * a / np.pi * (th - np.sin(2 * th) / 2)
+    b1 = -k * a / np.pi * np.sin(th) ** 2
+    # DFT of the exact loop sampled at 256 points: a1, b1 to the sampling error O(1/n^2)
+    assert 2 * np.mean(F * E[:, 1]) == pytest.approx(a1, rel=1e-3)
+    assert 2 * np.mean(F * E[:, 2]) == pytest.approx(b1, rel=1e-3)
+    assert W == pytest.approx(-np.pi * a * b1, rel=1e-12)
