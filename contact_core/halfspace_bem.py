@@ -221,6 +221,30 @@ def cylinder(radius: float, length: float, half_width: float, nx: int, ny: int,
     return condense_grid(grid, gap_cylinder(grid, radius), materials, directions, geometry)
 
 
+def condense(spec, directions=("z", "x")):
+    """The half-space model of a ``contact_core.spec.ContactSpec`` (sphere or cylinder).
+
+    Same potential zone (``spec.zone()``) and nodes per side (``spec.n_side``)
+    as the FE model, but a full grid (no symmetry, ``mult = 1``) of cells
+    centred on the nodes; a drop-in replacement for ``contact_core.condense.condense``.
+    """
+    import time
+
+    if spec.body not in ("sphere", "cylinder"):
+        raise ValueError(f"the half-space BEM model handles sphere and cylinder, not {spec.body!r}")
+    t0 = time.perf_counter()
+    zx, zy = spec.zone()
+    materials = ((spec.E1, spec.nu1), (spec.E2, spec.nu2))
+    n = spec.n_side
+    if spec.body == "sphere":
+        cc = sphere(spec.radius, zx, n, materials, directions)
+    else:
+        cc = cylinder(spec.radius, spec.length, zx, n, n, materials, directions)
+    cc.meta.update({"spec": spec.key_dict() | {"model": "bem"},
+                    "timings": {"influence": time.perf_counter() - t0}})
+    return cc
+
+
 def _check_positive(**values) -> None:
     for name, v in values.items():
         if not (np.isfinite(v) and v > 0):

@@ -1,0 +1,174 @@
+"""``damper tangential``: virgin curve T(u), k_t and stick/slip maps of a contact.
+
+Examples::
+
+    damper tangential --body sphere --radius 0.01 --force 200 --mu 0.5 --grid 21 --json
+    damper tangential --body cylinder --diameter 5e-3 --length 1.2e-3 --force 120 --mu 0.5 --out curve.json
+    damper tangential --body cylinder --diameter 5e-3 --length 1.2e-3 --approach 5e-6 --mu 0.5
+
+``--force`` holds the normal force (CNF), ``--approach`` the normal approach
+(CND). The curve runs from zero to gross slip (T = mu N) with points chosen
+where it bends. ``--tangential-force T`` adds the state at T in force control
+(refused above mu N); ``--loop-amplitude A`` adds a hysteresis loop 0 -> A ->
+-A -> A computed by the contact model, compared with Masing's loop.
+"""
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers) -> None:
+    """Add the ``tangential`` subcommand."""
+    p = subparsers.add_parser(
+        "tangential", help="tangential contact: virgin curve, k_t, stick/slip maps",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_body_options(p)
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--force", type=float, help="normal force N [N] (constant normal force, CNF)")
+    load.add_argument("--approach", type=float, help="normal approach [m] (constant normal displacement, CND)")
+    p.add_argument("--mu", type=float, required=True, help="friction coefficient (> 0)")
+    p.add_argument("--model", choices=("real", "halfspace", "bem"), default="real",
+                   help="real FE bodies, FE blocks with a curved gap, or the half-space BEM")
+    p.add_argument("--tangential-force", type=float, default=None,
+                   help="also solve at this tangential force [N] (force control)")
+    p.add_argument("--loop-amplitude", type=float, default=None,
+                   help="also compute a hysteresis loop at this displacement amplitude [m]")
+    p.add_argument("--tol", type=float, default=None, help="curve step tolerance (fraction of mu N)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--out", help="write the virgin-curve file (JSON) here")
+    p.add_argument("--plot", metavar="DIR", help="save curve, stick/slip and traction plots in DIR")
+    p.add_argument("--no-cache", action="store_true", help="do not use the condensation cache")
+    p.add_argument("--cache-dir", default=None, help="condensation cache folder")
+    p.set_defaults(func=run)
+
+
+def add_body_options(p) -> None:
+    """Body, material and grid options (the same meaning as ``damper normal``)."""
+    p.add_argument("--body", choices=("sphere", "cylinder"), required=True)
+    p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
+    p.add_argument("--diameter", type=float, help="cylinder or sphere diameter [m] (instead of --radius)")
+    p.add_argument("--length", type=float, help="cylinder length [m]")
+    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of both bodies [Pa]")
+    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of both bodies")
+    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa] (default --E)")
+    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane (default --nu)")
+    p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
+
+
+def spec_from_args(args, load_hint: float = 0.0):
+    """A ``ContactSpec`` from the body options; ValueError for missing or bad values."""
+    from contact_core.spec import ContactSpec
+
+    if args.radius is not None and args.diameter is not None:
+        raise ValueError("give --radius or --diameter, not both")
+    radius = args.radius if args.radius is not None else (
+        0.5 * args.diameter if args.diameter is not None else None)
+    if radius is None:
+        raise ValueError(f"--body {args.body} needs --radius or --diameter")
+    if args.body == "cylinder" and args.length is None:
+        raise ValueError("--body cylinder needs --length")
+    E2 = args.E if args.E2 is None else args.E2
+    nu2 = args.nu if args.nu2 is None else args.nu2
+    return ContactSpec(body=args.body, radius=radius, length=args.length or 0.0, E1=args.E,
+                       nu1=args.nu, E2=E2, nu2=nu2, grid=args.grid, load_hint=load_hint)
+
+
+def run(args) -> int:
+    """Compute the virgin curve; print JSON, write the curve file and plots as asked."""
+    import shlex
+    import sys
+
+    from contact_core import tangential_run
+    from contact_core.curve import write_curve
+    from contact_core.tangential_curve import CURVE_TOL
+    from harmonic_balance.cli.common import print_json
+
+    _check_finite(args)
+    spec = spec_from_args(args, load_hint=args.force or 0.0)
+    command = "damper " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+    result = tangential_run.run(spec, args.mu, force=args.force, approach=args.approach,
+                                model=args.model, cache=False if args.no_cache else args.cache_dir,
+                                tol=CURVE_TOL if args.tol is None else args.tol, command=command)
+    extra = _extras(result, args)
+    if args.out:
+        write_curve(result.curve, args.out)
+    if args.plot:
+        from contact_core.tangential_plots import plot_all
+
+        plot_all(result.virgin, result.problem, args.plot, _reference_curve(result))
+    if args.json:
+        print_json(summary(result) | extra)
+    else:
+        s = summary(result)
+        print(f"{s['load_case']}: N = {s['normal_force']:.6g} N, mu = {s['mu']:g}, "
+              f"k_t = {s['k_t']:.6g} N/m, k_n = {s['k_n']:.6g} N/m, gross slip at "
+              f"u = {s['u'][-1]:.6g} m ({len(s['u'])} points)")
+    return 0
+
+
+def _check_finite(args) -> None:
+    import math
+
+    for name in ("force", "approach", "mu", "tangential_force", "loop_amplitude", "tol",
+                 "radius", "diameter", "length", "E", "nu", "E2", "nu2"):
+        v = getattr(args, name, None)
+        if v is not None and not math.isfinite(v):
+            raise ValueError(f"--{name.replace('_', '-')} must be finite, got {v}")
+    if args.mu < 0:
+        raise ValueError(f"--mu must be >= 0, got {args.mu}")
+    if args.tol is not None and not 0 < args.tol < 0.5:
+        raise ValueError(f"--tol must lie in (0, 0.5), got {args.tol}")
+
+
+def summary(result) -> dict:
+    """The JSON object of a run (SI units)."""
+    from contact_core.tangential_reference import shear_modulus_star
+
+    path, prob, spec = result.virgin, result.problem, result.spec
+    out = {"load_case": result.load_case, "model": result.model, "body": spec.body,
+           "u": path.u, "T": path.T, "k_t": prob.k_t, "k_n": result.k_n,
+           "normal_force": prob.N, "approach": float(result.normal.q[0]), "mu": prob.mu,
+           "gross_slip_force": prob.mu * prob.N, "gross_slip_displacement": float(path.u[-1]),
+           "stick_fraction": path.stick_fraction, "iterations": int(path.iterations.sum()),
+           "iterations_per_point": path.iterations, "normal_iterations": result.normal.iterations,
+           "contact_nodes": prob.n_c, "grid": result.curve.grid, "timings": result.timings}
+    if spec.body == "sphere":
+        a = (3 * prob.N * spec.radius / (4 * spec.Estar)) ** (1 / 3)
+        Gs = shear_modulus_star(spec.E1, spec.nu1, spec.E2, spec.nu2)
+        out["mindlin"] = {"contact_radius": a, "k_t": 8 * Gs * a,
+                          "u_slip": 3 * prob.mu * prob.N / (16 * Gs * a)}
+    return out
+
+
+def _reference_curve(result):
+    """Cattaneo-Mindlin's curve for a sphere (None otherwise)."""
+    if result.spec.body != "sphere":
+        return None
+    import numpy as np
+
+    from contact_core.tangential_reference import mindlin_force
+
+    m = summary(result)["mindlin"]
+    u = np.linspace(0, m["u_slip"], 100)
+    return u, mindlin_force(u, result.problem.N, result.problem.mu, m["contact_radius"],
+                            m["k_t"] / (8 * m["contact_radius"]))
+
+
+def _extras(result, args) -> dict:
+    """Force-control point and hysteresis loop, when asked."""
+    from contact_core import tangential_curve as tc
+    from contact_core.tangential_reference import masing_loop_energy
+
+    out = {}
+    prob = result.problem
+    if args.tangential_force is not None:
+        sol, _ = tc.solve_force(prob, prob.initial_state(), args.tangential_force)
+        out["force_control"] = {"T": sol.T, "u": sol.delta, "stick_fraction": sol.stick_fraction,
+                                "iterations": sol.iterations}
+    if args.loop_amplitude is not None:
+        path, energy = tc.hysteresis_loop(prob, args.loop_amplitude)
+        W_masing = masing_loop_energy(args.loop_amplitude, result.curve.u, result.curve.T)
+        out["loop"] = {"amplitude": args.loop_amplitude, "u": path.u, "T": path.T,
+                       "W_direct": energy["W_friction"], "W_area": energy["W_area"],
+                       "W_masing": W_masing, "T_amplitude": energy["T_amplitude"]}
+    return out
