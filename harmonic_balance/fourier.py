@@ -179,7 +179,7 @@ class FourierBasis:
         c = np.asarray(coeffs, dtype=float)
         n = oversample * self.n_t
         th = 2.0 * np.pi * np.arange(n) / n
-        u = self.evaluate(c, th)
+        u = self._fine(oversample) @ c
         j = int(np.argmax(np.abs(u)))
         t = th[j]
         d1, d2 = self.dtheta @ c, self.dtheta @ (self.dtheta @ c)
@@ -193,16 +193,22 @@ class FourierBasis:
             t += step
         return float(max(abs(self.evaluate(c, t)), abs(u[j])))
 
+    def _fine(self, oversample: int) -> np.ndarray:
+        """Basis sampled at oversample * n_t points (cached)."""
+        cache = self.__dict__.setdefault("_fine_cache", {})
+        if oversample not in cache:
+            n = oversample * self.n_t
+            cache[oversample] = self.evaluate(np.eye(self.nb), 2.0 * np.pi * np.arange(n) / n)
+        return cache[oversample]
+
     def evaluate(self, coeffs: np.ndarray, theta) -> np.ndarray:
         """u(theta) for coefficients (n_b,) or (n_b, n) at arbitrary phases."""
         th = np.atleast_1d(np.asarray(theta, dtype=float))
-        cols = []
-        for h in self.harmonics:
-            if h == 0:
-                cols.append(np.ones_like(th))
-            else:
-                cols += [np.cos(h * th), np.sin(h * th)]
-        out = np.column_stack(cols) @ np.asarray(coeffs)
+        arg = np.outer(th, self.order)
+        is_sin = np.zeros(self.nb, dtype=bool)
+        is_sin[1 if self.harmonics[0] == 0 else 0::2] = False
+        is_sin[(2 if self.harmonics[0] == 0 else 1)::2] = True
+        out = np.where(is_sin, np.sin(arg), np.cos(arg)) @ np.asarray(coeffs)
         return out[0] if np.ndim(theta) == 0 else out
 
     def alias_ratio(self, samples: np.ndarray) -> float:

@@ -55,14 +55,15 @@ class FRFResult:
     peak_interior: bool = False
     status: str = "complete"
     extra: dict = field(default_factory=dict)
+    problem: "FRFProblem | None" = field(default=None, repr=False)
 
     @property
     def points(self) -> int:
         return len(self.omega)
 
     def summary(self) -> dict:
-        """JSON-able dictionary (the CLI's output)."""
-        return {
+        """JSON-able dictionary (the CLI's output); undefined numbers become None."""
+        out = {
             "omega": self.omega, "amplitude": self.amplitude, "amplitude_h1": self.amplitude_h1,
             "peak_omega": self.peak_omega, "peak_amplitude": self.peak_amplitude,
             "peak_amplitude_h1": self.peak_amplitude_h1, "peak_interior": self.peak_interior,
@@ -70,6 +71,16 @@ class FRFResult:
             "residual_evaluations": self.evaluations, "time_s": self.time_s,
             "harmonics": list(self.harmonics), "n_t": self.n_t, "status": self.status,
         }
+        return {k: _finite(v) for k, v in out.items()}
+
+
+def _finite(v):
+    """NaN/inf -> None (JSON has no NaN), recursively through arrays."""
+    if isinstance(v, np.ndarray):
+        return [_finite(float(e)) for e in v.ravel()]
+    if isinstance(v, float) and not np.isfinite(v):
+        return None
+    return v
 
 
 class FRFProblem:
@@ -117,7 +128,7 @@ class FRFProblem:
 
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
-                ds_max: float = 0.02, max_points: int = 2000, refine: bool = True) -> FRFResult:
+                ds_max: float = 0.05, max_points: int = 2000, refine: bool = True) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     Raises
@@ -154,7 +165,7 @@ def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
     amp = np.array([b.peak_abs(r) for r in resp])
     i = int(np.argmax(amp)) if len(amp) else 0
     return FRFResult(om, amp, np.asarray(h1), resp, list(branch.x), int(sum(branch.iterations)),
-                     prob.evaluations, time.perf_counter() - t0, b.harmonics, b.n_t,
+                     prob.evaluations, time.perf_counter() - t0, b.harmonics, b.n_t, problem=prob,
                      peak_omega=float(om[i]) if len(om) else float("nan"),
                      peak_amplitude=float(amp[i]) if len(amp) else float("nan"),
                      peak_amplitude_h1=float(h1[i]) if len(amp) else float("nan"),

@@ -1,0 +1,117 @@
+"""``damper frf``: forced-response curve by multi-harmonic balance and continuation.
+
+Examples::
+
+    damper frf --model sdof --mass 1 --stiffness 1 --damping 0.01 --contact-stiffness 1 \\
+        --slip-force 0.05 --force 0.05 --harmonics 1 --omega 0.9 1.3 --json
+    damper frf --model matrices.npz --elements elements.toml --harmonics odd:7 \\
+        --omega 100 300 --json --plot out/frf
+
+``--model`` is ``sdof`` (a mass on a spring and dashpot with one Jenkins element to
+the ground, forced by ``--force`` cos(omega t)) or a ``.npz`` file with an
+``--elements`` ``.toml`` file; both formats are documented in
+:mod:`harmonic_balance.model`. ``--harmonics`` takes H (harmonics 0..H), ``odd:H``
+or ``all:H``.
+
+JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of the
+response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
+``peak_omega`` and ``peak_amplitude`` (refined peak), ``points``,
+``newton_iterations`` (corrector iterations), ``time_s`` and ``status``. A run that
+fails part-way prints the points computed so far (``status`` says where and why)
+and exits with code 3.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser(
+        "frf", help="forced-response curve of a friction-damped model (harmonic balance)",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--model", required=True, help="'sdof' or a matrices .npz file")
+    p.add_argument("--elements", help="friction elements .toml (with a .npz model)")
+    g = p.add_argument_group("sdof model (SI units)")
+    g.add_argument("--mass", type=float, default=1.0, help="mass [kg]")
+    g.add_argument("--stiffness", type=float, default=1.0, help="spring to ground [N/m]")
+    g.add_argument("--damping", type=float, default=0.01, help="dashpot [N s/m]")
+    g.add_argument("--contact-stiffness", type=float, default=1.0, help="Jenkins spring [N/m]")
+    g.add_argument("--slip-force", type=float, default=0.05, help="Jenkins slip force [N]")
+    g.add_argument("--force", type=float, default=0.05, help="excitation amplitude [N]")
+    p.add_argument("--force-scale", type=float, default=1.0,
+                   help="multiply the .npz excitation by this factor")
+    p.add_argument("--response-dof", type=int, help="DOF reported (default: the file's, or 0)")
+    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
+    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
+                   help="frequency range [rad/s]")
+    p.add_argument("--max-step", type=float, default=0.05,
+                   help="largest continuation step (scaled arclength, default 0.05)")
+    p.add_argument("--max-points", type=int, default=2000)
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", help="also write the JSON to this file")
+    p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
+    p.set_defaults(func=run)
+
+
+def build_model(args):
+    """The Model described by the arguments (ValueError on bad input)."""
+    import numpy as np
+
+    from harmonic_balance.model import Model, load_elements, load_matrices, sdof_model
+
+    if args.model == "sdof":
+        if args.elements:
+            raise ValueError("--elements goes with a .npz model, not sdof")
+        return sdof_model(args.mass, args.stiffness, args.damping, args.contact_stiffness,
+                          args.slip_force, args.force)
+    if not args.elements:
+        raise ValueError("a .npz model needs --elements FILE.toml")
+    if not math.isfinite(args.force_scale):
+        raise ValueError("--force-scale must be finite")
+    lin, forcing, resp = load_matrices(args.model)
+    forcing = {h: args.force_scale * np.asarray(f, dtype=complex) for h, f in forcing.items()}
+    resp = resp if args.response_dof is None else args.response_dof
+    return Model(lin, load_elements(args.elements), forcing, resp)
+
+
+def run(args) -> int:
+    import os
+
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # small dense work: one thread is faster
+    from harmonic_balance.frf import FRFError, compute_frf
+
+    from .common import atomic_write, dumps, print_json
+
+    if args.model == "sdof" and args.response_dof not in (None, 0):
+        raise ValueError("the sdof model has one DOF (0)")
+    if args.max_step <= 0 or args.max_points < 2 or args.samples < 0:
+        raise ValueError("--max-step must be > 0, --max-points >= 2, --samples >= 0")
+    model = build_model(args)
+    try:
+        result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
+                             ds_max=args.max_step, max_points=args.max_points)
+    except FRFError as err:
+        _emit(args, err.result.summary(), print_json, atomic_write, dumps)
+        raise RuntimeError(f"{err} ({err.result.points} points kept)") from None
+    summary = result.summary()
+    if args.plot:
+        from harmonic_balance.plots import plot_frf
+
+        plot_frf(result, args.plot)
+    _emit(args, summary, print_json, atomic_write, dumps)
+    return 0
+
+
+def _emit(args, summary, print_json, atomic_write, dumps):
+    if args.out:
+        atomic_write(args.out, dumps(summary, indent=1) + "\n")
+    if args.json:
+        print_json(summary)
+        return
+    print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
+          f"{summary['time_s']:.3f} s, harmonics {summary['harmonics']}, n_t {summary['n_t']}")
+    print(f"peak: omega = {summary['peak_omega']:.9g} rad/s, amplitude = "
+          f"{summary['peak_amplitude']:.9g} m (first harmonic {summary['peak_amplitude_h1']:.9g} m)")
+    print(f"status: {summary['status']}")

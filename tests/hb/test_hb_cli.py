@@ -1,0 +1,83 @@
+"""``damper frf``: JSON interface, file models, exit codes."""
+import json
+
+import numpy as np
+import pytest
+
+from contact_core.curve import VirginCurve, write_curve
+from harmonic_balance.cli import main
+
+SDOF = ["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.01",
+        "--contact-stiffness", "1", "--slip-force", "0.05", "--force", "0.05"]
+#: Describing-function peak of this oscillator (test_hb_frf.df_peak), 0.1 % agreement.
+DF_PEAK, DF_RTOL = 0.200766, 1e-3
+
+
+def run_json(capsys, argv):
+    code = main(argv)
+    return code, json.loads(capsys.readouterr().out)
+
+
+def test_sdof_json_has_the_interface_fields(capsys):
+    code, out = run_json(capsys, SDOF + ["--harmonics", "1", "--omega", "0.9", "1.3", "--json"])
+    assert code == 0
+    for key in ("omega", "amplitude", "amplitude_h1", "peak_omega", "peak_amplitude",
+                "points", "newton_iterations", "time_s"):
+        assert key in out
+    assert len(out["omega"]) == len(out["amplitude"]) == out["points"]
+    assert abs(out["peak_amplitude"] / DF_PEAK - 1) < DF_RTOL
+    assert out["omega"][0] == 0.9 and out["omega"][-1] == 1.3
+
+
+@pytest.mark.parametrize("bad", [["--mass", "-1"], ["--omega", "1", "1"], ["--harmonics", "odd:0"],
+                                 ["--slip-force", "nan"]])
+def test_bad_input_exits_2(capsys, bad):
+    argv = SDOF + ["--omega", "0.9", "1.3"] + bad
+    assert main(argv) == 2
+    assert "error" in capsys.readouterr().err
+
+
+def test_unfinished_curve_exits_3_and_keeps_the_points(capsys):
+    code = main(SDOF + ["--omega", "0.9", "1.3", "--max-points", "5", "--json"])
+    cap = capsys.readouterr()
+    assert code == 3 and "stopped at parameter" in cap.err
+    out = json.loads(cap.out)
+    assert out["points"] == 5 and out["status"].startswith("continuation stopped")
+
+
+def write_two_dof(tmp_path):
+    M = np.diag([1.0, 0.5])
+    K = np.array([[2.0, -1.0], [-1.0, 1.5]])
+    np.savez(tmp_path / "m.npz", M=M, K=K, C=0.01 * M + 0.005 * K, force=np.array([0.05, 0.0]))
+    # concave virgin curve: slopes 0.8 then 0.3 then 0 -> sliders (0.5, 0.05) + (0.3, 0.03)
+    write_curve(VirginCurve(u=[0.0, 0.1, 0.2], T=[0.0, 0.08, 0.11], N=1.0), tmp_path / "c.json")
+    (tmp_path / "e.toml").write_text(
+        '[[element]]\ndofs = [0, 1]\ntype = "curve"\npath = "c.json"\n\n'
+        '[[element]]\ndofs = [1]\ntype = "sliders"\nk = [0.5, 0.3]\nfs = [0.05, 0.03]\n')
+
+
+def test_npz_and_toml_model_equals_the_same_model_built_in_python(tmp_path, capsys):
+    write_two_dof(tmp_path)
+    code, out = run_json(capsys, ["frf", "--model", str(tmp_path / "m.npz"), "--elements",
+                                  str(tmp_path / "e.toml"), "--harmonics", "odd:3",
+                                  "--omega", "0.6", "2.0", "--json"])
+    assert code == 0 and out["status"] == "complete"
+    from fmu_src.element import IwanElement
+    from harmonic_balance.aft import FrictionLink
+    from harmonic_balance.frf import compute_frf
+    from harmonic_balance.model import load_matrices, Model
+
+    lin, forcing, resp = load_matrices(tmp_path / "m.npz")
+    same = IwanElement.from_sliders([0.5, 0.3], [0.05, 0.03])
+    model = Model(lin, [FrictionLink(same, 0, 1), FrictionLink(same, 1)], forcing, resp)
+    ref = compute_frf(model, "odd:3", (0.6, 2.0))
+    assert abs(out["peak_amplitude"] / ref.peak_amplitude - 1) < 1e-8
+    assert abs(out["peak_omega"] / ref.peak_omega - 1) < 1e-6
+
+
+def test_bad_elements_file_exits_2(tmp_path, capsys):
+    write_two_dof(tmp_path)
+    (tmp_path / "e.toml").write_text('[[element]]\ndofs = [0, 5]\nk = 1.0\nfs = 0.1\n')
+    assert main(["frf", "--model", str(tmp_path / "m.npz"), "--elements",
+                 str(tmp_path / "e.toml"), "--omega", "0.6", "2.0"]) == 2
+    assert "DOF 5" in capsys.readouterr().err
