@@ -205,7 +205,8 @@ class IwanElement:
 
     # ------------------------------------------------------------ construction
     @classmethod
-    def from_curve(cls, u, T, N_ref, fit: str = "reject", scale: float = 1.0) -> "IwanElement":
+    def from_curve(cls, u, T, N_ref, fit: str = "reject", scale: float = 1.0,
+                   gross_slip: bool = False) -> "IwanElement":
         """Element reproducing a concave piecewise-linear virgin curve exactly (Iwan).
 
         Parameters
@@ -220,11 +221,17 @@ class IwanElement:
             least concave non-decreasing majorant (upper hull, flat after the maximum).
         scale : float
             Friction scale multiplying every slip strength (>= 0).
+        gross_slip : bool
+            The table ends at gross slip (T = mu N): continue it flat (k_res = 0)
+            instead of with its last slope.
         """
         if fit not in _FITS:
             raise IwanInputError(f"fit must be one of {sorted(_FITS)}, got {fit!r}")
         u = _vec(u, "u")
         T = _vec(T, "T", u.size)
+        if gross_slip:
+            u = np.append(u, 2.0 * u[-1])
+            T = np.append(T, T[-1])
         model = _Model()
         _check(_model_init(ct.byref(model), u.ctypes.data, T.ctypes.data, u.size,
                            float(N_ref), _FITS[fit]), "IwanElement.from_curve")
@@ -262,6 +269,21 @@ class IwanElement:
     k_res = property(lambda self: float(self._model.k_res))
     N_ref = property(lambda self: float(self._model.n_ref))
     scale = property(lambda self: float(self._model.scale))
+
+    def slip_radii(self, N: float | None = None) -> np.ndarray:
+        """Slider stretch at slip, fs_j scale N / (N_ref k_j) [m], shape (n_sliders,).
+
+        The virgin curve at N is piecewise linear with these breakpoints.
+        """
+        N = self.N_ref if N is None else float(N)
+        return self.fs * self.scale * (N / self.N_ref) / self.k
+
+    def gross_slip_force(self, N: float | None = None) -> float:
+        """Largest force of the element at N [N]: total slip strength, or inf if k_res > 0."""
+        if self.k_res > 0.0:
+            return float("inf")
+        N = self.N_ref if N is None else float(N)
+        return float(np.sum(self.fs) * self.scale * max(N, 0.0) / self.N_ref)
 
     def __repr__(self):
         return (f"IwanElement(n_sliders={self.n_sliders}, k_res={self.k_res!r}, "
@@ -377,10 +399,10 @@ class IwanElement:
                "IwanElement.periodic_jac")
         return F, dFdX, dFdXN, w.value
 
-    def virgin(self, u) -> np.ndarray:
-        """Virgin-curve force [N] at N_ref for displacements u (odd extension), shape (n,)."""
+    def virgin(self, u, N: float | None = None) -> np.ndarray:
+        """Virgin-curve force [N] at normal load N (default N_ref), odd extension, shape (n,)."""
         u = _vec(u, "u")
         order = np.argsort(np.abs(u), kind="stable")
         F = np.empty_like(u)
-        F[order] = self.series(np.abs(u)[order]).F
+        F[order] = self.series(np.abs(u)[order], None if N is None else float(N)).F
         return np.sign(u) * F
