@@ -1,0 +1,214 @@
+/*
+ * test_iwan.c -- unit tests of the Iwan core (iwan.h), plain C99, no framework.
+ * Each check compares with a closed form (references.md) or an independent
+ * computation; the Python tests (tests/element) cover the rest through the same
+ * library. Exit status = number of failed checks.
+ */
+#include "iwan.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Round-off of sums over a few hundred sliders and samples, relative. */
+#define ROUNDOFF 1e-11
+#define PI 3.14159265358979323846
+
+static int failures = 0;
+
+#define CHECK(cond, ...)                                                   \
+    do {                                                                   \
+        if (!(cond)) {                                                     \
+            ++failures;                                                    \
+            printf("FAIL %s:%d: ", __FILE__, __LINE__);                   \
+            printf(__VA_ARGS__);                                           \
+            printf("\n");                                                  \
+        }                                                                  \
+    } while (0)
+
+static int close_to(double a, double b, double rtol, double atol)
+{
+    return fabs(a - b) <= atol + rtol * fabs(b);
+}
+
+/* Concave table: g(u) = 10 (1 - (1 - u/us)^1.5) on [0, us], 24 segments, flat tail. */
+#define M_TAB 26
+static void sphere_table(double *u, double *T)
+{
+    const double us = 2e-6;
+    for (int i = 0; i <= 24; ++i) {
+        T[i] = 10.0 * i / 24.0;
+        u[i] = us * (1.0 - pow(1.0 - T[i] / 10.0, 2.0 / 3.0));
+    }
+    u[25] = 2.0 * us;
+    T[25] = 10.0;
+}
+
+static double table_g(const double *u, const double *T, double x)
+{
+    double s = x < 0 ? -1.0 : 1.0, a = fabs(x);
+    for (int i = 1; i < M_TAB; ++i)
+        if (a <= u[i]) return s * (T[i - 1] + (T[i] - T[i - 1]) * (a - u[i - 1]) / (u[i] - u[i - 1]));
+    return s * T[M_TAB - 1];
+}
+
+static void test_jenkins_loop_energy(void)
+{
+    const double k = 2e6, fs = 3.0, kk[1] = {k}, ff[1] = {fs};
+    iwan_model m;
+    CHECK(iwan_model_from_sliders(&m, kk, ff, 1, 0.0, 1.0) == IWAN_OK, "from_sliders");
+    double u[100], F[100], kt[100], dfdn[100], W;
+    int p;
+    for (int c = 0; c < 3; ++c) {
+        const double a = (c + 0.5) * 2.0 * fs / k;
+        for (int i = 0; i < 100; ++i) u[i] = a * cos(2.0 * PI * i / 100.0);
+        CHECK(iwan_periodic(&m, 100, u, NULL, F, kt, dfdn, &W, 10, 1e-12, &p) == IWAN_OK, "periodic");
+        const double want = a > fs / k ? 4.0 * fs * (a - fs / k) : 0.0;
+        CHECK(close_to(W, want, ROUNDOFF, 1e-20) && p == 1, "Jenkins W %g vs %g", W, want);
+    }
+}
+
+static void test_table_and_masing_branches(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m;
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_OK, "model_init");
+    CHECK(m.n == 24 && m.k_res == 0.0, "slider count %d, k_res %g", (int)m.n, m.k_res);
+    iwan_state s;
+    CHECK(iwan_state_init(&m, &s, 5.0) == IWAN_OK, "state_init");
+    double F[M_TAB];
+    CHECK(iwan_series(&m, &s, M_TAB, ut, NULL, F, NULL, NULL, NULL) == IWAN_OK, "series");
+    for (int i = 0; i < M_TAB; ++i)
+        CHECK(close_to(F[i], Tt[i], 0, ROUNDOFF * 10.0), "virgin %d: %g vs %g", i, F[i], Tt[i]);
+    /* reversal at u_r = 1.5e-6: branch F_r + 2 g((u - u_r)/2) */
+    const double u_r = 1.5e-6, F_r = table_g(ut, Tt, u_r);
+    iwan_output o;
+    CHECK(iwan_state_init(&m, &s, 5.0) == IWAN_OK && iwan_step(&m, &s, u_r, 5.0, &o) == IWAN_OK, "load");
+    for (int i = 1; i <= 20; ++i) {
+        const double x = u_r - i * 1.4e-7;
+        CHECK(iwan_step(&m, &s, x, 5.0, &o) == IWAN_OK, "step");
+        const double want = F_r + 2.0 * table_g(ut, Tt, (x - u_r) / 2.0);
+        CHECK(close_to(o.F, want, 0, ROUNDOFF * 10.0), "branch %g vs %g", o.F, want);
+    }
+}
+
+static void test_bad_inputs(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m, keep;
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_OK, "init");
+    keep = m;
+    Tt[4] -= 0.2;   /* dent (still increasing) */
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_ERR_NOT_CONCAVE, "concave");
+    CHECK(memcmp(&m, &keep, sizeof m) == 0, "model untouched on failure");
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_CONCAVE) == IWAN_OK && m.n < 24, "fit");
+    Tt[4] += 0.2;
+    ut[3] = NAN;
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_ERR_NONFINITE, "nan");
+    ut[3] = ut[2];
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_ERR_BAD_TABLE, "u order");
+    sphere_table(ut, Tt);
+    CHECK(iwan_model_init(&m, ut, Tt, 1, 5.0, IWAN_FIT_REJECT) == IWAN_ERR_BAD_TABLE, "short");
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 0.0, IWAN_FIT_REJECT) == IWAN_ERR_BAD_PARAM, "n_ref");
+    CHECK(iwan_model_init(NULL, ut, Tt, M_TAB, 1.0, IWAN_FIT_REJECT) == IWAN_ERR_BAD_PARAM, "null");
+    CHECK(iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT) == IWAN_OK, "init again");
+    iwan_state s, s0;
+    iwan_output o;
+    iwan_state_init(&m, &s, 5.0);
+    iwan_step(&m, &s, 1e-6, 5.0, &o);
+    s0 = s;
+    CHECK(iwan_step(&m, &s, NAN, 5.0, &o) == IWAN_ERR_NONFINITE, "nan u");
+    CHECK(iwan_step(&m, &s, 1e-6, INFINITY, &o) == IWAN_ERR_NONFINITE, "inf N");
+    CHECK(memcmp(&s, &s0, sizeof s) == 0, "state untouched on failure");
+    s.version = 99;
+    CHECK(iwan_step(&m, &s, 1e-6, 5.0, &o) == IWAN_ERR_BAD_STATE, "version");
+    m.scale = -1.0;
+    CHECK(iwan_step(&m, &s0, 1e-6, 5.0, &o) == IWAN_ERR_BAD_PARAM, "scale");
+    CHECK(strlen(iwan_status_text(IWAN_ERR_NOT_CONCAVE)) > 0, "text");
+}
+
+/* Piecewise-linear (u, N) path: vertices only vs refined samples give the same
+ * force at the vertices (exact straight-path update), with a lift-off on the way. */
+static void test_sampling_independence_and_lift_off(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m;
+    iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT);
+    enum { NV = 9, R = 7 };
+    const double vu[NV] = {0, 1.2e-6, -0.4e-6, 0.9e-6, 3e-6, -1e-6, 0.2e-6, 0.5e-6, -2e-6};
+    const double vN[NV] = {5, 6, 3, 8, -1, 2, 5, 9, 4};
+    double cu[NV], cN[NV], Fc[NV], Wc[NV], fu[(NV - 1) * R + 1], fN[(NV - 1) * R + 1];
+    double Ff[(NV - 1) * R + 1], Wf[(NV - 1) * R + 1];
+    memcpy(cu, vu, sizeof cu);
+    memcpy(cN, vN, sizeof cN);
+    fu[0] = vu[0];
+    fN[0] = vN[0];
+    for (int i = 0; i + 1 < NV; ++i)
+        for (int r = 1; r <= R; ++r) {
+            fu[i * R + r] = vu[i] + (vu[i + 1] - vu[i]) * r / R;
+            fN[i * R + r] = vN[i] + (vN[i + 1] - vN[i]) * r / R;
+        }
+    iwan_state a, b;
+    iwan_state_init(&m, &a, 5.0);
+    iwan_state_init(&m, &b, 5.0);
+    CHECK(iwan_series(&m, &a, NV, cu, cN, Fc, NULL, NULL, Wc) == IWAN_OK, "coarse");
+    CHECK(iwan_series(&m, &b, (NV - 1) * R + 1, fu, fN, Ff, NULL, NULL, Wf) == IWAN_OK, "fine");
+    for (int i = 0; i < NV; ++i) {
+        CHECK(close_to(Ff[i * R], Fc[i], 0, ROUNDOFF * 20.0), "F at vertex %d: %g vs %g", i, Ff[i * R], Fc[i]);
+        CHECK(close_to(Wf[i * R], Wc[i], 1e-10, 0), "W at vertex %d", i);
+    }
+    CHECK(Fc[4] == 0.0, "lift-off force %g", Fc[4]);
+    for (int i = 1; i < (NV - 1) * R + 1; ++i) CHECK(Wf[i] >= Wf[i - 1], "W decreasing at %d", i);
+}
+
+/* dF/dX of the periodic loop vs central differences, u = c0 + c1 cos + c2 sin 2t, N varying. */
+static void test_periodic_jacobian(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m;
+    iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT);
+    enum { NT = 48, NB = 3 };
+    double E[NT * NB], X[NB] = {0.2e-6, 1.5e-6, 0.4e-6}, XN[NB] = {5.0, 2.0, 1.0};
+    double u[NT], N[NT], F[NT], J[NT * NB], JN[NT * NB], W, Fp[NT], Fm[NT], Wp;
+    int p;
+    for (int t = 0; t < NT; ++t) {
+        const double th = 2.0 * PI * t / NT;
+        E[t * NB] = 1.0; E[t * NB + 1] = cos(th); E[t * NB + 2] = sin(2.0 * th);
+    }
+    for (int t = 0; t < NT; ++t) {
+        u[t] = N[t] = 0.0;
+        for (int c = 0; c < NB; ++c) { u[t] += E[t * NB + c] * X[c]; N[t] += E[t * NB + c] * XN[c]; }
+    }
+    CHECK(iwan_periodic_jac(&m, NT, u, N, E, E, NB, F, J, JN, &W, 50, 1e-12, &p) == IWAN_OK, "jac");
+    double jmax = 0.0;   /* FD round-off ~ eps F / h: tolerance relative to the largest entry */
+    for (int i = 0; i < NT * NB; ++i) jmax = fmax(jmax, fabs(J[i]));
+    for (int c = 0; c < NB; ++c) {
+        const double h = 1e-7 * X[1];
+        double up[NT], um[NT];
+        for (int t = 0; t < NT; ++t) { up[t] = u[t] + h * E[t * NB + c]; um[t] = u[t] - h * E[t * NB + c]; }
+        iwan_periodic(&m, NT, up, N, Fp, NULL, NULL, &Wp, 50, 1e-12, NULL);
+        iwan_periodic(&m, NT, um, N, Fm, NULL, NULL, &Wp, 50, 1e-12, NULL);
+        for (int t = 0; t < NT; ++t) {
+            const double fd = (Fp[t] - Fm[t]) / (2.0 * h);
+            CHECK(close_to(J[t * NB + c], fd, 0, 1e-6 * jmax), "dF[%d]/dX[%d] %g vs %g", t, c, J[t * NB + c], fd);
+        }
+    }
+    /* not converged within one period (N varies) */
+    CHECK(iwan_periodic(&m, NT, u, N, F, NULL, NULL, &W, 1, 1e-12, &p) == IWAN_ERR_NOT_CONVERGED,
+          "closure status");
+}
+
+int main(void)
+{
+    test_jenkins_loop_energy();
+    test_table_and_masing_branches();
+    test_bad_inputs();
+    test_sampling_independence_and_lift_off();
+    test_periodic_jacobian();
+    if (failures == 0) printf("test_iwan: all checks passed\n");
+    return failures;
+}
