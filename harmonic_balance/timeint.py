@@ -14,8 +14,8 @@ Stable for dt < 2 / omega_max, omega_max from K plus the stuck friction springs.
 Steady state: each period's response harmonics (DFT of its samples) are compared
 with the previous period's; the march stops when the change, extrapolated
 geometrically to infinity (the transient decays like rho^p), is below ``tol``
-relative to the amplitude. Time-step convergence: :func:`steady_amplitude` can run
-two step sizes and Richardson-extrapolate (second order).
+relative to the amplitude. Time-step convergence: :func:`steady_amplitude` runs two
+step sizes and reports their difference.
 """
 from __future__ import annotations
 
@@ -146,15 +146,18 @@ def _result(omega, hist, p, ns, ok):
     return SteadyState(omega, float(peak), float(h1), p, ns, ok, hist.copy())
 
 
-def steady_amplitude(model: Model, omega: float, steps_per_period: int = 256, **kw):
-    """Steady amplitude with steps_per_period and twice that, Richardson-extrapolated.
+def steady_amplitude(model: Model, omega: float, steps_per_period: int = 512, **kw):
+    """Steady amplitude at steps_per_period, checked against twice as many steps.
 
-    Returns (amplitude, amplitude_h1, estimated step error (relative), finer SteadyState).
+    Central differences with stick-slip kinks converge faster than second order in
+    practice (sdof Jenkins near its peak: changes 6e-5, 6e-6, 1e-7 per doubling from
+    256 steps), so the finer run is reported and the change is its error bound;
+    Richardson extrapolation at order 2 would over-correct.
+
+    Returns (amplitude, amplitude_h1, relative step-size error estimate, finer SteadyState).
     """
     a = march(model, omega, steps_per_period, **kw)
     b = march(model, omega, 2 * a.steps_per_period, **kw)
     if not (a.converged and b.converged):
         raise RuntimeError(f"time integration did not reach steady state at omega = {omega:g}")
-    amp = b.amplitude + (b.amplitude - a.amplitude) / 3.0
-    h1 = b.amplitude_h1 + (b.amplitude_h1 - a.amplitude_h1) / 3.0
-    return amp, h1, abs(b.amplitude - a.amplitude) / 3.0 / max(amp, 1e-300), b
+    return b.amplitude, b.amplitude_h1, abs(b.amplitude - a.amplitude) / max(b.amplitude, 1e-300), b

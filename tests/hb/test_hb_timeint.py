@@ -1,0 +1,41 @@
+"""Harmonic balance against a time integration of the same model to steady state."""
+import numpy as np
+import pytest
+
+from harmonic_balance.frf import compute_frf
+from harmonic_balance.timeint import march, steady_amplitude
+from hbcases import sdof, two_dof
+
+#: Agreement demanded by the issue between the converged HB and the reference.
+TI_RTOL = 5e-3
+#: Steady-state tolerance of the march (extrapolated change per period).
+SS_TOL = 1e-8
+
+
+@pytest.fixture(scope="module")
+def peaks():
+    model = sdof()
+    return model, {H: compute_frf(model, f"odd:{H}", (0.9, 1.3)) for H in (3, 5, 7)}
+
+
+def test_peak_converges_with_the_number_of_harmonics(peaks):
+    _, r = peaks
+    # the change shrinks as H grows (response harmonics fall off like 1/h^4)
+    d35 = abs(r[5].peak_amplitude - r[3].peak_amplitude)
+    d57 = abs(r[7].peak_amplitude - r[5].peak_amplitude)
+    assert d57 < d35 and d57 < 1e-3 * r[7].peak_amplitude
+
+
+def test_converged_hb_peak_agrees_with_time_integration(peaks):
+    model, r = peaks
+    amp, _, step_err, ss = steady_amplitude(model, r[7].peak_omega, 256, tol=SS_TOL)
+    assert ss.converged and step_err < 1e-3  # the reference itself is converged in dt
+    assert abs(r[7].peak_amplitude / amp - 1) < TI_RTOL
+
+
+def test_two_dof_hb_agrees_with_time_integration_at_the_peak():
+    # at the peak the friction damping is largest, so the march settles fastest
+    model = two_dof()
+    r = compute_frf(model, "odd:5", (0.6, 1.6))
+    s = march(model, r.peak_omega, 256, tol=SS_TOL)
+    assert s.converged and abs(r.peak_amplitude / s.amplitude - 1) < TI_RTOL
