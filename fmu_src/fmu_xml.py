@@ -152,23 +152,28 @@ def _fmi3_variables(curve_n: float) -> str:
 def _structure(fmi_version: int) -> str:
     """ModelStructure: every output depends directly on both inputs (feedthrough).
 
-    FMI 2 dependencies are 1-based indices into ModelVariables; FMI 3 dependencies
-    are value references.
+    During initialization the outputs also depend on the parameters (knowns with
+    initial="exact"). FMI 2 dependencies are 1-based indices into ModelVariables;
+    FMI 3 dependencies are value references.
     """
     inputs = by_causality("input")
+    knowns = inputs + by_causality("parameter")
+    outputs = by_causality("output")
     if fmi_version == 2:
         deps = " ".join(str(v.vr + 1) for v in inputs)
-        rows = [f'      <Unknown index="{v.vr + 1}" dependencies="{deps}"/>'
-                for v in by_causality("output")]
-        body = "\n".join(rows)
-        return (f"  <ModelStructure>\n    <Outputs>\n{body}\n    </Outputs>\n"
-                f"    <InitialUnknowns>\n{body}\n    </InitialUnknowns>\n  </ModelStructure>")
+        init_deps = " ".join(str(v.vr + 1) for v in knowns)
+        outs = "\n".join(f'      <Unknown index="{v.vr + 1}" dependencies="{deps}"/>'
+                         for v in outputs)
+        inits = "\n".join(f'      <Unknown index="{v.vr + 1}" dependencies="{init_deps}"/>'
+                          for v in outputs)
+        return (f"  <ModelStructure>\n    <Outputs>\n{outs}\n    </Outputs>\n"
+                f"    <InitialUnknowns>\n{inits}\n    </InitialUnknowns>\n  </ModelStructure>")
     deps = " ".join(str(v.vr) for v in inputs)
-    outs = [f'    <Output valueReference="{v.vr}" dependencies="{deps}"/>'
-            for v in by_causality("output")]
-    inits = [f'    <InitialUnknown valueReference="{v.vr}" dependencies="{deps}"/>'
-             for v in by_causality("output")]
-    return "  <ModelStructure>\n" + "\n".join(outs + inits) + "\n  </ModelStructure>"
+    init_deps = " ".join(str(v.vr) for v in knowns)
+    rows = [f'    <Output valueReference="{v.vr}" dependencies="{deps}"/>' for v in outputs]
+    rows += [f'    <InitialUnknown valueReference="{v.vr}" dependencies="{init_deps}"/>'
+             for v in outputs]
+    return "  <ModelStructure>\n" + "\n".join(rows) + "\n  </ModelStructure>"
 
 
 def render_model_description(fmi_version: int, curve_n: float, source_files: list[str],

@@ -39,7 +39,8 @@ def _variables(root, version):
 
 @pytest.mark.parametrize("version", [2, 3])
 def test_model_description_references_are_consistent(fmus, version):
-    """Unique value references, units defined, outputs depending on the inputs only."""
+    """Unique value references, units defined; outputs depend on the inputs (and,
+    while initializing, on the parameters), dependencies never point elsewhere."""
     root = _model_description(fmus[version])
     variables = _variables(root, version)
     vrs = [v[1] for v in variables]
@@ -47,20 +48,25 @@ def test_model_description_references_are_consistent(fmus, version):
     defined = {u.get("name") for u in root.find("UnitDefinitions")}
     assert all(v[3] and v[3] in defined for v in variables)
     structure = root.find("ModelStructure")
+    # FMI 2 refers to variables by 1-based index, FMI 3 by value reference
+    key = (lambda i, v: i) if version == 2 else (lambda i, v: v[1])
+    ids = {c: {key(i, v) for i, v in enumerate(variables, 1) if v[2] == c}
+           for c in ("input", "output", "parameter")}
     if version == 2:
-        inputs = {i for i, v in enumerate(variables, 1) if v[2] == "input"}
-        outputs = {i for i, v in enumerate(variables, 1) if v[2] == "output"}
-        rows = list(structure.find("Outputs")) + list(structure.find("InitialUnknowns"))
-        keys = [int(r.get("index")) for r in rows]
+        outs = [int(r.get("index")) for r in structure.find("Outputs")]
+        out_deps = [r.get("dependencies") for r in structure.find("Outputs")]
+        inits = [int(r.get("index")) for r in structure.find("InitialUnknowns")]
+        init_deps = [r.get("dependencies") for r in structure.find("InitialUnknowns")]
     else:
-        inputs = {v[1] for v in variables if v[2] == "input"}
-        outputs = {v[1] for v in variables if v[2] == "output"}
-        rows = list(structure)
-        keys = [int(r.get("valueReference")) for r in rows]
-    assert set(keys) == outputs and len(keys) == 2 * len(outputs)
-    for row in rows:
-        deps = {int(d) for d in row.get("dependencies").split()}
-        assert deps == inputs  # direct feedthrough from u and N, nothing else
+        outs = [int(r.get("valueReference")) for r in structure.iter("Output")]
+        out_deps = [r.get("dependencies") for r in structure.iter("Output")]
+        inits = [int(r.get("valueReference")) for r in structure.iter("InitialUnknown")]
+        init_deps = [r.get("dependencies") for r in structure.iter("InitialUnknown")]
+    assert sorted(outs) == sorted(ids["output"]) == sorted(inits)
+    for deps in out_deps:  # direct feedthrough from u and N, nothing else
+        assert {int(d) for d in deps.split()} == ids["input"]
+    for deps in init_deps:
+        assert {int(d) for d in deps.split()} == ids["input"] | ids["parameter"]
 
 
 @pytest.mark.parametrize("version", [2, 3])
