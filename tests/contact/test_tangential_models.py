@@ -81,6 +81,9 @@ def test_cnd_curve_equals_cnf_curve_at_the_same_normal_force():
     cnd = tangential_run.run(spec, MU, approach=4e-6, model="bem")
     cnf = tangential_run.run(spec, MU, force=cnd.problem.N, model="bem")
     assert cnd.load_case == "CND" and cnf.load_case == "CNF"
+    # Mindlin at fixed approach d: u_s = 3 mu N / (16 G* a) with N = 4 E* a^3 / (3 R),
+    # a^2 = R d, so u_s = mu E* d / (4 G*), whatever the radius or load
+    assert cnd.virgin.u[-1] == pytest.approx(MU * E_STAR * 4e-6 / (4 * G_STAR), rel=CURVE_TOL)
     np.testing.assert_allclose(cnd.normal.f, cnf.normal.f, rtol=1e-7, atol=1e-9 * cnd.normal.f.max())
     assert cnd.problem.k_t == pytest.approx(cnf.problem.k_t, rel=1e-7)
     T_cnf = np.interp(cnd.virgin.u, cnf.virgin.u, cnf.virgin.T)
