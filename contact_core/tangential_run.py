@@ -75,12 +75,16 @@ def build_contact(spec: ContactSpec, model: str = "real", cache=None):
     return condense.condense(replace(spec, model=model), directions=("z", "x"), cache=cache)
 
 
-def solve_normal(contact, force: float | None = None, approach: float | None = None):
-    """Normal state for CNF (``force`` [N]) or CND (``approach`` [m]); returns (solution, load case)."""
+def solve_normal(contact, force: float | None = None, approach: float | None = None,
+                 eccentricity: float | None = None):
+    """Normal state for CNF (``force`` [N]; flat face: and ``eccentricity`` [m]) or CND
+    (``approach`` [m]); returns (solution, load case)."""
     if (force is None) == (approach is None):
         raise ValueError("give exactly one of a normal force (CNF) or an approach (CND)")
+    if eccentricity is not None and (force is None or contact.rigid.shape[1] < 2):
+        raise ValueError("an eccentricity needs a normal force on a flat face")
     if force is not None:
-        return normal.solve_force(contact, float(force)), "CNF"
+        return normal.solve_force(contact, float(force), eccentricity), "CNF"
     approach = float(approach)
     if not (np.isfinite(approach) and approach > 0):
         raise ValueError(f"approach must be positive and finite, got {approach!r}")
@@ -91,7 +95,7 @@ def solve_normal(contact, force: float | None = None, approach: float | None = N
 
 
 def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: float | None = None,
-        model: str = "real", cache=None, tol: float = CURVE_TOL, command: str | None = None) -> TangentialRun:
+        eccentricity: float | None = None, model: str = "real", cache=None, tol: float = CURVE_TOL, command: str | None = None) -> TangentialRun:
     """Condense, solve the normal problem, and compute the virgin curve to gross slip.
 
     Parameters
@@ -102,6 +106,8 @@ def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: f
         Friction coefficient (> 0).
     force, approach : float
         Exactly one: normal force [N] (CNF) or approach [m] (CND).
+    eccentricity : float, optional
+        Flat face in CNF: x position of the normal resultant [m].
     model : {"real", "halfspace", "bem"}
     cache : see ``contact_core.condense.condense``
     tol : float
@@ -113,7 +119,7 @@ def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: f
     t0 = time.perf_counter()
     contact = build_contact(spec, model, cache)
     t1 = time.perf_counter()
-    nsol, load_case = solve_normal(contact, force, approach)
+    nsol, load_case = solve_normal(contact, force, approach, eccentricity)
     k_n = float(normal.tangent(contact, nsol.active)[0, 0])
     t2 = time.perf_counter()
     problem = TangentialProblem(contact, nsol.f, mu)

@@ -43,34 +43,38 @@ def register(subparsers) -> None:
 
 
 def add_body_options(p) -> None:
-    """Body, material and grid options (the same meaning as ``damper normal``)."""
-    p.add_argument("--body", choices=("sphere", "cylinder"), required=True)
+    """Body, material and grid options, with the meaning of ``damper normal``'s.
+
+    ``damper normal`` registers the same options inline; when it exposes them as
+    a helper this function should become that helper (no second list).
+    """
+    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
     p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
-    p.add_argument("--diameter", type=float, help="cylinder or sphere diameter [m] (instead of --radius)")
-    p.add_argument("--length", type=float, help="cylinder length [m]")
-    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of both bodies [Pa]")
-    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of both bodies")
-    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa] (default --E)")
-    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane (default --nu)")
+    p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
+    p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
+    p.add_argument("--width", type=float, help="flat-face width along x [m]")
+    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
+    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
+    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
+    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
     p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
+    p.add_argument("--p-design", type=float, default=2000e6,
+                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
+    p.add_argument("--eccentricity", type=float, default=None,
+                   help="flat face: x position of the normal resultant [m] (CNF only)")
 
 
-def spec_from_args(args, load_hint: float = 0.0):
-    """A ``ContactSpec`` from the body options; ValueError for missing or bad values."""
-    from contact_core.spec import ContactSpec
+def spec_from_args(args):
+    """The ``ContactSpec`` of the body options, built by ``damper normal``'s own reader.
 
-    if args.radius is not None and args.diameter is not None:
-        raise ValueError("give --radius or --diameter, not both")
-    radius = args.radius if args.radius is not None else (
-        0.5 * args.diameter if args.diameter is not None else None)
-    if radius is None:
-        raise ValueError(f"--body {args.body} needs --radius or --diameter")
-    if args.body == "cylinder" and args.length is None:
-        raise ValueError("--body cylinder needs --length")
-    E2 = args.E if args.E2 is None else args.E2
-    nu2 = args.nu if args.nu2 is None else args.nu2
-    return ContactSpec(body=args.body, radius=radius, length=args.length or 0.0, E1=args.E,
-                       nu1=args.nu, E2=E2, nu2=nu2, grid=args.grid, load_hint=load_hint)
+    The BEM model uses the FE half-space spec (same zone and grid).
+    """
+    import argparse as _argparse
+
+    from harmonic_balance.cli.normal import spec_from_args as normal_spec
+
+    fields = vars(args) | {"model": "halfspace" if args.model == "bem" else args.model, "curve": 0}
+    return normal_spec(_argparse.Namespace(**fields))
 
 
 def run(args) -> int:
@@ -84,10 +88,10 @@ def run(args) -> int:
     from harmonic_balance.cli.common import print_json
 
     _check_finite(args)
-    spec = spec_from_args(args, load_hint=args.force or 0.0)
+    spec = spec_from_args(args)
     command = "damper " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     result = tangential_run.run(spec, args.mu, force=args.force, approach=args.approach,
-                                model=args.model, cache=False if args.no_cache else args.cache_dir,
+                                eccentricity=args.eccentricity, model=args.model, cache=False if args.no_cache else args.cache_dir,
                                 tol=CURVE_TOL if args.tol is None else args.tol, command=command)
     extra = _extras(result, args)
     if args.out:
@@ -110,7 +114,8 @@ def _check_finite(args) -> None:
     import math
 
     for name in ("force", "approach", "mu", "tangential_force", "loop_amplitude", "tol",
-                 "radius", "diameter", "length", "E", "nu", "E2", "nu2"):
+                 "radius", "diameter", "length", "width", "E", "nu", "E2", "nu2",
+                 "eccentricity", "p_design"):
         v = getattr(args, name, None)
         if v is not None and not math.isfinite(v):
             raise ValueError(f"--{name.replace('_', '-')} must be finite, got {v}")

@@ -76,3 +76,15 @@ def test_cylinder_without_length_is_refused(capsys):
     argv = ["tangential", "--body", "cylinder", "--radius", "2.5e-3", "--force", "10", "--mu", "0.5"]
     assert main(argv) == 2
     assert "--length" in capsys.readouterr().err
+
+
+def test_bem_refuses_the_flat_face(capsys):
+    argv = ["tangential", "--body", "flat", "--width", "1.2e-3", "--length", "5e-3", "--force", "500",
+            "--mu", "0.5", "--model", "bem"]
+    assert main(argv) == 2
+    assert "sphere and cylinder" in capsys.readouterr().err
+
+
+def test_eccentricity_needs_a_flat_face(capsys):
+    assert main(SPHERE + ["--force", "200", "--eccentricity", "1e-5"]) == 2
+    assert "flat face" in capsys.readouterr().err
