@@ -1,0 +1,95 @@
+"""Derived results of a normal contact state: areas, radii, pressures, stiffness.
+
+Symbols as in ``contact_core.normal``; p = f / area the nodal pressure [Pa].
+Contact size estimators:
+
+* ``contact_radius`` (sphere): the radius a of the Hertz-form pressure
+  p^2 = c (a^2 - r^2) fitted (least squares) to the nodal pressures of the
+  contact nodes; it interpolates the edge between grid nodes, where the area of
+  the active nodes (``contact_radius_area`` = sqrt(A / pi)) jumps by whole cells.
+* ``contact_halfwidth`` (cylinder, mid-length): the same fit p^2 = c (b^2 - x^2)
+  on the row y = 0; ``contact_halfwidth_end``: the outer edge (last contact node
+  plus half a cell) of the row at the cylinder's end y = L/2, where the pressure
+  is not elliptical (edge effect).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .condensed import CondensedContact
+from .normal import NormalSolution, resultants, tangent
+
+
+def _fit_edge(u: np.ndarray, p: np.ndarray) -> float:
+    """Edge a of p^2 = c (a^2 - u^2) fitted to points (u, p), or nan if < 2 points."""
+    if u.size < 2 or np.ptp(u**2) == 0:
+        return float("nan")
+    slope, icept = np.polyfit(u**2, p**2, 1)
+    return float(np.sqrt(icept / -slope)) if slope < 0 < icept else float("nan")
+
+
+def _row_extent(u: np.ndarray, active: np.ndarray, spacing: float) -> float:
+    """Outer edge of the contact on a grid row: last active |u| plus half a cell."""
+    return float(np.max(np.abs(u[active])) + 0.5 * spacing) if active.any() else 0.0
+
+
+def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
+    """Scalar results and maps of a solved state (full-model values, SI units)."""
+    g, P = cc.grid, sol.active
+    p = sol.f / g.area
+    res = resultants(cc, sol.f)
+    area = float(np.sum(g.mult * g.area * P))
+    T = tangent(cc, P)
+    u1 = cc.Czz_bodies[0] @ sol.f
+    i0 = int(np.argmin(g.h + 1e30 * ~P)) if P.any() else 0
+    out = {
+        "force": float(res[0]),
+        "approach": float(sol.q[0]),
+        "contact_area": area,
+        "p_max": float(p.max()),
+        "p_mean": float(res[0] / area) if area > 0 else 0.0,
+        "k_n": float(T[0, 0]),
+        "iterations": int(sol.iterations),
+        "newton_steps": int(sol.newton),
+        "n_contact_nodes": int(np.sum(g.copies * P)) if g.copies is not None else int(P.sum()),
+        "body1_share": float(u1[i0] / sol.q[0]) if sol.q[0] > 0 else float("nan"),
+        "max_penetration": float(max(0.0, -sol.g.min())),
+        "min_force": float(sol.f.min()),
+        "zone_edge_in_contact": bool(_zone_edge_hit(cc, P, body)),
+    }
+    if cc.rigid.shape[1] > 1:
+        out["rotation"] = float(sol.q[1])
+        out["moment"] = float(res[1])
+        out["eccentricity"] = float(res[1] / res[0]) if res[0] > 0 else 0.0
+    s = float(np.min(np.diff(np.unique(g.x))))
+    if body == "sphere":
+        r = np.hypot(g.x, g.y)
+        out["contact_radius"] = _fit_edge(r[P], p[P])
+        out["contact_radius_area"] = float(np.sqrt(area / np.pi))
+    elif body == "cylinder":
+        mid = np.abs(g.y) <= 1e-9 * s
+        end = np.abs(g.y - g.y.max()) <= 1e-9 * s
+        out["contact_halfwidth"] = _fit_edge(g.x[mid & P], p[mid & P])
+        out["contact_halfwidth_mid_extent"] = _row_extent(g.x[mid], P[mid], s)
+        out["contact_halfwidth_end"] = _row_extent(g.x[end], P[end], s)
+        out["p_mid_max"] = float(p[mid].max())
+        out["p_end_max"] = float(p[end].max())
+    return out
+
+
+def _zone_edge_hit(cc: CondensedContact, P: np.ndarray, body: str) -> bool:
+    """True if a node on the outer x edge (sphere: x or y edge) of the zone is in contact."""
+    if body == "flat":
+        return False
+    g = cc.grid
+    edge = np.isclose(g.x, g.x.max())
+    if body == "sphere":
+        edge |= np.isclose(g.y, g.y.max())
+    return bool(np.any(P & edge))
+
+
+def maps(cc: CondensedContact, sol: NormalSolution) -> dict:
+    """Per-node arrays of the modelled part: x, y [m], pressure [Pa], gap [m], contact."""
+    g = cc.grid
+    return {"x": g.x, "y": g.y, "pressure": sol.f / g.area, "gap": sol.g,
+            "contact": sol.active.astype(int)}

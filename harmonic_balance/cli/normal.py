@@ -1,0 +1,122 @@
+"""``damper normal``: normal contact of a sphere, cylinder or flat face on a plane.
+
+FE bodies (scikit-fem meshes), Guyan condensation onto the contact nodes (cached
+on disk), active-set normal solve (thesis Appendix A.1). Prints one JSON object
+with ``--json``; SI units.
+"""
+from __future__ import annotations
+
+import argparse
+
+from .common import atomic_write, dumps, print_json
+
+
+def register(subparsers) -> None:
+    """Add the ``normal`` subcommand."""
+    p = subparsers.add_parser(
+        "normal", help="normal contact (FE, condensation, active set): k_n, pressure, area",
+        description=__doc__, formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
+    p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
+    p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
+    p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
+    p.add_argument("--width", type=float, help="flat-face width along x [m]")
+    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
+    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
+    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
+    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
+    p.add_argument("--model", choices=("real", "halfspace"), default="real",
+                   help="real half-sphere/half-cylinder, or block on block with curvature in the gap")
+    p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
+    p.add_argument("--p-design", type=float, default=2000e6,
+                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
+    load = p.add_mutually_exclusive_group(required=True)
+    load.add_argument("--force", type=float, help="normal force [N] (force control)")
+    load.add_argument("--approach", type=float, help="imposed approach [m] (displacement control)")
+    p.add_argument("--eccentricity", type=float, default=None,
+                   help="flat face: x position of the resultant [m] (rotation about y solved)")
+    p.add_argument("--curve", type=int, default=0, help="points of an F-approach curve up to the load")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+    p.add_argument("--out", default=None, help="write the full result (with maps, curve) as JSON")
+    p.add_argument("--plot", default=None, metavar="DIR", help="write pressure map, contact area, F-approach plots")
+    p.add_argument("--no-cache", action="store_true", help="do not use the condensation cache")
+    p.add_argument("--cache-dir", default=None, help="condensation cache folder (default $DAMPER_CACHE_DIR or .damper_cache)")
+    p.add_argument("--stiffness", nargs=2, metavar=("BODY1", "BODY2"), default=None,
+                   help="bring your own bodies: stiffness matrices (.mtx or .npz), one per body")
+    p.add_argument("--nodes", nargs=2, metavar=("BODY1", "BODY2"), default=None,
+                   help="node files (.npz: coords (N,3), contact, distant[, sym_x0, sym_y0]) for --stiffness")
+    p.set_defaults(func=run)
+
+
+def _radius(args) -> float | None:
+    if args.radius is not None and args.diameter is not None:
+        raise ValueError("give --radius or --diameter, not both")
+    if args.diameter is not None:
+        return 0.5 * args.diameter
+    return args.radius
+
+
+def spec_from_args(args):
+    """A ``ContactSpec`` from the options; ValueError for missing or bad values."""
+    from contact_core.spec import ContactSpec
+
+    radius = _radius(args)
+    if args.body in ("sphere", "cylinder") and radius is None:
+        raise ValueError(f"--body {args.body} needs --radius or --diameter")
+    if args.body in ("cylinder", "flat") and args.length is None:
+        raise ValueError(f"--body {args.body} needs --length")
+    if args.body == "flat" and args.width is None:
+        raise ValueError("--body flat needs --width")
+    if args.force is not None and not args.force > 0:
+        raise ValueError(f"--force must be positive, got {args.force}")
+    if args.approach is not None and not args.approach > 0:
+        raise ValueError(f"--approach must be positive, got {args.approach}")
+    if args.curve < 0:
+        raise ValueError("--curve must be >= 0")
+    return ContactSpec(body=args.body, radius=radius or 0.0, length=args.length or 0.0,
+                       width=args.width or 0.0, E1=args.E, nu1=args.nu,
+                       E2=args.E if args.E2 is None else args.E2,
+                       nu2=args.nu if args.nu2 is None else args.nu2, model=args.model,
+                       grid=args.grid, p_design=args.p_design, load_hint=args.force or 0.0)
+
+
+def _brief(result: dict) -> dict:
+    """The JSON printed on stdout: scalars, Hertz comparison, timings (no maps)."""
+    return {k: v for k, v in result.items() if k not in ("maps", "curve")}
+
+
+def run(args) -> int:
+    """Solve one load case; print, write and plot as asked."""
+    from contact_core import api
+
+    cache = False if args.no_cache else args.cache_dir
+    if args.stiffness or args.nodes:
+        from contact_core import byo
+        result = byo.run_from_files(args, cache)
+    else:
+        spec = spec_from_args(args)
+        result = api.run_normal(spec, force=args.force, approach=args.approach,
+                                eccentricity=args.eccentricity, cache=cache,
+                                curve_points=args.curve if (args.curve or not args.plot) else 8)
+    if args.plot:
+        from contact_core.plots import plot_all
+        plot_all(result, args.body, args.plot)
+    if args.out:
+        atomic_write(args.out, dumps(result, indent=1) + "\n")
+    if args.json:
+        print_json(_brief(result))
+    else:
+        _print_text(result)
+    return 0
+
+
+def _print_text(r: dict) -> None:
+    keys = ("force", "approach", "contact_area", "contact_radius", "contact_halfwidth",
+            "contact_halfwidth_end", "p_max", "p_mean", "k_n", "body1_share", "eccentricity",
+            "iterations", "n_contact_nodes")
+    for k in keys:
+        if k in r:
+            print(f"{k:24s} {r[k]:.6g}")
+    if "hertz" in r:
+        errs = {k: v for k, v in r["hertz"].items() if k.startswith("error")}
+        print("vs Hertz: " + ", ".join(f"{k[6:]} {100 * v:+.2f} %" for k, v in errs.items()))

@@ -1,0 +1,229 @@
+"""Normal contact: FE condensation and active-set solve against Hertz and invariants."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+from scipy import optimize
+
+from contact_core import api, assembly, hertz, mesh, normal, report
+from contact_core.condense import condense
+from contact_core.spec import ContactSpec
+from harmonic_balance.cli import main as damper
+
+F_SPHERE = 200.0
+F_CYL = 350.0
+#: Contact radius and peak pressure against Hertz (issue 2): 2 %. Measured on
+#: the 21-node grid: -0.65 % and +0.6 %.
+HERTZ_RTOL = 0.02
+#: Approach against Hertz's half-space a^2/R: finite bodies are stiffer
+#: (references.md: 1-3 % for a real half-sphere); measured -1.5 to -2 %.
+APPROACH_RTOL = 0.05
+#: k_n against 2 E* a: the same finite-body stiffening; measured +2 to +3 %.
+KN_RTOL = 0.05
+#: Cylinder mid-length against 2D (plane-strain) Hertz: a finite cylinder is
+#: not in plane strain and its ends carry more than F/L (edge effect), and the
+#: 15-node grid is coarse; measured -2.0 % (half-width) and -1.4 % (p0).
+CYL_RTOL = 0.05
+#: The edge pressure peak at the cylinder's ends is well above the mid-length
+#: peak (thesis Fig. 9: ~3x on a fine grid; 1.8x measured on 15 nodes).
+EDGE_PEAK_RATIO = 1.3
+#: k_t / k_n of a stuck rigid patch on like half-spaces: 4 G*/E* = 2(1-nu)/(2-nu)
+#: (Mindlin); the coarse 9-node grid and finite blocks give +0.9 %.
+KT_KN_RTOL = 0.03
+#: Stiffness matrix against scikit-fem: same quadrature, so round-off only.
+ASSEMBLY_RTOL = 1e-10
+#: Seeds of the random LCP instances, written out.
+LCP_SEEDS = (20261122, 31415926, 27182818)
+
+
+@pytest.mark.parametrize("name", ["sphere_real", "sphere_halfspace"])
+def test_sphere_matches_hertz(condensed, specs, name):
+    cc = condensed(name)
+    sol = normal.solve_force(cc, F_SPHERE)
+    out = report.summarize(cc, sol, "sphere")
+    ref = hertz.sphere(F_SPHERE, specs[name].radius, specs[name].Estar)
+    assert out["contact_radius"] == pytest.approx(ref["a"], rel=HERTZ_RTOL)
+    assert out["p_max"] == pytest.approx(ref["p0"], rel=HERTZ_RTOL)
+    assert out["approach"] == pytest.approx(ref["approach"], rel=APPROACH_RTOL)
+    assert out["k_n"] == pytest.approx(2 * specs[name].Estar * out["contact_radius"], rel=KN_RTOL)
+    assert out["iterations"] >= 1 and not out["zone_edge_in_contact"]
+
+
+def test_solution_is_in_equilibrium_without_tension_or_penetration(condensed):
+    cc = condensed("sphere_real")
+    sol = normal.solve_force(cc, F_SPHERE)
+    tol = normal.GAP_RTOL * np.max(np.abs(cc.grid.h - sol.q[0]))
+    assert np.sum(cc.grid.mult * sol.f) == pytest.approx(F_SPHERE, rel=normal.FORCE_RTOL)
+    assert np.all(sol.f >= 0)                        # no tension
+    assert np.all(sol.g >= -tol)                     # no penetration
+    assert np.all(sol.f[~sol.active] == 0)
+    assert np.all(np.abs(sol.g[sol.active]) <= tol)  # complementarity
+    # the gap is the one of the data contract
+    assert np.allclose(sol.g, cc.grid.h - cc.rigid @ sol.q + cc.Czz @ sol.f, atol=tol)
+
+
+def test_force_and_displacement_control_agree(condensed):
+    cc = condensed("sphere_halfspace")
+    sol_f = normal.solve_force(cc, 123.0)
+    assert sol_f.newton >= 1
+    sol_d = normal.solve_displacement(cc, sol_f.q[0])
+    assert normal.resultants(cc, sol_d.f)[0] == pytest.approx(123.0, rel=1e-8)
+    assert np.array_equal(sol_d.active, sol_f.active)
+
+
+def test_k_n_is_the_derivative_of_force_by_approach(condensed):
+    cc = condensed("sphere_real")
+    sol = normal.solve_force(cc, F_SPHERE)
+    k_n = normal.tangent(cc, sol.active)[0, 0]
+    d, eps = sol.q[0], 1e-7 * sol.q[0]
+    Fp = normal.resultants(cc, normal.solve_displacement(cc, d + eps).f)[0]
+    Fm = normal.resultants(cc, normal.solve_displacement(cc, d - eps).f)[0]
+    assert (Fp - Fm) / (2 * eps) == pytest.approx(k_n, rel=1e-6)
+
+
+def test_cylinder_mid_length_matches_2d_hertz_with_edge_peak(condensed, specs):
+    cc = condensed("cylinder_real")
+    out = report.summarize(cc, normal.solve_force(cc, F_CYL), "cylinder")
+    spec = specs["cylinder_real"]
+    ref = hertz.cylinder(F_CYL, spec.length, spec.radius, spec.Estar)
+    assert out["contact_halfwidth"] == pytest.approx(ref["b"], rel=CYL_RTOL)
+    assert out["p_mid_max"] == pytest.approx(ref["p0"], rel=CYL_RTOL)
+    assert out["p_end_max"] > EDGE_PEAK_RATIO * out["p_mid_max"]
+    assert out["contact_halfwidth_end"] >= out["contact_halfwidth_mid_extent"]  # widens (thesis Fig. 5)
+    assert 0.2 < out["body1_share"] < 0.8
+
+
+def test_flat_face_meets_force_and_eccentricity(condensed, specs):
+    cc = condensed("flat")
+    width = specs["flat"].width
+    for e in (0.0, 1e-4, 0.4 * width):
+        sol = normal.solve_force(cc, 500.0, e)
+        F, M = normal.resultants(cc, sol.f)
+        assert F == pytest.approx(500.0, rel=1e-8)
+        assert M == pytest.approx(500.0 * e, abs=1e-8 * 500.0 * width)
+        if e:
+            assert np.sign(sol.q[1]) == np.sign(e)  # the face tilts towards the resultant
+    assert not sol.active.all()  # a large eccentricity lifts the heel of the face
+    # the centred load is symmetric in x
+    sol = normal.solve_force(cc, 500.0, 0.0)
+    mirror = np.lexsort((cc.grid.y, -cc.grid.x))
+    order = np.lexsort((cc.grid.y, cc.grid.x))
+    assert np.allclose(sol.f[order], sol.f[mirror], rtol=1e-6, atol=1e-12 * sol.f.max())
+
+
+def _random_lcp(seed, n=60):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    C = A @ A.T / n + 0.05 * np.eye(n)
+    b = rng.standard_normal(n)
+    return C, b
+
+
+@pytest.mark.parametrize("seed", LCP_SEEDS)
+def test_lcp_matches_nnls_oracle(seed):
+    C, b = _random_lcp(seed)
+    f, active, it = normal.lcp(C, b)
+    # min 1/2 f'Cf + b'f, f >= 0  ==  min |L'f + L^-1 b|, f >= 0 with C = L L'
+    L = np.linalg.cholesky(C)
+    f_ref, _ = optimize.nnls(L.T, -sla.solve_triangular(L, b, lower=True))
+    assert np.allclose(f, f_ref, atol=1e-9 * np.abs(f_ref).max())
+    assert it >= 1 and np.all(f[~active] == 0) and np.all(f[active] > 0)
+
+
+def test_lcp_reports_non_convergence():
+    C, b = _random_lcp(LCP_SEEDS[0])
+    with pytest.raises(RuntimeError, match="did not converge"):
+        normal.lcp(C, b, P0=np.zeros(b.size, bool), max_iter=1)
+
+
+def test_tangential_compliance_has_mindlin_stiffness_ratio(contact_cache):
+    spec = ContactSpec(body="sphere", model="halfspace", grid=9)
+    cc = condense(spec, directions=("x",), cache=contact_cache)
+    assert cc.Cxx is not None and np.allclose(cc.Cxx, cc.Cxx.T)
+    r = np.hypot(cc.grid.x, cc.grid.y)
+    P = r < 0.55 * r.max()
+    m = cc.grid.mult[P]
+    k_n = m @ np.linalg.solve(cc.Czz[np.ix_(P, P)], np.ones(P.sum()))
+    k_t = m @ np.linalg.solve(cc.Cxx[np.ix_(P, P)], np.ones(P.sum()))
+    nu = spec.nu1
+    assert k_t / k_n == pytest.approx(2 * (1 - nu) / (2 - nu), rel=KT_KN_RTOL)
+
+
+def test_cache_returns_identical_results(contact_cache):
+    spec = ContactSpec(body="sphere", model="halfspace", grid=5)
+    first = condense(spec, cache=contact_cache)
+    again = condense(spec, cache=contact_cache)
+    assert again.meta["cache"]["hit"] and again.meta["cache"]["key"] == first.meta["cache"]["key"]
+    assert np.array_equal(first.Czz, again.Czz) and np.array_equal(first.grid.h, again.grid.h)
+    fresh = condense(spec, cache=False)
+    assert not fresh.meta["cache"]["hit"]
+    assert np.allclose(fresh.Czz, first.Czz, rtol=1e-12, atol=0)
+    other = condense(ContactSpec(body="sphere", model="halfspace", grid=5, E2=100e9), cache=contact_cache)
+    assert other.meta["cache"]["key"] != first.meta["cache"]["key"]
+
+
+def test_scipy_fallback_equals_default_solver(monkeypatch):
+    spec = ContactSpec(body="sphere", model="real", grid=5)
+    default = condense(spec, cache=False)
+    monkeypatch.setenv("DAMPER_SOLVER", "scipy")
+    fallback = condense(spec, cache=False)
+    assert fallback.meta["solver"] == "superlu"
+    assert np.allclose(fallback.Czz, default.Czz, rtol=1e-9, atol=0)
+
+
+def test_assembly_matches_scikit_fem():
+    from skfem import Basis, ElementHex1, ElementVector, MeshHex, asm
+    from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    b1, _, _ = mesh.build(ContactSpec(body="sphere", model="real", grid=5))  # mapped, distorted
+    K = assembly.stiffness(b1.p, b1.t, 210e9, 0.28)
+    basis = Basis(MeshHex(b1.p, b1.t), ElementVector(ElementHex1()), intorder=3)
+    K_ref = asm(linear_elasticity(*lame_parameters(210e9, 0.28)), basis)
+    n = b1.p.shape[1]
+    perm = np.empty(3 * n, dtype=int)
+    perm[(3 * np.arange(n)[None, :] + np.arange(3)[:, None]).ravel()] = basis.nodal_dofs.ravel()
+    diff = abs(K - K_ref[perm][:, perm]).max()
+    assert diff <= ASSEMBLY_RTOL * abs(K).max()
+
+
+def test_cli_json_has_the_interface_keys(tmp_path, capsys):
+    rc = damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "200", "--grid", "5",
+                 "--model", "halfspace", "--json", "--cache-dir", str(tmp_path)])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("force", "approach", "contact_area", "p_max", "p_mean", "k_n", "iterations",
+                "n_contact_nodes", "contact_radius"):
+        assert key in out and np.isfinite(out[key])
+    assert out["force"] == pytest.approx(200.0, rel=1e-8)
+
+
+BAD_INPUT = [
+    ["--body", "sphere", "--radius", "0.01", "--force", "200", "--nu", "0.5"],
+    ["--body", "sphere", "--radius", "0.01", "--force", "200", "--E", "0"],
+    ["--body", "sphere", "--radius", "-0.01", "--force", "200"],
+    ["--body", "sphere", "--radius", "0.01", "--force", "200", "--grid", "2"],
+    ["--body", "sphere", "--radius", "0.01", "--force", "0"],
+    ["--body", "sphere", "--radius", "0.01", "--force", "-5"],
+    ["--body", "cylinder", "--diameter", "5e-3", "--force", "350"],
+    ["--body", "flat", "--width", "1.2e-3", "--length", "5e-3", "--force", "500", "--eccentricity", "7e-4"],
+    ["--body", "sphere", "--radius", "0.01", "--force", "200", "--E2", "-1"],
+]
+
+
+@pytest.mark.parametrize("argv", BAD_INPUT)
+def test_bad_input_exits_2_with_a_message(argv, tmp_path, capsys):
+    out_file = tmp_path / "r.json"
+    rc = damper(["normal", *argv, "--no-cache", "--out", str(out_file)])
+    assert rc == 2
+    assert "error:" in capsys.readouterr().err
+    assert not out_file.exists()
+
+
+def test_run_normal_reports_hertz_errors(contact_cache):
+    spec = ContactSpec(body="sphere", model="halfspace", grid=5)
+    out = api.run_normal(spec, approach=4e-6, cache=contact_cache, curve_points=3)
+    assert out["approach"] == 4e-6 and len(out["curve"]["force"]) == 3
+    assert set(out["hertz"]) >= {"error_size", "error_p0", "error_approach", "error_k_n"}
