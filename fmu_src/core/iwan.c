@@ -364,55 +364,72 @@ iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, doub
 
 /* ------------------------------------------------------------- time series */
 
-/* One sweep of samples at constant committed N > 0. For constant N the exact
- * update reduces to the play operator z <- clamp(z, u - r, u + r), and the
- * friction work to g |dz|. `up` is a compile-time constant after inlining, so
- * the slip test has no branch on the direction. */
-static inline void sweep_const(const iwan_model *m, double *z, const double *r,
-                               const double *g, double u, int up, double *F, double *kslip,
-                               double *fslip, double *dw)
-{
-    double Fa = 0.0, ks = 0.0, fsl = 0.0, w = 0.0;
-    for (int32_t j = 0; j < m->n; ++j) {
-        const double z0 = z[j], lo = u - r[j], hi = u + r[j];
-        double zn = z0 < lo ? lo : z0;
-        zn = zn > hi ? hi : zn;
-        w += g[j] * fabs(zn - z0);
-        z[j] = zn;
-        Fa += m->k[j] * (u - zn);
-        const int slipping = up ? zn <= lo : zn >= hi;
-        ks += slipping ? m->k[j] : 0.0;
-        fsl += slipping ? m->fs[j] : 0.0;
+/* One sample at constant committed N > 0 for every slider. For constant N the
+ * exact update reduces to the play operator z <- clamp(z, u - r, u + r) and the
+ * friction work to g |dz|. Moving up (u >= previous u), z <= u + r
+ * holds already, so only the lower bound can bind: z <- max(z, u - r), and the
+ * slider slips iff it binds (mirror for down). Two partial sums per quantity
+ * shorten the add-latency chains.
+ * acc = {sum k (u - z), sum of k over sticking, sum of fs over slipping, work}. */
+/* Body of one slider update in lane L (written once, expanded for both
+ * directions and both lanes so that -O2 needs no unrolling or inlining). */
+#define SWEEP_SLIDER(J, L, BOUND, SLIPS, WORK)                                   \
+    do {                                                                        \
+        const double z0 = z[J], bound = (BOUND);                                \
+        const int slipping = (SLIPS);                                           \
+        const double zn = slipping ? bound : z0;                                \
+        w##L += g[J] * (WORK);                                                  \
+        z[J] = zn;                                                              \
+        Fa##L += k[J] * (u - zn);                                               \
+        ks##L += slipping ? 0.0 : k[J];                                         \
+        fsl##L += slipping ? fs[J] : 0.0;                                       \
+    } while (0)
+
+#define SWEEP_FUNCTION(NAME, BOUND, SLIPS, WORK)                                \
+    static void NAME(int32_t n, double *restrict z, const double *restrict r,  \
+                     const double *restrict g, const double *restrict k,        \
+                     const double *restrict fs, double u, double acc[4])        \
+    {                                                                           \
+        double Fa0 = 0.0, Fa1 = 0.0, ks0 = 0.0, ks1 = 0.0;                      \
+        double fsl0 = 0.0, fsl1 = 0.0, w0 = 0.0, w1 = 0.0;                      \
+        int32_t j = 0;                                                          \
+        for (; j + 1 < n; j += 2) {                                             \
+            SWEEP_SLIDER(j, 0, BOUND(j), SLIPS, WORK);                          \
+            SWEEP_SLIDER(j + 1, 1, BOUND(j + 1), SLIPS, WORK);                  \
+        }                                                                       \
+        if (j < n) SWEEP_SLIDER(j, 0, BOUND(j), SLIPS, WORK);                   \
+        acc[0] = Fa0 + Fa1;                                                     \
+        acc[1] = ks0 + ks1;                                                     \
+        acc[2] = fsl0 + fsl1;                                                   \
+        acc[3] = w0 + w1;                                                       \
     }
-    *F = Fa;
-    *kslip = ks;
-    *fslip = fsl;
-    *dw = w;
-}
+
+#define BOUND_UP(J) (u - r[J])
+#define BOUND_DOWN(J) (u + r[J])
+SWEEP_FUNCTION(sweep_up, BOUND_UP, z0 <= bound, zn - z0)
+SWEEP_FUNCTION(sweep_down, BOUND_DOWN, z0 >= bound, z0 - zn)
 
 static void run_const(const iwan_model *m, iwan_state *s, size_t n, const double *u,
                       double *F, double *kt, double *dFdN, double *W)
 {
     double r[IWAN_MAX_SLIDERS], g[IWAN_MAX_SLIDERS];
     const double f = strength_factor(m, s->N), dgdN = m->scale / m->n_ref;
-    double ktot = m->k_res;
     for (int32_t j = 0; j < m->n; ++j) {
         r[j] = m->fs[j] * f / m->k[j];   /* same expression as outputs(): same limits */
         g[j] = m->fs[j] * f;
-        ktot += m->k[j];
     }
     for (size_t i = 0; i < n; ++i) {
         const double ui = u[i];
-        double Fs, ks, fsl, dw;
+        double acc[4];
         if (ui > s->u) s->dir = 1.0;
         else if (ui < s->u) s->dir = -1.0;
-        if (s->dir > 0.0) sweep_const(m, s->z, r, g, ui, 1, &Fs, &ks, &fsl, &dw);
-        else sweep_const(m, s->z, r, g, ui, 0, &Fs, &ks, &fsl, &dw);
+        if (s->dir > 0.0) sweep_up(m->n, s->z, r, g, m->k, m->fs, ui, acc);
+        else sweep_down(m->n, s->z, r, g, m->k, m->fs, ui, acc);
         s->u = ui;
-        s->w_diss += dw;
-        if (F) F[i] = Fs + m->k_res * (ui - s->u_contact);
-        if (kt) kt[i] = ktot - ks;
-        if (dFdN) dFdN[i] = s->dir * fsl * dgdN;
+        s->w_diss += acc[3];
+        if (F) F[i] = acc[0] + m->k_res * (ui - s->u_contact);
+        if (kt) kt[i] = m->k_res + acc[1];
+        if (dFdN) dFdN[i] = s->dir * acc[2] * dgdN;
         if (W) W[i] = s->w_diss;
     }
 }
