@@ -1,0 +1,26 @@
+"""Smoke test of examples/bench_element.py (tiny sizes; never gates on wall time)."""
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+BENCH = Path(__file__).resolve().parents[2] / "examples" / "bench_element.py"
+
+
+def load_bench():
+    spec = importlib.util.spec_from_file_location("bench_element", BENCH)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_bench_element_runs_and_its_numbers_agree(capsys):
+    bench = load_bench()
+    rows = bench.run([1, 5], n_samples=300, repeats=2)
+    assert [r["sliders"] for r in rows] == [1, 5]
+    for r in rows:
+        assert r["c_ns_sample"] > 0 and r["py_ns_sample"] > 0
+        assert r["diff"] < 1e-12           # same C code on both paths: round-off only
+        assert r["masing_err"] < 1e-12     # loop energy vs Masing's integral, exact for a table
+    assert bench.main(["--sizes", "2", "--samples", "100", "--repeats", "1"]) == 0
+    assert "ns/slider" in capsys.readouterr().out
