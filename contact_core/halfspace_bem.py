@@ -105,6 +105,37 @@ def _rect_x2_rho3(X1, X2, Y1, Y2):
     return _corner_sum(lambda X, Y: _xlog(Y, X), X1, X2, Y1, Y2)
 
 
+def offset_kernels(grid: HalfspaceGrid) -> tuple[np.ndarray, np.ndarray]:
+    """Kernel integrals over one cell for every index offset between nodes.
+
+    Returns
+    -------
+    k1, k2 : ndarray, shape (2 ny - 1, 2 nx - 1)
+        ``k[dy + ny - 1, dx + nx - 1]``: integral of 1/rho (k1) and of
+        X^2/rho^3 (k2) over a cell seen from a node ``dx`` cells along x and
+        ``dy`` along y away [m].
+    """
+    ox = np.arange(-(grid.nx - 1), grid.nx) * grid.dx
+    oy = np.arange(-(grid.ny - 1), grid.ny) * grid.dy
+    OX, OY = np.meshgrid(ox, oy, indexing="xy")
+    hx, hy = 0.5 * grid.dx, 0.5 * grid.dy
+    return (_rect_inv_rho(OX - hx, OX + hx, OY - hy, OY + hy),
+            _rect_x2_rho3(OX - hx, OX + hx, OY - hy, OY + hy))
+
+
+def toeplitz(k: np.ndarray, grid: HalfspaceGrid) -> np.ndarray:
+    """The (n, n) block-Toeplitz matrix ``M[i, j] = k[offset(i, j)]`` (node i, cell j).
+
+    Gathered block-wise (an (nx, nx) Toeplitz block per y offset), so no (n, n)
+    index array is ever formed.
+    """
+    nx, ny = grid.nx, grid.ny
+    ix, iy = np.arange(nx), np.arange(ny)
+    blocks = k[:, ix[:, None] - ix[None, :] + nx - 1]          # (2 ny - 1, nx, nx)
+    full = blocks[iy[:, None] - iy[None, :] + ny - 1]           # (ny, ny, nx, nx)
+    return full.transpose(0, 2, 1, 3).reshape(nx * ny, nx * ny)
+
+
 def cell_integrals(grid: HalfspaceGrid) -> tuple[np.ndarray, np.ndarray]:
     """Kernel integrals between every node i and every cell j.
 
@@ -113,22 +144,9 @@ def cell_integrals(grid: HalfspaceGrid) -> tuple[np.ndarray, np.ndarray]:
     I1, I2 : ndarray, shape (n, n)
         ``I1[i, j]`` = integral over cell j of 1/rho, ``I2[i, j]`` of
         X^2/rho^3, with (X, Y) the vector from the source point to node i [m].
-    Notes
-    -----
-    The grid is regular, so each integral depends only on the index offset:
-    it is evaluated once per offset (block-Toeplitz) and gathered.
     """
-    ox = np.arange(-(grid.nx - 1), grid.nx) * grid.dx
-    oy = np.arange(-(grid.ny - 1), grid.ny) * grid.dy
-    OX, OY = np.meshgrid(ox, oy, indexing="xy")
-    hx, hy = 0.5 * grid.dx, 0.5 * grid.dy
-    k1 = _rect_inv_rho(OX - hx, OX + hx, OY - hy, OY + hy)
-    k2 = _rect_x2_rho3(OX - hx, OX + hx, OY - hy, OY + hy)
-    ix = np.tile(np.arange(grid.nx), grid.ny)
-    iy = np.repeat(np.arange(grid.ny), grid.nx)
-    di = ix[:, None] - ix[None, :] + grid.nx - 1
-    dj = iy[:, None] - iy[None, :] + grid.ny - 1
-    return k1[dj, di], k2[dj, di]
+    k1, k2 = offset_kernels(grid)
+    return toeplitz(k1, grid), toeplitz(k2, grid)
 
 
 def body_compliances(I1, I2, area, E: float, nu: float) -> tuple[np.ndarray, np.ndarray]:
@@ -142,8 +160,10 @@ def body_compliances(I1, I2, area, E: float, nu: float) -> tuple[np.ndarray, np.
     if not (np.isfinite(nu) and -1.0 < nu < 0.5):
         raise ValueError(f"halfspace: Poisson's ratio must be in (-1, 0.5), got {nu}")
     G = E / (2.0 * (1.0 + nu))
-    Czz = (1.0 - nu**2) / (np.pi * E) * I1 / area[None, :]
-    Cxx = ((1.0 - nu) * I1 + nu * I2) / (2.0 * np.pi * G) / area[None, :]
+    area = np.asarray(area, float)
+    per_cell = area[None, :] if area.ndim == 1 else area  # scalar for offset kernels
+    Czz = (1.0 - nu**2) / (np.pi * E) * I1 / per_cell
+    Cxx = ((1.0 - nu) * I1 + nu * I2) / (2.0 * np.pi * G) / per_cell
     return Czz, Cxx
 
 
@@ -182,10 +202,18 @@ def condense_grid(grid: HalfspaceGrid, h: np.ndarray, materials=(STEEL, STEEL),
     from contact_core.condensed import CondensedContact, ContactGrid
 
     area = grid.area
-    I1, I2 = cell_integrals(grid)
+    k1, k2 = offset_kernels(grid)
     (E1, nu1), (E2, nu2) = materials
-    z1, x1 = body_compliances(I1, I2, area, E1, nu1)
-    z2, x2 = body_compliances(I1, I2, area, E2, nu2)
+    # compliances are linear in the kernels: combine on the small offset
+    # arrays, gather each distinct (n, n) matrix once; like bodies share theirs
+    kz1, kx1 = body_compliances(k1, k2, grid.dx * grid.dy, E1, nu1)
+    kz2, kx2 = body_compliances(k1, k2, grid.dx * grid.dy, E2, nu2)
+    same = (E1, nu1) == (E2, nu2)
+    tangential = "x" in directions
+    z1 = toeplitz(kz1, grid)
+    z2 = z1 if same else toeplitz(kz2, grid)
+    x1 = toeplitz(kx1, grid) if tangential else None
+    x2 = x1 if same or not tangential else toeplitz(kx2, grid)
     n = grid.x.size
     cgrid = ContactGrid(x=grid.x, y=grid.y, area=area, mult=np.ones(n),
                         h=np.asarray(h, float), copies=np.ones(n, dtype=int))
@@ -193,7 +221,9 @@ def condense_grid(grid: HalfspaceGrid, h: np.ndarray, materials=(STEEL, STEEL),
             "grid": {"nx": grid.nx, "ny": grid.ny, "dx": grid.dx, "dy": grid.dy,
                      "symmetry": "none"}}
     info.update(meta or {})
-    tangential = "x" in directions
+    for m in (z1, z2, x1, x2):  # shared between bodies: keep them unmodifiable
+        if m is not None:
+            m.setflags(write=False)
     return CondensedContact(grid=cgrid, Czz=z1 + z2, rigid=np.ones((n, 1)), Czz_bodies=(z1, z2),
                             Cxx=(x1 + x2) if tangential else None,
                             Cxx_bodies=(x1, x2) if tangential else None, meta=info)

@@ -91,3 +91,17 @@ def test_bad_material_is_refused():
     I1, I2 = hb.cell_integrals(grid)
     with pytest.raises(ValueError, match="Poisson"):
         hb.body_compliances(I1, I2, grid.area, E, 0.5)
+
+
+def test_dissimilar_bodies_add_their_compliances():
+    """Each body keeps its own compliance; the pair's is their sum (1/E* rule)."""
+    mats = ((200e9, 0.3), (110e9, 0.34))
+    contact = hb.sphere(0.01, 1e-4, 7, materials=mats)
+    like = hb.sphere(0.01, 1e-4, 7)
+    C1, C2 = contact.Czz_bodies
+    assert C1 is not C2
+    np.testing.assert_allclose(contact.Czz, C1 + C2, rtol=1e-14)
+    # normal compliance scales with (1 - nu^2) / E of each body
+    ratio = ((1 - 0.34**2) / 110e9) / ((1 - 0.3**2) / 200e9)
+    np.testing.assert_allclose(C2, ratio * C1, rtol=1e-12)
+    np.testing.assert_allclose(C1, like.Czz_bodies[0], rtol=1e-14)
