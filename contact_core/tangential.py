@@ -241,15 +241,17 @@ def _active_set(K, b, bound, q0, u_scale):
     q = np.clip(q0, -bound, bound)
     g = K @ q - b
     gtol = SOLVE_TOL * u_scale  # g = W (C q - r): weighted slip increment [m]
+    F, cho = None, None
     for it in range(1, MAX_ITER + 1):
         free = _kkt_free(q, g, bound, gtol)
-        if free is not None:
-            return q, it - 1, free, None
+        if free is not None:  # reuse the last factor if it is the stick set's
+            same = F is not None and np.array_equal(F, free)
+            return q, it - 1, free, cho if same else None
         pg = np.abs(q - np.clip(q - dinv * g, -bound, bound))
         eps = min(1e-3 * bound.max(), float(pg.max()))
         held = ((q <= -bound + eps) & (g > 0)) | ((q >= bound - eps) & (g < 0))
         step = -dinv * g
-        F = ~held
+        F, cho = ~held, None
         if F.any():
             cho = linalg.cho_factor(K[np.ix_(F, F)])
             step[F] = -linalg.cho_solve(cho, g[F])
