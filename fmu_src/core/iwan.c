@@ -34,6 +34,9 @@
  * previous one by this fraction of the largest slope (round-off in slopes of
  * collinear points computed from a curve), not more. */
 #define IWAN_CONCAVE_RTOL 1e-9
+/* Slopes equal to this relative precision count as one segment (round-off of
+ * slopes computed from nearly equal differences). */
+#define IWAN_COLLINEAR_RTOL 1e-12
 
 /* Anchor codes for the exact periodic Jacobian (see iwan_periodic_jac). A slider
  * stuck since sample a (>= 0) has force k (u(t) - u(a)) + sg * g(N(aN)). */
@@ -116,17 +119,21 @@ static iwan_status slopes_check(const double *u, const double *T, size_t m, iwan
     return IWAN_OK;
 }
 
-/* Largest slope from point i to any later point (upper-hull edge by gift
- * wrapping, O(m) per vertex and no scratch memory); *next = farthest point
- * attaining it, so collinear points are dropped. */
+/* Upper-hull edge from point i by gift wrapping (O(m) per vertex, no scratch
+ * memory): the largest slope to any later point, taken to the farthest point
+ * whose slope equals it to IWAN_COLLINEAR_RTOL, so that points collinear up to
+ * round-off are merged instead of becoming sliders of stiffness ~1e-16 k. */
 static double hull_edge(const double *u, const double *T, size_t m, size_t i, size_t *next)
 {
     double best = -INFINITY;
     for (size_t j = i + 1; j < m; ++j) {
-        double s = (T[j] - T[i]) / (u[j] - u[i]);
-        if (s >= best) { best = s; *next = j; }
+        const double s = (T[j] - T[i]) / (u[j] - u[i]);
+        if (s > best) best = s;
     }
-    return best;
+    const double floor = best - IWAN_COLLINEAR_RTOL * fabs(best);
+    for (size_t j = i + 1; j < m; ++j)
+        if ((T[j] - T[i]) / (u[j] - u[i]) >= floor) *next = j;
+    return (T[*next] - T[i]) / (u[*next] - u[i]);
 }
 
 /* Sliders of the least concave non-decreasing majorant of the table: its upper

@@ -76,6 +76,10 @@ typedef struct {
     double W;      /* cumulative dissipated energy [J] */
     double E;      /* stored elastic energy [J] */
     double slip;   /* slip fraction: slipping strength / total strength, in [0, 1] */
+    /* "Slipping" = at its slip limit on the side of `dir` (it slips on continued
+     * motion in that direction): such a slider adds 0 to kt and +-fs*scale/n_ref to
+     * dFdN (the derivative when N decreases; when N grows it sticks). After lift-off
+     * F = kt = dFdN = E = 0 and slip = 1 (also slip = 1 if the total strength is 0). */
 } iwan_output;
 
 /* Curve-table handling for iwan_model_init. */
@@ -86,7 +90,12 @@ typedef enum {
 
 /* Build a model from a virgin-curve table u[0..m-1], T[0..m-1], u[0] = T[0] = 0,
  * u strictly increasing. The last segment's slope continues as the residual spring
- * unless the table ends flat (gross slip). */
+ * unless the table ends flat (gross slip). IWAN_FIT_REJECT accepts slope increases
+ * up to 1e-9 of the largest slope (round-off of collinear points) and refuses a
+ * decreasing T (IWAN_ERR_BAD_TABLE); IWAN_FIT_CONCAVE takes the least concave
+ * non-decreasing majorant (upper hull, flat after the largest T). Collinear points
+ * are merged; more than IWAN_MAX_SLIDERS slope changes is IWAN_ERR_BAD_TABLE.
+ * model->scale is set to 1 (change it afterwards to scale every slip strength). */
 iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T, size_t m,
                             double n_ref, iwan_fit fit);
 
@@ -118,7 +127,14 @@ iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
  * is exact in one pass (the sweep starts at the maximum of u); otherwise periods are
  * repeated until the loop closes to `tol` (relative to the force range), at most
  * `max_periods`. Outputs per sample; W_cycle = energy dissipated per period [J];
- * periods_used may be NULL. */
+ * periods_used may be NULL.
+ * Static-state convention (sliders that never slip are not fixed by the loop): the
+ * element is virgin at u = 0 (residual spring at rest there) and each slider is
+ * shifted by the least amount that keeps it between its limits over the loop,
+ * z_j = clamp(0, M - r_j, m + r_j) at the maximum M (minimum m) of u; a slider
+ * with M - m >= 2 r_j slips every cycle and z_j = M - r_j. Closure check: the state
+ * at the sweep start recurs to tol * (force range) in sum_j k_j |dz_j| + k_res |du_c|.
+ * On IWAN_ERR_NOT_CONVERGED the outputs hold the last (unconverged) period. */
 iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, const double *N,
                           double *F, double *kt, double *dFdN, double *W_cycle,
                           int max_periods, double tol, int *periods_used);
@@ -127,7 +143,12 @@ iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, co
  * u[t] = sum_c Eu[t*nb + c] X[c] (and N[t] = sum_c EN[t*nb + c] XN[c] when EN != NULL).
  * Writes dFdX[t*nb + c] = dF[t]/dX[c], including the dependence of every sticking
  * slider on the sample where it last stuck (its reversal point), and, when EN and
- * dFdXN are not NULL, dFdXN[t*nb + c] = dF[t]/dXN[c]. Same F, W_cycle as iwan_periodic. */
+ * dFdXN are not NULL, dFdXN[t*nb + c] = dF[t]/dXN[c]. Same F, W_cycle as iwan_periodic
+ * (to round-off). A slider stuck since sample a has F_j = k_j (u(t) - u(a)) +- g_j(N(a)),
+ * one stuck since re-contact depends on the re-contact point of the straight path,
+ * one that slipped into t has F_j = +-g_j(N(t)); the derivative is one-sided where a
+ * slider sits exactly on a switch. With varying N, periods_used counts the closure
+ * periods plus the final pass. Eu, EN are row-major (n, nb). */
 iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
                               const double *Eu, const double *EN, size_t nb,
                               double *F, double *dFdX, double *dFdXN, double *W_cycle,
