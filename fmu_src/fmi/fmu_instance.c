@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -157,18 +158,35 @@ static fmu_status ensure_model(fmu_instance *inst)
     return FMU_OK;
 }
 
-/* Outputs at the current inputs (trial from the committed state), cached. */
+static int outputs_finite(const iwan_output *o)
+{
+    return isfinite(o->F) && isfinite(o->kt) && isfinite(o->dFdN) && isfinite(o->W)
+           && isfinite(o->slip);
+}
+
+/* Outputs at the current inputs (trial from the committed state), cached. Finite
+ * inputs so large that a force or energy overflows are refused, not passed on. */
 static fmu_status ensure_outputs(fmu_instance *inst)
 {
     iwan_status st;
     if (ensure_model(inst) != FMU_OK) return FMU_ERROR;
     if (inst->out_valid) return FMU_OK;
     st = model_eval(inst, inst->s.value[VR_U], inst->s.value[VR_N], &inst->out);
+    if (st == IWAN_OK && !outputs_finite(&inst->out)) st = IWAN_ERR_NONFINITE;
     if (st != IWAN_OK)
         return fmu_log(inst, FMU_ERROR, "evaluating the element at u = %g m, N = %g N: %s",
-                       inst->s.value[VR_U], inst->s.value[VR_N], iwan_status_text(st));
+                       inst->s.value[VR_U], inst->s.value[VR_N],
+                       st == IWAN_ERR_NONFINITE ? "outputs overflow (inputs too large)"
+                                                : iwan_status_text(st));
     inst->out_valid = 1;
     return FMU_OK;
+}
+
+/* Copy the part of a state an n-slider model uses: header, z[0..n-1], dir. */
+static void copy_state(iwan_state *dst, const iwan_state *src, int32_t n)
+{
+    memcpy(dst, src, offsetof(iwan_state, z) + (size_t)n * sizeof(double));
+    dst->dir = src->dir;
 }
 
 fmu_status fmu_enter_init(fmu_instance *inst, double start_time)
@@ -275,7 +293,8 @@ fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double 
 }
 
 /* Commit the history to the current inputs, then along their straight lines to
- * time + h (FMI 2 input derivatives); the core's straight-path update is exact. */
+ * time + h (FMI 2 input derivatives); the core's straight-path update is exact.
+ * All or nothing: a failed or overflowing update leaves the history as it was. */
 fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
 {
     double u = inst->s.value[VR_U], N = inst->s.value[VR_N];
@@ -290,15 +309,21 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     if (!isfinite(u + du) || !isfinite(N + dN))
         return fmu_log(inst, FMU_ERROR, "DoStep: extrapolated inputs overflow");
     if (ensure_model(inst) != FMU_OK) return FMU_ERROR;
+    copy_state(&inst->backup, &inst->s.committed, inst->model.n);
     st = model_commit(inst, u, N, &inst->out);
-    if (st == IWAN_OK && (du != 0.0 || dN != 0.0)) {
+    if (st == IWAN_OK && (du != 0.0 || dN != 0.0))
         st = model_commit(inst, u + du, N + dN, &inst->out);
-        inst->s.value[VR_U] = u + du;
-        inst->s.value[VR_N] = N + dN;
+    if (st == IWAN_OK && !outputs_finite(&inst->out)) st = IWAN_ERR_NONFINITE;
+    if (st != IWAN_OK) {
+        copy_state(&inst->s.committed, &inst->backup, inst->model.n);
+        inst->out_valid = 0;
+        return fmu_log(inst, FMU_ERROR, "DoStep to u = %g m, N = %g N refused: %s", u + du,
+                       N + dN, st == IWAN_ERR_NONFINITE ? "outputs overflow (inputs too large)"
+                                                        : iwan_status_text(st));
     }
-    inst->out_valid = (st == IWAN_OK);
-    if (st != IWAN_OK)
-        return fmu_log(inst, FMU_ERROR, "DoStep: %s", iwan_status_text(st));
+    inst->s.value[VR_U] = u + du;
+    inst->s.value[VR_N] = N + dN;
+    inst->out_valid = 1;
     inst->s.time = t + h;
     return FMU_OK;
 }
@@ -362,11 +387,17 @@ fmu_status fmu_state_set(fmu_instance *inst, const void *state)
     memcpy(&tmp, state, sizeof tmp);
     if (!state_valid(&tmp)) return fmu_log(inst, FMU_ERROR, "SetFMUState: not a state of "
                                            "this FMU (magic or version differ)");
-    if (tmp.value[VR_SCALE] != inst->s.value[VR_SCALE]
-        || tmp.value[VR_N_REF] != inst->s.value[VR_N_REF])
-        inst->model_ready = 0;
-    inst->s = tmp;
     inst->out_valid = 0;
+    if (inst->model_ready && tmp.value[VR_SCALE] == inst->s.value[VR_SCALE]
+        && tmp.value[VR_N_REF] == inst->s.value[VR_N_REF]) {
+        inst->s = tmp;
+        return FMU_OK;
+    }
+    inst->s = tmp;  /* parameters of the saved state: rebuild the model, keep the history */
+    inst->model_ready = model_build(inst) == IWAN_OK;
+    if (!inst->model_ready)
+        return fmu_log(inst, FMU_ERROR, "SetFMUState: cannot rebuild the element for the "
+                       "state's parameters");
     return FMU_OK;
 }
 

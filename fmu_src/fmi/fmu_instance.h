@@ -63,6 +63,7 @@ typedef struct {
     int model_ready;        /* model and committed state match the parameters */
     int out_valid;          /* `out` holds the outputs at the current inputs */
     iwan_output out;
+    iwan_state backup;      /* committed state before the doStep in progress */
     /* virgin curve read from <resources>/curve.txt */
     size_t n_points;
     double *curve_u, *curve_T;

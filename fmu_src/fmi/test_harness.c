@@ -376,6 +376,16 @@ static void test_nonfinite_inputs(const api *a)
     }
     CHECK(do_step(&x, 1e-3) == 0 && get(&x, VR_F, &F1) == 0 && F1 == F0,
           "FMI %d: history changed by refused inputs", a->v);
+    /* finite but absurd inputs whose force or energy overflows: refused, history kept */
+    CHECK(set(&x, VR_U, -1e300) == 0 && set(&x, VR_N, 1e300) == 0, "FMI %d: set", a->v);
+    logs = g_log_count;
+    expect_error(&x, get(&x, VR_W, &after), "outputs that overflow");
+    expect_error(&x, do_step(&x, 1e-3), "a step whose outputs overflow");
+    CHECK(g_log_count > logs && strstr(g_last_log, "overflow"),
+          "FMI %d: overflow not logged clearly: '%s'", a->v, g_last_log);
+    CHECK(set(&x, VR_U, 0.3 * U_SLIP) == 0 && set(&x, VR_N, N_CURVE) == 0
+          && do_step(&x, 1e-3) == 0 && get(&x, VR_F, &F1) == 0 && F1 == F0,
+          "FMI %d: history changed by a refused step", a->v);
     release(&x);
 }
 
