@@ -12,6 +12,7 @@ import os
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 #: Right-hand sides per block solve (bounds the dense work array).
@@ -43,8 +44,17 @@ def factorize(K: sp.spmatrix):
 def compliance_block(K: sp.spmatrix, dofs: np.ndarray) -> np.ndarray:
     """Rows and columns ``dofs`` of K^-1: the compliance at those DOFs, shape (m, m).
 
-    Solves K X = E for the unit vectors E of ``dofs`` in blocks of RHS_BLOCK.
+    CHOLMOD: the DOFs are ordered last after a fill-reducing ordering of the
+    rest, so the trailing block L22 of the Cholesky factor K = L L' satisfies
+    L22 L22' = S, the Schur complement (condensed stiffness) on ``dofs``, and
+    the compliance is S^-1 = L22^-T L22^-1: no solves with the whole factor.
+    Otherwise (or if CHOLMOD re-orders the trailing block) K X = E is solved for
+    the unit vectors E of ``dofs`` in blocks of RHS_BLOCK.
     """
+    if backend() == "cholmod":
+        C = _schur_compliance(sp.csc_matrix(K), dofs)
+        if C is not None:
+            return C
     solve = factorize(K)
     n, m = K.shape[0], dofs.size
     C = np.empty((m, m))
@@ -54,3 +64,21 @@ def compliance_block(K: sp.spmatrix, dofs: np.ndarray) -> np.ndarray:
         B[cols, np.arange(cols.size)] = 1.0
         C[:, start:start + cols.size] = solve(B)[dofs]
     return 0.5 * (C + C.T)  # symmetric by Maxwell-Betti; remove round-off asymmetry
+
+
+def _schur_compliance(K: sp.csc_matrix, dofs: np.ndarray) -> np.ndarray | None:
+    """S^-1 from the trailing block of a Cholesky factor with ``dofs`` last (CHOLMOD)."""
+    from sksparse.cholmod import analyze, cholesky
+
+    n, m = K.shape[0], dofs.size
+    order = analyze(K).P()
+    is_dof = np.zeros(n, bool)
+    is_dof[dofs] = True
+    perm = np.concatenate([order[~is_dof[order]], dofs])
+    factor = cholesky(K[perm][:, perm].tocsc(), ordering_method="natural")
+    if not np.array_equal(factor.P(), np.arange(n)):
+        return None
+    L22 = factor.L()[n - m:, n - m:].toarray()
+    Linv = sla.solve_triangular(L22, np.eye(m), lower=True, check_finite=False)
+    C = Linv.T @ Linv
+    return 0.5 * (C + C.T)

@@ -227,3 +227,56 @@ def test_run_normal_reports_hertz_errors(contact_cache):
     out = api.run_normal(spec, approach=4e-6, cache=contact_cache, curve_points=3)
     assert out["approach"] == 4e-6 and len(out["curve"]["force"]) == 3
     assert set(out["hertz"]) >= {"error_size", "error_p0", "error_approach", "error_k_n"}
+
+
+def _export_pair(tmp_path, spec, suffix=".npz"):
+    """Write a built-in pair in the bring-your-own format; return the CLI file args."""
+    from contact_core import byo
+
+    b1, b2, meta = mesh.build(spec)
+    files = []
+    for i, (body, E, nu) in enumerate(((b1, spec.E1, spec.nu1), (b2, spec.E2, spec.nu2)), start=1):
+        K = assembly.stiffness(body.p, body.t, E, nu)
+        files.append((tmp_path / f"K{i}{suffix}", tmp_path / f"nodes{i}.npz"))
+        byo.export_body(body, K, *files[-1], symmetry=meta["symmetry"])
+    return files
+
+
+def test_bring_your_own_bodies_reproduce_the_built_in_model(tmp_path, contact_cache):
+    from contact_core import byo
+
+    spec = ContactSpec(body="sphere", model="real", grid=5)
+    (k1, n1), (k2, n2) = _export_pair(tmp_path, spec, ".mtx")
+    cc = byo.condense_bodies(byo.load_matrix(k1), byo.load_nodes(n1), byo.load_matrix(k2),
+                             byo.load_nodes(n2), cache=False)
+    ref = condense(spec, cache=contact_cache)
+    assert np.allclose(cc.Czz, ref.Czz, rtol=1e-9, atol=0)
+    assert np.allclose(cc.grid.h, ref.grid.h, rtol=0, atol=1e-15)
+    assert np.allclose(cc.grid.area, ref.grid.area) and np.array_equal(cc.grid.mult, ref.grid.mult)
+    rc = damper(["normal", "--body", "sphere", "--force", "150", "--json", "--stiffness", str(k1), str(k2),
+                 "--nodes", str(n1), str(n2), "--cache-dir", str(tmp_path / "c")])
+    assert rc == 0
+
+
+def test_inconsistent_imported_matrices_exit_2(tmp_path, capsys):
+    import scipy.sparse as sp
+
+    from contact_core import byo
+
+    spec = ContactSpec(body="sphere", model="halfspace", grid=3)
+    (k1, n1), (k2, n2) = _export_pair(tmp_path, spec)
+    K = byo.load_matrix(k1)
+    bad = {"short": K[:-3, :-3], "asym": K + sp.csr_matrix(([1e3 * abs(K).max()], ([0], [1])), shape=K.shape)}
+    for name, M in bad.items():
+        path = tmp_path / f"{name}.npz"
+        sp.save_npz(path, sp.csr_matrix(M))
+        rc = damper(["normal", "--body", "sphere", "--force", "100", "--no-cache",
+                     "--stiffness", str(path), str(k2), "--nodes", str(n1), str(n2)])
+        assert rc == 2, name
+    nodes = dict(np.load(n1))
+    nodes["coords"] = nodes["coords"] + np.array([1e-4, 0, 0])  # contact nodes no longer coincide
+    np.savez(tmp_path / "moved.npz", **nodes)
+    rc = damper(["normal", "--body", "sphere", "--force", "100", "--no-cache",
+                 "--stiffness", str(k1), str(k2), "--nodes", str(tmp_path / "moved.npz"), str(n2)])
+    assert rc == 2
+    assert "x-y" in capsys.readouterr().err
