@@ -30,6 +30,8 @@ import scipy.linalg as sla
 #: Relative size of the off-diagonal part of phi^T C phi below which C counts as
 #: modal (proportional) damping; round-off of eigh is ~1e-14.
 MODAL_DAMPING_TOL = 1e-9
+#: Relative asymmetry tolerated in M, C, K (round-off of an assembly).
+SYMMETRY_TOL = 1e-10
 
 
 @dataclass
@@ -64,6 +66,8 @@ class LinearModel:
                 A = np.zeros((n, n)) if A is None else np.atleast_2d(np.asarray(A, dtype=float))
                 if A.shape != (n, n) or not np.all(np.isfinite(A)):
                     raise ValueError(f"{name} must be a finite ({n}, {n}) matrix, got shape {A.shape}")
+                if not np.allclose(A, A.T, rtol=0.0, atol=SYMMETRY_TOL * np.abs(A).max()):
+                    raise ValueError(f"{name} must be symmetric")
                 setattr(self, name, A)
             if self.phi is None:
                 self._try_modal()
@@ -129,22 +133,25 @@ class LinearModel:
             dg = -(-2.0 * Omega + 1j * self.c_r) * g**2
             return G, (A * dg) @ B.T
         Z = self.K - Omega**2 * self.M + 1j * Omega * self.C
+        # Z is complex symmetric (M, C, K symmetric), so G = Z^-1 is too: its rows
+        # are the transposed columns, one solve with the union of both index sets.
+        both = np.union1d(rows, cols)
+        I = np.zeros((self.n, both.size), dtype=complex)
+        I[both, np.arange(both.size)] = 1.0
         try:
-            lu = sla.lu_factor(Z, check_finite=False)
-        except (np.linalg.LinAlgError, ValueError) as err:
+            Y = np.linalg.solve(Z, I)
+        except np.linalg.LinAlgError as err:
             raise RuntimeError(f"singular dynamic stiffness at Omega = {Omega:g} rad/s") from err
-        I = np.zeros((self.n, cols.size), dtype=complex)
-        I[cols, np.arange(cols.size)] = 1.0
-        Y = sla.lu_solve(lu, I)
         if not np.all(np.isfinite(Y)):
             raise RuntimeError(f"singular dynamic stiffness at Omega = {Omega:g} rad/s")
-        G = Y[rows]
+        pos = {int(d): i for i, d in enumerate(both)}
+        Yc = Y[:, [pos[int(c)] for c in cols]]
+        G = Yc[rows]
         if not deriv:
             return G, None
+        Yr = Y[:, [pos[int(r)] for r in rows]]
         dZ = -2.0 * Omega * self.M + 1j * self.C
-        # G^T = G for symmetric M, C, K; dG = -G dZ G, restricted to (rows, cols).
-        Yr = sla.lu_solve(lu, np.eye(self.n, dtype=complex)[:, rows], trans=1)
-        return G, -(Yr.T @ dZ @ Y)
+        return G, -(Yr.T @ dZ @ Yc)  # dG = -G dZ G, restricted to (rows, cols)
 
     def response(self, Omega: float, rows, f: np.ndarray, deriv: bool = False):
         """G[rows, :] @ f for a complex load f (n,), and its Omega derivative."""
