@@ -211,7 +211,9 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
                 fmu_xml.render_build_description(names))
         binary = root / "binaries" / PLATFORM[fmi_version] / f"{fmu_xml.MODEL_IDENTIFIER}.so"
         compile_binary(root / "sources", names, binary, compiler)
-        return atomic_write(out, _zip_dir(root))
+        path = atomic_write(out, _zip_dir(root))
+    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
+    return path
 
 
 def header_is_current() -> bool:

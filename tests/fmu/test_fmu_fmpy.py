@@ -54,6 +54,18 @@ def test_direct_drive_equals_array_api(fmus, version):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_variable_step_sizes_change_nothing(fmus, version):
+    """Rate independence: the same samples at random step sizes, the same results."""
+    t, u, N = _history(120)
+    ref = _reference(u, N)
+    steps = np.random.default_rng(SEED + 1).uniform(1e-6, 10.0, u.size)
+    s = Slave(fmus[version], version).initialize(u[0], N[0])
+    F = [s.step(u[k], N[k], h=steps[k])[0] for k in range(u.size)]
+    s.close()
+    _assert_close(F, ref.F, np.max(np.abs(ref.F)))
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_simulate_fmu_equals_array_api_one_sample_late(fmus, version):
     """fmpy records outputs right after doStep, before the next input: one sample late."""
     t, u, N = _history()
