@@ -3,7 +3,8 @@
 Prints one line per case (normal force, k_n, k_t, gross-slip displacement,
 points, error against Cattaneo-Mindlin for the sphere) and a hysteresis loop
 computed directly by the contact model against Masing's loop from its virgin
-curve; saves plots to ``--out``.
+curve, and the CND cylinder against the thesis's fit (seed eq. 2.14, a
+comparison, not an oracle); saves plots and curve files to ``--out``.
 
     python examples/virgin_curves.py                    # half-space BEM, 31 nodes per side
     python examples/virgin_curves.py --model real --grid 21
@@ -64,6 +65,24 @@ def run_cases(model: str, grid: int) -> dict:
     return runs
 
 
+def thesis_eq_2_14(T, length: float, diameter: float):
+    """Seed eq. 2.14, the thesis's fit of its CND cylinder curves (dz = 5 um):
+    delta [um] = 14.337 T^1.010 / L^1.052 * D^0.144, T in N, L and D in um. Returns m."""
+    return 14.337 * np.asarray(T) ** 1.010 / (length * 1e6) ** 1.052 * (diameter * 1e6) ** 0.144 * 1e-6
+
+
+def compare_with_thesis(run) -> None:
+    """Our CND cylinder curve against the thesis's fit (a comparison, not an oracle)."""
+    limit = run.problem.mu * run.problem.N
+    print(f"cylinder CND vs seed eq. 2.14 ({run.model} model):")
+    for frac in (0.25, 0.5, 0.75):
+        T = frac * limit
+        u = float(np.interp(T, run.virgin.T, run.virgin.u))
+        u_fit = float(thesis_eq_2_14(T, run.spec.length, 2 * run.spec.radius))
+        print(f"  T = {T:7.2f} N: u = {u * 1e6:.3f} um, eq. 2.14 {u_fit * 1e6:.3f} um "
+              f"({u / u_fit - 1:+.1%})")
+
+
 def loop_vs_masing(run, fraction: float = 0.6) -> dict:
     """Direct loop at a = fraction * u_gs against Masing's loop from the virgin curve."""
     a = fraction * run.virgin.u[-1]
@@ -116,6 +135,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     runs = run_cases(args.model, 9 if args.smoke else args.grid)
     loop = loop_vs_masing(runs["sphere CNF"])
+    compare_with_thesis(runs["cylinder CND"])
     for name, run in runs.items():
         write_curve(run.curve, args.out / f"{name.replace(' ', '_')}.json")
     plot(runs, loop, args.out)

@@ -17,7 +17,7 @@ def load(name):
 def test_virgin_curves_example_smoke(tmp_path, capsys):
     assert load("virgin_curves").main(["--smoke", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "sphere CNF" in out and "cylinder CND" in out and "Masing" in out
+    assert "sphere CNF" in out and "cylinder CND" in out and "Masing" in out and "eq. 2.14" in out
     assert (tmp_path / "virgin_curves.png").exists()
     assert len(list(tmp_path.glob("*.json"))) == 4
 
