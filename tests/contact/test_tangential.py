@@ -181,3 +181,45 @@ def test_solver_matches_bounded_least_squares_on_a_random_problem():
         ref = optimize.lsq_linear(L.T, rhs, bounds=(-prob.bound, prob.bound), method="bvls", tol=1e-15)
         np.testing.assert_allclose(sol.q, ref.x, atol=1e-9 * prob.bound.max())
         state = new
+
+
+def test_bvls_fallback_gives_the_same_solution(problem, monkeypatch):
+    """The fallback (used only if the projected Newton iteration stalls) agrees."""
+    import contact_core.tangential as tg
+
+    delta = 0.7 * problem.gross_slip_displacement(problem.initial_state())
+    ref, _ = problem.solve(problem.initial_state(), delta)
+    monkeypatch.setattr(tg, "MAX_ITER", 0)
+    fb, _ = problem.solve(problem.initial_state(), delta)
+    assert fb.iterations >= 0
+    np.testing.assert_allclose(fb.q, ref.q, atol=1e-8 * problem.bound.max())
+    assert np.array_equal(fb.stick, ref.stick)
+
+
+def test_non_reciprocal_compliance_is_refused(problem):
+    from dataclasses import replace
+
+    C = problem.contact.Cxx.copy()
+    C[0, 1] *= 1.5
+    with pytest.raises(ValueError, match="symmetric"):
+        TangentialProblem(replace(problem.contact, Cxx=C), problem.f_n + 1.0, MU)
+
+
+def test_extreme_friction_coefficients(problem):
+    """mu -> infinity: the stuck line up to huge loads; mu tiny: gross slip at once."""
+    stuck = TangentialProblem(problem.contact, problem.f_n, 1e6)
+    u = 10 * problem.gross_slip_displacement(problem.initial_state())
+    sol, _ = stuck.solve(stuck.initial_state(), u)
+    assert sol.stick.sum() == stuck.n_c and sol.T == pytest.approx(stuck.k_t * u, rel=1e-9)
+    slick = TangentialProblem(problem.contact, problem.f_n, 1e-9)
+    curve = tc.virgin_curve(slick)
+    assert curve.T[-1] == pytest.approx(1e-9 * slick.N, rel=1e-9)
+    assert slick.k_t == pytest.approx(problem.k_t, rel=1e-12)  # stiffness does not see mu
+
+
+def test_one_huge_step_lands_in_gross_slip(problem):
+    u = 50 * problem.gross_slip_displacement(problem.initial_state())
+    sol, state = problem.solve(problem.initial_state(), u)
+    assert not sol.stick.any() and sol.T == pytest.approx(MU * problem.N, rel=1e-12)
+    again, _ = problem.solve(state, u)  # same displacement again: nothing changes
+    np.testing.assert_array_equal(again.q, sol.q)

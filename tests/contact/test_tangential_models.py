@@ -121,10 +121,14 @@ def test_cylinder_mid_length_follows_2d_cattaneo(cylinder, ratio):
 
 
 def test_cylinder_ends_carry_the_edge_peak(cylinder):
-    prob, grid, _ = cylinder
+    prob, grid, R = cylinder
     y = prob.contact.grid.y
     end, mid = np.isclose(y, y.max()), np.isclose(y, y[np.argmin(np.abs(y))])
     assert prob.f_n[end].sum() > 1.2 * prob.f_n[mid].sum()
+    # mid-length peak pressure against 2D Hertz for the local line load
+    P_line = prob.f_n[mid].sum() / grid.dy
+    p0 = 2 * P_line / (np.pi * np.sqrt(4 * P_line * R / (np.pi * E_STAR)))
+    assert prob.f_n[mid].max() / (grid.dx * grid.dy) == pytest.approx(p0, rel=HERTZ_RTOL)
 
 
 def test_small_fe_model_matches_mindlin():
