@@ -109,3 +109,20 @@ def test_tangent_is_the_one_sided_derivative_in_the_direction_of_motion(curve):
         d = np.sign(u[i] - u[i - 1]) or 1.0
         F_h = el.series([u[i] + d * h], state=el.series(u[: i + 1]).state).F[0]
         assert (F_h - r.F[i]) / (d * h) == pytest.approx(r.kt[i], rel=1e-5)
+
+
+def test_fast_constant_N_sweep_equals_the_general_straight_path_update(curve):
+    # series() sweeps runs of constant N with the play operator; step() always takes
+    # the general straight-path update: both must agree, also across N changes
+    u_tab, _, el = curve
+    rng = np.random.default_rng(SEED + 21)
+    u = random_reversal_history(rng, 30, 1.3 * u_tab[-2])
+    N = N_SPHERE * np.repeat(rng.uniform(0.5, 1.5, u.size // 10 + 1), 10)[: u.size]
+    fast = el.series(u, N)
+    st = el.initial_state(N[0])
+    steps = [el.step(st, ui, Ni) for ui, Ni in zip(u, N)]
+    scale = np.abs(fast.F).max()
+    np.testing.assert_allclose([s.F for s in steps], fast.F, rtol=0, atol=ROUNDOFF * scale)
+    np.testing.assert_allclose([s.kt for s in steps], fast.kt, rtol=1e-12)
+    np.testing.assert_allclose([s.dFdN for s in steps], fast.dFdN, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose([s.W for s in steps], fast.W, rtol=1e-12)
