@@ -223,3 +223,12 @@ def test_one_huge_step_lands_in_gross_slip(problem):
     assert not sol.stick.any() and sol.T == pytest.approx(MU * problem.N, rel=1e-12)
     again, _ = problem.solve(state, u)  # same displacement again: nothing changes
     np.testing.assert_array_equal(again.q, sol.q)
+
+
+def test_points_are_dense_where_the_curve_bends(virgin):
+    """Mindlin's curve bends most towards gross slip: the steps shrink there."""
+    steps = np.diff(virgin.u)
+    # (single steps vary: a ring of nodes switching to slip is a kink in the
+    # discrete curve, which the step control also refines)
+    assert steps[-5:].mean() < 0.5 * steps[:5].mean()
+    assert len(virgin.u) <= 60  # still a compact table
