@@ -232,3 +232,11 @@ def test_points_are_dense_where_the_curve_bends(virgin):
     # discrete curve, which the step control also refines)
     assert steps[-5:].mean() < 0.5 * steps[:5].mean()
     assert len(virgin.u) <= 60  # still a compact table
+
+
+def test_table_interpolates_the_model_within_the_step_tolerance(problem, virgin):
+    """Linear interpolation between the chosen points against the model at the midpoints."""
+    mids = 0.5 * (virgin.u[1:] + virgin.u[:-1])
+    exact = np.array([problem.solve(problem.initial_state(), u)[0].T for u in mids])
+    interp = np.interp(mids, virgin.u, virgin.T)
+    assert np.abs(exact - interp).max() <= tc.CURVE_TOL * MU * problem.N
