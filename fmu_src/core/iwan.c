@@ -8,7 +8,7 @@
  *     r_j(N) = g_j(N) / k_j                                       (slip radius)
  * The residual spring carries k_res (u - u_contact) and never slips.
  *
- * Exact straight-path update (README of issue 3): between two committed points
+ * Exact straight-path update (issue 3, iwan.h): between two committed points
  * (u0, N0) -> (u1, N1) both u and r_j are linear in the path parameter s, so the
  * trial stretch e0 + s du and the limits +-r_j(s) are linear too. A slider that
  * ends outside its limit crossed it once, at s* = (r0 - e0) / (du - dr) (upper
@@ -677,7 +677,8 @@ iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u
 {
     iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
     if (st != IWAN_OK) return st;
-    if (!Eu || nb == 0) return IWAN_ERR_BAD_PARAM;
+    /* anchors hold sample indices as int32; n * nb must not overflow */
+    if (!Eu || nb == 0 || n > (size_t)INT32_MAX / 2 || nb > SIZE_MAX / n) return IWAN_ERR_BAD_PARAM;
     if (check_finite(Eu, n * nb) || (EN && check_finite(EN, n * nb))) return IWAN_ERR_NONFINITE;
     iwan_state s;
     anchors an;
