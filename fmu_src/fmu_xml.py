@@ -100,7 +100,7 @@ def _fmt(x: float) -> str:
     return repr(float(x))  # shortest repr round-trips exactly
 
 
-def _units_xml(fmi_version: int) -> str:
+def _units_xml() -> str:
     lines = ["  <UnitDefinitions>"]
     for name, exps in UNITS.items():
         base = " ".join(f'{k}="{v}"' for k, v in exps.items())
@@ -217,7 +217,7 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
         variables = _fmi3_variables(curve_n)
     else:
         raise ValueError(f"fmi_version must be 2 or 3, not {fmi_version!r}")
-    parts = ['<?xml version="1.0" encoding="UTF-8"?>', head, _units_xml(fmi_version),
+    parts = ['<?xml version="1.0" encoding="UTF-8"?>', head, _units_xml(),
              _log_categories_xml(),
              '  <DefaultExperiment startTime="0" stopTime="1"/>',
              variables, _structure(fmi_version), "</fmiModelDescription>", ""]
