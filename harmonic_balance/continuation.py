@@ -20,7 +20,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 from scipy.optimize import minimize_scalar
 
 from .newton import NewtonError, newton
@@ -80,7 +79,9 @@ class _Scaled:
         A = np.vstack([J, t_prev])
         rhs = np.zeros(A.shape[0])
         rhs[-1] = 1.0
-        t = sla.solve(A, rhs)
+        t = np.linalg.solve(A, rhs)
+        if not np.all(np.isfinite(t)):
+            raise np.linalg.LinAlgError("non-finite tangent")
         return t / np.linalg.norm(t)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):

@@ -137,7 +137,7 @@ class FRFProblem:
 
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
-                ds_max: float = 0.05, max_points: int = 2000, refine: bool = True) -> FRFResult:
+                ds_max: float = 0.1, max_points: int = 2000, refine: bool = True) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     Raises

@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 #: Armijo constant: accept a step that gives at least this fraction of the predicted decrease.
 ARMIJO = 1e-4
@@ -63,9 +62,11 @@ def newton(fun, x0, tol: float, max_iter: int = 30) -> NewtonResult:
         if it == max_iter:
             break
         try:
-            dx = sla.solve(J, -R, check_finite=True)
-        except (np.linalg.LinAlgError, ValueError):
-            raise NewtonError("singular or non-finite Jacobian", x, it, nr) from None
+            dx = np.linalg.solve(J, -R)  # LAPACK gesv; scipy's wrapper costs more at this size
+        except np.linalg.LinAlgError:
+            raise NewtonError("singular Jacobian", x, it, nr) from None
+        if not np.all(np.isfinite(dx)):
+            raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         alpha = 1.0
         while True:
             xt = x + alpha * dx

@@ -46,8 +46,8 @@ def register(subparsers) -> None:
     p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
     p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
                    help="frequency range [rad/s]")
-    p.add_argument("--max-step", type=float, default=0.05,
-                   help="largest continuation step (scaled arclength, default 0.05)")
+    p.add_argument("--max-step", type=float, default=0.1,
+                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
     p.add_argument("--max-points", type=int, default=2000)
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", help="also write the JSON to this file")

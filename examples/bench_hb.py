@@ -1,0 +1,198 @@
+"""Harmonic-balance benchmark: accuracy vs H against time integration, cost vs model size.
+
+Run:  .venv/bin/python examples/bench_hb.py [--smoke] [--no-ivp]
+
+Table 1 (Jenkins-damped oscillator m = k = kt = 1, c = 0.01, Fs = P = 0.05, the CLI's
+example): for each H the refined FRF peak, its error against the time-integration
+reference peak, the curve's cost. The reference: central differences at 512 and 1024
+steps per period (their difference is the reference's own error), marched to steady
+state at five frequencies around the peak, peak from a parabola through them.
+
+Table 2: a full curve (H = 7, odd harmonics) against model size: the 2-DOF test
+model and chains of n modes with 8 Jenkins elements (4 between DOFs, 4 to ground),
+receptance-condensed onto the 12 element DOFs.
+
+Speed-up: the HB curve against time integration of the same curve, frequency by
+frequency (measured at 5 frequencies, scaled to the number of HB points), and
+against scipy's solve_ivp (LSODA) to steady state at one frequency, scaled likewise.
+The solve_ivp run needs the Jenkins law in rate form (z' = x' while slipping); that
+few-line version lives here only as a benchmark baseline, never in the package.
+
+Wall times depend on the machine's load; nothing here gates CI.
+"""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # small dense work: 1 thread is faster
+
+import argparse  # noqa: E402
+import resource  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from harmonic_balance.aft import FrictionLink  # noqa: E402
+from harmonic_balance.frf import compute_frf  # noqa: E402
+from harmonic_balance.linear import LinearModel  # noqa: E402
+from harmonic_balance.model import Model, jenkins_element, sdof_model  # noqa: E402
+from harmonic_balance.timeint import march  # noqa: E402
+
+SDOF = dict(mass=1.0, stiffness=1.0, damping=0.01, contact_stiffness=1.0, slip_force=0.05,
+            force=0.05)
+BAND = (0.9, 1.3)
+#: Seed of the chain models' element placement.
+SEED = 20261122
+
+
+def rss_mb() -> float:
+    """Peak resident memory of this process so far [MB]."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def ti_peak(model, w0, steps, tol, rel=(-0.01, -0.005, 0.0, 0.005, 0.01)):
+    """Time-integration peak near w0: parabola through steady amplitudes.
+
+    Returns (peak amplitude, its step-size error estimate, seconds).
+    """
+    t0 = time.perf_counter()
+    ws = w0 * (1.0 + np.asarray(rel))
+    peaks = []
+    for ns in (steps, 2 * steps):
+        amp = [march(model, w, ns, tol=tol).amplitude for w in ws]
+        c = np.polyfit(ws - w0, amp, 2)
+        peaks.append(c[2] - c[1] ** 2 / (4 * c[0]))
+    return peaks[1], abs(peaks[1] - peaks[0]) / peaks[1], time.perf_counter() - t0
+
+
+def table_h(model, Hs, steps, tol, rel):
+    print("\nTable 1: sdof Jenkins, peak vs H against the time-integration reference")
+    first = compute_frf(model, f"odd:{Hs[-1]}", BAND)
+    ref, ref_err, t_ref = ti_peak(model, first.peak_omega, steps, tol, rel)
+    print(f"reference peak {ref:.7f} m (step-size error {100 * ref_err:.4f} %, {t_ref:.1f} s)")
+    print(f"{'H':>3} {'n_t':>5} {'points':>6} {'evals':>6} {'time_s':>7} {'peak_omega':>11} "
+          f"{'peak_amp':>10} {'err_%':>8} {'mem_MB':>7}")
+    rows = []
+    for H in Hs:
+        r = compute_frf(model, f"odd:{H}", BAND)
+        err = 100 * (r.peak_amplitude / ref - 1)
+        rows.append((H, r, err))
+        print(f"{H:>3} {r.n_t:>5} {r.points:>6} {r.evaluations:>6} {r.time_s:>7.3f} "
+              f"{r.peak_omega:>11.6f} {r.peak_amplitude:>10.7f} {err:>8.4f} {rss_mb():>7.0f}")
+    return rows, ref, ref_err
+
+
+def chain_model(n_modes: int, n_elem: int = 8) -> Model:
+    """Chain of n masses (modal receptance), 8 Jenkins elements, force on DOF 0."""
+    n = n_modes
+    M = np.diag(np.linspace(1.0, 0.5, n))
+    K = 2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+    C = 0.02 * M + 0.001 * K
+    rng = np.random.default_rng(SEED)
+    # 4 pairs + 4 grounded DOFs = 12 distinct DOFs when the chain is long enough
+    dofs = rng.choice(np.arange(1, n), size=min(n - 1, 3 * n_elem // 2), replace=False)
+    links = []
+    for e in range(n_elem):
+        if e < n_elem // 2:
+            a, b = int(dofs[2 * e]), int(dofs[2 * e + 1])
+        else:
+            a, b = int(dofs[(n_elem + e - n_elem // 2) % dofs.size]), None
+        links.append(FrictionLink(jenkins_element(0.3, 0.005), a, b, f"e{e}"))
+    f = np.zeros(n)
+    f[0] = 0.02
+    return Model(LinearModel(M=M, C=C, K=K), links, {1: f}, response_dof=0)
+
+
+def two_dof_model() -> Model:
+    """The 2-DOF test model (tests/hb/hbcases.two_dof): elements between and to ground."""
+    M = np.diag([1.0, 0.5])
+    K = np.array([[2.0, -1.0], [-1.0, 1.5]])
+    links = [FrictionLink(jenkins_element(0.8, 0.04), 0, 1, "between"),
+             FrictionLink(jenkins_element(0.5, 0.08), 1, None, "ground")]
+    return Model(LinearModel(M=M, C=0.01 * M + 0.005 * K, K=K), links,
+                 {1: np.array([0.05, 0.0])}, response_dof=0)
+
+
+def table_size(sizes, spec):
+    print(f"\nTable 2: full curve, harmonics {spec}, against model size")
+    print(f"{'case':>22} {'DOFs':>5} {'unknowns':>8} {'points':>6} {'evals':>6} {'time_s':>7} "
+          f"{'ms/eval':>8} {'mem_MB':>7}")
+    cases = [("2-DOF, 2 elements", two_dof_model(), (0.6, 1.6))]
+    for n in sizes:
+        model = chain_model(n)
+        lam = model.linear.w_r[0]  # first mode of the linear chain (friction free)
+        cases.append((f"chain {n} modes, 8 el.", model, (0.8 * lam, 1.6 * lam)))
+    out = []
+    for name, model, band in cases:
+        r = compute_frf(model, spec, band)
+        size = r.solutions[0].size
+        print(f"{name:>22} {model.n:>5} {size:>8} {r.points:>6} {r.evaluations:>6} "
+              f"{r.time_s:>7.3f} {1e3 * r.time_s / r.evaluations:>8.3f} {rss_mb():>7.0f}")
+        out.append((name, r))
+    return out
+
+
+def ti_curve_rate(model, steps, tol, n=5):
+    """Seconds per frequency of the time-integration reference, over the band."""
+    t0 = time.perf_counter()
+    for w in np.linspace(*BAND, n):
+        march(model, w, steps, tol=tol)
+    return (time.perf_counter() - t0) / n
+
+
+def ivp_one_frequency(w, tol):
+    """scipy solve_ivp (LSODA) of the sdof with the Jenkins law in rate form, to steady state."""
+    from scipy.integrate import solve_ivp
+
+    m, k, c, kt, fs, P = (SDOF[key] for key in ("mass", "stiffness", "damping",
+                                                "contact_stiffness", "slip_force", "force"))
+
+    def rhs(t, y):
+        x, v, z = y
+        F = kt * (x - z)
+        slipping = abs(F) >= fs and np.sign(v) == np.sign(F)
+        return [v, (P * np.cos(w * t) - c * v - k * x - np.clip(F, -fs, fs)) / m,
+                v if slipping else 0.0]
+
+    T = 2 * np.pi / w
+    y, prev = np.zeros(3), None
+    t0 = time.perf_counter()
+    for p in range(5000):
+        sol = solve_ivp(rhs, (p * T, (p + 1) * T), y, method="LSODA", rtol=1e-8, atol=1e-11,
+                        max_step=T / 50)
+        y = sol.y[:, -1]
+        amp = np.abs(sol.y[0]).max()
+        if prev is not None and abs(amp - prev) < tol * amp:
+            break
+        prev = amp
+    return time.perf_counter() - t0, amp, p + 1
+
+
+def main(argv=None) -> dict:
+    """Print the tables; return their numbers (for the smoke test)."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--smoke", action="store_true", help="tiny settings (a test runs this)")
+    ap.add_argument("--no-ivp", action="store_true", help="skip the solve_ivp baseline")
+    args = ap.parse_args(argv)
+    model = sdof_model(**SDOF)
+    Hs = (1, 3) if args.smoke else (1, 3, 5, 7, 9)
+    steps, tol = (64, 1e-5) if args.smoke else (512, 1e-8)
+    rel = (-0.01, 0.0, 0.01) if args.smoke else (-0.01, -0.005, 0.0, 0.005, 0.01)
+    rows, ref, ref_err = table_h(model, Hs, steps, tol, rel)
+    sizes = table_size(() if args.smoke else (10, 50, 200), "odd:3" if args.smoke else "odd:7")
+    hb = rows[-1][1]
+    per_w = ti_curve_rate(model, steps, tol, 2 if args.smoke else 5)
+    print(f"\nSpeed-up on the sdof curve ({hb.points} points, harmonics {list(hb.harmonics)}):")
+    print(f"  HB curve {hb.time_s:.3f} s; time integration {per_w:.2f} s per frequency "
+          f"-> {per_w * hb.points:.0f} s per curve: {per_w * hb.points / hb.time_s:.0f}x")
+    if not (args.smoke or args.no_ivp):
+        t_ivp, amp, periods = ivp_one_frequency(hb.peak_omega, 1e-7)
+        print(f"  solve_ivp at the peak: {t_ivp:.1f} s ({periods} periods, amplitude {amp:.6f}, "
+              f"{100 * (amp / ref - 1):+.3f} % vs reference) -> {t_ivp * hb.points:.0f} s per "
+              f"curve: {t_ivp * hb.points / hb.time_s:.0f}x")
+    return {"rows": rows, "reference": ref, "reference_error": ref_err, "sizes": sizes}
+
+
+if __name__ == "__main__":
+    main()
