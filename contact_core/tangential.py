@@ -13,10 +13,11 @@ q      (n_c,) nodal tangential forces [N]: the force the contact exerts on the
        plane (body 2) along +x, and on the curved body along -x
 C      (n_c, n_c) combined tangential compliance ``Cxx`` [m/N]
 w      (n_c,) full-model weights ``mult``; T = sum(w q) is the full tangential force
-s      (n_c,) relative slip of body 1 over body 2 [m]
+s      (n_c,) accumulated relative slip of body 1 over body 2 [m]
 
 Kinematics: the surfaces' relative x displacement at node i is
-``s = delta - C q``: the rigid motion minus the elastic give of both bodies.
+``delta - (C q)_i``, the rigid motion minus the elastic give of both bodies;
+it is the accumulated slip, so ``s = delta - C q`` after every step.
 
 Incremental problem (from a state ``s_prev`` to a new ``delta``): find q with
 
@@ -31,15 +32,24 @@ convex quadratic programme with box constraints
     min_q  1/2 q^T W C q - q^T W (delta - s_prev)   s.t.  -mu f <= q <= mu f,
 
 W = diag(w) (W C is symmetric by reciprocity), whose gradient is ``-W ds``.
-It has one solution (W C is positive definite). It is solved by a
-primal-dual active-set iteration (Hintermueller, Ito, Kunisch, SIAM J. Optim.
-13, 2003), which is the thesis's stick/slip iteration (A.2.3-A.2.6) with a
-rule that also lets slip nodes return to stick; each iteration solves the stick
-set exactly (a dense Cholesky solve), and the iteration ends when the sets
-repeat, which is an exact KKT point. Should a set ever recur without
-convergence (cycling), the QP is handed to scipy's bounded-variable least
-squares (``lsq_linear``, method ``bvls``), a finite active-set method. The
-result is then checked against the KKT conditions with ``KKT_TOL``.
+It has one solution (W C is positive definite). Each increment is solved as
+one step (the history inside a step is taken as proportional, as in any
+incremental plasticity scheme; ``contact_core.tangential_curve`` chooses the
+steps).
+
+Solver: Bertsekas' projected Newton method (``_active_set``). Its Newton step
+is the thesis's stick-set solve (A.2.5, eq. A.40) with the slip nodes held at
++-mu f (A.34-A.36). Exchanging stick and slip sets by their violations alone
+(A.2.6, or a primal-dual active-set method that also releases slip nodes)
+was seen to cycle on the dense half-space compliances (whole sets flipping
+between +mu f and -mu f); here the step is projected onto the bounds and
+shortened by an Armijo rule, so the QP objective falls at every iteration
+and no set can recur, while slip nodes may still return to stick (needed on
+unloading). It stops at a KKT point
+within ``SOLVE_TOL``; should it not within ``MAX_ITER`` iterations, scipy's
+bounded-variable least squares (``lsq_linear``, ``bvls``, a finite
+active-set method) takes over. Every result is checked against the KKT
+conditions with ``KKT_TOL`` (RuntimeError otherwise).
 
 Full stick (all |q_i| < mu f_i) is linear: ``q = delta C^-1 1``, so the
 initial tangential stiffness is exactly ``k_t = w^T C^-1 1``. Gross slip
