@@ -170,7 +170,7 @@ def _zip_dir(root: Path) -> bytes:
 
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
               fit: str = "reject", model: str = "iwan", description: str = "",
-              compiler: str | None = None) -> Path:
+              compiler: str | None = None, curve_json: str | None = None) -> Path:
     """Write a co-simulation FMU of the friction element for one contact.
 
     Parameters
@@ -190,6 +190,9 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         Text for the model description (e.g. the curve's source).
     compiler : str, optional
         C compiler (default ``$CC`` or ``cc``).
+    curve_json : str, optional
+        Text of the source curve file, kept as ``resources/curve.json`` for
+        provenance (the binary reads ``resources/curve.txt``).
 
     Returns
     -------
@@ -202,6 +205,8 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         names = _copy_sources(root / "sources", fmi_version, model)
         (root / "resources").mkdir()
         (root / "resources" / "curve.txt").write_text(curve_resource_text(u, T, n_ref, fit))
+        if curve_json is not None:
+            (root / "resources" / "curve.json").write_text(curve_json)
         (root / "documentation").mkdir()
         (root / "documentation" / "index.html").write_text(_documentation())
         text = fmu_xml.render_model_description(fmi_version, n_ref, names, description)

@@ -31,6 +31,8 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Read the curve, build and write the FMU; print the output path."""
+    from pathlib import Path
+
     from contact_core.curve import read_curve
     from fmu_src.fmu_build import build_fmu
 
@@ -42,6 +44,7 @@ def run(args) -> int:
                    f"({curve.u.size} points, N_ref = {n_ref:g} N"
                    + (f", mu = {curve.mu:g}" if curve.mu is not None else "") + ")")
     path = build_fmu(curve.u, curve.T, n_ref, args.output, fmi_version=args.fmi_version,
-                     fit=args.fit, description=description)
+                     fit=args.fit, description=description,
+                     curve_json=Path(args.curve).read_text())
     print(path)
     return 0

@@ -89,6 +89,8 @@ def test_cli_writes_an_fmu(tmp_path, capsys):
     assert damper_main(["fmu", "--curve", str(tmp_path / "c.json"), "--fmi-version", "3",
                         "-o", str(out)]) == 0
     assert _model_description(out).get("fmiVersion") == "3.0"
+    with zipfile.ZipFile(out) as zf:  # the source curve file travels along (provenance)
+        assert zf.read("resources/curve.json").decode() == (tmp_path / "c.json").read_text()
 
 
 @pytest.mark.parametrize("change", ["not_concave", "no_N", "truncated"])
