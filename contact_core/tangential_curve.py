@@ -152,6 +152,35 @@ def solve_force(problem: TangentialProblem, state: TangentialState, T_target: fl
     return problem.solve(state, delta)
 
 
+def state_of(problem: TangentialProblem, sol: TangentialSolution) -> TangentialState:
+    """The slip history a computed point leaves behind (to continue loading from it)."""
+    return TangentialState(sol.delta, sol.s[problem.idx].copy(), sol.q[problem.idx].copy())
+
+
+def virgin_point(problem: TangentialProblem, *, u: float | None = None, T: float | None = None,
+                 tol: float = CURVE_TOL) -> TangentialSolution:
+    """The state on the virgin curve at displacement ``u`` [m] or force ``T`` [N].
+
+    Loads from the virgin state with the curve's step control, carrying the
+    slip history, so tractions and slips at the point are those of the curve.
+    ValueError for a force beyond gross slip.
+    """
+    if (u is None) == (T is None):
+        raise ValueError("give exactly one of u or T")
+    state = problem.initial_state()
+    if u is not None:
+        return march(problem, state, u, tol).points[-1]
+    T = float(T)
+    if not np.isfinite(T):
+        raise ValueError(f"tangential force must be finite, got {T}")
+    if abs(T) > problem.mu * problem.N * (1.0 + FORCE_TOL):
+        return solve_force(problem, state, T)[0]  # raises the gross-slip ValueError
+    sign = 1.0 if T >= 0 else -1.0
+    path = march(problem, state, problem.gross_slip_displacement(state, sign), tol)
+    before = [p for p in path.points if sign * p.T <= sign * T]
+    return solve_force(problem, state_of(problem, before[-1]), T)[0]
+
+
 def cyclic(problem: TangentialProblem, turning_points, tol: float = CURVE_TOL) -> TangentialPath:
     """Displacement-controlled loading through ``turning_points`` [m], from the virgin state.
 

@@ -167,7 +167,7 @@ def _extras(result, args) -> dict:
     out = {}
     prob = result.problem
     if args.tangential_force is not None:
-        sol, _ = tc.solve_force(prob, prob.initial_state(), args.tangential_force)
+        sol = tc.virgin_point(prob, T=args.tangential_force)
         out["force_control"] = {"T": sol.T, "u": sol.delta, "stick_fraction": sol.stick_fraction,
                                 "iterations": sol.iterations}
     if args.loop_amplitude is not None:

@@ -240,3 +240,17 @@ def test_table_interpolates_the_model_within_the_step_tolerance(problem, virgin)
     exact = np.array([problem.solve(problem.initial_state(), u)[0].T for u in mids])
     interp = np.interp(mids, virgin.u, virgin.T)
     assert np.abs(exact - interp).max() <= tc.CURVE_TOL * MU * problem.N
+
+
+def test_virgin_point_carries_the_history_and_matches_one_step_loading(problem, virgin):
+    """On Cattaneo-Mindlin's monotone path the stick zone only shrinks, so one
+    step from the virgin state and the stepped march give the same state."""
+    target = 0.55 * MU * problem.N
+    marched = tc.virgin_point(problem, T=target)
+    direct, _ = tc.solve_force(problem, problem.initial_state(), target)
+    assert marched.T == pytest.approx(target, rel=1e-9)
+    np.testing.assert_allclose(marched.q, direct.q, atol=1e-9 * problem.bound.max())
+    at_u = tc.virgin_point(problem, u=marched.delta)
+    np.testing.assert_allclose(at_u.q, marched.q, atol=1e-9 * problem.bound.max())
+    with pytest.raises(ValueError, match="gross-slip"):
+        tc.virgin_point(problem, T=1.5 * MU * problem.N)
