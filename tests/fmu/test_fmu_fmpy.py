@@ -119,3 +119,19 @@ def test_nonfinite_input_is_refused_and_history_kept(fmus, version, bad):
         s.set(["u"], [bad])
     assert s.get(["u", "F"]) == [0.5 * U_SLIP, F0]
     s.close()
+
+
+@pytest.mark.parametrize("version", [2, 3])
+@pytest.mark.parametrize("scale", [0.0, 1.0, 3.5])
+def test_extreme_histories_equal_array_api(fmus, version, scale):
+    """Lift-off (N <= 0) and re-contact, gross slip far past the curve, tiny and
+    zero increments, a zero friction scale: still the array API's numbers."""
+    u = np.array([0, 1e-12, 1e-12, 5, -40, 3, 3, 0.2, -0.7, 1.1, 1e-300, 0.4]) * U_SLIP
+    N = N_CURVE * np.array([1, 1, 0.5, 2, 1, -0.5, 0.0, 0.3, 1e-9, 1, 1, 4])
+    ref = _reference(u, N, scale=scale)
+    s = Slave(fmus[version], version).initialize(u[0], N[0], scale=scale)
+    F, kt, W, slip = s.run(u, N)
+    s.close()
+    _assert_close(F, ref.F, max(1.0, np.max(np.abs(ref.F))))
+    _assert_close(W, ref.W, max(1e-12, ref.W[-1]))
+    assert np.all(np.isfinite(kt)) and np.all((slip >= 0) & (slip <= 1))
