@@ -21,7 +21,8 @@ def plot_curve(path, problem, out: Path, reference=None) -> Path:
     fig, ax = plt.subplots(figsize=(5, 3.6))
     u, T = path.u, path.T
     ax.plot(u * 1e6, T, "o-", ms=3, label="contact model")
-    ax.plot(u * 1e6, np.minimum(problem.k_t * u, T.max() * 1.2), ":", label="k_t u")
+    u_line = np.array([0.0, min(u[-1], 1.1 * problem.mu * problem.N / problem.k_t)])
+    ax.plot(u_line * 1e6, problem.k_t * u_line, ":", label="k_t u")
     if reference is not None:
         ax.plot(reference[0] * 1e6, reference[1], "--", label="Cattaneo-Mindlin")
     ax.axhline(problem.mu * problem.N, color="0.6", lw=0.8)
@@ -64,6 +65,24 @@ def plot_traction(path, problem, out: Path, fraction: float = 0.6) -> Path:
            title=f"traction at T/(mu N) = {p.T / (problem.mu * problem.N):.2f}")
     ax.legend()
     return _save(fig, out / "traction.png")
+
+
+def plot_loop(loop_path, amplitude: float, curve_u, curve_T, out: Path) -> Path:
+    """A loop computed by the contact model against Masing's branches from the virgin table."""
+    from contact_core.tangential_reference import masing_branch
+
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5, 3.6))
+    ax.plot(loop_path.u * 1e6, loop_path.T, "-", label="contact model (slip history)")
+    T_a = float(np.interp(amplitude, curve_u, curve_T))
+    down = np.linspace(amplitude, -amplitude, 100)
+    ax.plot(down * 1e6, masing_branch(down, amplitude, T_a, curve_u, curve_T), "k--", label="Masing")
+    ax.plot(-down * 1e6, masing_branch(-down, -amplitude, -T_a, curve_u, curve_T), "k--")
+    ax.set(xlabel="u [um]", ylabel="T [N]", title=f"hysteresis loop, a = {amplitude * 1e6:.3g} um")
+    ax.legend()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    return _save(fig, out / "loop.png")
 
 
 def plot_all(path, problem, out, reference=None) -> list:

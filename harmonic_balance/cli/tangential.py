@@ -100,6 +100,12 @@ def run(args) -> int:
         from contact_core.tangential_plots import plot_all
 
         plot_all(result.virgin, result.problem, args.plot, _reference_curve(result))
+        if "loop" in extra:
+            from contact_core.tangential_plots import plot_loop
+
+            plot_loop(extra.pop("_loop_path"), args.loop_amplitude, result.curve.u,
+                      result.curve.T, args.plot)
+    extra.pop("_loop_path", None)
     if args.json:
         print_json(summary(result) | extra)
     else:
@@ -176,4 +182,5 @@ def _extras(result, args) -> dict:
         out["loop"] = {"amplitude": args.loop_amplitude, "u": path.u, "T": path.T,
                        "W_direct": energy["W_friction"], "W_area": energy["W_area"],
                        "W_masing": W_masing, "T_amplitude": energy["T_amplitude"]}
+        out["_loop_path"] = path  # for --plot; not printed
     return out

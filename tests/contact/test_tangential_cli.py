@@ -46,9 +46,10 @@ def test_constant_normal_displacement(capsys):
     assert out["T"][-1] == pytest.approx(0.5 * out["normal_force"], rel=1e-9)
 
 
-def test_force_control_and_loop(capsys):
+def test_force_control_and_loop(capsys, tmp_path):
     out = run_json(capsys, SPHERE + ["--force", "200", "--tangential-force", "50",
-                                     "--loop-amplitude", "1e-6"])
+                                     "--loop-amplitude", "1e-6", "--plot", str(tmp_path)])
+    assert (tmp_path / "loop.png").exists()
     assert out["force_control"]["T"] == pytest.approx(50.0, rel=1e-9)
     assert 0 < out["force_control"]["stick_fraction"] < 1
     loop = out["loop"]
