@@ -238,7 +238,8 @@ static double sliders_path(const iwan_model *m, double *z, double u0, double f0,
     double dw = 0.0;
     for (int32_t j = 0; j < m->n; ++j) {
         const double k = m->k[j];
-        const double r0 = m->fs[j] * f0 / k, r1 = m->fs[j] * f1 / k, dr = r1 - r0;
+        const double r0 = m->fs[j] * f0 / k, r1 = f1 == f0 ? r0 : m->fs[j] * f1 / k;
+        const double dr = r1 - r0;
         double e0 = u0 - z[j];
         if (e0 > r0 || e0 < -r0) {        /* outside only by round-off: project */
             e0 = e0 > r0 ? r0 : -r0;
@@ -263,6 +264,15 @@ static double sliders_path(const iwan_model *m, double *z, double u0, double f0,
         }
     }
     return dw;
+}
+
+/* Force of a state (the F of outputs(), without the rest). */
+static double force(const iwan_model *m, const iwan_state *s)
+{
+    if (!s->in_contact) return 0.0;
+    double F = m->k_res * (s->u - s->u_contact);
+    for (int32_t j = 0; j < m->n; ++j) F += m->k[j] * (s->u - s->z[j]);
+    return F;
 }
 
 static void release(const iwan_model *m, iwan_state *s, double u)
@@ -696,11 +706,9 @@ iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u
     const double w0 = s.w_diss;
     for (size_t k = 1; k <= n; ++k) {       /* final pass from the closed state */
         const size_t t = (tM + k) % n;
-        iwan_output o;
         an.t = (int32_t)t;
         advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
-        outputs(model, &s, &o);
-        if (F) F[t] = o.F;
+        if (F) F[t] = force(model, &s);
         if (dFdX) {
             jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + t * nb,
                     (EN && dFdXN) ? dFdXN + t * nb : NULL);
