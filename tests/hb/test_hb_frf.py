@@ -94,3 +94,10 @@ def test_scaling_force_and_slip_strength_scales_the_response():
     a = solve_at(sdof(M, K, C, KT, FS, P), "odd:5", om)
     b = solve_at(sdof(M, K, C, KT, 3.7 * FS, 3.7 * P), "odd:5", om)
     np.testing.assert_allclose(b, 3.7 * a, rtol=EXACT_RTOL)
+
+
+def test_a_coarse_time_grid_is_flagged_as_aliased():
+    fine = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2))
+    coarse = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2), n_t=16)
+    assert fine.status == "complete" and fine.alias_ratio < 1e-3
+    assert "warning" in coarse.status and coarse.alias_ratio > 1e-2
