@@ -40,6 +40,8 @@ CASES = {
     "mostly stuck, offset": (np.array([2e-6, 0.4e-6, 0.1e-6, 0, 0.05e-6, 0, 0]), None),
     "varying N": (np.array([1e-6, 6e-6, 1e-6, 1.5e-6, 0, 0, 0.4e-6]),
                   np.array([N_SPHERE, 30, 0, 0, 10, 5, 0])),
+    "stuck, negative offset, varying N": (np.array([-3e-6, 0.4e-6, 0.1e-6, 0, 0.05e-6, 0, 0]),
+                                           np.array([N_SPHERE, 10, 5, 0, 3, 0, 0])),
     "lift-off": (np.array([1e-6, 6e-6, 1e-6, 1.5e-6, 0, 0, 0.4e-6]),
                  np.array([N_SPHERE, 120, 0, 0, 10, 5, 0])),
 }
