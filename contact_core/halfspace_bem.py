@@ -11,14 +11,16 @@ of size ``dx * dy``; node i sits at the centre of cell i. A nodal force f_j
 [N] is a uniform traction f_j / (dx dy) over cell j, and displacements are
 collocated at the nodes. The surface displacement of a half-space (modulus E,
 Poisson's ratio nu, shear modulus G = E / (2 (1 + nu))) under a point force at
-distance rho = sqrt(X^2 + Y^2) is (Johnson, Contact Mechanics, eqs. 3.19a and
-3.22; Love 1929 for the uniform rectangle)
+distance rho = sqrt(X^2 + Y^2) is (Johnson, Contact Mechanics, 1985, ch. 3:
+concentrated normal and tangential forces; Love 1929 for the uniformly loaded
+rectangle)
 
     normal force P (Boussinesq):       u_z = (1 - nu^2) / (pi E) * P / rho
     tangential force Q_x (Cerruti):    u_x = Q_x / (2 pi G) * [(1 - nu) / rho + nu X^2 / rho^3]
 
 Integrated over a rectangle these have closed forms (``_rect_inv_rho``,
-``_rect_x2_rho3``). The combined (relative) compliance of the pair is the sum
+``_rect_x2_rho3``; checked against quadrature and Love's centre displacement
+in tests/contact/test_halfspace_bem.py). The combined (relative) compliance of the pair is the sum
 over the two bodies; the coupling of normal and tangential displacements
 (Johnson's constant beta) is neglected, exactly so for like materials and as
 the thesis does (Appendix A.2, decoupled problems).
