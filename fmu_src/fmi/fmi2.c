@@ -184,7 +184,8 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     WRAPPER(c);                                                                            \
     (void)vr; (void)value;                                                                 \
     if (nvr == 0) return fmi2OK;                                                           \
-    RET(fmu_log(w->inst, FMU_ERROR, "this FMU has no " type " variables (vr %u)", vr[0]))
+    RET(fmu_log(w->inst, FMU_ERROR, "this FMU has no " type " variables (vr %u)",         \
+                vr ? vr[0] : 0u))
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Integer value[]) { NO_VARIABLES("Integer"); }

@@ -507,6 +507,53 @@ static void test_input_derivatives(const api *a)
     release(&y);
 }
 
+/* Unsupported functions (other types, Model Exchange, events, clocks) answer with
+ * an error, also when handed NULL arrays. */
+static void test_unsupported(const api *a)
+{
+    inst x = start(a, "unsupported");
+    void *fn;
+    const unsigned int vr = VR_U;
+    if (!x.c) return;
+    if (a->v == 2) {
+        fmi2GetIntegerTYPE *gi;
+        fmi2CancelStepTYPE *cancel;
+        fmi2GetRealOutputDerivativesTYPE *god;
+        *(void **)(&gi) = dlsym(a->lib, "fmi2GetInteger");
+        *(void **)(&cancel) = dlsym(a->lib, "fmi2CancelStep");
+        *(void **)(&god) = dlsym(a->lib, "fmi2GetRealOutputDerivatives");
+        expect_error(&x, (int)gi(x.c, NULL, 1, NULL), "fmi2GetInteger(NULL arrays)");
+        expect_error(&x, (int)cancel(x.c), "fmi2CancelStep");
+        expect_error(&x, (int)god(x.c, &vr, 1, NULL, NULL), "fmi2GetRealOutputDerivatives");
+    } else {
+        fmi3EnterEventModeTYPE *event;
+        fmi3GetInt32TYPE *gi;
+        fmi3SetTimeTYPE *set_time;
+        fmi3UpdateDiscreteStatesTYPE *update;
+        fmi3GetAdjointDerivativeTYPE *adjoint;
+        *(void **)(&event) = dlsym(a->lib, "fmi3EnterEventMode");
+        *(void **)(&gi) = dlsym(a->lib, "fmi3GetInt32");
+        *(void **)(&set_time) = dlsym(a->lib, "fmi3SetTime");
+        *(void **)(&update) = dlsym(a->lib, "fmi3UpdateDiscreteStates");
+        *(void **)(&adjoint) = dlsym(a->lib, "fmi3GetAdjointDerivative");
+        expect_error(&x, (int)event(x.c), "fmi3EnterEventMode");
+        expect_error(&x, (int)gi(x.c, &vr, 1, NULL, 1), "fmi3GetInt32");
+        expect_error(&x, (int)set_time(x.c, 1.0), "fmi3SetTime");
+        expect_error(&x, (int)update(x.c, NULL, NULL, NULL, NULL, NULL, NULL),
+                     "fmi3UpdateDiscreteStates");
+        expect_error(&x, (int)adjoint(x.c, &vr, 1, &vr, 1, NULL, 1, NULL, 1),
+                     "fmi3GetAdjointDerivative");
+    }
+    fn = dlsym(a->lib, a->v == 2 ? "fmi2GetVersion" : "fmi3GetVersion");
+    {
+        const char *(*version)(void);
+        *(void **)(&version) = fn;
+        CHECK(version && strcmp(version(), a->v == 2 ? "2.0" : "3.0") == 0, "GetVersion");
+    }
+    CHECK(do_step(&x, 1e-3) == 0, "FMI %d: instance usable after refused calls", a->v);
+    release(&x);
+}
+
 static int write_curve(const char *dir)
 {
     char path[1100];
@@ -546,6 +593,7 @@ int main(int argc, char **argv)
             test_rollback_and_serialization(apis[i]);
             test_directional_derivatives(apis[i]);
             test_side_by_side(apis[i], apis[1 - i]);
+            test_unsupported(apis[i]);
         }
         test_input_derivatives(&a2);
     }
