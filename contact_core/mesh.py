@@ -26,6 +26,13 @@ HEX_OFFSETS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0],
 #: Largest angular step [rad] along a curved surface, so the polygonal surface
 #: stays within 0.2 % of the arc.
 MAX_ARC_STEP = math.pi / 24
+#: Layers below (above) the contact face graded gently: the peak pressure is set
+#: by the first layers (measured, sphere 21x21: ratio 1.45 everywhere gave p0
+#: +0.63 %, these 8 layers at 1.1 then a faster growth -0.03 %).
+NEAR_LAYERS = 8
+NEAR_RATIO = 1.1
+#: Extra growth ratio of the deeper layers over the lateral grading ratio.
+DEEP_EXTRA = 0.15
 
 
 @dataclass(frozen=True)
@@ -65,6 +72,17 @@ def graded(start: float, end: float, s0: float, q: float, cap: float = np.inf) -
         total += step
     steps = np.asarray(steps) * (span / total)
     return start + np.cumsum(steps)
+
+
+def depth_levels(span: float, s0: float, q: float) -> np.ndarray:
+    """Levels 0 < z <= span away from the contact face: NEAR_LAYERS steps growing by
+    NEAR_RATIO from s0, then by q + DEEP_EXTRA; scaled so the last level is span."""
+    steps, step, total = [], s0 / NEAR_RATIO, 0.0
+    while total < span * (1.0 - 1e-9):
+        step *= NEAR_RATIO if len(steps) < NEAR_LAYERS else q + DEEP_EXTRA
+        steps.append(step)
+        total += step
+    return np.cumsum(steps) * (span / total)
 
 
 def zone_points(extent: float, n_side: int, symmetric_half: bool) -> np.ndarray:
@@ -124,7 +142,7 @@ def _centered(xline: np.ndarray, nzx: int) -> np.ndarray:
 
 def plane_block(xs, ys, depth: float, s: float, q: float, nzx: int, nzy: int) -> BodyMesh:
     """Body 2: the block below z = 0 on x-y lines ``xs``, ``ys``, graded in depth."""
-    zs = -graded(0.0, depth, s, q)[::-1]
+    zs = -depth_levels(depth, s, q)[::-1]
     zs = np.concatenate([zs, [0.0]])
     X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
     nz = zs.size
@@ -134,7 +152,7 @@ def plane_block(xs, ys, depth: float, s: float, q: float, nzx: int, nzy: int) ->
 
 def upper_block(xs, ys, height: float, s: float, q: float, nzx: int, nzy: int) -> BodyMesh:
     """Body 1 as a block above z = 0 (half-space variant, flat face)."""
-    zs = np.concatenate([[0.0], graded(0.0, height, s, q)])
+    zs = np.concatenate([[0.0], depth_levels(height, s, q)])
     X, Y, Z = np.meshgrid(xs, ys, zs, indexing="ij")
     idx = np.arange(X.size).reshape(X.shape)
     return _body(X, Y, Z, nzx, nzy, 0, idx[:, :, -1].ravel())
@@ -142,7 +160,7 @@ def upper_block(xs, ys, height: float, s: float, q: float, nzx: int, nzy: int) -
 
 def _lift(X2, Y2, zsurf, R, s, q):
     """Columns from the curved surface z_s up to the flat distant face z = R."""
-    phi = np.concatenate([[0.0], graded(0.0, 1.0, s / R, q)])
+    phi = np.concatenate([[0.0], depth_levels(1.0, s / R, q)])
     Z = zsurf[:, :, None] + (R - zsurf)[:, :, None] * phi[None, None, :]
     X = np.repeat(X2[:, :, None], phi.size, axis=2)
     Y = np.repeat(Y2[:, :, None], phi.size, axis=2)
