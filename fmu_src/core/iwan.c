@@ -7,6 +7,9 @@
  * position z_j, elastic stretch e_j = u - z_j, force k_j e_j, |e_j| <= r_j,
  *     r_j(N) = g_j(N) / k_j                                       (slip radius)
  * The residual spring carries k_res (u - u_contact) and never slips.
+ * Parallel sliders built from a concave table reproduce the virgin curve and
+ * Masing's branches F_r + 2 f((x - x_r)/2) (thesis eqs. 2.15-2.16; Iwan 1966)
+ * exactly, with the memory of nested loops.
  *
  * Exact straight-path update (issue 3, iwan.h): between two committed points
  * (u0, N0) -> (u1, N1) both u and r_j are linear in the path parameter s, so the

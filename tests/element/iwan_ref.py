@@ -4,8 +4,8 @@ Independent of the slider (Iwan) formulation used by the C core: it only knows
 the virgin curve g(u) (odd extension) and Masing's rules (Masing 1926; the
 "extended" memory rules, e.g. Segalman & Starr):
 
-1. virgin loading follows F = g(u);
-2. after a reversal at (u_r, F_r) the branch is F = F_r + 2 g((u - u_r) / 2);
+1. virgin loading follows F = g(u), odd extension (thesis eq. 2.15);
+2. after a reversal at (u_r, F_r) the branch is F = F_r + 2 g((u - u_r) / 2) (eq. 2.16);
 3. when a branch reaches the reversal point where the previous branch started,
    that inner loop is closed and forgotten: the response continues on the
    branch that was interrupted (for the first loop, on the virgin curve at -u_r).
