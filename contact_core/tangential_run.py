@@ -30,6 +30,13 @@ from contact_core.tangential import TangentialProblem
 from contact_core.tangential_curve import CURVE_TOL, TangentialPath, to_virgin_curve, virgin_curve
 
 MODELS = ("real", "halfspace", "bem")
+#: Fewer full-model contact nodes than this cannot carry a stick/slip pattern:
+#: refused (ValueError) rather than returned as a number.
+MIN_CONTACT_NODES = 4
+#: Fewer grid nodes across the contact than this: the curve is returned with
+#: a warning (k_t is then typically several per cent off; 3 nodes per side
+#: gave +8 % on the sphere).
+WARN_NODES_ACROSS = 7
 
 
 @dataclass(frozen=True)
@@ -50,6 +57,8 @@ class TangentialRun:
         Normal contact stiffness dN/d(approach) at the normal state [N/m].
     timings : dict
         Seconds per stage.
+    warnings : list of str
+        Doubts about the result (a contact resolved by few nodes).
     """
 
     spec: ContactSpec
@@ -62,6 +71,7 @@ class TangentialRun:
     curve: VirginCurve
     k_n: float
     timings: dict
+    warnings: list
 
 
 def build_contact(spec: ContactSpec, model: str = "real", cache=None):
@@ -123,6 +133,7 @@ def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: f
     k_n = float(normal.tangent(contact, nsol.active)[0, 0])
     t2 = time.perf_counter()
     problem = TangentialProblem(contact, nsol.f, mu)
+    warnings = check_resolution(contact, nsol.f)
     path = virgin_curve(problem, tol)
     t3 = time.perf_counter()
     curve = to_virgin_curve(path, problem, load_case=load_case, k_n=k_n,
@@ -130,7 +141,28 @@ def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: f
                             grid=_grid_info(spec, contact, problem), command=command)
     timings = {"condense": t1 - t0, "normal": t2 - t1, "tangential": t3 - t2,
                "condense_stages": contact.meta.get("timings", {})}
-    return TangentialRun(spec, model, load_case, contact, nsol, problem, path, curve, k_n, timings)
+    return TangentialRun(spec, model, load_case, contact, nsol, problem, path, curve, k_n, timings,
+                         warnings)
+
+
+def check_resolution(contact, f_n) -> list:
+    """Refuse a contact on too few nodes; warn when it spans few nodes across.
+
+    Counts full-model nodes (``grid.copies``, symmetry images) in contact; the
+    nodes across are those of a disc of that many nodes, sqrt(4 n / pi).
+    """
+    grid = contact.grid
+    copies = grid.copies if grid.copies is not None else np.ones(grid.n)
+    n_full = int(np.sum(np.asarray(copies)[np.asarray(f_n) > 0]))
+    hint = "refine --grid or lower --p-design (the potential zone is sized for that peak pressure)"
+    if n_full < MIN_CONTACT_NODES:
+        raise ValueError(f"the contact covers only {n_full} grid node(s): too few for a "
+                         f"tangential stick/slip solution; {hint}")
+    across = float(np.sqrt(4.0 * n_full / np.pi))
+    if across < WARN_NODES_ACROSS:
+        return [f"the contact spans only ~{across:.1f} grid nodes across ({n_full} nodes): "
+                f"k_t and the curve may be several per cent off; {hint}"]
+    return []
 
 
 def _check_mu(mu) -> float:

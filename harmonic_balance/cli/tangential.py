@@ -93,6 +93,8 @@ def run(args) -> int:
     result = tangential_run.run(spec, args.mu, force=args.force, approach=args.approach,
                                 eccentricity=args.eccentricity, model=args.model, cache=False if args.no_cache else args.cache_dir,
                                 tol=CURVE_TOL if args.tol is None else args.tol, command=command)
+    for warning in result.warnings:
+        print(f"damper tangential: warning: {warning}", file=sys.stderr)
     extra = _extras(result, args)
     if args.out:
         write_curve(result.curve, args.out)
@@ -142,7 +144,8 @@ def summary(result) -> dict:
            "gross_slip_force": prob.mu * prob.N, "gross_slip_displacement": float(path.u[-1]),
            "stick_fraction": path.stick_fraction, "iterations": int(path.iterations.sum()),
            "iterations_per_point": path.iterations, "normal_iterations": result.normal.iterations,
-           "contact_nodes": prob.n_c, "grid": result.curve.grid, "timings": result.timings}
+           "contact_nodes": prob.n_c, "grid": result.curve.grid, "timings": result.timings,
+           "warnings": result.warnings}
     if spec.body == "sphere":
         a = (3 * prob.N * spec.radius / (4 * spec.Estar)) ** (1 / 3)
         Gs = shear_modulus_star(spec.E1, spec.nu1, spec.E2, spec.nu2)

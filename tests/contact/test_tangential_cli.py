@@ -89,3 +89,15 @@ def test_bem_refuses_the_flat_face(capsys):
 def test_eccentricity_needs_a_flat_face(capsys):
     assert main(SPHERE + ["--force", "200", "--eccentricity", "1e-5"]) == 2
     assert "flat face" in capsys.readouterr().err
+
+
+def test_a_contact_on_one_node_is_refused(capsys):
+    # 1 mN on a zone sized for 2000 MPa: the contact falls inside one grid cell
+    assert main(SPHERE + ["--force", "1e-3"]) == 2
+    assert "too few" in capsys.readouterr().err
+
+
+def test_a_coarse_contact_is_flagged(capsys):
+    argv = [a if a != "13" else "5" for a in SPHERE]
+    out = run_json(capsys, argv + ["--force", "200"])
+    assert out["warnings"] and "grid nodes across" in out["warnings"][0]
