@@ -46,7 +46,8 @@ def plot_all(result: dict, body: str, out_dir: str | Path) -> list[Path]:
     sc = ax.scatter(x * 1e3, y * 1e3, c=p / 1e6, s=12, cmap="viridis")
     fig.colorbar(sc, label="pressure [MPa]")
     ax.set(xlabel="x [mm]", ylabel="y [mm]", title=f"{body}: pressure, F = {result['force']:.4g} N")
-    ax.set_aspect("equal")
+    if np.ptp(y) <= 3 * np.ptp(x):
+        ax.set_aspect("equal")
     files.append(_save(fig, out_dir / "pressure_map.png"))
     plt.close(fig)
 
@@ -61,11 +62,14 @@ def plot_all(result: dict, body: str, out_dir: str | Path) -> list[Path]:
         for s in (-1, 1):
             ax.axvline(s * h["b"] * 1e3, color="k", label="Hertz" if s > 0 else None)
     ax.set(xlabel="x [mm]", ylabel="y [mm]", title="contact area")
-    ax.set_aspect("equal")
+    if np.ptp(y) <= 3 * np.ptp(x):
+        ax.set_aspect("equal")
     ax.legend(loc="upper right")
     files.append(_save(fig, out_dir / "contact_area.png"))
     plt.close(fig)
 
+    if h:
+        files.append(_profiles(result, body, out_dir, plt))
     if "curve" in result:
         cv = result["curve"]
         fig, ax = plt.subplots(figsize=(6, 4.5))
@@ -80,3 +84,25 @@ def plot_all(result: dict, body: str, out_dir: str | Path) -> list[Path]:
         files.append(_save(fig, out_dir / "f_approach.png"))
         plt.close(fig)
     return files
+
+
+def _profiles(result: dict, body: str, out_dir: Path, plt) -> Path:
+    """Pressure along x on the row y = 0 (and, cylinder, at the end y = L/2) vs Hertz."""
+    m, h = result["maps"], result["hertz"]
+    x, y, p = (np.asarray(m[k]) for k in ("x", "y", "pressure"))
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    rows = [(np.abs(y) <= 1e-12, "FE, y = 0")]
+    if body == "cylinder":
+        rows.append((np.isclose(y, y.max()), "FE, end y = L/2"))
+    for sel, label in rows:
+        order = np.argsort(x[sel])
+        ax.plot(x[sel][order] * 1e3, p[sel][order] / 1e6, "o-", ms=3, label=label)
+    size = h["a"] if body == "sphere" else h["b"]
+    xs = np.linspace(0, size, 200)
+    ax.plot(xs * 1e3, h["p0"] * np.sqrt(1 - (xs / size) ** 2) / 1e6, "k--",
+            label="Hertz" if body == "sphere" else "2D Hertz")
+    ax.set(xlabel="x [mm]", ylabel="pressure [MPa]", title=f"{body}: pressure profiles")
+    ax.legend()
+    path = _save(fig, out_dir / "pressure_profiles.png")
+    plt.close(fig)
+    return path
