@@ -242,7 +242,6 @@ fmu_status fmu_set(fmu_instance *inst, const unsigned int *vr, size_t n, const d
     }
     for (i = 0; i < n; i++) {
         inst->s.value[vr[i]] = v[i];
-        inst->s.deriv[vr[i]] = 0.0;  /* a new value starts a held (constant) input */
         if (damper_causality_of[vr[i]] == CAUS_PARAMETER) inst->model_ready = 0;
     }
     inst->out_valid = 0;
@@ -293,7 +292,8 @@ fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double 
 }
 
 /* Commit the history to the current inputs, then along their straight lines to
- * time + h (FMI 2 input derivatives); the core's straight-path update is exact.
+ * time + h (FMI 2 input derivatives, then reset: a master that sets none holds
+ * its inputs); the core's straight-path update is exact.
  * All or nothing: a failed or overflowing update leaves the history as it was. */
 fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
 {
@@ -323,6 +323,7 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     }
     inst->s.value[VR_U] = u + du;
     inst->s.value[VR_N] = N + dN;
+    inst->s.deriv[VR_U] = inst->s.deriv[VR_N] = 0.0;  /* valid for one step only */
     inst->out_valid = 1;
     inst->s.time = t + h;
     return FMU_OK;

@@ -11,9 +11,10 @@
  * - the committed history changes only in doStep; getters evaluate a trial update
  *   from the committed state to the current inputs (direct feedthrough), so a master
  *   may set/get any number of times without corrupting the history;
- * - an input is a straight line in time, x(t) = x + dx (t - time): SetReal sets x
- *   (and clears dx), FMI 2 SetRealInputDerivatives sets dx. doStep(h) commits the
- *   path to the current inputs, then along the straight line to time + h; the core
+ * - an input is a straight line in time, x(t) = x + dx (t - time): SetReal sets x,
+ *   FMI 2 SetRealInputDerivatives sets dx for the next step (any order; dx is reset
+ *   to 0 after each doStep). doStep(h) commits the path to the current inputs, then
+ *   along the straight line to time + h, where the inputs then stand; the core
  *   advances every slider exactly along a straight (u, N) path, so no step-size
  *   dependence and no sub-stepping by the master are needed;
  * - everything a saved FMU state holds is the flat struct fmu_flat (no pointers).

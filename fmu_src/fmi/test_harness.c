@@ -483,25 +483,32 @@ static void test_side_by_side(const api *a, const api *b)
     release(&w);
 }
 
-/* FMI 2 input derivatives: one step of 2h equals two steps of h (straight path). */
+/* FMI 2 input derivatives (u and N together): one step of 2h equals two steps of
+ * h along the same straight path; derivatives hold for one step only. */
 static void test_input_derivatives(const api *a)
 {
     inst x = start(a, "deriv1"), y = start(a, "deriv2");
     const unsigned int vrs[2] = {VR_U, VR_N};
     const fmi2Integer order[2] = {1, 1};
     const double rate[2] = {0.15 * U_SLIP / 1e-3, -0.02 * N_CURVE / 1e-3};
-    double Fx, Fy;
+    double Fx, Fy, u0, u1;
     int k;
     if (!x.c || !y.c) return;
     for (k = 0; k < 3; k++) {
         CHECK(a->sid2(x.c, vrs, 2, order, rate) == 0 && do_step(&x, 2e-3) == 0, "deriv step");
         CHECK(a->sid2(y.c, vrs, 2, order, rate) == 0 && do_step(&y, 1e-3) == 0
-              && do_step(&y, 1e-3) == 0, "deriv steps");
+              && a->sid2(y.c, vrs, 2, order, rate) == 0 && do_step(&y, 1e-3) == 0,
+              "deriv steps");
     }
     get(&x, VR_F, &Fx);
     get(&y, VR_F, &Fy);
     CHECK(fabs(Fx - Fy) <= 1e-12 * fabs(Fx) && Fx != 0.0,
           "input derivatives: one step %.17g vs two %.17g", Fx, Fy);
+    get(&x, VR_U, &u0);
+    CHECK(fabs(u0 - 6e-3 * rate[0]) <= 1e-12 * fabs(u0), "u extrapolated to %g", u0);
+    do_step(&x, 1e-3);
+    get(&x, VR_U, &u1);
+    CHECK(u1 == u0, "FMI 2: input derivative kept beyond its step (u %g -> %g)", u0, u1);
     expect_error(&x, a->sid2(x.c, vrs, 1, (const fmi2Integer[]){2}, rate), "order 2");
     release(&x);
     release(&y);
