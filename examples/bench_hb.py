@@ -10,7 +10,9 @@ state at five frequencies around the peak, peak from a parabola through them.
 
 Table 2: a full curve (H = 7, odd harmonics) against model size: the 2-DOF test
 model and chains of n modes with 8 Jenkins elements (4 between DOFs, 4 to ground),
-receptance-condensed onto the 12 element DOFs.
+receptance-condensed onto the 12 element DOFs, over the first resonance (from the
+free to the stuck natural frequency). Point counts differ (adaptive steps), so the
+cost is also given per 200 points.
 
 Speed-up: the HB curve against time integration of the same curve, frequency by
 frequency (measured at 5 frequencies, scaled to the number of HB points), and
@@ -51,7 +53,7 @@ def rss_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
-def ti_peak(model, w0, steps, tol, rel=(-0.01, -0.005, 0.0, 0.005, 0.01)):
+def ti_peak(model, w0, steps, tol, rel):
     """Time-integration peak near w0: parabola through steady amplitudes.
 
     Returns (peak amplitude, its step-size error estimate, seconds).
@@ -114,21 +116,37 @@ def two_dof_model() -> Model:
                  {1: np.array([0.05, 0.0])}, response_dof=0)
 
 
+def friction_band(model: Model):
+    """From 0.9 x the free to 1.1 x the stuck first natural frequency [rad/s]."""
+    import scipy.linalg as sla
+
+    K = model.linear.K.copy()
+    for link in model.links:
+        a, b = link.dof_a, link.dof_b
+        K[a, a] += link.k0
+        if b is not None:
+            K[b, b] += link.k0
+            K[a, b] -= link.k0
+            K[b, a] -= link.k0
+    w_stuck = np.sqrt(sla.eigh(K, model.linear.M, eigvals_only=True)[0])
+    return 0.9 * model.linear.w_r[0], 1.1 * w_stuck
+
+
 def table_size(sizes, spec):
     print(f"\nTable 2: full curve, harmonics {spec}, against model size")
     print(f"{'case':>22} {'DOFs':>5} {'unknowns':>8} {'points':>6} {'evals':>6} {'time_s':>7} "
-          f"{'ms/eval':>8} {'mem_MB':>7}")
+          f"{'s/200pts':>8} {'ms/eval':>8} {'mem_MB':>7}")
     cases = [("2-DOF, 2 elements", two_dof_model(), (0.6, 1.6))]
     for n in sizes:
         model = chain_model(n)
-        lam = model.linear.w_r[0]  # first mode of the linear chain (friction free)
-        cases.append((f"chain {n} modes, 8 el.", model, (0.8 * lam, 1.6 * lam)))
+        cases.append((f"chain {n} modes, 8 el.", model, friction_band(model)))
     out = []
     for name, model, band in cases:
         r = compute_frf(model, spec, band)
         size = r.solutions[0].size
         print(f"{name:>22} {model.n:>5} {size:>8} {r.points:>6} {r.evaluations:>6} "
-              f"{r.time_s:>7.3f} {1e3 * r.time_s / r.evaluations:>8.3f} {rss_mb():>7.0f}")
+              f"{r.time_s:>7.3f} {200 * r.time_s / r.points:>8.3f} "
+              f"{1e3 * r.time_s / r.evaluations:>8.3f} {rss_mb():>7.0f}")
         out.append((name, r))
     return out
 
@@ -141,8 +159,14 @@ def ti_curve_rate(model, steps, tol, n=5):
     return (time.perf_counter() - t0) / n
 
 
-def ivp_one_frequency(w, tol):
-    """scipy solve_ivp (LSODA) of the sdof with the Jenkins law in rate form, to steady state."""
+def ivp_one_frequency(w, tol, eps=1e-3):
+    """scipy solve_ivp (LSODA) of the sdof to steady state, Jenkins law in rate form.
+
+    The exact rate form (z' = x' while |F| = Fs and loading) chatters at the
+    stick-slip switch and stalls an adaptive integrator; the slip rate is therefore
+    ramped over the last ``eps`` of the slip force (z' = s x', s from 0 at
+    (1 - eps) Fs to 1 at Fs), which changes the loop by O(eps).
+    """
     from scipy.integrate import solve_ivp
 
     m, k, c, kt, fs, P = (SDOF[key] for key in ("mass", "stiffness", "damping",
@@ -151,16 +175,14 @@ def ivp_one_frequency(w, tol):
     def rhs(t, y):
         x, v, z = y
         F = kt * (x - z)
-        slipping = abs(F) >= fs and np.sign(v) == np.sign(F)
-        return [v, (P * np.cos(w * t) - c * v - k * x - np.clip(F, -fs, fs)) / m,
-                v if slipping else 0.0]
+        s = np.clip((abs(F) - fs * (1 - eps)) / (eps * fs), 0.0, 1.0) if v * F > 0 else 0.0
+        return [v, (P * np.cos(w * t) - c * v - k * x - F) / m, s * v]
 
     T = 2 * np.pi / w
     y, prev = np.zeros(3), None
     t0 = time.perf_counter()
     for p in range(5000):
-        sol = solve_ivp(rhs, (p * T, (p + 1) * T), y, method="LSODA", rtol=1e-8, atol=1e-11,
-                        max_step=T / 50)
+        sol = solve_ivp(rhs, (p * T, (p + 1) * T), y, method="LSODA", rtol=1e-8, atol=1e-11)
         y = sol.y[:, -1]
         amp = np.abs(sol.y[0]).max()
         if prev is not None and abs(amp - prev) < tol * amp:
@@ -178,7 +200,9 @@ def main(argv=None) -> dict:
     model = sdof_model(**SDOF)
     Hs = (1, 3) if args.smoke else (1, 3, 5, 7, 9)
     steps, tol = (64, 1e-5) if args.smoke else (512, 1e-8)
-    rel = (-0.01, 0.0, 0.01) if args.smoke else (-0.01, -0.005, 0.0, 0.005, 0.01)
+    # the peak is asymmetric: a parabola over +-1 % overestimated it by 0.035 %, over
+    # +-0.2 % the fit error is below the reference's step error
+    rel = (-0.002, 0.0, 0.002) if args.smoke else (-0.002, -0.001, 0.0, 0.001, 0.002)
     rows, ref, ref_err = table_h(model, Hs, steps, tol, rel)
     sizes = table_size(() if args.smoke else (10, 50, 200), "odd:3" if args.smoke else "odd:7")
     hb = rows[-1][1]

@@ -81,3 +81,12 @@ def test_bad_elements_file_exits_2(tmp_path, capsys):
     assert main(["frf", "--model", str(tmp_path / "m.npz"), "--elements",
                  str(tmp_path / "e.toml"), "--omega", "0.6", "2.0"]) == 2
     assert "DOF 5" in capsys.readouterr().err
+
+
+def test_non_concave_curve_file_exits_2_with_the_reason(tmp_path, capsys):
+    write_two_dof(tmp_path)
+    write_curve(VirginCurve(u=[0.0, 0.1, 0.2], T=[0.0, 0.02, 0.11], N=1.0), tmp_path / "c.json")
+    (tmp_path / "e.toml").write_text('[[element]]\ndofs = [0]\ntype = "curve"\npath = "c.json"\n')
+    assert main(["frf", "--model", str(tmp_path / "m.npz"), "--elements",
+                 str(tmp_path / "e.toml"), "--omega", "0.6", "2.0"]) == 2
+    assert "concave" in capsys.readouterr().err
