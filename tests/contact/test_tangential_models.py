@@ -30,8 +30,12 @@ KT_RTOL = 0.02
 #: a kink at the stick edge x = +-c that a grid of spacing dx ~ 0.07 b smears
 #: (3.4 % measured).
 TRACTION_TOL = 0.05
-#: The small FE case (11 nodes per side, ~6 across the contact): 1.1 % measured.
-FE_CURVE_TOL = 0.02
+#: The small FE case (15 nodes per side, ~9 across the contact): the issue's
+#: 1 % of mu N on the curve (0.4 % measured); k_t within 3 %: on grids this
+#: coarse it scatters by +-3 % between 11 and 15 nodes per side as the discrete
+#: contact boundary moves (0.06 % measured at 15).
+FE_CURVE_TOL = 0.01
+FE_KT_RTOL = 0.03
 
 
 @pytest.fixture(scope="module")
@@ -132,11 +136,11 @@ def test_cylinder_ends_carry_the_edge_peak(cylinder):
 
 
 def test_small_fe_model_matches_mindlin():
-    spec = ContactSpec(body="sphere", radius=0.01, grid=11, load_hint=200.0)
+    spec = ContactSpec(body="sphere", radius=0.01, grid=15, load_hint=200.0)
     fe = tangential_run.run(spec, MU, force=200.0, model="halfspace", cache=False)
     a = hertz.sphere(200.0, 0.01, E_STAR)["a"]
     T_ref = tr.mindlin_force(fe.virgin.u, 200.0, MU, a, G_STAR)
     assert np.abs(fe.virgin.T - T_ref).max() <= FE_CURVE_TOL * MU * 200.0
     assert fe.problem.N == pytest.approx(200.0, rel=1e-9)
     assert fe.contact.grid.mult.max() == 4.0  # quarter model: weights carried through
-    assert fe.problem.k_t == pytest.approx(8 * G_STAR * a, rel=FE_CURVE_TOL)
+    assert fe.problem.k_t == pytest.approx(8 * G_STAR * a, rel=FE_KT_RTOL)
