@@ -49,7 +49,7 @@ def plot_stick_slip(path, problem, out: Path, fractions=(0.25, 0.5, 0.75, 0.95))
 
 
 def plot_traction(path, problem, out: Path, fraction: float = 0.6) -> Path:
-    """Traction q/area and the slip limit mu p along x on the line y = 0, near T/(mu N) = fraction."""
+    """Traction q/area, the slip limit mu p and the slip along x on y = 0, near T/(mu N) = fraction."""
     plt = _pyplot()
     grid = problem.contact.grid
     p = path.points[int(np.argmin(np.abs(path.T - fraction * problem.mu * problem.N)))]
@@ -62,8 +62,11 @@ def plot_traction(path, problem, out: Path, fraction: float = 0.6) -> Path:
     ax.plot(x * 1e3, lim / 1e6, "--", label="mu p")
     ax.plot(x * 1e3, tau / 1e6, "o-", ms=3, label="traction q")
     ax.set(xlabel="x [mm] (y = 0)", ylabel="traction [MPa]",
-           title=f"traction at T/(mu N) = {p.T / (problem.mu * problem.N):.2f}")
-    ax.legend()
+           title=f"traction and slip at T/(mu N) = {p.T / (problem.mu * problem.N):.2f}")
+    ax.legend(loc="upper left")
+    slip_ax = ax.twinx()
+    slip_ax.plot(x * 1e3, p.s[line][order] * 1e9, "s:", ms=2, color="tab:red")
+    slip_ax.set_ylabel("accumulated slip [nm]", color="tab:red")
     return _save(fig, out / "traction.png")
 
 
