@@ -215,27 +215,20 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     WRAPPER(c);
-    fmu_state_free(FMUstate);
-    return fmi2OK;
+    RET(fmu_state_free(w->inst, FMUstate));
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
 {
     WRAPPER(c);
-    if (!FMUstate || !size) RET(fmu_log(w->inst, FMU_ERROR, "SerializedFMUstateSize: null"));
-    *size = fmu_state_size();
-    return fmi2OK;
+    RET(fmu_state_size(w->inst, FMUstate, size));
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate,
                                  fmi2Byte serializedState[], size_t size)
 {
     WRAPPER(c);
-    if (!FMUstate || !serializedState || size != fmu_state_size())
-        RET(fmu_log(w->inst, FMU_ERROR, "SerializeFMUstate: null state or wrong size %lu",
-                    (unsigned long)size));
-    memcpy(serializedState, FMUstate, size);
-    return fmi2OK;
+    RET(fmu_state_serialize(w->inst, FMUstate, serializedState, size));
 }
 
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[],

@@ -275,28 +275,20 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     WRAPPER(instance);
-    fmu_state_free(FMUState);
-    return fmi3OK;
+    RET(fmu_state_free(w->inst, FMUState));
 }
 
-fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState,
-                                      size_t *size)
+fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size)
 {
     WRAPPER(instance);
-    if (!FMUState || !size) RET(fmu_log(w->inst, FMU_ERROR, "SerializedFMUStateSize: null"));
-    *size = fmu_state_size();
-    return fmi3OK;
+    RET(fmu_state_size(w->inst, FMUState, size));
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState,
                                  fmi3Byte serializedState[], size_t size)
 {
     WRAPPER(instance);
-    if (!FMUState || !serializedState || size != fmu_state_size())
-        RET(fmu_log(w->inst, FMU_ERROR, "SerializeFMUState: null state or wrong size %lu",
-                    (unsigned long)size));
-    memcpy(serializedState, FMUState, size);
-    return fmi3OK;
+    RET(fmu_state_serialize(w->inst, FMUState, serializedState, size));
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[],

@@ -10,6 +10,8 @@
 
 #include "model.h"
 
+static void free_all_states(fmu_instance *inst);
+
 /* A communication point may differ from the FMU's time by round-off of the master's
  * own t + h sums; more than this (relative to max(1, |t|)) is a master error. */
 #define TIME_TOLERANCE 1e-9
@@ -117,6 +119,7 @@ fmu_instance *fmu_new(const char *name, const char *token, const char *resource_
 void fmu_free(fmu_instance *inst)
 {
     if (!inst) return;
+    free_all_states(inst);  /* states the importer did not free */
     free(inst->curve_u);
     free(inst->curve_T);
     free(inst);
@@ -360,16 +363,41 @@ fmu_status fmu_directional_derivative(fmu_instance *inst, const unsigned int *un
     return FMU_OK;
 }
 
-size_t fmu_state_size(void) { return sizeof(fmu_flat); }
+static size_t find_state(const fmu_instance *inst, const void *state)
+{
+    size_t i;
+    for (i = 0; i < inst->n_states; i++)
+        if (state && inst->states[i] == state) return i;
+    return (size_t)-1;
+}
+
+/* The state at *state if this instance handed it out, else a new registered one. */
+static fmu_flat *own_state(fmu_instance *inst, void **state)
+{
+    fmu_flat *s;
+    if (find_state(inst, *state) != (size_t)-1) return (fmu_flat *)*state;
+    if (inst->n_states == inst->cap_states) {
+        size_t cap = inst->cap_states ? 2 * inst->cap_states : 8;
+        void **grown = (void **)realloc(inst->states, cap * sizeof(void *));
+        if (!grown) return NULL;
+        inst->states = grown;
+        inst->cap_states = cap;
+    }
+    s = (fmu_flat *)malloc(sizeof(fmu_flat));
+    if (s) inst->states[inst->n_states++] = s;
+    return s;
+}
 
 fmu_status fmu_state_get(fmu_instance *inst, void **state)
 {
+    fmu_flat *s;
     if (fmu_check_mode(inst, MODE_INIT | MODE_STEP | MODE_TERMINATED, "GetFMUState"))
         return FMU_ERROR;
     if (!state) return fmu_log(inst, FMU_ERROR, "GetFMUState: null pointer");
-    if (!*state) *state = malloc(sizeof(fmu_flat));
-    if (!*state) return fmu_log(inst, FMU_ERROR, "GetFMUState: out of memory");
-    memcpy(*state, &inst->s, sizeof(fmu_flat));
+    s = own_state(inst, state);
+    if (!s) return fmu_log(inst, FMU_ERROR, "GetFMUState: out of memory");
+    memcpy(s, &inst->s, sizeof(fmu_flat));
+    *state = s;
     return FMU_OK;
 }
 
@@ -384,10 +412,9 @@ fmu_status fmu_state_set(fmu_instance *inst, const void *state)
     fmu_flat tmp;
     if (fmu_check_mode(inst, MODE_INIT | MODE_STEP | MODE_TERMINATED, "SetFMUState"))
         return FMU_ERROR;
-    if (!state) return fmu_log(inst, FMU_ERROR, "SetFMUState: null state");
+    if (find_state(inst, state) == (size_t)-1)
+        return fmu_log(inst, FMU_ERROR, "SetFMUState: not a state of this instance");
     memcpy(&tmp, state, sizeof tmp);
-    if (!state_valid(&tmp)) return fmu_log(inst, FMU_ERROR, "SetFMUState: not a state of "
-                                           "this FMU (magic or version differ)");
     inst->out_valid = 0;
     if (inst->model_ready && tmp.value[VR_SCALE] == inst->s.value[VR_SCALE]
         && tmp.value[VR_N_REF] == inst->s.value[VR_N_REF]) {
@@ -402,25 +429,60 @@ fmu_status fmu_state_set(fmu_instance *inst, const void *state)
     return FMU_OK;
 }
 
-void fmu_state_free(void **state)
+fmu_status fmu_state_free(fmu_instance *inst, void **state)
 {
-    if (!state) return;
+    size_t i;
+    if (!state || !*state) return FMU_OK;  /* freeing NULL is a no-op */
+    i = find_state(inst, *state);
+    if (i == (size_t)-1)
+        return fmu_log(inst, FMU_ERROR, "FreeFMUState: not a state of this instance");
     free(*state);
+    inst->states[i] = inst->states[--inst->n_states];
     *state = NULL;
+    return FMU_OK;
+}
+
+static void free_all_states(fmu_instance *inst)
+{
+    size_t i;
+    for (i = 0; i < inst->n_states; i++) free(inst->states[i]);
+    free(inst->states);
+    inst->states = NULL;
+    inst->n_states = inst->cap_states = 0;
+}
+
+fmu_status fmu_state_size(fmu_instance *inst, const void *state, size_t *size)
+{
+    if (find_state(inst, state) == (size_t)-1 || !size)
+        return fmu_log(inst, FMU_ERROR, "SerializedFMUStateSize: not a state of this instance");
+    *size = sizeof(fmu_flat);
+    return FMU_OK;
+}
+
+fmu_status fmu_state_serialize(fmu_instance *inst, const void *state, void *bytes,
+                               size_t size)
+{
+    if (find_state(inst, state) == (size_t)-1 || !bytes || size != sizeof(fmu_flat))
+        return fmu_log(inst, FMU_ERROR, "SerializeFMUState: not a state of this instance, "
+                       "or %lu bytes instead of %lu", (unsigned long)size,
+                       (unsigned long)sizeof(fmu_flat));
+    memcpy(bytes, state, size);
+    return FMU_OK;
 }
 
 fmu_status fmu_state_from_bytes(fmu_instance *inst, const void *bytes, size_t size,
                                 void **state)
 {
-    fmu_flat tmp;
+    fmu_flat tmp, *s;
     if (!bytes || !state || size != sizeof(fmu_flat))
         return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: expected %lu bytes, got %lu",
                        (unsigned long)sizeof(fmu_flat), (unsigned long)size);
     memcpy(&tmp, bytes, sizeof tmp);
     if (!state_valid(&tmp))
         return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: not a state of this FMU");
-    if (!*state) *state = malloc(sizeof(fmu_flat));
-    if (!*state) return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: out of memory");
-    memcpy(*state, &tmp, sizeof tmp);
+    s = own_state(inst, state);
+    if (!s) return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: out of memory");
+    memcpy(s, &tmp, sizeof tmp);
+    *state = s;
     return FMU_OK;
 }

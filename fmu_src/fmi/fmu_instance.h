@@ -70,6 +70,8 @@ typedef struct {
     double *curve_u, *curve_T;
     double curve_n;
     int curve_fit;
+    void **states;          /* FMU states this instance handed out (others are refused) */
+    size_t n_states, cap_states;
     char name[128];
     fmu_logger log;
     void *log_ctx;
@@ -103,11 +105,16 @@ fmu_status fmu_directional_derivative(fmu_instance *inst, const unsigned int *un
                                       size_t n_unknowns, const unsigned int *knowns,
                                       size_t n_knowns, const double *seed, double *sensitivity);
 
-/* FMU state: a heap copy of fmu_flat, serialized as its bytes. */
+/* FMU state: a heap copy of fmu_flat, serialized as its bytes. The instance keeps
+ * a list of the states it handed out: a pointer not in it (an importer passing an
+ * uninitialized FMUstate, a state of another instance, one already freed) is never
+ * dereferenced or freed; GetFMUState then allocates a new state. */
 fmu_status fmu_state_get(fmu_instance *inst, void **state);
 fmu_status fmu_state_set(fmu_instance *inst, const void *state);
-void fmu_state_free(void **state);
-size_t fmu_state_size(void);
+fmu_status fmu_state_free(fmu_instance *inst, void **state);
+fmu_status fmu_state_size(fmu_instance *inst, const void *state, size_t *size);
+fmu_status fmu_state_serialize(fmu_instance *inst, const void *state, void *bytes,
+                               size_t size);
 fmu_status fmu_state_from_bytes(fmu_instance *inst, const void *bytes, size_t size,
                                 void **state);
 

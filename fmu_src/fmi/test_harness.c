@@ -416,9 +416,22 @@ static void test_rollback_and_serialization(const api *a)
     expect_error(&y, deserialize(&y, junk, sizeof junk, &s2), "deserializing 16 junk bytes");
     memset(bytes, 0xAB, 8);  /* corrupt the magic and version */
     expect_error(&y, deserialize(&y, bytes, size, &s2), "deserializing a corrupted state");
+    /* An importer passing an uninitialized FMUstate (FMI4j 0.38 does) gets a new
+     * state; pointers the instance did not hand out are refused, never touched. */
+    {
+        void *garbage = (void *)junk, *fresh = garbage;
+        CHECK(get_state(&x, &fresh) == 0 && fresh != garbage, "FMI %d: garbage FMUstate "
+              "reused", a->v);
+        expect_error(&x, set_state(&x, garbage), "SetFMUState with a foreign pointer");
+        expect_error(&x, set_state(&x, s2), "SetFMUState with another instance's state");
+        if (a->v == 2) expect_error(&x, (int)a->fs2(x.c, &garbage), "freeing a foreign pointer");
+        else expect_error(&x, (int)a->fs3(x.c, &garbage), "freeing a foreign pointer");
+        free_state(&x, &fresh);
+    }
     free_state(&x, &s);
     free_state(&y, &s2);
     CHECK(s == NULL && s2 == NULL, "FMI %d: FreeFMUState leaves the pointer set", a->v);
+    CHECK(get_state(&x, &s) == 0, "FMI %d: a state left to FreeInstance", a->v);
     free(bytes);
     release(&x);
     release(&y);
