@@ -124,17 +124,21 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     s_x = max(_rms(first.x), 1e-300)
     t_prev = np.zeros(len(x0) + 1)
     t_prev[-1] = sign
+    _, Jx, Jl = fun(first.x, lam0)
+    J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
     while len(branch.lam) < max_points:
         sc = _Scaled(fun, s_x, s_lam, tol)
         y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
-        R, J = sc.jac(y)
+        col = np.append(np.full(len(x0), s_x), s_lam)
+        J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
         try:
             t = sc.tangent(J, t_prev)
         except (np.linalg.LinAlgError, ValueError):
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
         if t @ t_prev < 0:
             t = -t
-        y_new, it, ds = _step(sc, y, t, t_prev, ds, ds_min, branch)
+        y_new, it, ds, J_new = _step(sc, y, t, t_prev, ds, ds_min, branch)
+        J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
             x_end = _interpolate(branch, y_new[:-1] * s_x, lam_new, lam_end)
@@ -163,7 +167,7 @@ def _step(sc, y, t, t_prev, ds, ds_min, branch):
             # C0 in the Jacobian) keeps its turn at any step, so the turn limit only
             # applies to steps above KINK_STEP.
             if ds <= KINK_STEP or _turn_ok(sc, res, t):
-                return res.x, res.iterations, ds
+                return res.x, res.iterations, ds, res.J[:-1]
             reason = "tangent turned too much"
         except NewtonError as err:
             reason = err.reason

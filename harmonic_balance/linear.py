@@ -153,6 +153,29 @@ class LinearModel:
         dZ = -2.0 * Omega * self.M + 1j * self.C
         return G, -(Yr.T @ dZ @ Yc)  # dG = -G dZ G, restricted to (rows, cols)
 
+    def receptances(self, Omegas, rows, cols, deriv: bool = False):
+        """:meth:`receptance` at several frequencies: (k, len(rows), len(cols)) arrays.
+
+        Modal data are evaluated for all frequencies in one product.
+        """
+        Om = np.asarray(Omegas, dtype=float)
+        if not self.modal:
+            pairs = [self.receptance(o, rows, cols, deriv) for o in Om]
+            return (np.array([p[0] for p in pairs]),
+                    np.array([p[1] for p in pairs]) if deriv else None)
+        rows = np.arange(self.n) if rows is None else np.asarray(rows)
+        cols = np.arange(self.n) if cols is None else np.asarray(cols)
+        den = self.w_r**2 - Om[:, None] ** 2 + 1j * Om[:, None] * self.c_r
+        if np.any(den == 0):
+            raise RuntimeError(f"undamped resonance of the linear part at Omega in {Om} rad/s")
+        g = 1.0 / den
+        A, B = self.phi[rows], self.phi[cols]
+        G = (A[None] * g[:, None, :]) @ B.T
+        if not deriv:
+            return G, None
+        dg = -(-2.0 * Om[:, None] + 1j * self.c_r) * g**2
+        return G, (A[None] * dg[:, None, :]) @ B.T
+
     def response(self, Omega: float, rows, f: np.ndarray, deriv: bool = False):
         """G[rows, :] @ f for a complex load f (n,), and its Omega derivative."""
         f = np.asarray(f, dtype=complex)

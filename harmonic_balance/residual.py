@@ -45,26 +45,30 @@ class _Residual:
             self._ends.append((link, ia, ib))
         self.size = nb * self.m
         self.Fext = model.forcing_coeffs(basis)  # (nb, n)
+        # Signed incidence B (size, L n_b): column block l maps link l's harmonics
+        # to its two ends (+1 at a, -1 at b), so U = B^T x, F_nl = B F_h and
+        # dF_nl/dx = B blockdiag(dF_h/dU) B^T: three dense products, no scatter loop.
+        L = len(self._ends)
+        self._B = np.zeros((self.size, L * nb))
+        for l, (_, ia, ib) in enumerate(self._ends):
+            self._B[ia, l * nb + np.arange(nb)] = 1.0
+            if ib is not None:
+                self._B[ib, l * nb + np.arange(nb)] = -1.0
 
     def nonlinear(self, x: np.ndarray, jac: bool = True):
         """Internal friction forces (size,) on the active DOFs, Jacobian, energies."""
-        Fnl = np.zeros(self.size)
-        dF = np.zeros((self.size, self.size)) if jac else None
+        nb, L = self.basis.nb, len(self._ends)
+        U = (self._B.T @ x).reshape(L, nb)
+        Fh = np.empty((L, nb))
+        J = np.zeros((L * nb, L * nb)) if jac else None
         W = []
-        for link, ia, ib in self._ends:
-            U = x[ia] if ib is None else x[ia] - x[ib]
-            Fh, J, w, _ = aft_link(link, U, self.basis)
+        for l, (link, _, _) in enumerate(self._ends):
+            Fh[l], Jl, w, _ = aft_link(link, U[l], self.basis)
             W.append(w)
-            Fnl[ia] += Fh
             if jac:
-                dF[np.ix_(ia, ia)] += J
-            if ib is not None:
-                Fnl[ib] -= Fh
-                if jac:
-                    dF[np.ix_(ia, ib)] -= J
-                    dF[np.ix_(ib, ia)] -= J
-                    dF[np.ix_(ib, ib)] += J
-        return Fnl, dF, W
+                J[l * nb:(l + 1) * nb, l * nb:(l + 1) * nb] = Jl
+        Fnl = self._B @ Fh.ravel()
+        return Fnl, (self._B @ J @ self._B.T if jac else None), W
 
     def link_samples(self, x: np.ndarray):
         """Per link: relative displacement and force over one period, (n_t,) each."""
@@ -132,10 +136,10 @@ class CondensedResidual(_Residual):
         nr, nc = len(rows), len(cols)
         G = np.zeros((b.nb, nr, b.nb, nc))
         dG = np.zeros_like(G) if deriv else None
-        for h in b.harmonics:
+        gs, dgs = lin.receptances(np.asarray(b.harmonics) * omega, rows, cols, deriv)
+        for k, h in enumerate(b.harmonics):
             ic, isn = b.index(h)
-            g, dg = lin.receptance(h * omega, rows, cols, deriv)
-            for out, val in ((G, g), (dG, None if dg is None else h * dg)):
+            for out, val in ((G, gs[k]), (dG, None if dgs is None else h * dgs[k])):
                 if out is None:
                     continue
                 if isn is None:
