@@ -25,6 +25,8 @@ targets to ``FORCE_RTOL``.
 """
 from __future__ import annotations
 
+import contextlib
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -38,6 +40,34 @@ GAP_RTOL = 1e-10
 FORCE_RTOL = 1e-9
 #: Newton steps allowed in force control.
 MAX_NEWTON = 60
+
+
+@functools.lru_cache(maxsize=1)
+def _blas_controller():
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:  # optional: without it BLAS keeps its default threads
+        return None
+    return ThreadpoolController()
+
+
+def one_blas_thread():
+    """Context limiting BLAS to one thread (threadpoolctl, optional).
+
+    The active-set solves are many small dense factorisations, where BLAS
+    threads only synchronise: measured 9 ms vs 140 ms per force-controlled
+    solve (31x31 sphere, 2 busy cores; performance.md saw 15x in the HB stage).
+    """
+    ctl = _blas_controller()
+    return contextlib.nullcontext() if ctl is None else ctl.limit(limits=1, user_api="blas")
+
+
+def _single_threaded(func):
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with one_blas_thread():
+            return func(*args, **kwargs)
+    return wrapper
 
 
 @dataclass
@@ -138,6 +168,7 @@ def lcp(C: np.ndarray, b: np.ndarray, P0: np.ndarray | None = None, max_iter: in
         f, P = step
 
 
+@_single_threaded
 def solve_displacement(cc: CondensedContact, q, P0=None) -> NormalSolution:
     """Contact state for imposed rigid DOFs q (approach [m] and, flat face, rotation [rad])."""
     q = np.atleast_1d(np.asarray(q, float))
@@ -147,6 +178,7 @@ def solve_displacement(cc: CondensedContact, q, P0=None) -> NormalSolution:
     return NormalSolution(f=f, g=cc.Czz @ f + b, q=q, active=P, iterations=it)
 
 
+@_single_threaded
 def tangent(cc: CondensedContact, active: np.ndarray) -> np.ndarray:
     """Exact d(resultants)/dq for a fixed active set, shape (r, r).
 
@@ -166,6 +198,7 @@ def resultants(cc: CondensedContact, f: np.ndarray) -> np.ndarray:
     return (cc.grid.mult * f) @ cc.rigid
 
 
+@_single_threaded
 def solve_force(cc: CondensedContact, force: float, eccentricity: float | None = None) -> NormalSolution:
     """Contact state for a target full-model force [N] (flat face: and eccentricity [m]).
 

@@ -94,7 +94,7 @@ class ContactSpec:
             if self.load_hint > 0:
                 b = max(b, hertz.cylinder(self.load_hint, self.length, R, Es)["b"])
             # the edge effect widens the contact at the ends (thesis Fig. 5)
-            return min(1.5 * self.zone_margin * b, 0.5 * R), 0.5 * self.length
+            return min(1.3 * self.zone_margin * b, 0.5 * R), 0.5 * self.length
         return 0.5 * self.width, 0.5 * self.length
 
     def key_dict(self) -> dict:
