@@ -85,11 +85,18 @@ class _Scaled:
         return t / np.linalg.norm(t)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
-        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred."""
-        def aug(y):
-            R, J = self.jac(y)
-            return np.append(R, normal @ (y - y_pred)), np.vstack([J, normal])
-        return newton(aug, y_pred, self.tol, max_iter)
+        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
+
+        The unknown is the offset d = y - y_pred, so the plane equation carries no
+        round-off of |y| (which would otherwise floor |R| near tol when y is large
+        in scaled units, e.g. during peak refinement).
+        """
+        def aug(d):
+            R, J = self.jac(y_pred + d)
+            return np.append(R, normal @ d), np.vstack([J, normal])
+        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter)
+        res.x = y_pred + res.x
+        return res
 
 
 def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
