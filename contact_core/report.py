@@ -41,7 +41,8 @@ def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
     area = float(np.sum(g.mult * g.area * P))
     T = tangent(cc, P)
     u1 = cc.Czz_bodies[0] @ sol.f
-    i0 = int(np.argmin(g.h + 1e30 * ~P)) if P.any() else 0
+    # the first touching point (least gap, nearest the centre) of the contact
+    i0 = int(np.lexsort((np.hypot(g.x, g.y), g.h + 1e30 * ~P))[0])
     out = {
         "force": float(res[0]),
         "approach": float(sol.q[0]),
