@@ -33,6 +33,9 @@ TOL_REL = 1e-10
 #: Peak frequency located to this relative tolerance (the amplitude error is second
 #: order in it, ~1e-12 relative).
 PEAK_TOL_REL = 1e-6
+#: A local maximum is a resonance peak (refined, listed in ``peaks``) when its
+#: prominence exceeds this fraction of the curve's maximum; AFT ripples are ~1e-4.
+PEAK_PROMINENCE = 0.01
 
 
 #: Aliasing indicator (FourierBasis.alias_ratio at the peak) above which the
@@ -69,6 +72,7 @@ class FRFResult:
     peak_solution: np.ndarray | None = None
     peak_interior: bool = False
     alias_ratio: float = float("nan")
+    peaks: list = field(default_factory=list)
     status: str = "complete"
     extra: dict = field(default_factory=dict)
     problem: "FRFProblem | None" = field(default=None, repr=False)
@@ -83,6 +87,7 @@ class FRFResult:
             "omega": self.omega, "amplitude": self.amplitude, "amplitude_h1": self.amplitude_h1,
             "peak_omega": self.peak_omega, "peak_amplitude": self.peak_amplitude,
             "peak_amplitude_h1": self.peak_amplitude_h1, "peak_interior": self.peak_interior,
+            "peaks": [{k: _finite(v) for k, v in p.items()} for p in self.peaks],
             "points": self.points, "newton_iterations": self.newton_iterations,
             "residual_evaluations": self.evaluations, "time_s": self.time_s,
             "harmonics": list(self.harmonics), "n_t": self.n_t, "alias_ratio": self.alias_ratio,
@@ -200,18 +205,30 @@ def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
 
 
 def _refine_peak(prob, branch, result, tol):
-    """Refine the highest interior maximum of the amplitude in place."""
-    i = int(np.argmax(result.amplitude))
-    if not 0 < i < result.points - 1:
-        return  # the maximum is at an end of the range: no interior peak to refine
-    try:
-        x, w, amp, nfev = refine_max(prob, branch, i, prob.amplitude, tol,
-                                     PEAK_TOL_REL * abs(result.omega[i]))
-    except RuntimeError as err:
-        raise FRFError(f"peak refinement near omega = {result.omega[i]:.6g} rad/s failed: {err}",
-                       result) from None
-    r = prob.response(x, w)
-    result.peak_omega, result.peak_amplitude, result.peak_solution = w, amp, x
-    result.peak_amplitude_h1 = float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics else float("nan")
-    result.peak_interior = True
+    """Refine every resonance peak (interior maxima with prominence above
+    :data:`PEAK_PROMINENCE` of the highest amplitude, so AFT ripples are skipped);
+    the highest refined one becomes the result's peak. Updates ``result`` in place."""
+    from scipy.signal import find_peaks
+
+    amp = result.amplitude
+    idx, _ = find_peaks(amp, prominence=PEAK_PROMINENCE * amp.max())
+    peaks, nfev = [], 0
+    for i in idx:
+        try:
+            x, w, a, n = refine_max(prob, branch, int(i), prob.amplitude, tol,
+                                    PEAK_TOL_REL * abs(result.omega[i]))
+        except RuntimeError as err:
+            raise FRFError(f"peak refinement near omega = {result.omega[i]:.6g} rad/s failed: "
+                           f"{err}", result) from None
+        peaks.append((a, w, x))
+        nfev += n
     result.extra["peak_refinement_evaluations"] = nfev
+    result.peaks = [{"omega": w, "amplitude": a} for a, w, _ in sorted(peaks, key=lambda p: p[1])]
+    if not peaks or max(peaks, key=lambda p: p[0])[0] < amp.max():
+        return  # the maximum is at an end of the range: no interior peak to refine
+    a, w, x = max(peaks, key=lambda p: p[0])
+    r = prob.response(x, w)
+    result.peak_omega, result.peak_amplitude, result.peak_solution = w, a, x
+    result.peak_amplitude_h1 = (float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics
+                                else float("nan"))
+    result.peak_interior = True

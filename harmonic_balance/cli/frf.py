@@ -15,7 +15,8 @@ or ``all:H``.
 
 JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of the
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
-``peak_omega`` and ``peak_amplitude`` (refined peak), ``points``,
+``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
+refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``points``,
 ``newton_iterations`` (corrector iterations), ``time_s`` and ``status``. A run that
 fails part-way prints the points computed so far (``status`` says where and why)
 and exits with code 3.

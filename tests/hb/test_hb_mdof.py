@@ -97,3 +97,16 @@ def test_singular_system_reports_the_frequency_and_keeps_points():
     with pytest.raises(FRFError, match="parameter 0.5") as info:
         compute_frf(model, "all:1", (0.5, 1.0))
     assert isinstance(info.value, RuntimeError) and info.value.result is not None
+
+
+def test_both_resonances_of_the_two_dof_model_are_refined():
+    model = two_dof(True)
+    r = compute_frf(model, "odd:3", (0.5, 4.0))
+    assert len(r.peaks) == 2 and r.peaks[0]["omega"] < 1.5 < r.peaks[1]["omega"]
+    assert r.peak_amplitude == max(p["amplitude"] for p in r.peaks)
+    prob = FRFProblem(model, "odd:3")
+    for p in r.peaks:  # each is a maximum of the curve: lower on both sides
+        for dw in (-2e-3, 2e-3):
+            w = p["omega"] * (1 + dw)
+            x = newton(lambda z: prob(z, w)[:2], prob.residual.linear_guess(w), 1e-14).x
+            assert prob.amplitude(x, w) < p["amplitude"]
