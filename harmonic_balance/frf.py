@@ -3,8 +3,9 @@
 ``compute_frf(model, harmonics, (omega_start, omega_end))`` traces the branch with
 :func:`continuation.continuation`, reports for the response DOF the peak absolute
 displacement over the period (``amplitude``) and the first-harmonic magnitude
-(``amplitude_h1``), and refines the highest peak of ``amplitude`` to
-:data:`PEAK_TOL_REL` in frequency (:func:`continuation.refine_max`).
+(``amplitude_h1``), and refines every resonance peak of ``amplitude`` (prominence
+above :data:`PEAK_PROMINENCE`) to :data:`PEAK_TOL_REL` in frequency
+(:func:`continuation.refine_max`); the highest is ``peak_omega``/``peak_amplitude``.
 
 Accuracy of the peak: the refinement locates the maximum of the *discrete* HB
 curve (given H and n_t) to PEAK_TOL_REL in frequency, hence its amplitude to
