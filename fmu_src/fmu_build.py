@@ -2,7 +2,7 @@
 
 An FMU holds: ``modelDescription.xml`` (from the variable table in
 :mod:`fmu_src.fmu_xml`), the virgin curve as ``resources/curve.txt``, the C
-sources (the FMI wrapper of ``fmu_src/fmi`` and the core ``fmu_src/core/iwan.c``,
+sources (the FMI wrapper of ``fmu_src/fmi`` and the core ``fmu_src/core``,
 so ``fmpy compile`` can rebuild it: FMI 2 ``<SourceFiles>``, FMI 3
 ``sources/buildDescription.xml``) and a Linux binary compiled from those very
 sources (``binaries/linux64/damper.so`` or ``binaries/x86_64-linux/damper.so``).
@@ -47,6 +47,9 @@ _FMI_HEADERS = {
     3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
 }
 _WRAPPER_HEADERS = ("fmu_instance.h", "model.h", "damper_vr.h")
+#: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
+CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
+CORE_HEADERS = ("iwan.h", "iwan_internal.h")
 #: Flags of the binary inside the FMU (the same as the CMake build's).
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
           "-Wall", "-Wextra", "-Werror", "-Wl,--no-undefined")
@@ -57,7 +60,7 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", MODELS[model], "iwan.c"]
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", MODELS[model], *CORE_SOURCES]
 
 
 def _check_version(fmi_version: int) -> None:
@@ -119,10 +122,9 @@ def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
     """Copy the C sources and headers flat into ``dest``; return the .c names."""
     dest.mkdir(parents=True)
     names = c_sources(fmi_version, model)
-    for name in names[:-1] + list(_WRAPPER_HEADERS):
-        shutil.copy(FMI_DIR / name, dest / name)
-    for name in ("iwan.c", "iwan.h"):
-        shutil.copy(CORE_DIR / name, dest / name)
+    for name in names + list(_WRAPPER_HEADERS + CORE_HEADERS):
+        src = CORE_DIR if name in CORE_SOURCES + CORE_HEADERS else FMI_DIR
+        shutil.copy(src / name, dest / name)
     for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
         shutil.copy(FMI_DIR / "headers" / name,
                     dest / ("FMI_HEADERS_LICENSE.txt" if name == "LICENSE.txt" else name))

@@ -1,5 +1,7 @@
 /*
- * iwan.c -- the Masing/Iwan friction element (implementation of iwan.h).
+ * iwan.c -- the Masing/Iwan friction element (implementation of iwan.h): model
+ * building, the exact straight-path step, outputs and the time series. The periodic
+ * loop and its Jacobian are in iwan_periodic.c; shared helpers in iwan_internal.h.
  *
  * Symbols (SI): u tangential displacement [m], N normal load [N], F force [N].
  * Slider j: spring k_j in series with a Coulomb slider of strength
@@ -28,7 +30,7 @@
  * counted as friction work. Re-contact at N = 0 (inside a step, by the same
  * straight path) restarts the element virgin at the re-contact displacement.
  */
-#include "iwan.h"
+#include "iwan_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -40,22 +42,6 @@
 /* Slopes equal to this relative precision count as one segment (round-off of
  * slopes computed from nearly equal differences). */
 #define IWAN_COLLINEAR_RTOL 1e-12
-
-/* Anchor codes for the exact periodic Jacobian (see iwan_periodic_jac). A slider
- * stuck since sample a (>= 0) has force k (u(t) - u(a)) + sg * g(N(aN)). */
-#define ANCHOR_ORIGIN (-1)               /* stuck since the virgin state at u = 0 */
-#define ANCHOR_RECONTACT(t) (-2 - (int32_t)(t)) /* stuck since re-contact in the step to t */
-#define ANCHOR_IS_RECONTACT(a) ((a) <= -2)
-#define ANCHOR_RECONTACT_STEP(a) ((size_t)(-2 - (a)))
-
-typedef struct {
-    int32_t au[IWAN_MAX_SLIDERS];   /* sample fixing the slider position (or code above) */
-    int32_t aN[IWAN_MAX_SLIDERS];   /* sample fixing the slip force at the anchor */
-    int8_t sg[IWAN_MAX_SLIDERS];    /* sign of the slip force at the anchor */
-    int8_t slip[IWAN_MAX_SLIDERS];  /* 1 if the slider slipped in the step just made */
-    int32_t res;                    /* residual-spring anchor: ANCHOR_ORIGIN or re-contact */
-    int32_t t;                      /* index of the sample being reached */
-} anchors;
 
 const char *iwan_status_text(iwan_status status)
 {
@@ -73,7 +59,7 @@ const char *iwan_status_text(iwan_status status)
 
 /* ------------------------------------------------------------------ checks */
 
-static iwan_status check_model(const iwan_model *m)
+iwan_status iwanp_check_model(const iwan_model *m)
 {
     if (!m || m->n < 0 || m->n > IWAN_MAX_SLIDERS) return IWAN_ERR_BAD_PARAM;
     if (!isfinite(m->n_ref) || !isfinite(m->scale) || !isfinite(m->k_res))
@@ -95,7 +81,7 @@ static iwan_status check_state(const iwan_state *s)
     return IWAN_OK;
 }
 
-static iwan_status check_finite(const double *x, size_t n)
+iwan_status iwanp_check_finite(const double *x, size_t n)
 {
     for (size_t i = 0; i < n; ++i)
         if (!isfinite(x[i])) return IWAN_ERR_NONFINITE;
@@ -174,7 +160,7 @@ iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T,
     if (!isfinite(n_ref)) return IWAN_ERR_NONFINITE;
     if (!(n_ref > 0.0)) return IWAN_ERR_BAD_PARAM;
     if (m < 2) return IWAN_ERR_BAD_TABLE;
-    if (check_finite(u, m) || check_finite(T, m)) return IWAN_ERR_NONFINITE;
+    if (iwanp_check_finite(u, m) || iwanp_check_finite(T, m)) return IWAN_ERR_NONFINITE;
     if (u[0] != 0.0 || T[0] != 0.0) return IWAN_ERR_BAD_TABLE;
     for (size_t i = 1; i < m; ++i)
         if (!(u[i] > u[i - 1])) return IWAN_ERR_BAD_TABLE;
@@ -195,7 +181,7 @@ iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const do
 {
     if (!model || (n > 0 && (!k || !fs)) || n > IWAN_MAX_SLIDERS) return IWAN_ERR_BAD_PARAM;
     if (!isfinite(k_res) || !isfinite(n_ref)) return IWAN_ERR_NONFINITE;
-    if (n > 0 && (check_finite(k, n) || check_finite(fs, n))) return IWAN_ERR_NONFINITE;
+    if (n > 0 && (iwanp_check_finite(k, n) || iwanp_check_finite(fs, n))) return IWAN_ERR_NONFINITE;
     for (size_t j = 0; j < n; ++j)
         if (!(k[j] > 0.0) || !(fs[j] >= 0.0)) return IWAN_ERR_BAD_PARAM;
     iwan_model md;
@@ -205,7 +191,7 @@ iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const do
     md.k_res = k_res;
     md.n_ref = n_ref;
     md.scale = 1.0;
-    iwan_status st = check_model(&md);
+    iwan_status st = iwanp_check_model(&md);
     if (st != IWAN_OK) return st;
     *model = md;
     return IWAN_OK;
@@ -213,7 +199,7 @@ iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const do
 
 iwan_status iwan_state_init(const iwan_model *model, iwan_state *state, double N)
 {
-    iwan_status st = check_model(model);
+    iwan_status st = iwanp_check_model(model);
     if (st != IWAN_OK) return st;
     if (!state) return IWAN_ERR_BAD_PARAM;
     if (!isfinite(N)) return IWAN_ERR_NONFINITE;
@@ -226,11 +212,6 @@ iwan_status iwan_state_init(const iwan_model *model, iwan_state *state, double N
 }
 
 /* ------------------------------------------------------------------ update */
-
-static double strength_factor(const iwan_model *m, double N)
-{
-    return m->scale * (N / m->n_ref);
-}
 
 /* Advance every slider along the straight path (u0, f0) -> (u1, f1) of
  * displacement and strength factor (f0, f1 >= 0); return the friction work. */
@@ -269,8 +250,8 @@ static double sliders_path(const iwan_model *m, double *z, double u0, double f0,
     return dw;
 }
 
-/* Force of a state (the F of outputs(), without the rest). */
-static double force(const iwan_model *m, const iwan_state *s)
+/* Force of a state (the F of iwanp_outputs(), without the rest). */
+double iwanp_force(const iwan_model *m, const iwan_state *s)
 {
     if (!s->in_contact) return 0.0;
     double F = m->k_res * (s->u - s->u_contact);
@@ -278,7 +259,7 @@ static double force(const iwan_model *m, const iwan_state *s)
     return F;
 }
 
-static void release(const iwan_model *m, iwan_state *s, double u)
+void iwanp_release(const iwan_model *m, iwan_state *s, double u)
 {
     for (int32_t j = 0; j < m->n; ++j) s->z[j] = u;
     s->u_contact = u;
@@ -287,7 +268,7 @@ static void release(const iwan_model *m, iwan_state *s, double u)
 
 /* Exact update of s along the straight path to (u1, N1), with lift-off and
  * re-contact at the point where N crosses zero. */
-static void advance(const iwan_model *m, iwan_state *s, double u1, double N1, anchors *an)
+void iwanp_advance(const iwan_model *m, iwan_state *s, double u1, double N1, anchors *an)
 {
     const double u0 = s->u, N0 = s->N, du = u1 - u0;
     if (N0 > 0.0 && N1 > 0.0) {
@@ -296,7 +277,7 @@ static void advance(const iwan_model *m, iwan_state *s, double u1, double N1, an
     } else if (N0 > 0.0) {                 /* lift-off where N = 0 */
         const double sl = N0 / (N0 - N1);
         s->w_diss += sliders_path(m, s->z, u0, strength_factor(m, N0), u0 + sl * du, 0.0, an);
-        release(m, s, u1);
+        iwanp_release(m, s, u1);
     } else if (N1 > 0.0) {                 /* re-contact where N = 0: virgin there */
         const double sc = -N0 / (N1 - N0);
         const double uc = u0 + sc * du;
@@ -309,7 +290,7 @@ static void advance(const iwan_model *m, iwan_state *s, double u1, double N1, an
         }
         s->w_diss += sliders_path(m, s->z, uc, 0.0, u1, strength_factor(m, N1), an);
     } else {
-        release(m, s, u1);
+        iwanp_release(m, s, u1);
     }
     if (du > 0.0) s->dir = 1.0;
     else if (du < 0.0) s->dir = -1.0;
@@ -320,7 +301,7 @@ static void advance(const iwan_model *m, iwan_state *s, double u1, double N1, an
 /* Outputs of a state. A slider counts as slipping when it sits at its limit on
  * the side of the last motion (it would slip on continued motion): it adds
  * nothing to kt and +-dg/dN to dF/dN. */
-static void outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
+void iwanp_outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
 {
     o->W = s->w_diss;
     if (!s->in_contact) {
@@ -355,15 +336,15 @@ static void outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
 iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, double u, double N,
                       iwan_state *trial, iwan_output *out)
 {
-    iwan_status st = check_model(model);
+    iwan_status st = iwanp_check_model(model);
     if (st != IWAN_OK) return st;
     st = check_state(committed);
     if (st != IWAN_OK) return st;
     if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
     if (trial == committed) return IWAN_ERR_BAD_PARAM;
     iwan_state s = *committed;
-    advance(model, &s, u, N, NULL);
-    if (out) outputs(model, &s, out);
+    iwanp_advance(model, &s, u, N, NULL);
+    if (out) iwanp_outputs(model, &s, out);
     if (trial) *trial = s;
     return IWAN_OK;
 }
@@ -371,13 +352,13 @@ iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, doub
 iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, double N,
                       iwan_output *out)
 {
-    iwan_status st = check_model(model);
+    iwan_status st = iwanp_check_model(model);
     if (st != IWAN_OK) return st;
     st = check_state(state);
     if (st != IWAN_OK) return st;
     if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
-    advance(model, state, u, N, NULL);
-    if (out) outputs(model, state, out);
+    iwanp_advance(model, state, u, N, NULL);
+    if (out) iwanp_outputs(model, state, out);
     return IWAN_OK;
 }
 
@@ -429,13 +410,13 @@ iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, doub
 SWEEP_FUNCTION(sweep_up, BOUND_UP, z0 <= bound, zn - z0)
 SWEEP_FUNCTION(sweep_down, BOUND_DOWN, z0 >= bound, z0 - zn)
 
-static void run_const(const iwan_model *m, iwan_state *s, size_t n, const double *u,
+void iwanp_run_const(const iwan_model *m, iwan_state *s, size_t n, const double *u,
                       double *F, double *kt, double *dFdN, double *W)
 {
     double r[IWAN_MAX_SLIDERS], g[IWAN_MAX_SLIDERS];
     const double f = strength_factor(m, s->N), dgdN = m->scale / m->n_ref;
     for (int32_t j = 0; j < m->n; ++j) {
-        r[j] = m->fs[j] * f / m->k[j];   /* same expression as outputs(): same limits */
+        r[j] = m->fs[j] * f / m->k[j];   /* same expression as iwanp_outputs(): same limits */
         g[j] = m->fs[j] * f;
     }
     for (size_t i = 0; i < n; ++i) {
@@ -454,7 +435,7 @@ static void run_const(const iwan_model *m, iwan_state *s, size_t n, const double
     }
 }
 
-static void store(const iwan_output *o, size_t i, double *F, double *kt, double *dFdN, double *W)
+void iwanp_store(const iwan_output *o, size_t i, double *F, double *kt, double *dFdN, double *W)
 {
     if (F) F[i] = o->F;
     if (kt) kt[i] = o->kt;
@@ -466,12 +447,12 @@ iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
                         const double *u, const double *N,
                         double *F, double *kt, double *dFdN, double *W)
 {
-    iwan_status st = check_model(model);
+    iwan_status st = iwanp_check_model(model);
     if (st != IWAN_OK) return st;
     st = check_state(state);
     if (st != IWAN_OK) return st;
     if (!u || n == 0) return IWAN_ERR_BAD_PARAM;
-    if (check_finite(u, n) || (N && check_finite(N, n))) return IWAN_ERR_NONFINITE;
+    if (iwanp_check_finite(u, n) || (N && iwanp_check_finite(N, n))) return IWAN_ERR_NONFINITE;
     size_t i = 0;
     while (i < n) {
         const double Ni = N ? N[i] : model->n_ref;
@@ -479,245 +460,16 @@ iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
             size_t j = i + 1;
             if (N) while (j < n && N[j] == Ni) ++j;
             else j = n;
-            run_const(model, state, j - i, u + i, F ? F + i : NULL, kt ? kt + i : NULL,
+            iwanp_run_const(model, state, j - i, u + i, F ? F + i : NULL, kt ? kt + i : NULL,
                       dFdN ? dFdN + i : NULL, W ? W + i : NULL);
             i = j;
         } else {
             iwan_output o;
-            advance(model, state, u[i], Ni, NULL);
-            outputs(model, state, &o);
-            store(&o, i, F, kt, dFdN, W);
+            iwanp_advance(model, state, u[i], Ni, NULL);
+            iwanp_outputs(model, state, &o);
+            iwanp_store(&o, i, F, kt, dFdN, W);
             ++i;
         }
     }
-    return IWAN_OK;
-}
-
-/* ------------------------------------------------------------ periodic loop */
-
-/* Start of the periodic sweep, at the first maximum tM of u (index of the first
- * minimum tm). Convention for the loop's static state (non-unique for sliders
- * that never slip): the element is virgin at u = 0 (residual spring and sliders
- * at rest there) and every slider is shifted by the least amount that keeps it
- * stuck between the loop's extremes, z_j = clamp(0, M - r_j, m + r_j); a slider
- * with M - m >= 2 r_j slips in every cycle and sits at its upper limit at M,
- * z_j = M - r_j, whatever the history. With constant N this state is exactly
- * periodic, so one pass gives the loop (play operator). */
-static void periodic_start(const iwan_model *m, size_t n, const double *u, const double *N,
-                           iwan_state *s, anchors *an, size_t *tMo)
-{
-    size_t tM = 0, tm = 0;
-    for (size_t i = 1; i < n; ++i) {
-        if (u[i] > u[tM]) tM = i;
-        if (u[i] < u[tm]) tm = i;
-    }
-    const double M = u[tM], mn = u[tm], NM = N ? N[tM] : m->n_ref;
-    memset(s, 0, sizeof *s);
-    memset(an, 0, sizeof *an);
-    s->version = IWAN_STATE_VERSION;
-    s->u = M;
-    s->N = NM;
-    s->dir = 1.0;
-    an->res = ANCHOR_ORIGIN;
-    *tMo = tM;
-    if (!(NM > 0.0)) {
-        release(m, s, M);
-        for (int32_t j = 0; j < m->n; ++j) an->au[j] = ANCHOR_ORIGIN;
-        return;
-    }
-    s->in_contact = 1;
-    const double f = strength_factor(m, NM);
-    for (int32_t j = 0; j < m->n; ++j) {
-        const double r = m->fs[j] * f / m->k[j];
-        an->aN[j] = (int32_t)tM;
-        if (M - mn >= 2.0 * r || 0.0 < M - r) {
-            s->z[j] = M - r;
-            an->au[j] = (int32_t)tM;
-            an->sg[j] = 1;
-        } else if (0.0 > mn + r) {
-            s->z[j] = mn + r;
-            an->au[j] = (int32_t)tm;
-            an->sg[j] = -1;
-        } else {
-            s->z[j] = 0.0;
-            an->au[j] = ANCHOR_ORIGIN;
-        }
-    }
-}
-
-/* Force-weighted distance of two states: bounds the change of F over a period. */
-static double state_distance(const iwan_model *m, const iwan_state *a, const iwan_state *b)
-{
-    if (a->in_contact != b->in_contact) return INFINITY;
-    double d = m->k_res * fabs(a->u_contact - b->u_contact);
-    for (int32_t j = 0; j < m->n; ++j) d += m->k[j] * fabs(a->z[j] - b->z[j]);
-    return d;
-}
-
-/* Repeat periods from the state s at sample tM until the state at tM recurs
- * within tol times the force range of the period. */
-static iwan_status march(const iwan_model *m, size_t n, const double *u, const double *N,
-                         size_t tM, iwan_state *s, anchors *an, int max_periods, double tol,
-                         double *F, double *kt, double *dFdN, double *W_cycle, int *periods)
-{
-    for (int p = 1; p <= max_periods; ++p) {
-        const iwan_state s0 = *s;
-        double fmin = INFINITY, fmax = -INFINITY;
-        for (size_t k = 1; k <= n; ++k) {
-            const size_t t = (tM + k) % n;
-            iwan_output o;
-            if (an) an->t = (int32_t)t;
-            advance(m, s, u[t], N ? N[t] : m->n_ref, an);
-            outputs(m, s, &o);
-            store(&o, t, F, kt, dFdN, NULL);
-            if (o.F < fmin) fmin = o.F;
-            if (o.F > fmax) fmax = o.F;
-        }
-        *W_cycle = s->w_diss - s0.w_diss;
-        *periods = p;
-        if (state_distance(m, &s0, s) <= tol * (fmax - fmin)) return IWAN_OK;
-    }
-    return IWAN_ERR_NOT_CONVERGED;
-}
-
-static int all_equal(const double *x, size_t n)
-{
-    for (size_t i = 1; i < n; ++i)
-        if (x[i] != x[0]) return 0;
-    return 1;
-}
-
-static iwan_status check_periodic(const iwan_model *model, size_t n, const double *u,
-                                  const double *N, int max_periods, double tol)
-{
-    iwan_status st = check_model(model);
-    if (st != IWAN_OK) return st;
-    if (!u || n == 0 || max_periods < 1) return IWAN_ERR_BAD_PARAM;
-    if (!isfinite(tol)) return IWAN_ERR_NONFINITE;
-    if (!(tol >= 0.0)) return IWAN_ERR_BAD_PARAM;
-    if (check_finite(u, n) || (N && check_finite(N, n))) return IWAN_ERR_NONFINITE;
-    return IWAN_OK;
-}
-
-iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, const double *N,
-                          double *F, double *kt, double *dFdN, double *W_cycle,
-                          int max_periods, double tol, int *periods_used)
-{
-    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
-    if (st != IWAN_OK) return st;
-    iwan_state s;
-    anchors an;
-    size_t tM;
-    double w = 0.0;
-    int p = 0;
-    periodic_start(model, n, u, N, &s, &an, &tM);
-    if (s.in_contact && (!N || all_equal(N, n))) {
-        /* exact in one pass: tM+1 .. n-1, then 0 .. tM (closing the period) */
-        run_const(model, &s, n - 1 - tM, u + tM + 1, F ? F + tM + 1 : NULL,
-                  kt ? kt + tM + 1 : NULL, dFdN ? dFdN + tM + 1 : NULL, NULL);
-        run_const(model, &s, tM + 1, u, F, kt, dFdN, NULL);
-        w = s.w_diss;
-        p = 1;
-    } else {
-        st = march(model, n, u, N, tM, &s, NULL, max_periods, tol, F, kt, dFdN, &w, &p);
-    }
-    if (W_cycle) *W_cycle = w;
-    if (periods_used) *periods_used = p;
-    return st;
-}
-
-/* ------------------------------------------------- periodic loop Jacobian */
-
-/* d u_c / dX and d u_c / dXN of the re-contact point in the step p -> tc,
- * u_c = u_p + s_c (u_tc - u_p), s_c = -N_p / (N_tc - N_p) (see advance()). */
-static void recontact_grad(size_t n, size_t nb, const double *u, const double *N,
-                           const double *Eu, const double *EN, size_t tc, double w,
-                           double *rX, double *rXN)
-{
-    const size_t p = (tc + n - 1) % n;
-    const double N0 = N[p], N1 = N[tc], D = N1 - N0, sc = -N0 / D, du = u[tc] - u[p];
-    const double ds0 = -N1 / (D * D), ds1 = N0 / (D * D);
-    for (size_t c = 0; c < nb; ++c) {
-        rX[c] -= w * ((1.0 - sc) * Eu[p * nb + c] + sc * Eu[tc * nb + c]);
-        if (rXN) rXN[c] -= w * du * (ds0 * EN[p * nb + c] + ds1 * EN[tc * nb + c]);
-    }
-}
-
-/* Row t of dF/dX (and dF/dXN): a slider that slipped into t carries
- * sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) + sg g(N(aN));
- * one stuck since the virgin state k u(t); one stuck since re-contact
- * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy. */
-static void jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
-                    size_t nb, const double *u, const double *N, const double *Eu,
-                    const double *EN, double *rX, double *rXN)
-{
-    const size_t t = (size_t)an->t;
-    const double dgdN = m->scale / m->n_ref;
-    for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
-    if (!s->in_contact) return;
-    double kst = m->k_res, krc = ANCHOR_IS_RECONTACT(an->res) ? m->k_res : 0.0, cnow = 0.0;
-    double gk = 0.0, gc = 0.0;
-    int32_t ga = ANCHOR_ORIGIN, gn = 0;
-    for (int32_t j = 0; j <= m->n; ++j) {
-        const int last = j == m->n;
-        const int32_t a = last ? ANCHOR_ORIGIN : an->au[j];
-        if (!last && an->slip[j]) { cnow += an->sg[j] * m->fs[j] * dgdN; continue; }
-        if (!last) kst += m->k[j];
-        if (!last && ANCHOR_IS_RECONTACT(a)) { krc += m->k[j]; continue; }
-        if (ga >= 0 && (last || a != ga || an->aN[j] != gn)) {   /* flush the group */
-            for (size_t c = 0; c < nb; ++c) {
-                rX[c] -= gk * Eu[(size_t)ga * nb + c];
-                if (rXN) rXN[c] += gc * EN[(size_t)gn * nb + c];
-            }
-            gk = gc = 0.0;
-        }
-        if (last) break;
-        ga = a;
-        gn = an->aN[j];
-        if (a >= 0) { gk += m->k[j]; gc += an->sg[j] * m->fs[j] * dgdN; }
-    }
-    for (size_t c = 0; c < nb; ++c) {
-        rX[c] += kst * Eu[t * nb + c];
-        if (rXN) rXN[c] += cnow * EN[t * nb + c];
-    }
-    if (krc > 0.0) recontact_grad(n, nb, u, N, Eu, EN, ANCHOR_RECONTACT_STEP(an->res), krc, rX, rXN);
-}
-
-iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
-                              const double *Eu, const double *EN, size_t nb,
-                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
-                              int max_periods, double tol, int *periods_used)
-{
-    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
-    if (st != IWAN_OK) return st;
-    /* anchors hold sample indices as int32; n * nb must not overflow */
-    if (!Eu || nb == 0 || n > (size_t)INT32_MAX / 2 || nb > SIZE_MAX / n) return IWAN_ERR_BAD_PARAM;
-    if (check_finite(Eu, n * nb) || (EN && check_finite(EN, n * nb))) return IWAN_ERR_NONFINITE;
-    iwan_state s;
-    anchors an;
-    size_t tM;
-    double w = 0.0;
-    int p = 0;
-    periodic_start(model, n, u, N, &s, &an, &tM);
-    if (N && !all_equal(N, n)) {
-        st = march(model, n, u, N, tM, &s, &an, max_periods, tol, NULL, NULL, NULL, &w, &p);
-        if (st != IWAN_OK) {
-            if (periods_used) *periods_used = p;
-            return st;
-        }
-    }
-    const double w0 = s.w_diss;
-    for (size_t k = 1; k <= n; ++k) {       /* final pass from the closed state */
-        const size_t t = (tM + k) % n;
-        an.t = (int32_t)t;
-        advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
-        if (F) F[t] = force(model, &s);
-        if (dFdX) {
-            jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + t * nb,
-                    (EN && dFdXN) ? dFdXN + t * nb : NULL);
-        }
-    }
-    if (W_cycle) *W_cycle = s.w_diss - w0;
-    if (periods_used) *periods_used = p + 1;
     return IWAN_OK;
 }

@@ -1,0 +1,242 @@
+/*
+ * iwan_periodic.c -- periodic steady state of the Masing/Iwan element (iwan.h:
+ * iwan_periodic, iwan_periodic_jac). Symbols as in iwan.c: slider j has stiffness
+ * k_j, strength g_j(N) = fs_j scale N / n_ref, radius r_j = g_j / k_j, position z_j.
+ * At constant N the loop is exact in one pass of the play operator from the
+ * maximum of u; with varying N periods are repeated (exact straight-path steps,
+ * iwanp_advance) until the state at the sweep start recurs. The Jacobian follows
+ * every slider's anchor (the sample where it last slipped).
+ */
+#include "iwan_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* ------------------------------------------------------------ periodic loop */
+
+/* Start of the periodic sweep, at the first maximum tM of u (index of the first
+ * minimum tm). Convention for the loop's static state (non-unique for sliders
+ * that never slip): the element is virgin at u = 0 (residual spring and sliders
+ * at rest there) and every slider is shifted by the least amount that keeps it
+ * stuck between the loop's extremes, z_j = clamp(0, M - r_j, m + r_j); a slider
+ * with M - m >= 2 r_j slips in every cycle and sits at its upper limit at M,
+ * z_j = M - r_j, whatever the history. With constant N this state is exactly
+ * periodic, so one pass gives the loop (play operator). */
+static void periodic_start(const iwan_model *m, size_t n, const double *u, const double *N,
+                           iwan_state *s, anchors *an, size_t *tMo)
+{
+    size_t tM = 0, tm = 0;
+    for (size_t i = 1; i < n; ++i) {
+        if (u[i] > u[tM]) tM = i;
+        if (u[i] < u[tm]) tm = i;
+    }
+    const double M = u[tM], mn = u[tm], NM = N ? N[tM] : m->n_ref;
+    memset(s, 0, sizeof *s);
+    memset(an, 0, sizeof *an);
+    s->version = IWAN_STATE_VERSION;
+    s->u = M;
+    s->N = NM;
+    s->dir = 1.0;
+    an->res = ANCHOR_ORIGIN;
+    *tMo = tM;
+    if (!(NM > 0.0)) {
+        iwanp_release(m, s, M);
+        for (int32_t j = 0; j < m->n; ++j) an->au[j] = ANCHOR_ORIGIN;
+        return;
+    }
+    s->in_contact = 1;
+    const double f = strength_factor(m, NM);
+    for (int32_t j = 0; j < m->n; ++j) {
+        const double r = m->fs[j] * f / m->k[j];
+        an->aN[j] = (int32_t)tM;
+        if (M - mn >= 2.0 * r || 0.0 < M - r) {
+            s->z[j] = M - r;
+            an->au[j] = (int32_t)tM;
+            an->sg[j] = 1;
+        } else if (0.0 > mn + r) {
+            s->z[j] = mn + r;
+            an->au[j] = (int32_t)tm;
+            an->sg[j] = -1;
+        } else {
+            s->z[j] = 0.0;
+            an->au[j] = ANCHOR_ORIGIN;
+        }
+    }
+}
+
+/* Force-weighted distance of two states: bounds the change of F over a period. */
+static double state_distance(const iwan_model *m, const iwan_state *a, const iwan_state *b)
+{
+    if (a->in_contact != b->in_contact) return INFINITY;
+    double d = m->k_res * fabs(a->u_contact - b->u_contact);
+    for (int32_t j = 0; j < m->n; ++j) d += m->k[j] * fabs(a->z[j] - b->z[j]);
+    return d;
+}
+
+/* Repeat periods from the state s at sample tM until the state at tM recurs
+ * within tol times the force range of the period. */
+static iwan_status march(const iwan_model *m, size_t n, const double *u, const double *N,
+                         size_t tM, iwan_state *s, anchors *an, int max_periods, double tol,
+                         double *F, double *kt, double *dFdN, double *W_cycle, int *periods)
+{
+    for (int p = 1; p <= max_periods; ++p) {
+        const iwan_state s0 = *s;
+        double fmin = INFINITY, fmax = -INFINITY;
+        for (size_t k = 1; k <= n; ++k) {
+            const size_t t = (tM + k) % n;
+            iwan_output o;
+            if (an) an->t = (int32_t)t;
+            iwanp_advance(m, s, u[t], N ? N[t] : m->n_ref, an);
+            iwanp_outputs(m, s, &o);
+            iwanp_store(&o, t, F, kt, dFdN, NULL);
+            if (o.F < fmin) fmin = o.F;
+            if (o.F > fmax) fmax = o.F;
+        }
+        *W_cycle = s->w_diss - s0.w_diss;
+        *periods = p;
+        if (state_distance(m, &s0, s) <= tol * (fmax - fmin)) return IWAN_OK;
+    }
+    return IWAN_ERR_NOT_CONVERGED;
+}
+
+static int all_equal(const double *x, size_t n)
+{
+    for (size_t i = 1; i < n; ++i)
+        if (x[i] != x[0]) return 0;
+    return 1;
+}
+
+static iwan_status check_periodic(const iwan_model *model, size_t n, const double *u,
+                                  const double *N, int max_periods, double tol)
+{
+    iwan_status st = iwanp_check_model(model);
+    if (st != IWAN_OK) return st;
+    if (!u || n == 0 || max_periods < 1) return IWAN_ERR_BAD_PARAM;
+    if (!isfinite(tol)) return IWAN_ERR_NONFINITE;
+    if (!(tol >= 0.0)) return IWAN_ERR_BAD_PARAM;
+    if (iwanp_check_finite(u, n) || (N && iwanp_check_finite(N, n))) return IWAN_ERR_NONFINITE;
+    return IWAN_OK;
+}
+
+iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, const double *N,
+                          double *F, double *kt, double *dFdN, double *W_cycle,
+                          int max_periods, double tol, int *periods_used)
+{
+    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
+    if (st != IWAN_OK) return st;
+    iwan_state s;
+    anchors an;
+    size_t tM;
+    double w = 0.0;
+    int p = 0;
+    periodic_start(model, n, u, N, &s, &an, &tM);
+    if (s.in_contact && (!N || all_equal(N, n))) {
+        /* exact in one pass: tM+1 .. n-1, then 0 .. tM (closing the period) */
+        iwanp_run_const(model, &s, n - 1 - tM, u + tM + 1, F ? F + tM + 1 : NULL,
+                  kt ? kt + tM + 1 : NULL, dFdN ? dFdN + tM + 1 : NULL, NULL);
+        iwanp_run_const(model, &s, tM + 1, u, F, kt, dFdN, NULL);
+        w = s.w_diss;
+        p = 1;
+    } else {
+        st = march(model, n, u, N, tM, &s, NULL, max_periods, tol, F, kt, dFdN, &w, &p);
+    }
+    if (W_cycle) *W_cycle = w;
+    if (periods_used) *periods_used = p;
+    return st;
+}
+
+/* ------------------------------------------------- periodic loop Jacobian */
+
+/* d u_c / dX and d u_c / dXN of the re-contact point in the step p -> tc,
+ * u_c = u_p + s_c (u_tc - u_p), s_c = -N_p / (N_tc - N_p) (see iwanp_advance()). */
+static void recontact_grad(size_t n, size_t nb, const double *u, const double *N,
+                           const double *Eu, const double *EN, size_t tc, double w,
+                           double *rX, double *rXN)
+{
+    const size_t p = (tc + n - 1) % n;
+    const double N0 = N[p], N1 = N[tc], D = N1 - N0, sc = -N0 / D, du = u[tc] - u[p];
+    const double ds0 = -N1 / (D * D), ds1 = N0 / (D * D);
+    for (size_t c = 0; c < nb; ++c) {
+        rX[c] -= w * ((1.0 - sc) * Eu[p * nb + c] + sc * Eu[tc * nb + c]);
+        if (rXN) rXN[c] -= w * du * (ds0 * EN[p * nb + c] + ds1 * EN[tc * nb + c]);
+    }
+}
+
+/* Row t of dF/dX (and dF/dXN): a slider that slipped into t carries
+ * sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) + sg g(N(aN));
+ * one stuck since the virgin state k u(t); one stuck since re-contact
+ * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy. */
+static void jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
+                    size_t nb, const double *u, const double *N, const double *Eu,
+                    const double *EN, double *rX, double *rXN)
+{
+    const size_t t = (size_t)an->t;
+    const double dgdN = m->scale / m->n_ref;
+    for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
+    if (!s->in_contact) return;
+    double kst = m->k_res, krc = ANCHOR_IS_RECONTACT(an->res) ? m->k_res : 0.0, cnow = 0.0;
+    double gk = 0.0, gc = 0.0;
+    int32_t ga = ANCHOR_ORIGIN, gn = 0;
+    for (int32_t j = 0; j <= m->n; ++j) {
+        const int last = j == m->n;
+        const int32_t a = last ? ANCHOR_ORIGIN : an->au[j];
+        if (!last && an->slip[j]) { cnow += an->sg[j] * m->fs[j] * dgdN; continue; }
+        if (!last) kst += m->k[j];
+        if (!last && ANCHOR_IS_RECONTACT(a)) { krc += m->k[j]; continue; }
+        if (ga >= 0 && (last || a != ga || an->aN[j] != gn)) {   /* flush the group */
+            for (size_t c = 0; c < nb; ++c) {
+                rX[c] -= gk * Eu[(size_t)ga * nb + c];
+                if (rXN) rXN[c] += gc * EN[(size_t)gn * nb + c];
+            }
+            gk = gc = 0.0;
+        }
+        if (last) break;
+        ga = a;
+        gn = an->aN[j];
+        if (a >= 0) { gk += m->k[j]; gc += an->sg[j] * m->fs[j] * dgdN; }
+    }
+    for (size_t c = 0; c < nb; ++c) {
+        rX[c] += kst * Eu[t * nb + c];
+        if (rXN) rXN[c] += cnow * EN[t * nb + c];
+    }
+    if (krc > 0.0) recontact_grad(n, nb, u, N, Eu, EN, ANCHOR_RECONTACT_STEP(an->res), krc, rX, rXN);
+}
+
+iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
+                              const double *Eu, const double *EN, size_t nb,
+                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
+                              int max_periods, double tol, int *periods_used)
+{
+    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
+    if (st != IWAN_OK) return st;
+    /* anchors hold sample indices as int32; n * nb must not overflow */
+    if (!Eu || nb == 0 || n > (size_t)INT32_MAX / 2 || nb > SIZE_MAX / n) return IWAN_ERR_BAD_PARAM;
+    if (iwanp_check_finite(Eu, n * nb) || (EN && iwanp_check_finite(EN, n * nb))) return IWAN_ERR_NONFINITE;
+    iwan_state s;
+    anchors an;
+    size_t tM;
+    double w = 0.0;
+    int p = 0;
+    periodic_start(model, n, u, N, &s, &an, &tM);
+    if (N && !all_equal(N, n)) {
+        st = march(model, n, u, N, tM, &s, &an, max_periods, tol, NULL, NULL, NULL, &w, &p);
+        if (st != IWAN_OK) {
+            if (periods_used) *periods_used = p;
+            return st;
+        }
+    }
+    const double w0 = s.w_diss;
+    for (size_t k = 1; k <= n; ++k) {       /* final pass from the closed state */
+        const size_t t = (tM + k) % n;
+        an.t = (int32_t)t;
+        iwanp_advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
+        if (F) F[t] = iwanp_force(model, &s);
+        if (dFdX) {
+            jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + t * nb,
+                    (EN && dFdXN) ? dFdXN + t * nb : NULL);
+        }
+    }
+    if (W_cycle) *W_cycle = s.w_diss - w0;
+    if (periods_used) *periods_used = p + 1;
+    return IWAN_OK;
+}
