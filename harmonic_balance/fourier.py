@@ -182,15 +182,17 @@ class FourierBasis:
         u = self._fine(oversample) @ c
         j = int(np.argmax(np.abs(u)))
         t = th[j]
-        d1, d2 = self.dtheta @ c, self.dtheta @ (self.dtheta @ c)
+        d = np.column_stack([c, self.dtheta @ c, self.dtheta @ (self.dtheta @ c)])
         for _ in range(8):
-            g1, g2 = self.evaluate(d1, t), self.evaluate(d2, t)
+            g0, g1, g2 = self.evaluate(d, t)
             if g2 == 0.0:
                 break
             step = -g1 / g2
             if abs(step) > 2.0 * np.pi / n:  # left the grid cell: keep the grid value
                 break
             t += step
+            if abs(step) < 1e-15:  # quadratic convergence reached round-off
+                break
         return float(max(abs(self.evaluate(c, t)), abs(u[j])))
 
     def _fine(self, oversample: int) -> np.ndarray:
