@@ -22,6 +22,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.signal import find_peaks
 
 from .continuation import ContinuationError, continuation, refine_max
 from .fourier import FourierBasis, parse_harmonics
@@ -209,8 +210,6 @@ def _refine_peak(prob, branch, result, tol):
     """Refine every resonance peak (interior maxima with prominence above
     :data:`PEAK_PROMINENCE` of the highest amplitude, so AFT ripples are skipped);
     the highest refined one becomes the result's peak. Updates ``result`` in place."""
-    from scipy.signal import find_peaks
-
     amp = result.amplitude
     idx, _ = find_peaks(amp, prominence=PEAK_PROMINENCE * amp.max())
     peaks, nfev = [], 0
