@@ -24,8 +24,9 @@ from .spec import ContactSpec
 HEX_OFFSETS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0],
                         [0, 1, 1], [1, 0, 1], [1, 1, 0], [1, 1, 1]])
 #: Largest angular step [rad] along a curved surface, so the polygonal surface
-#: stays within 0.2 % of the arc.
-MAX_ARC_STEP = math.pi / 24
+#: stays within 0.9 % of the arc (far from the contact; sphere 41x41: approach
+#: -1.96 % -> -1.99 % vs Hertz, a and p0 unchanged, 25 % fewer DOF than pi/24).
+MAX_ARC_STEP = math.pi / 12
 #: Layers below (above) the contact face graded gently, down to NEAR_DEPTH times
 #: the zone half-width: the peak pressure is set by the first layers (measured,
 #: sphere 21x21: ratio 1.45 everywhere gave p0 +0.63 %, 8 layers at 1.1 then a
