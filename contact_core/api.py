@@ -75,7 +75,8 @@ def run_normal(spec: ContactSpec, force=None, approach=None, eccentricity=None,
     out = report.summarize(cc, sol, spec.body)
     if out["zone_edge_in_contact"]:
         raise ValueError("the contact reaches the edge of the potential contact zone: raise the "
-                         "design pressure (--p-design) so the zone holds this load")
+                         "design pressure (--p-design) so the zone holds this load, or the grid "
+                         "if it is very coarse")
     ref = hertz_reference(spec, out["force"])
     if ref is not None:
         key = "contact_radius" if spec.body == "sphere" else "contact_halfwidth"

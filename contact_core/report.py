@@ -7,6 +7,8 @@ Contact size estimators:
   p^2 = c (a^2 - r^2) fitted (least squares) to the nodal pressures of the
   contact nodes; it interpolates the edge between grid nodes, where the area of
   the active nodes (``contact_radius_area`` = sqrt(A / pi)) jumps by whole cells.
+  With too few contact nodes for the fit the area radius is reported
+  (``contact_size_method``).
 * ``contact_halfwidth`` (cylinder, mid-length): the same fit p^2 = c (b^2 - x^2)
   on the row y = 0; ``contact_halfwidth_end``: the outer edge (last contact node
   plus half a cell) of the row at the cylinder's end y = L/2, where the pressure
@@ -18,6 +20,10 @@ import numpy as np
 
 from .condensed import CondensedContact
 from .normal import NormalSolution, resultants, tangent
+
+#: A contact narrower than this many grid spacings (radius or half-width) is
+#: flagged ``under_resolved``: its size and peak pressure are then rough.
+MIN_NODES_ACROSS = 3
 
 
 def _fit_edge(u: np.ndarray, p: np.ndarray) -> float:
@@ -53,7 +59,7 @@ def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
         "iterations": int(sol.iterations),
         "newton_steps": int(sol.newton),
         "n_contact_nodes": int(np.sum(g.copies * P)) if g.copies is not None else int(P.sum()),
-        "body1_share": float(u1[i0] / sol.q[0]) if sol.q[0] > 0 else float("nan"),
+        "body1_share": float(u1[i0] / sol.q[0]) if sol.q[0] > 0 else 0.0,
         "max_penetration": float(max(0.0, -sol.g.min())),
         "min_force": float(sol.f.min()),
         "zone_edge_in_contact": bool(_zone_edge_hit(cc, P, body)),
@@ -65,13 +71,19 @@ def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
     s = float(np.min(np.diff(np.unique(g.x))))
     if body == "sphere":
         r = np.hypot(g.x, g.y)
-        out["contact_radius"] = _fit_edge(r[P], p[P])
         out["contact_radius_area"] = float(np.sqrt(area / np.pi))
+        fit = _fit_edge(r[P], p[P])
+        out["contact_radius"] = fit if np.isfinite(fit) else out["contact_radius_area"]
+        out["contact_size_method"] = "pressure fit" if np.isfinite(fit) else "area"
+        out["under_resolved"] = bool(out["contact_radius"] < MIN_NODES_ACROSS * s)
     elif body == "cylinder":
         mid = np.abs(g.y) <= 1e-9 * s
         end = np.abs(g.y - g.y.max()) <= 1e-9 * s
-        out["contact_halfwidth"] = _fit_edge(g.x[mid & P], p[mid & P])
         out["contact_halfwidth_mid_extent"] = _row_extent(g.x[mid], P[mid], s)
+        fit = _fit_edge(g.x[mid & P], p[mid & P])
+        out["contact_halfwidth"] = fit if np.isfinite(fit) else out["contact_halfwidth_mid_extent"]
+        out["contact_size_method"] = "pressure fit" if np.isfinite(fit) else "extent"
+        out["under_resolved"] = bool(out["contact_halfwidth"] < MIN_NODES_ACROSS * s)
         out["contact_halfwidth_end"] = _row_extent(g.x[end], P[end], s)
         out["p_mid_max"] = float(p[mid].max())
         out["p_end_max"] = float(p[end].max())

@@ -280,3 +280,11 @@ def test_inconsistent_imported_matrices_exit_2(tmp_path, capsys):
                  "--stiffness", str(k1), str(k2), "--nodes", str(tmp_path / "moved.npz"), str(n2)])
     assert rc == 2
     assert "x-y" in capsys.readouterr().err
+
+
+def test_tiny_load_is_flagged_under_resolved_not_nan(condensed):
+    cc = condensed("sphere_halfspace")
+    out = report.summarize(cc, normal.solve_force(cc, 1e-3), "sphere")
+    assert out["under_resolved"] and out["contact_size_method"] == "area"
+    assert all(np.isfinite(v) for v in out.values() if isinstance(v, float))
+    assert not report.summarize(cc, normal.solve_force(cc, F_SPHERE), "sphere")["under_resolved"]
