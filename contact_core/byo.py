@@ -27,7 +27,7 @@ import scipy.sparse as sp
 
 from . import linsolve
 from .cache import DiskCache, make_key
-from .condense import _tributary
+from .condense import tributary
 from .condensed import CondensedContact, ContactGrid
 
 SYMMETRIES = {"full": 1.0, "half": 2.0, "quarter": 4.0}
@@ -100,8 +100,8 @@ def _grid(n1: dict, n2: dict, symmetry: str) -> ContactGrid:
         ux, uy = np.unique(x), np.unique(y)
         if ux.size * uy.size != x.size:
             raise ValueError("contact nodes are not a tensor grid: give 'area' in the node file")
-        tx = dict(zip(ux, _tributary(ux, True)))
-        ty = dict(zip(uy, _tributary(uy, True)))
+        tx = dict(zip(ux, tributary(ux)))
+        ty = dict(zip(uy, tributary(uy)))
         area = np.array([tx[a] * ty[b] for a, b in zip(x, y)])
     tol = 1e-9 * size
     copies = np.ones(x.size, int)

@@ -66,8 +66,9 @@ def body_compliance(K, body: mesh.BodyMesh, direction: str, symmetry: str) -> np
     return linsolve.compliance_block(Kff, dofs)
 
 
-def _tributary(u: np.ndarray, on_symmetry_plane: bool) -> np.ndarray:
-    """1D tributary lengths of zone nodes u; the end nodes own half a cell inside."""
+def tributary(u: np.ndarray) -> np.ndarray:
+    """1D tributary lengths of sorted zone nodes u; the end nodes own half a cell
+    inside the zone (on a symmetry plane: the half inside the modelled part)."""
     mid = 0.5 * (u[1:] + u[:-1])
     lo = np.concatenate([[u[0]], mid])
     hi = np.concatenate([mid, [u[-1]]])
@@ -78,7 +79,7 @@ def make_grid(spec: ContactSpec, b1: mesh.BodyMesh, b2: mesh.BodyMesh, symmetry:
     """Contact grid (positions, areas, weights, initial gap) of the modelled part."""
     x, y = b2.p[0, b2.contact], b2.p[1, b2.contact]
     ux, uy = np.unique(x), np.unique(y)
-    area = np.outer(_tributary(ux, True), _tributary(uy, True)).ravel()
+    area = np.outer(tributary(ux), tributary(uy)).ravel()
     if spec.model == "real" and spec.body != "flat":
         h = b1.p[2, b1.contact] - b2.p[2, b2.contact]   # the true surface z_s(x, y)
     elif spec.body == "sphere":

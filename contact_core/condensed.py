@@ -23,6 +23,7 @@ distant faces held, ``Czz = Ktilde_zz^-1`` where ``Ktilde_zz`` is eq. A.10/A.11
 (the z block of the Guyan-reduced contact stiffness with the tangential contact
 DOFs condensed out, i.e. left free and unloaded).  We build it directly as the
 z-z block of the contact compliance, so no stiffness inverse is ever formed.
+Likewise ``Cxx = Ktilde_x^-1`` of eqs A.27-A.28 (x block, normal DOFs free).
 """
 from __future__ import annotations
 

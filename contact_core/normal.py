@@ -10,7 +10,10 @@ For given q the contact problem is the linear complementarity problem
     g = C f + (h - R_q q) >= 0,  f >= 0,  f g = 0,
 
 equivalently the strictly convex QP  min 1/2 f'Cf + f'(h - R_q q), f >= 0 (C is
-symmetric positive definite). It is solved by the thesis's active-set idea
+symmetric positive definite). For a trial contact set P the thesis reduces the
+stiffness onto P (eqs A.12-A.15: nodes outside carry no force); in compliance
+form that reduction is simply the sub-block C_PP, so each trial costs one dense
+Cholesky solve C_PP f_P = (R_q q - h)_P (the gap closes on P, eq. A.17). It is solved by the thesis's active-set idea
 (nodes in tension leave the contact, penetrating nodes re-enter) organised as a
 Lawson-Hanson primal active-set method: every outer iteration ends on the exact
 minimiser over its active set with f > 0 there and strictly lowers the QP
@@ -223,13 +226,14 @@ def solve_force(cc: CondensedContact, force: float, eccentricity: float | None =
         if np.all(np.abs(err) <= FORCE_RTOL * force * np.array([1.0, _arm(cc)][:r])):
             sol.iterations, sol.newton = its, k
             return sol
-        if r == 1:
+        if r == 1:  # F(delta) is increasing: keep a bracket [lo, hi] of the root
             lo, hi = (q[0], hi) if err[0] > 0 else (lo, q[0])
-        T = tangent(cc, sol.active)
-        dq = np.linalg.lstsq(T, err, rcond=None)[0] if sol.active.any() else np.array([q[0] - h0] + [0] * (r - 1))
-        q = q + dq
-        if r == 1 and (q[0] <= lo or (hi is not None and q[0] >= hi)):
-            q[0] = 0.5 * (lo + (hi if hi is not None else 2 * q[0] - lo))
+        if sol.active.any():
+            q = q + np.linalg.lstsq(tangent(cc, sol.active), err, rcond=None)[0]
+        else:  # no contact yet: double the closing
+            q[0] = 2 * q[0] - h0
+        if r == 1 and not lo < q[0] < (np.inf if hi is None else hi):
+            q[0] = 0.5 * (lo + hi) if hi is not None else 2 * lo - h0
     raise RuntimeError(f"force control did not converge in {MAX_NEWTON} Newton steps "
                        f"(target {target}, reached {res})")
 
