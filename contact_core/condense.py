@@ -53,17 +53,25 @@ def _fixed_dofs(body: mesh.BodyMesh, direction: str, symmetry: str) -> np.ndarra
     return np.unique(np.concatenate(fixed))
 
 
-def body_compliance(K, body: mesh.BodyMesh, direction: str, symmetry: str) -> np.ndarray:
-    """Compliance (n, n) [m/N] of one body at its contact nodes in ``direction``."""
+def body_compliance(K, body: mesh.BodyMesh, direction: str, symmetry: str,
+                    probes: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Compliance (n, n) [m/N] of one body at its contact nodes in ``direction``.
+
+    With ``probes``, also the displacement of the probe nodes per unit contact
+    force, shape (n_probe, n), returned as the second item.
+    """
     ndof = K.shape[0]
     free = np.setdiff1d(np.arange(ndof), _fixed_dofs(body, direction, symmetry))
     local = np.full(ndof, -1)
     local[free] = np.arange(free.size)
-    dofs = local[3 * body.contact + "xyz".index(direction)]
+    comp = "xyz".index(direction)
+    dofs = local[3 * body.contact + comp]
     if np.any(dofs < 0):
         raise ValueError("a contact DOF is constrained: the contact zone touches a clamped face")
-    Kff = K[free][:, free]
-    return linsolve.compliance_block(Kff, dofs)
+    n = dofs.size
+    extra = local[3 * body.probe + comp] if probes else np.empty(0, dtype=int)
+    C = linsolve.compliance_block(K[free][:, free], np.concatenate([dofs, extra]))
+    return (C[:n, :n], C[n:, :n]) if probes else C
 
 
 def tributary(u: np.ndarray) -> np.ndarray:
@@ -115,7 +123,11 @@ def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
         dofs.append(K.shape[0])
         for d in directions:
             t0 = time.perf_counter()
-            arrays[f"C{d}{d}_{ib}"] = body_compliance(K, body, d, sym)
+            if d == "z" and ib == 1 and body.probe.size:
+                arrays["Czz_1"], arrays["probe_C1"] = body_compliance(K, body, d, sym, probes=True)
+                arrays["probe_x"] = body.p[0, body.probe]
+            else:
+                arrays[f"C{d}{d}_{ib}"] = body_compliance(K, body, d, sym)
             timings["condensation"] += time.perf_counter() - t0
         del K
     rigid = [np.ones_like(grid.x)] + ([grid.x] if spec.body == "flat" else [])
@@ -131,7 +143,8 @@ def _assemble_result(arrays: dict, meta: dict) -> CondensedContact:
     z = (arrays["Czz_1"], arrays["Czz_2"])
     x = (arrays["Cxx_1"], arrays["Cxx_2"]) if "Cxx_1" in arrays else None
     return CondensedContact(grid=grid, Czz=z[0] + z[1], rigid=arrays["rigid"], Czz_bodies=z,
-                            Cxx=None if x is None else x[0] + x[1], Cxx_bodies=x, meta=meta)
+                            Cxx=None if x is None else x[0] + x[1], Cxx_bodies=x, meta=meta,
+                            probe_x=arrays.get("probe_x"), probe_C1=arrays.get("probe_C1"))
 
 
 def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedContact:

@@ -102,6 +102,11 @@ class CondensedContact:
     meta : dict
         Geometry, materials, grid, symmetry, mesh sizes, timings per stage
         [s], cache key and hit.
+    probe_x : ndarray, shape (p,), optional
+        x [m] of free surface nodes of body 1 on the row y = 0 beyond the zone.
+    probe_C1 : ndarray, shape (p, n), optional
+        Their elastic normal displacement (away from the plane) per unit
+        contact force: body 1's compression outside the contact (thesis 2.2.5).
     """
 
     grid: ContactGrid
@@ -111,6 +116,8 @@ class CondensedContact:
     Cxx: np.ndarray | None = None
     Cxx_bodies: tuple | None = None
     meta: dict = field(default_factory=dict)
+    probe_x: np.ndarray | None = None
+    probe_C1: np.ndarray | None = None
 
     @property
     def n(self) -> int:

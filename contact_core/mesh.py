@@ -14,7 +14,7 @@ flat face. Element local node order is scikit-fem's ``MeshHex``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -52,6 +52,9 @@ class BodyMesh:
     contact : ndarray, shape (n,)  node index of each contact-grid node
     distant : ndarray        nodes of the distant face (clamped: rigid motion imposed)
     sym_x0, sym_y0 : ndarray nodes on the symmetry planes x = 0 and y = 0
+    probe : ndarray          free surface nodes on the row y = 0 beyond the zone
+                             (quarter models): where the thesis measures the
+                             body's compression outside the contact (section 2.2.5)
     """
 
     p: np.ndarray
@@ -60,6 +63,7 @@ class BodyMesh:
     distant: np.ndarray
     sym_x0: np.ndarray
     sym_y0: np.ndarray
+    probe: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
 
 
 def graded(start: float, end: float, s0: float, q: float, cap: float = np.inf,
@@ -138,9 +142,12 @@ def _body(X, Y, Z, nzx: int, nzy: int, contact_k: int, distant: np.ndarray) -> B
     ii = np.arange(nzx) if xline[0] >= 0 else _centered(xline, nzx)
     contact = idx[np.ix_(ii, np.arange(nzy), [contact_k])].ravel()
     tol = 1e-12 * np.max(np.abs(p))
+    probe = np.empty(0, dtype=int)
+    if xline[0] >= 0:
+        probe = np.setdiff1d(idx[nzx:, 0, contact_k], distant)
     return BodyMesh(p=p, t=t, contact=contact, distant=distant,
                     sym_x0=np.flatnonzero(np.abs(p[0]) <= tol),
-                    sym_y0=np.flatnonzero(np.abs(p[1]) <= tol))
+                    sym_y0=np.flatnonzero(np.abs(p[1]) <= tol), probe=probe)
 
 
 def _centered(xline: np.ndarray, nzx: int) -> np.ndarray:

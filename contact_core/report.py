@@ -24,6 +24,9 @@ from .normal import NormalSolution, resultants, tangent
 #: A contact narrower than this many grid spacings (radius or half-width) is
 #: flagged ``under_resolved``: its size and peak pressure are then rough.
 MIN_NODES_ACROSS = 3
+#: Distance (in contact radii / half-widths) where the thesis measures a body's
+#: compression outside the contact (section 2.2.5: "3b").
+FAR_PROBE = 3.0
 
 
 def _fit_edge(u: np.ndarray, p: np.ndarray) -> float:
@@ -76,6 +79,7 @@ def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
         out["contact_radius"] = fit if np.isfinite(fit) else out["contact_radius_area"]
         out["contact_size_method"] = "pressure fit" if np.isfinite(fit) else "area"
         out["under_resolved"] = bool(out["contact_radius"] < MIN_NODES_ACROSS * s)
+        _share_far(out, cc, sol, out["contact_radius"])
     elif body == "cylinder":
         mid = np.abs(g.y) <= 1e-9 * s
         end = np.abs(g.y - g.y.max()) <= 1e-9 * s
@@ -85,9 +89,25 @@ def summarize(cc: CondensedContact, sol: NormalSolution, body: str) -> dict:
         out["contact_size_method"] = "pressure fit" if np.isfinite(fit) else "extent"
         out["under_resolved"] = bool(out["contact_halfwidth"] < MIN_NODES_ACROSS * s)
         out["contact_halfwidth_end"] = _row_extent(g.x[end], P[end], s)
+        _share_far(out, cc, sol, out["contact_halfwidth"])
         out["p_mid_max"] = float(p[mid].max())
         out["p_end_max"] = float(p[end].max())
     return out
+
+
+def _share_far(out: dict, cc: CondensedContact, sol: NormalSolution, size: float) -> None:
+    """Body 1's compression outside the contact, u_1o / delta at x ~ 3 b (thesis 2.2.5).
+
+    u_1o is the elastic displacement of body 1's free surface at the probe
+    nearest x = FAR_PROBE * size (accepted within 2.5-4 sizes); it excludes
+    the local indentation that ``body1_share`` (at the centre) includes.
+    """
+    if cc.probe_x is None or cc.probe_x.size == 0 or sol.q[0] <= 0:
+        return
+    i = int(np.argmin(np.abs(cc.probe_x - FAR_PROBE * size)))
+    if 2.5 * size <= cc.probe_x[i] <= 4.0 * size:
+        out["body1_share_far"] = float(cc.probe_C1[i] @ sol.f / sol.q[0])
+        out["body1_share_far_at"] = float(cc.probe_x[i])
 
 
 def _zone_edge_hit(cc: CondensedContact, P: np.ndarray, body: str) -> bool:

@@ -50,6 +50,8 @@ def test_sphere_matches_hertz(condensed, specs, name):
     assert out["approach"] == pytest.approx(ref["approach"], rel=APPROACH_RTOL)
     assert out["k_n"] == pytest.approx(2 * specs[name].Estar * out["contact_radius"], rel=KN_RTOL)
     assert out["iterations"] >= 1 and not out["zone_edge_in_contact"]
+    if name == "sphere_real":  # thesis 2.2.5: the sphere's own compression is < 8 %
+        assert 0 < out["body1_share_far"] < 0.08
 
 
 def test_solution_is_in_equilibrium_without_tension_or_penetration(condensed):
@@ -94,6 +96,8 @@ def test_cylinder_mid_length_matches_2d_hertz_with_edge_peak(condensed, specs):
     assert out["p_end_max"] > EDGE_PEAK_RATIO * out["p_mid_max"]
     assert out["contact_halfwidth_end"] >= out["contact_halfwidth_mid_extent"]  # widens (thesis Fig. 5)
     assert 0.2 < out["body1_share"] < 0.8
+    # compression of the cylinder outside the contact (thesis 2.2.5: 25-40 %)
+    assert 0.1 < out["body1_share_far"] < out["body1_share"]
 
 
 def test_flat_face_meets_force_and_eccentricity(condensed, specs):
