@@ -98,8 +98,16 @@ class ContactSpec:
         return 0.5 * self.width, 0.5 * self.length
 
     def key_dict(self) -> dict:
-        """Fields that define the FE model (for the cache key)."""
+        """Fields that define the FE model (for the cache key).
+
+        The zone sizing inputs (p_design, load_hint, zone_margin) enter through
+        the zone they produce, so load cases below the design pressure share
+        one condensed model.
+        """
         d = asdict(self)
+        for name in ("p_design", "load_hint", "zone_margin"):
+            d.pop(name)
+        d["zone"] = [float(v) for v in self.zone()]
         if self.body == "flat":
             d["model"] = "halfspace"  # a flat face has no curvature to model
         return d

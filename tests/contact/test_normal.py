@@ -167,6 +167,10 @@ def test_cache_returns_identical_results(contact_cache):
     assert np.allclose(fresh.Czz, first.Czz, rtol=1e-12, atol=0)
     other = condense(ContactSpec(body="sphere", model="halfspace", grid=5, E2=100e9), cache=contact_cache)
     assert other.meta["cache"]["key"] != first.meta["cache"]["key"]
+    # another load case below the design pressure reuses the condensed model
+    load_case = condense(ContactSpec(body="sphere", model="halfspace", grid=5, load_hint=150.0),
+                         cache=contact_cache)
+    assert load_case.meta["cache"]["hit"]
 
 
 def test_scipy_fallback_equals_default_solver(monkeypatch):
