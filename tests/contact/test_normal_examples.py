@@ -43,3 +43,15 @@ def test_bench_contact_quick_case_runs(tmp_path, monkeypatch):
     rows = json.loads((tmp_path / "bench_contact.json").read_text())
     assert not rows[0]["cold"]["cache_hit"] and rows[0]["cached"]["cache_hit"]
     assert rows[0]["cached"]["end_to_end"] < rows[0]["cold"]["end_to_end"]
+
+
+def test_normal_validation_writes_json_and_plots(tmp_path, contact_cache):
+    val = _load("normal_validation")
+    summary = val.main(tmp_path, cache=contact_cache)
+    data = json.loads((tmp_path / "normal_validation.json").read_text())
+    assert set(data) == {"sphere", "cylinder"} == set(summary)
+    assert abs(data["sphere"]["hertz"]["error_size"]) < 0.02
+    assert abs(data["sphere"]["approach_fit"]["error_A"]) < 0.02
+    for case in ("sphere", "cylinder"):
+        for png in ("pressure_map", "contact_area", "f_approach", "pressure_profiles"):
+            assert (tmp_path / case / f"{png}.png").stat().st_size > 1000
