@@ -42,8 +42,11 @@ test: ctest pytest
 demo: $(STAMP)
 	$(PY) examples/demo.py --out out
 
+# Benchmarks print tables (case, size, error, time, memory); long, never in CI.
+BENCHES := contact tangential element fmu hb
 bench: $(STAMP) cbuild
-	$(PY) examples/benchmarks.py
+	@for b in $(BENCHES); do echo "== examples/bench_$$b.py"; \
+	  $(PY) examples/bench_$$b.py || exit 1; done
 
 clean:
 	rm -rf build out .damper_cache
