@@ -236,7 +236,7 @@ def build(spec: ContactSpec) -> tuple[BodyMesh, BodyMesh, dict]:
     elif spec.body == "cylinder":
         xz = zone_points(zx, n, True)
         s = xz[1] - xz[0]
-        yz = _cylinder_y(zy, s)
+        yz = _cylinder_y(zy, s, n)
         size = R
         xs = np.concatenate([xz, graded(zx, size, s, q)])
         ys = np.concatenate([yz, graded(zy, zy + size, yz[-1] - yz[-2], q)])
@@ -261,12 +261,10 @@ def build(spec: ContactSpec) -> tuple[BodyMesh, BodyMesh, dict]:
     return b1, b2, meta
 
 
-def _cylinder_y(zy: float, s: float) -> np.ndarray:
-    """Lines along the cylinder, 0 <= y <= L/2: spacing 2s in the middle, refined
-    to s/2 towards the end y = L/2 where the edge pressure peak sits."""
-    fine = s / 2.0
-    tail = zy - graded(0.0, min(zy, 12.0 * s), fine, 1.25, 2.0 * s, far=1.25)[::-1]
-    head_end = tail[0]
-    nh = max(1, int(math.ceil(head_end / (2.0 * s))))
-    head = np.linspace(0.0, head_end, nh + 1)
-    return np.unique(np.round(np.concatenate([head, tail, [zy]]) / (1e-9 * s)) * (1e-9 * s))
+def _cylinder_y(zy: float, s: float, n_side: int) -> np.ndarray:
+    """Lines along the cylinder, 0 <= y <= L/2: s/2 at the end y = L/2, where the
+    edge pressure peak sits, growing by 1.25 towards the middle up to the larger
+    of 2 s and (L/2) / n_side (a long cylinder is nearly plane strain there)."""
+    cap = max(2.0 * s, zy / n_side)
+    d = graded(0.0, zy, s / 2.0, 1.25, cap, far=1.25)      # distances from the end
+    return np.concatenate([[0.0], zy - d[::-1][1:], [zy]])
