@@ -53,7 +53,10 @@ class IwanNotConvergedError(RuntimeError):
 class _Model(ct.Structure):
     _fields_ = [("n", ct.c_int32), ("k", ct.c_double * MAX_SLIDERS),
                 ("fs", ct.c_double * MAX_SLIDERS), ("k_res", ct.c_double),
-                ("n_ref", ct.c_double), ("scale", ct.c_double)]
+                ("n_ref", ct.c_double), ("scale", ct.c_double),
+                # derived by the init functions (appended in iwan.h)
+                ("rad", ct.c_double * MAX_SLIDERS), ("fs_sum", ct.c_double),
+                ("derived_n", ct.c_int32)]
 
 
 class _State(ct.Structure):
@@ -200,6 +203,9 @@ class IwanElement:
     """
 
     def __init__(self, model: _Model):
+        if model.derived_n != model.n:  # _Model must mirror iwan_model field by field
+            raise ImportError("fmu_src._iwan does not match fmu_src.element._Model: "
+                              "rebuild with `pip install -e .`")
         self._model = model
         self._mp = ct.addressof(model)
 

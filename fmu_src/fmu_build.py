@@ -49,7 +49,7 @@ _FMI_HEADERS = {
 _WRAPPER_HEADERS = ("fmu_instance.h", "model.h", "damper_vr.h")
 #: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
 CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
-CORE_HEADERS = ("iwan.h", "iwan_internal.h")
+CORE_HEADERS = ("iwan.h", "iwan_internal.h", "iwan_sweep.h")
 #: Flags of the binary inside the FMU (the same as the CMake build's).
 CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
           "-Wall", "-Wextra", "-Werror", "-Wl,--no-undefined")

@@ -31,6 +31,7 @@
  * straight path) restarts the element virgin at the re-contact displacement.
  */
 #include "iwan_internal.h"
+#include "iwan_sweep.h"
 
 #include <math.h>
 #include <string.h>
@@ -66,6 +67,7 @@ iwan_status iwanp_check_model(const iwan_model *m)
         return IWAN_ERR_NONFINITE;
     if (!(m->n_ref > 0.0) || !(m->scale >= 0.0) || !(m->k_res >= 0.0)) return IWAN_ERR_BAD_PARAM;
     if (m->n == 0 && m->k_res == 0.0) return IWAN_ERR_BAD_PARAM;
+    if (m->derived_n != m->n) return IWAN_ERR_BAD_PARAM;  /* not built by the init functions */
     return IWAN_OK;
 }
 
@@ -152,6 +154,21 @@ static iwan_status hull_sliders(iwan_model *md, const double *u, const double *T
     return IWAN_OK;
 }
 
+/* Derived model fields (iwan.h): radii per unit strength factor, rad_j = fs_j / k_j,
+ * so r_j(N) = rad_j f(N) is one multiplication in every path (straight path,
+ * constant-N sweep, periodic start: the same bits everywhere); fs_sum added in
+ * the sweep's two-lane order, so that slip = 1 exactly when every slider slips. */
+static void derive(iwan_model *md)
+{
+    double lane[2] = {0.0, 0.0};
+    for (int32_t j = 0; j < md->n; ++j) {
+        md->rad[j] = md->fs[j] / md->k[j];
+        lane[j & 1] += md->fs[j];
+    }
+    md->fs_sum = lane[0] + lane[1];
+    md->derived_n = md->n;
+}
+
 iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T, size_t m,
                             double n_ref, iwan_fit fit)
 {
@@ -172,6 +189,7 @@ iwan_status iwan_model_init(iwan_model *model, const double *u, const double *T,
     if (st != IWAN_OK) return st;
     md.n_ref = n_ref;
     md.scale = 1.0;
+    derive(&md);
     *model = md;
     return IWAN_OK;
 }
@@ -191,6 +209,7 @@ iwan_status iwan_model_from_sliders(iwan_model *model, const double *k, const do
     md.k_res = k_res;
     md.n_ref = n_ref;
     md.scale = 1.0;
+    derive(&md);
     iwan_status st = iwanp_check_model(&md);
     if (st != IWAN_OK) return st;
     *model = md;
@@ -222,7 +241,7 @@ static double sliders_path(const iwan_model *m, double *z, double u0, double f0,
     double dw = 0.0;
     for (int32_t j = 0; j < m->n; ++j) {
         const double k = m->k[j];
-        const double r0 = m->fs[j] * f0 / k, r1 = f1 == f0 ? r0 : m->fs[j] * f1 / k;
+        const double r0 = m->rad[j] * f0, r1 = m->rad[j] * f1;
         const double dr = r1 - r0;
         double e0 = u0 - z[j];
         if (e0 > r0 || e0 < -r0) {        /* outside only by round-off: project */
@@ -298,39 +317,62 @@ void iwanp_advance(const iwan_model *m, iwan_state *s, double u1, double N1, anc
     s->N = N1;
 }
 
-/* Outputs of a state. A slider counts as slipping when it sits at its limit on
- * the side of the last motion (it would slip on continued motion): it adds
- * nothing to kt and +-dg/dN to dF/dN. */
+/* Direction of the motion to u (unchanged when u does not move). */
+static double new_dir(const iwan_state *s, double u)
+{
+    return u > s->u ? 1.0 : (u < s->u ? -1.0 : s->dir);
+}
+
+/* Outputs of an in-contact state at strength factor f from its sweep sums. A slider
+ * counts as slipping at its limit on the side of the last motion (it would slip on
+ * continued motion): it adds nothing to kt and +-dg/dN to dF/dN. */
+static void sums_to_outputs(const iwan_model *m, const iwan_state *s, double f,
+                            const sweep_sums *a, iwan_output *o)
+{
+    const double ur = s->u - s->u_contact;
+    o->F = a->F + m->k_res * ur;
+    o->kt = m->k_res + a->ks;
+    o->dFdN = s->dir * a->fsl * (m->scale / m->n_ref);
+    o->W = s->w_diss;
+    o->E = 0.5 * (a->E2 + m->k_res * ur * ur);
+    o->slip = (m->fs_sum > 0.0 && f > 0.0) ? a->fsl / m->fs_sum : 1.0;
+}
+
+/* Outputs of a state: the sweep at its own point (positions unchanged). */
 void iwanp_outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
 {
-    o->W = s->w_diss;
     if (!s->in_contact) {
+        o->W = s->w_diss;
         o->F = o->kt = o->dFdN = o->E = 0.0;
         o->slip = 1.0;
         return;
     }
-    const double f = strength_factor(m, s->N), u = s->u, ur = u - s->u_contact;
-    const double dgdN = m->scale / m->n_ref;
-    double F = m->k_res * ur, kt = m->k_res, dfdn = 0.0, E = 0.5 * m->k_res * ur * ur;
-    double g_slip = 0.0, g_all = 0.0;
-    for (int32_t j = 0; j < m->n; ++j) {
-        const double k = m->k[j], r = m->fs[j] * f / k, e = u - s->z[j];
-        const int slipping = s->dir > 0.0 ? s->z[j] <= u - r : s->z[j] >= u + r;
-        F += k * e;
-        E += 0.5 * k * e * e;
-        g_all += m->fs[j];
-        if (slipping) {
-            dfdn += s->dir * m->fs[j] * dgdN;
-            g_slip += m->fs[j];
-        } else {
-            kt += k;
-        }
-    }
-    o->F = F;
-    o->kt = kt;
-    o->dFdN = dfdn;
-    o->E = E;
-    o->slip = (g_all > 0.0 && f > 0.0) ? g_slip / g_all : 1.0;
+    const double f = strength_factor(m, s->N);
+    sweep_sums a;
+    sweep_dir(m, s->z, NULL, f, s->u, s->dir, 0, 1, &a);
+    sums_to_outputs(m, s, f, &a, o);
+}
+
+/* Step to u at the constant N > 0 of the state s (the fast path of iwan_step and
+ * iwan_eval): one pass reads the positions from z, writes them to zout (may be z, or
+ * NULL for outputs only), updates the header of s (u, dir, w_diss) and the outputs. */
+static void step_const(const iwan_model *m, iwan_state *s, const double *z, double *zout,
+                       double u, iwan_output *o)
+{
+    const double f = strength_factor(m, s->N);
+    sweep_sums a;
+    s->dir = new_dir(s, u);
+    s->u = u;
+    if (zout) sweep_dir(m, z, zout, f, u, s->dir, 1, 1, &a);
+    else sweep_dir(m, z, NULL, f, u, s->dir, 0, 1, &a);
+    s->w_diss += f * a.w;
+    if (o) sums_to_outputs(m, s, f, &a, o);
+}
+
+/* The constant-N fast path applies: in contact and N unchanged. */
+static int constant_n(const iwan_state *s, double N)
+{
+    return s->in_contact && N == s->N;
 }
 
 iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, double u, double N,
@@ -342,10 +384,20 @@ iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, doub
     if (st != IWAN_OK) return st;
     if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
     if (trial == committed) return IWAN_ERR_BAD_PARAM;
-    iwan_state s = *committed;
+    if (trial) {
+        *trial = *committed;
+        return iwan_step(model, trial, u, N, out);
+    }
+    iwan_state s;
+    if (constant_n(committed, N)) {        /* outputs only: copy the header, not z */
+        memcpy(&s, committed, offsetof(iwan_state, z));
+        s.dir = committed->dir;
+        step_const(model, &s, committed->z, NULL, u, out);
+        return IWAN_OK;
+    }
+    s = *committed;
     iwanp_advance(model, &s, u, N, NULL);
     if (out) iwanp_outputs(model, &s, out);
-    if (trial) *trial = s;
     return IWAN_OK;
 }
 
@@ -357,80 +409,33 @@ iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, doub
     st = check_state(state);
     if (st != IWAN_OK) return st;
     if (!isfinite(u) || !isfinite(N)) return IWAN_ERR_NONFINITE;
-    iwanp_advance(model, state, u, N, NULL);
-    if (out) iwanp_outputs(model, state, out);
+    if (constant_n(state, N)) {
+        step_const(model, state, state->z, state->z, u, out);
+    } else {
+        iwanp_advance(model, state, u, N, NULL);
+        if (out) iwanp_outputs(model, state, out);
+    }
     return IWAN_OK;
 }
 
-
 /* ------------------------------------------------------------- time series */
 
-/* One sample at constant committed N > 0 for every slider. For constant N the
- * exact update reduces to the play operator z <- clamp(z, u - r, u + r) and the
- * friction work to g |dz|. Moving up (u >= previous u), z <= u + r
- * holds already, so only the lower bound can bind: z <- max(z, u - r), and the
- * slider slips iff it binds (mirror for down). Two partial sums per quantity
- * shorten the add-latency chains.
- * acc = {sum k (u - z), sum of k over sticking, sum of fs over slipping, work}. */
-/* Body of one slider update in lane L (written once, expanded for both
- * directions and both lanes so that -O2 needs no unrolling or inlining). */
-#define SWEEP_SLIDER(J, L, BOUND, SLIPS, WORK)                                   \
-    do {                                                                        \
-        const double z0 = z[J], bound = (BOUND);                                \
-        const int slipping = (SLIPS);                                           \
-        const double zn = slipping ? bound : z0;                                \
-        w##L += g[J] * (WORK);                                                  \
-        z[J] = zn;                                                              \
-        Fa##L += k[J] * (u - zn);                                               \
-        ks##L += slipping ? 0.0 : k[J];                                         \
-        fsl##L += slipping ? fs[J] : 0.0;                                       \
-    } while (0)
-
-#define SWEEP_FUNCTION(NAME, BOUND, SLIPS, WORK)                                \
-    static void NAME(int32_t n, double *restrict z, const double *restrict r,  \
-                     const double *restrict g, const double *restrict k,        \
-                     const double *restrict fs, double u, double acc[4])        \
-    {                                                                           \
-        double Fa0 = 0.0, Fa1 = 0.0, ks0 = 0.0, ks1 = 0.0;                      \
-        double fsl0 = 0.0, fsl1 = 0.0, w0 = 0.0, w1 = 0.0;                      \
-        int32_t j = 0;                                                          \
-        for (; j + 1 < n; j += 2) {                                             \
-            SWEEP_SLIDER(j, 0, BOUND(j), SLIPS, WORK);                          \
-            SWEEP_SLIDER(j + 1, 1, BOUND(j + 1), SLIPS, WORK);                  \
-        }                                                                       \
-        if (j < n) SWEEP_SLIDER(j, 0, BOUND(j), SLIPS, WORK);                   \
-        acc[0] = Fa0 + Fa1;                                                     \
-        acc[1] = ks0 + ks1;                                                     \
-        acc[2] = fsl0 + fsl1;                                                   \
-        acc[3] = w0 + w1;                                                       \
-    }
-
-#define BOUND_UP(J) (u - r[J])
-#define BOUND_DOWN(J) (u + r[J])
-SWEEP_FUNCTION(sweep_up, BOUND_UP, z0 <= bound, zn - z0)
-SWEEP_FUNCTION(sweep_down, BOUND_DOWN, z0 >= bound, z0 - zn)
-
+/* n samples at the committed constant N > 0: the step's own pass per sample
+ * (step_const), outputs stored per sample. */
 void iwanp_run_const(const iwan_model *m, iwan_state *s, size_t n, const double *u,
-                      double *F, double *kt, double *dFdN, double *W)
+                     double *F, double *kt, double *dFdN, double *W)
 {
-    double r[IWAN_MAX_SLIDERS], g[IWAN_MAX_SLIDERS];
     const double f = strength_factor(m, s->N), dgdN = m->scale / m->n_ref;
-    for (int32_t j = 0; j < m->n; ++j) {
-        r[j] = m->fs[j] * f / m->k[j];   /* same expression as iwanp_outputs(): same limits */
-        g[j] = m->fs[j] * f;
-    }
     for (size_t i = 0; i < n; ++i) {
-        const double ui = u[i];
-        double acc[4];
-        if (ui > s->u) s->dir = 1.0;
-        else if (ui < s->u) s->dir = -1.0;
-        if (s->dir > 0.0) sweep_up(m->n, s->z, r, g, m->k, m->fs, ui, acc);
-        else sweep_down(m->n, s->z, r, g, m->k, m->fs, ui, acc);
-        s->u = ui;
-        s->w_diss += acc[3];
-        if (F) F[i] = acc[0] + m->k_res * (ui - s->u_contact);
-        if (kt) kt[i] = m->k_res + acc[1];
-        if (dFdN) dFdN[i] = s->dir * acc[2] * dgdN;
+        sweep_sums a;
+        s->dir = new_dir(s, u[i]);
+        s->u = u[i];
+        sweep_dir(m, s->z, s->z, f, u[i], s->dir, 1, 0, &a);
+        s->w_diss += f * a.w;
+        /* the expressions of sums_to_outputs: the same bits as iwan_step */
+        if (F) F[i] = a.F + m->k_res * (u[i] - s->u_contact);
+        if (kt) kt[i] = m->k_res + a.ks;
+        if (dFdN) dFdN[i] = s->dir * a.fsl * dgdN;
         if (W) W[i] = s->w_diss;
     }
 }

@@ -54,6 +54,12 @@ typedef struct {
     double k_res;                 /* residual (never slipping) spring [N/m] */
     double n_ref;                 /* normal load the curve was computed at [N] */
     double scale;                 /* friction scale: multiplies every fs (1 = as tabulated) */
+    /* Derived from k and fs by iwan_model_init / iwan_model_from_sliders (fields
+     * appended; do not change k or fs afterwards, build a new model instead): */
+    double rad[IWAN_MAX_SLIDERS]; /* slip radius per unit strength factor fs_j / k_j [m] */
+    double fs_sum;                /* sum of fs, in the order the step adds them [N] */
+    int32_t derived_n;            /* n when derived (a model not built by the init
+                                     functions is refused: IWAN_ERR_BAD_PARAM) */
 } iwan_model;
 
 /* History of one element (flat, copyable, versioned). */
@@ -112,7 +118,11 @@ iwan_status iwan_state_init(const iwan_model *model, iwan_state *state, double N
 iwan_status iwan_eval(const iwan_model *model, const iwan_state *committed, double u, double N,
                       iwan_state *trial, iwan_output *out);
 
-/* In-place update of `state` to (u, N); `out` may be NULL. */
+/* In-place update of `state` to (u, N); `out` may be NULL.
+ * At constant N in contact (N equal to the committed N) the exact update is the
+ * play operator and one pass over the sliders gives the new state and every
+ * output; iwan_series and iwan_eval run the same code, so a history gives the
+ * same bits through iwan_step, iwan_eval + commit or iwan_series. */
 iwan_status iwan_step(const iwan_model *model, iwan_state *state, double u, double N,
                       iwan_output *out);
 

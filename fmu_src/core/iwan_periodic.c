@@ -47,7 +47,7 @@ static void periodic_start(const iwan_model *m, size_t n, const double *u, const
     s->in_contact = 1;
     const double f = strength_factor(m, NM);
     for (int32_t j = 0; j < m->n; ++j) {
-        const double r = m->fs[j] * f / m->k[j];
+        const double r = m->rad[j] * f;   /* the sweep's radius: z = M - r is its bound */
         an->aN[j] = (int32_t)tM;
         if (M - mn >= 2.0 * r || 0.0 < M - r) {
             s->z[j] = M - r;

@@ -5,6 +5,7 @@
  * library. Exit status = number of failed checks.
  */
 #include "iwan.h"
+#include "iwan_internal.h"   /* the straight-path update, to check the fast path against */
 
 #include <math.h>
 #include <stdio.h>
@@ -202,6 +203,80 @@ static void test_periodic_jacobian(void)
           "closure status");
 }
 
+/* Reproducible uniform numbers in [0, 1) (64-bit LCG, Knuth's MMIX constants). */
+static double lcg(uint64_t *x)
+{
+    *x = *x * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*x >> 11) / 9007199254740992.0;
+}
+
+/* Outputs of an in-contact state written out slider by slider (independent of the
+ * core's sweep): slipping = at the limit on the side of the last motion. */
+static void ref_outputs(const iwan_model *m, const iwan_state *s, iwan_output *o)
+{
+    const double f = m->scale * s->N / m->n_ref, ur = s->u - s->u_contact;
+    double g_all = 0.0, g_slip = 0.0;
+    o->F = m->k_res * ur;
+    o->kt = m->k_res;
+    o->dFdN = 0.0;
+    o->E = 0.5 * m->k_res * ur * ur;
+    o->W = s->w_diss;
+    for (int j = 0; j < m->n; ++j) {
+        const double e = s->u - s->z[j], r = m->fs[j] * f / m->k[j];
+        const int slipping = s->dir > 0 ? e >= r * (1.0 - 1e-12) : e <= -r * (1.0 - 1e-12);
+        o->F += m->k[j] * e;
+        o->E += 0.5 * m->k[j] * e * e;
+        g_all += m->fs[j];
+        if (slipping) {
+            o->dFdN += s->dir * m->fs[j] * m->scale / m->n_ref;
+            g_slip += m->fs[j];
+        } else {
+            o->kt += m->k[j];
+        }
+    }
+    o->slip = g_slip / g_all;
+}
+
+/* The one-pass constant-N step (iwan_step, iwan_eval) against the general exact
+ * straight-path update (iwanp_advance, an independent code path; outputs of its
+ * state by ref_outputs)
+ * over random reversals with gross slip, at a friction scale != 1. */
+static void test_fast_step_equals_straight_path(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m;
+    iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT);
+    m.scale = 0.7;
+    iwan_state a, b, c;
+    iwan_output oa, ob, oc;
+    uint64_t seed = 20261122u;
+    double u = 0.0;
+    iwan_state_init(&m, &a, 4.0);
+    b = a;
+    for (int i = 0; i < 400; ++i) {
+        u += (lcg(&seed) - 0.5) * 3e-6 * (i % 7 == 0 ? 3.0 : 0.3);
+        CHECK(iwan_eval(&m, &a, u, 4.0, NULL, &oc) == IWAN_OK, "eval");
+        CHECK(iwan_eval(&m, &a, u, 4.0, &c, NULL) == IWAN_OK, "eval trial");
+        CHECK(iwan_step(&m, &a, u, 4.0, &oa) == IWAN_OK, "step");
+        iwanp_advance(&m, &b, u, 4.0, NULL);
+        ref_outputs(&m, &b, &ob);
+        CHECK(memcmp(&oa, &oc, sizeof oa) == 0 && memcmp(&a, &c, sizeof a) == 0,
+              "eval differs from step at %d", i);
+        CHECK(close_to(oa.F, ob.F, 0, ROUNDOFF * 10.0), "F %d: %g vs %g", i, oa.F, ob.F);
+        CHECK(close_to(oa.W, ob.W, ROUNDOFF, 1e-20), "W %d: %g vs %g", i, oa.W, ob.W);
+        CHECK(close_to(oa.E, ob.E, ROUNDOFF, 1e-20), "E %d: %g vs %g", i, oa.E, ob.E);
+        CHECK(close_to(oa.kt, ob.kt, ROUNDOFF, 0) && close_to(oa.dFdN, ob.dFdN, ROUNDOFF, 1e-15)
+              && close_to(oa.slip, ob.slip, ROUNDOFF, 0), "kt, dF/dN, slip %d", i);
+        for (int j = 0; j < m.n; ++j) CHECK(close_to(a.z[j], b.z[j], 0, 1e-20), "z[%d] at %d", j, i);
+    }
+    /* a model not made by the init functions (derived fields missing) is refused */
+    iwan_model bad;
+    memset(&bad, 0, sizeof bad);
+    bad.n = 1; bad.k[0] = 1.0; bad.fs[0] = 1.0; bad.n_ref = 1.0; bad.scale = 1.0;
+    CHECK(iwan_state_init(&bad, &c, 1.0) == IWAN_ERR_BAD_PARAM, "hand-made model accepted");
+}
+
 int main(void)
 {
     test_jenkins_loop_energy();
@@ -209,6 +284,7 @@ int main(void)
     test_bad_inputs();
     test_sampling_independence_and_lift_off();
     test_periodic_jacobian();
+    test_fast_step_equals_straight_path();
     if (failures == 0) printf("test_iwan: all checks passed\n");
     return failures;
 }
