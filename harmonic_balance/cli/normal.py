@@ -34,7 +34,8 @@ def register(subparsers) -> None:
     load.add_argument("--force", type=float, help="normal force [N] (force control)")
     load.add_argument("--approach", type=float, help="imposed approach [m] (displacement control)")
     p.add_argument("--eccentricity", type=float, default=None,
-                   help="flat face: x position of the resultant [m] (rotation about y solved)")
+                   help="flat face: x position of the resultant [m] (rotation about y solved); "
+                   "write a negative value as --eccentricity=-1e-4")
     p.add_argument("--curve", type=int, default=0, help="points of an F-approach curve up to the load")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--out", default=None, help="write the full result (with maps, curve) as JSON")
