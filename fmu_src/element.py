@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
+           "ends_at_gross_slip", "with_flat_tail", "GROSS_SLIP_RTOL",
            "MAX_SLIDERS"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
@@ -121,6 +122,44 @@ def _vec(x, name: str, n: int | None = None) -> np.ndarray:
         want = f"({n},)" if n is not None else "(n,) with n >= 1"
         raise IwanInputError(f"{name} must have shape {want}, got {a.shape}")
     return a
+
+
+#: A curve ends at gross slip when its last force is mu N to this relative tolerance
+#: (a curve file stores mu N rounded; the tail's force is the table's own T[-1]).
+GROSS_SLIP_RTOL = 1e-6
+
+
+def ends_at_gross_slip(T, mu: float | None, N: float | None) -> bool:
+    """Whether a virgin curve ends at gross slip, T[-1] = mu N (to ``GROSS_SLIP_RTOL``).
+
+    The one rule of every tool (``damper loop``, ``damper fmu``): such a curve is
+    continued flat beyond its end (:func:`with_flat_tail`), any other with its last
+    slope.
+
+    Parameters
+    ----------
+    T : array_like, shape (m,)
+        Tangential force of the virgin curve [N].
+    mu : float or None
+        Friction coefficient the curve file declares [-].
+    N : float or None
+        Normal load the curve was computed at [N].
+    """
+    if mu is None or N is None or not (mu > 0.0 and N > 0.0):
+        return False
+    T_end = float(np.asarray(T, dtype=float).ravel()[-1])
+    return abs(T_end - mu * N) <= GROSS_SLIP_RTOL * mu * N
+
+
+def with_flat_tail(u, T) -> tuple[np.ndarray, np.ndarray]:
+    """The table (u, T), shape (m,), with a point (2 u[-1], T[-1]) appended, shape (m + 1,).
+
+    Its last segment is flat, so the element built from it has no residual spring
+    (k_res = 0): the force stays at T[-1] past the end of the curve (gross slip).
+    """
+    u = _vec(u, "u")
+    T = _vec(T, "T", u.size)
+    return np.append(u, 2.0 * u[-1]), np.append(T, T[-1])
 
 
 def _normal(N, n: int, default: float) -> np.ndarray:
@@ -228,16 +267,16 @@ class IwanElement:
         scale : float
             Friction scale multiplying every slip strength (>= 0).
         gross_slip : bool
-            The table ends at gross slip (T = mu N): continue it flat (k_res = 0)
-            instead of with its last slope.
+            The table ends at gross slip (T = mu N, see :func:`ends_at_gross_slip`):
+            continue it flat (:func:`with_flat_tail`, k_res = 0) instead of with its
+            last slope.
         """
         if fit not in _FITS:
             raise IwanInputError(f"fit must be one of {sorted(_FITS)}, got {fit!r}")
         u = _vec(u, "u")
         T = _vec(T, "T", u.size)
         if gross_slip:
-            u = np.append(u, 2.0 * u[-1])
-            T = np.append(T, T[-1])
+            u, T = with_flat_tail(u, T)
         model = _Model()
         _check(_model_init(ct.byref(model), u.ctypes.data, T.ctypes.data, u.size,
                            float(N_ref), _FITS[fit]), "IwanElement.from_curve")

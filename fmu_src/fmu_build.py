@@ -172,7 +172,8 @@ def _zip_dir(root: Path) -> bytes:
 
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
               fit: str = "reject", model: str = "iwan", description: str = "",
-              compiler: str | None = None, curve_json: str | None = None) -> Path:
+              compiler: str | None = None, curve_json: str | None = None,
+              gross_slip: bool = False) -> Path:
     """Write a co-simulation FMU of the friction element for one contact.
 
     Parameters
@@ -195,12 +196,21 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
     curve_json : str, optional
         Text of the source curve file, kept as ``resources/curve.json`` for
         provenance (the binary reads ``resources/curve.txt``).
+    gross_slip : bool
+        The curve ends at gross slip (:func:`fmu_src.element.ends_at_gross_slip`):
+        ``resources/curve.txt`` gets the flat tail of
+        :func:`fmu_src.element.with_flat_tail`, so the FMU stays at T[-1] past the
+        end of the curve, as ``IwanElement.from_curve(..., gross_slip=True)``.
 
     Returns
     -------
     Path of the written FMU.
     """
     _check_version(fmi_version)
+    if gross_slip:
+        from fmu_src.element import with_flat_tail
+
+        u, T = with_flat_tail(u, T)
     u, T = check_curve(u, T, n_ref, fit)
     with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
         root = Path(tmp) / "fmu"

@@ -20,10 +20,6 @@ from __future__ import annotations
 import argparse
 import math
 
-#: A curve ends at gross slip when its last force is mu N to this relative tolerance.
-GROSS_SLIP_RTOL = 1e-6
-
-
 def register(subparsers) -> None:
     """Add the ``loop`` subcommand."""
     p = subparsers.add_parser(
@@ -63,11 +59,10 @@ def _check_args(args) -> None:
 
 def build_element(curve, fit: str, scale: float):
     """Element of a virgin curve; flat beyond the end when the curve ends at mu N."""
-    from fmu_src.element import IwanElement
+    from fmu_src.element import IwanElement, ends_at_gross_slip
 
     N_ref = curve.N if curve.N is not None else 1.0
-    ends_at_slip = (curve.mu is not None and curve.N is not None and curve.mu > 0.0
-                    and abs(curve.T[-1] - curve.mu * curve.N) <= GROSS_SLIP_RTOL * curve.mu * curve.N)
+    ends_at_slip = ends_at_gross_slip(curve.T, curve.mu, curve.N)   # the rule of damper fmu too
     el = IwanElement.from_curve(curve.u, curve.T, N_ref, fit=fit, scale=scale,
                                 gross_slip=ends_at_slip)
     return el, ends_at_slip

@@ -5,7 +5,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from fmu_helpers import N_CURVE, VR, Slave, curve_table
+from fmu_helpers import MU, N_CURVE, VR, Slave, curve_table
 
 from contact_core.curve import VirginCurve, write_curve
 from fmu_src import fmu_build, fmu_xml
@@ -122,3 +122,30 @@ def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
     # same C code and one code path for step and series (two builds of it): the
     # issue's 1e-12
     assert np.max(np.abs(F - ref.F)) <= 1e-12 * np.max(np.abs(ref.F))
+
+
+@pytest.mark.parametrize("mu", [MU, None])
+def test_cli_fmu_continues_the_curve_past_its_end_like_damper_loop(tmp_path, mu):
+    """A file whose T[-1] = mu N ends at gross slip: the FMU stays at mu N past the
+    end (flat tail), as the loop CLI's element; without mu the last slope goes on.
+    Both CLIs take the rule from fmu_src.element.ends_at_gross_slip."""
+    from harmonic_balance.cli.loop import build_element
+
+    u, T = curve_table(11)                          # T[-1] = MU N_CURVE exactly
+    curve = VirginCurve(u=u, T=T, N=N_CURVE, mu=mu)
+    write_curve(curve, tmp_path / "c.json")
+    out = tmp_path / "c.fmu"
+    assert damper_main(["fmu", "--curve", str(tmp_path / "c.json"), "-o", str(out)]) == 0
+    hist = np.array([0.0, 0.5, 1.5, 3.0, -0.2, -4.0, 2.5]) * u[-1]   # far past both ends
+    s = Slave(out, 2).initialize()
+    F = s.run(hist)[0]
+    s.close()
+    el, tail = build_element(curve, "reject", 1.0)
+    assert tail == (mu is not None)
+    ref = el.series(hist).F
+    assert np.max(np.abs(F - ref)) <= 1e-12 * np.max(np.abs(ref))
+    beyond = np.abs(hist) >= u[-1]
+    if mu is not None:      # at gross slip: |F| = mu N wherever the motion went past the end
+        np.testing.assert_allclose(np.abs(F[beyond][:3]), MU * N_CURVE, rtol=1e-12)
+    else:                   # last slope continued: the force keeps rising past mu N
+        assert F[3] > 1.5 * MU * N_CURVE
