@@ -2,7 +2,15 @@
 
 FE bodies (scikit-fem meshes), Guyan condensation onto the contact nodes (cached
 on disk), active-set normal solve (thesis Appendix A.1). Prints one JSON object
-with ``--json``; SI units.
+with ``--json``; SI units. Keys: force [N], approach [m], contact_area [m^2],
+p_max, p_mean [Pa], k_n = dF/d(approach) [N/m], iterations, newton_steps,
+n_contact_nodes, body1_share (body 1's part of the approach at the centre),
+body1_share_far (its compression outside the contact at ~3 radii/half-widths,
+thesis 2.2.5), max_penetration [m], under_resolved; sphere: contact_radius [m];
+cylinder: contact_halfwidth (mid-length), contact_halfwidth_end [m], p_mid_max,
+p_end_max [Pa]; flat: rotation [rad], moment [N m], eccentricity [m]; hertz
+(reference values, relative errors), timings [s], meta (mesh, DOFs, solver,
+cache). ``--out`` adds the per-node maps and the F-approach curve.
 """
 from __future__ import annotations
 
