@@ -149,3 +149,23 @@ def test_cli_fmu_continues_the_curve_past_its_end_like_damper_loop(tmp_path, mu)
         np.testing.assert_allclose(np.abs(F[beyond][:3]), MU * N_CURVE, rtol=1e-12)
     else:                   # last slope continued: the force keeps rising past mu N
         assert F[3] > 1.5 * MU * N_CURVE
+
+
+def test_package_data_ships_every_file_the_packager_copies():
+    """A non-editable install must hold the C sources damper fmu copies into an FMU
+    (pyproject [tool.setuptools.package-data] globs against fmu_build's file lists)."""
+    import fnmatch
+    import tomllib
+    from pathlib import Path
+
+    root = Path(fmu_build.__file__).resolve().parents[1]
+    globs = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"][
+        "package-data"]["fmu_src"]
+    needed = {f"core/{n}" for n in fmu_build.CORE_SOURCES + fmu_build.CORE_HEADERS}
+    for v in (2, 3):
+        needed |= {f"fmi/{n}" for n in fmu_build.c_sources(v) if n not in fmu_build.CORE_SOURCES}
+        needed |= {f"fmi/headers/{n}" for n in fmu_build._FMI_HEADERS[v] + ("LICENSE.txt",)}
+    needed |= {f"fmi/{n}" for n in fmu_build._WRAPPER_HEADERS + ("model_passthrough.c",)}
+    missing = sorted(n for n in needed if not any(fnmatch.fnmatch(n, g) for g in globs))
+    assert not missing, f"add to package-data: {missing}"
+    assert all((root / "fmu_src" / n).is_file() for n in needed)
