@@ -37,6 +37,9 @@ NEAR_RATIO = 1.1
 #: (measured, sphere 41x41: a and p0 unchanged to 0.01 %, 20 % fewer DOF).
 LATERAL_NEAR = 3
 FAR_RATIO = 2.0
+#: Most modelled contact nodes accepted: the dense compliances are n x n
+#: (4000: 128 MB each, a few of them alive at once).
+MAX_CONTACT_NODES = 4000
 #: Extra growth ratio of the deeper layers over the lateral grading ratio.
 DEEP_EXTRA = 0.15
 
@@ -256,6 +259,9 @@ def build(spec: ContactSpec) -> tuple[BodyMesh, BodyMesh, dict]:
         b2 = plane_block(xs, ys, size, s, q, xz.size, yz.size, near)
         b1 = upper_block(xz, yz, size, s, q, xz.size, yz.size, near)
         sym = "half"
+    if b1.contact.size > MAX_CONTACT_NODES:
+        raise ValueError(f"{b1.contact.size} contact nodes exceed {MAX_CONTACT_NODES}: "
+                         f"lower --grid (dense compliances grow as n^2)")
     meta = {"symmetry": sym, "zone": [zx, zy], "spacing": float(s), "n_side": n,
             "nodes": [b1.p.shape[1], b2.p.shape[1]], "elements": [b1.t.shape[1], b2.t.shape[1]]}
     return b1, b2, meta
