@@ -70,7 +70,12 @@ def body_compliance(K, body: mesh.BodyMesh, direction: str, symmetry: str,
         raise ValueError("a contact DOF is constrained: the contact zone touches a clamped face")
     n = dofs.size
     extra = local[3 * body.probe + comp] if probes else np.empty(0, dtype=int)
-    C = linsolve.compliance_block(K[free][:, free], np.concatenate([dofs, extra]))
+    order = None
+    if body.shape is not None:  # fill-reducing order from the block structure
+        nodes = mesh.nd_order(body.shape)
+        order = local[(3 * nodes[:, None] + np.arange(3)).ravel()]
+        order = order[order >= 0]
+    C = linsolve.compliance_block(K[free][:, free], np.concatenate([dofs, extra]), order)
     return (C[:n, :n], C[n:, :n]) if probes else C
 
 

@@ -41,18 +41,24 @@ def factorize(K: sp.spmatrix):
     return lu.solve
 
 
-def compliance_block(K: sp.spmatrix, dofs: np.ndarray) -> np.ndarray:
+def compliance_block(K: sp.spmatrix, dofs: np.ndarray, order: np.ndarray | None = None) -> np.ndarray:
     """Rows and columns ``dofs`` of K^-1: the compliance at those DOFs, shape (m, m).
 
     CHOLMOD: the DOFs are ordered last after a fill-reducing ordering of the
     rest, so the trailing block L22 of the Cholesky factor K = L L' satisfies
     L22 L22' = S, the Schur complement (condensed stiffness) on ``dofs``, and
     the compliance is S^-1 = L22^-T L22^-1: no solves with the whole factor.
-    Otherwise (or if CHOLMOD re-orders the trailing block) K X = E is solved for
+    SuperLU with a fill-reducing ``order`` (a permutation of K's rows, e.g. the
+    mesh's nested dissection): the same with K = L U, S = L22 U22. Otherwise
+    (or if a factorisation re-orders the trailing block) K X = E is solved for
     the unit vectors E of ``dofs`` in blocks of RHS_BLOCK.
     """
     if backend() == "cholmod":
         C = _schur_compliance(sp.csc_matrix(K), dofs)
+        if C is not None:
+            return C
+    elif order is not None:
+        C = _schur_superlu(sp.csc_matrix(K), dofs, order)
         if C is not None:
             return C
     solve = factorize(K)
@@ -81,4 +87,26 @@ def _schur_compliance(K: sp.csc_matrix, dofs: np.ndarray) -> np.ndarray | None:
     L22 = factor.L()[n - m:, n - m:].toarray()
     Linv = sla.solve_triangular(L22, np.eye(m), lower=True, check_finite=False)
     C = Linv.T @ Linv
+    return 0.5 * (C + C.T)
+
+
+def _trailing_last(order: np.ndarray, dofs: np.ndarray, n: int) -> np.ndarray:
+    """``order`` with ``dofs`` moved to the end (in the order given)."""
+    is_dof = np.zeros(n, bool)
+    is_dof[dofs] = True
+    return np.concatenate([order[~is_dof[order]], dofs])
+
+
+def _schur_superlu(K: sp.csc_matrix, dofs: np.ndarray, order: np.ndarray) -> np.ndarray | None:
+    """S^-1 from the trailing blocks of K = L U (SuperLU, no pivoting) with ``dofs`` last."""
+    n, m = K.shape[0], dofs.size
+    if np.sort(order).size != n or not np.array_equal(np.sort(order), np.arange(n)):
+        raise ValueError("order is not a permutation of the matrix rows")
+    perm = _trailing_last(order, dofs, n)
+    lu = spla.splu(K[perm][:, perm].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                   options={"SymmetricMode": True})
+    if not (np.array_equal(lu.perm_r, np.arange(n)) and np.array_equal(lu.perm_c, np.arange(n))):
+        return None
+    S = lu.L[n - m:, n - m:].toarray() @ lu.U[n - m:, n - m:].toarray()
+    C = sla.inv(S, check_finite=False)
     return 0.5 * (C + C.T)

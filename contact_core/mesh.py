@@ -37,6 +37,8 @@ NEAR_RATIO = 1.1
 #: (measured, sphere 41x41: a and p0 unchanged to 0.01 %, 20 % fewer DOF).
 LATERAL_NEAR = 3
 FAR_RATIO = 2.0
+#: Box side (in nodes) below which nested dissection stops splitting.
+ND_LEAF = 6
 #: Most modelled contact nodes accepted: the dense compliances are n x n
 #: (4000: 128 MB each, a few of them alive at once).
 MAX_CONTACT_NODES = 4000
@@ -58,6 +60,8 @@ class BodyMesh:
     probe : ndarray          free surface nodes on the row y = 0 beyond the zone
                              (quarter models): where the thesis measures the
                              body's compression outside the contact (section 2.2.5)
+    shape : tuple (nx, ny, nz) logical size of the structured block (node
+                             (i, j, k) has index (i ny + j) nz + k)
     """
 
     p: np.ndarray
@@ -67,6 +71,7 @@ class BodyMesh:
     sym_x0: np.ndarray
     sym_y0: np.ndarray
     probe: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
+    shape: tuple | None = None
 
 
 def graded(start: float, end: float, s0: float, q: float, cap: float = np.inf,
@@ -150,7 +155,34 @@ def _body(X, Y, Z, nzx: int, nzy: int, contact_k: int, distant: np.ndarray) -> B
         probe = np.setdiff1d(idx[nzx:, 0, contact_k], distant)
     return BodyMesh(p=p, t=t, contact=contact, distant=distant,
                     sym_x0=np.flatnonzero(np.abs(p[0]) <= tol),
-                    sym_y0=np.flatnonzero(np.abs(p[1]) <= tol), probe=probe)
+                    sym_y0=np.flatnonzero(np.abs(p[1]) <= tol), probe=probe, shape=X.shape)
+
+
+def nd_order(shape: tuple, leaf: int = ND_LEAF) -> np.ndarray:
+    """Nested-dissection order of the nodes of a structured (nx, ny, nz) hex grid.
+
+    The longest logical side is split at its middle plane, which separates the
+    two halves (hexahedra couple neighbouring planes only); the order is [left
+    half, right half, plane], recursively: the classic optimal ordering of grid
+    graphs, used to give SuperLU a fill-reducing order (METIS-like fill, where
+    its own MMD ordering filled 25 % more on a test block).
+    """
+    idx = np.arange(int(np.prod(shape))).reshape(shape)
+    out = []
+
+    def split(lo, hi):
+        ext = [h - l for l, h in zip(lo, hi)]
+        d = int(np.argmax(ext))
+        if ext[d] <= leaf:
+            out.append(idx[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]].ravel())
+            return
+        m = (lo[d] + hi[d]) // 2
+        split(lo, hi[:d] + [m] + hi[d + 1:])
+        split(lo[:d] + [m + 1] + lo[d + 1:], hi)
+        out.append(idx[tuple(slice(m, m + 1) if e == d else slice(lo[e], hi[e]) for e in range(3))].ravel())
+
+    split([0, 0, 0], list(shape))
+    return np.concatenate(out)
 
 
 def _centered(xline: np.ndarray, nzx: int) -> np.ndarray:

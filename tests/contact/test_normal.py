@@ -313,3 +313,24 @@ def test_fe_halfspace_agrees_with_boussinesq_model(condensed, specs):
     assert out[0]["contact_radius"] == pytest.approx(out[1]["contact_radius"], rel=BEM_RTOL)
     assert out[0]["p_max"] == pytest.approx(out[1]["p_max"], rel=BEM_RTOL)
     assert out[0]["approach"] < out[1]["approach"]  # clamped finite blocks are stiffer
+
+
+def test_superlu_schur_and_block_solves_agree(monkeypatch):
+    """The SuperLU paths: Schur block of a nested-dissection factor vs unit-load solves."""
+    from contact_core import linsolve
+    from contact_core.condense import _fixed_dofs
+
+    monkeypatch.setenv("DAMPER_SOLVER", "scipy")
+    b1, _, _ = mesh.build(ContactSpec(body="sphere", model="real", grid=5))
+    order_nodes = mesh.nd_order(b1.shape)
+    assert np.array_equal(np.sort(order_nodes), np.arange(b1.p.shape[1]))  # a permutation
+    K = assembly.stiffness(b1.p, b1.t, 200e9, 0.3)
+    free = np.setdiff1d(np.arange(K.shape[0]), _fixed_dofs(b1, "z", "quarter"))
+    local = np.full(K.shape[0], -1)
+    local[free] = np.arange(free.size)
+    dofs = local[3 * b1.contact + 2]
+    order = local[(3 * order_nodes[:, None] + np.arange(3)).ravel()]
+    Kff = K[free][:, free]
+    C_schur = linsolve.compliance_block(Kff, dofs, order[order >= 0])
+    C_solve = linsolve.compliance_block(Kff, dofs)
+    assert np.allclose(C_schur, C_solve, rtol=1e-10, atol=0)
