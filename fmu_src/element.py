@@ -283,6 +283,19 @@ class IwanElement:
         return cls._scaled(model, scale)
 
     @classmethod
+    def from_virgin_curve(cls, curve, fit: str = "reject", scale: float = 1.0) -> "IwanElement":
+        """Element of a curve object (``.u``, ``.T``, ``.N``, ``.mu``; e.g. ``contact_core.curve.VirginCurve``).
+
+        The one place where every tool (``damper loop``, ``damper fmu``, harmonic
+        balance) turns a curve file into an element: N_ref is the curve's N (1 when
+        it records none), and a curve ending at gross slip (:func:`ends_at_gross_slip`)
+        continues flat beyond its end.
+        """
+        N_ref = curve.N if curve.N is not None else 1.0
+        return cls.from_curve(curve.u, curve.T, N_ref, fit=fit, scale=scale,
+                              gross_slip=ends_at_gross_slip(curve.T, curve.mu, curve.N))
+
+    @classmethod
     def from_sliders(cls, k, fs, k_res: float = 0.0, N_ref: float = 1.0) -> "IwanElement":
         """Element from slider stiffnesses ``k`` [N/m] and strengths ``fs`` [N] (shape (n,))."""
         k = np.atleast_1d(np.asarray(k, dtype=np.float64)).copy()

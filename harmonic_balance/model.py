@@ -182,9 +182,9 @@ def _element_link(t: dict, i: int, base: Path) -> FrictionLink:
         from contact_core.curve import read_curve
 
         c = read_curve(base / t["path"])
-        # A curve without a recorded normal load is used as tabulated (N_ref = 1).
-        el = IwanElement.from_curve(c.u, c.T, c.N if c.N is not None else 1.0, fit=t.get("fit", "reject"),
-                                    scale=float(t.get("scale", 1.0)))
+        # Same rule as damper loop / damper fmu: N_ref = the curve's N (1 if none),
+        # flat beyond the end when the curve ends at gross slip (T = mu N).
+        el = IwanElement.from_virgin_curve(c, fit=t.get("fit", "reject"), scale=float(t.get("scale", 1.0)))
     else:
         raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")
     b = int(dofs[1]) if len(dofs) == 2 else None

@@ -61,11 +61,8 @@ def build_element(curve, fit: str, scale: float):
     """Element of a virgin curve; flat beyond the end when the curve ends at mu N."""
     from fmu_src.element import IwanElement, ends_at_gross_slip
 
-    N_ref = curve.N if curve.N is not None else 1.0
-    ends_at_slip = ends_at_gross_slip(curve.T, curve.mu, curve.N)   # the rule of damper fmu too
-    el = IwanElement.from_curve(curve.u, curve.T, N_ref, fit=fit, scale=scale,
-                                gross_slip=ends_at_slip)
-    return el, ends_at_slip
+    el = IwanElement.from_virgin_curve(curve, fit=fit, scale=scale)
+    return el, ends_at_gross_slip(curve.T, curve.mu, curve.N)
 
 
 def amplitude_for_force(el, T_amp: float, N: float) -> float:
