@@ -5,7 +5,7 @@ condensation, solve) and cached (the condensed matrices loaded from disk, then
 the solve). Peak memory is the process's maximum resident set. Prints a table
 and writes ``bench_contact.json`` into ``--out``::
 
-    python examples/bench_contact.py [--out out/bench] [--quick]
+    python examples/bench_contact.py [--out out/bench] [--quick] [--solver scipy]
 
 Goal (issue 2): sphere, 41x41 grid, contact radius and p0 within 0.5 % of
 Hertz, 20 s cold and 1 s cached end to end on a 2-core machine.
@@ -52,20 +52,22 @@ def child(body: str, model: str, grid: int, force: float, cache_dir: str) -> dic
             "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}
 
 
-def _spawn(case, cache_dir) -> dict:
+def _spawn(case, cache_dir, solver=None) -> dict:
     cmd = [sys.executable, __file__, "--child", *map(str, case), cache_dir]
     env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "2"))
+    if solver:
+        env["DAMPER_SOLVER"] = solver
     out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def run(cases=CASES) -> list[dict]:
+def run(cases=CASES, solver=None) -> list[dict]:
     """Cold and cached run of every case; returns one row per case."""
     rows = []
     for case in cases:
         with tempfile.TemporaryDirectory(prefix="damper_bench_") as cache_dir:
-            cold = _spawn(case, cache_dir)
-            warm = _spawn(case, cache_dir)
+            cold = _spawn(case, cache_dir, solver)
+            warm = _spawn(case, cache_dir, solver)
         rows.append({"cold": cold, "cached": warm})
         _print_row(cold, warm)
     return rows
@@ -75,19 +77,21 @@ def _print_row(c: dict, w: dict) -> None:
     t = c["timings"]
     if not hasattr(_print_row, "done"):
         print(f"{'case':18s} {'grid':>4s} {'DOF':>15s} {'err a/b':>8s} {'err p0':>7s} {'err d':>7s} "
-              f"{'mesh':>5s} {'asm':>5s} {'cond':>6s} {'solve':>6s} {'cold':>6s} {'cached':>6s} {'peak MB':>7s}")
+              f"{'mesh':>5s} {'asm':>5s} {'cond':>6s} {'solve':>6s} {'cold':>6s} {'cached':>6s} {'peak MB':>7s} solver")
         _print_row.done = True
     dofs = "+".join(str(d) for d in c["dofs"])
     ed = f"{100 * c['err_approach']:+6.2f}%" if c["err_approach"] is not None else "      -"
     print(f"{c['case']:18s} {c['grid']:4d} {dofs:>15s} {100 * c['err_size']:+7.2f}% {100 * c['err_p0']:+6.2f}% "
           f"{ed} {t['mesh']:5.2f} {t['assembly']:5.2f} {t['condensation']:6.2f} {t['solve']:6.3f} "
-          f"{c['end_to_end']:6.2f} {w['end_to_end']:6.3f} {max(c['peak_mb'], w['peak_mb']):7.0f}")
+          f"{c['end_to_end']:6.2f} {w['end_to_end']:6.3f} {max(c['peak_mb'], w['peak_mb']):7.0f} {c['solver']}")
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--quick", action="store_true", help="one tiny case (smoke test)")
+    ap.add_argument("--solver", choices=("scipy",), default=None,
+                    help="force the scipy (SuperLU) fallback instead of CHOLMOD")
     ap.add_argument("--child", nargs=5, metavar=("BODY", "MODEL", "GRID", "FORCE", "CACHE"),
                     help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -95,7 +99,7 @@ def main(argv=None) -> int:
         b, m, g, f, c = args.child
         print(json.dumps(child(b, m, int(g), float(f), c)))
         return 0
-    rows = run(QUICK if args.quick else CASES)
+    rows = run(QUICK if args.quick else CASES, args.solver)
     from contact_core.fileio import atomic_write
 
     atomic_write(Path(args.out) / "bench_contact.json", json.dumps(rows, indent=1) + "\n")
