@@ -41,6 +41,9 @@ from .condensed import CondensedContact
 GAP_RTOL = 1e-10
 #: Relative accuracy of force control (force and moment).
 FORCE_RTOL = 1e-9
+#: A node whose entry round-off forbids is accepted as converged if it
+#: penetrates less than this many gap tolerances.
+STALL_FACTOR = 1e3
 #: Newton steps allowed in force control.
 MAX_NEWTON = 60
 
@@ -166,8 +169,11 @@ def lcp(C: np.ndarray, b: np.ndarray, P0: np.ndarray | None = None, max_iter: in
             one = np.zeros(n, bool)
             one[np.argmin(np.where(viol, w, np.inf))] = True
             step = _enter(C, b, f, P, one)
-            if step is None:
-                raise RuntimeError("normal contact active set stalled (ill-conditioned compliance)")
+            if step is None:  # Lawson-Hanson guarantees progress in exact arithmetic only
+                if -w[viol].min() <= STALL_FACTOR * tol:
+                    return f, P, it
+                raise RuntimeError("normal contact active set stalled (ill-conditioned compliance, "
+                                   f"penetration {-w[viol].min():.3e} m)")
         f, P = step
 
 
