@@ -351,3 +351,18 @@ def test_dissimilar_materials_follow_hertz_with_e_star(contact_cache):
     assert out["p_max"] == pytest.approx(ref["p0"], rel=HERTZ_RTOL)
     lam1, lam2 = (1 - spec.nu1**2) / spec.E1, (1 - nu2**2) / E2
     assert out["body1_share"] == pytest.approx(lam1 / (lam1 + lam2), rel=SHARE_RTOL)
+
+
+def test_lcp_matches_nnls_on_a_boussinesq_like_kernel():
+    """A smooth 1/r kernel (ill-conditioned like real compliances) on a 15 x 15 grid."""
+    x, y = np.meshgrid(np.linspace(-1, 1, 15), np.linspace(-1, 1, 15))
+    x, y = x.ravel(), y.ravel()
+    dx = 2 / 14
+    r = np.hypot(x[:, None] - x[None, :], y[:, None] - y[None, :])
+    C = 1.0 / np.maximum(r, 0.4 * dx)            # self term ~ a cell's own influence
+    b = (x**2 + y**2) / 2 - 0.3                   # h = r^2 / 2R - delta
+    f, active, _ = normal.lcp(C, b)
+    L = np.linalg.cholesky(C)
+    f_ref, _ = optimize.nnls(L.T, -sla.solve_triangular(L, b, lower=True), maxiter=10 * b.size)
+    assert np.allclose(f, f_ref, atol=1e-8 * f_ref.max())
+    assert 0 < active.sum() < b.size
