@@ -27,7 +27,7 @@ import numpy as np
 
 __all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
            "ends_at_gross_slip", "with_flat_tail", "GROSS_SLIP_RTOL",
-           "MAX_SLIDERS"]
+           "MAX_SLIDERS", "STATE_DTYPE"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
 _STATE_VERSION = 1         # IWAN_STATE_VERSION in iwan.h
@@ -66,6 +66,14 @@ class _State(ct.Structure):
                 ("z", ct.c_double * MAX_SLIDERS), ("dir", ct.c_double)]
 
 
+#: numpy view of ``iwan_state`` (one record per state; checked against ctypes below).
+STATE_DTYPE = np.dtype([("version", "<i4"), ("in_contact", "<i4"), ("u", "<f8"),
+                        ("N", "<f8"), ("u_contact", "<f8"), ("w_diss", "<f8"),
+                        ("z", "<f8", (MAX_SLIDERS,)), ("dir", "<f8")], align=True)
+assert STATE_DTYPE.itemsize == ct.sizeof(_State) and all(
+    STATE_DTYPE.fields[name][1] == getattr(_State, name).offset for name, _ in _State._fields_)
+
+
 class _Output(ct.Structure):
     _fields_ = [(name, ct.c_double) for name in ("F", "kt", "dFdN", "W", "E", "slip")]
 
@@ -102,6 +110,7 @@ _series = _declare("iwan_series", _P, _P, _S, _P, _P, _P, _P, _P, _P)
 _periodic = _declare("iwan_periodic", _P, _S, _P, _P, _P, _P, _P, _P, _I, _D, _P)
 _periodic_jac = _declare("iwan_periodic_jac", _P, _S, _P, _P, _P, _P, _S, _P, _P, _P, _P,
                          _I, _D, _P)
+_step_batch = _declare("iwan_step_batch", _P, _P, _S, _P, _P, _P, _P)
 _lib.iwan_status_text.argtypes = [ct.c_int]
 _lib.iwan_status_text.restype = ct.c_char_p
 
@@ -361,6 +370,85 @@ class IwanElement:
         _check(_step(ct.byref(self._model), ct.byref(state._raw), float(u),
                      self.N_ref if N is None else float(N), ct.byref(out)), "IwanElement.step")
         return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
+
+    def initial_states(self, n: int, N=None) -> np.ndarray:
+        """``n`` virgin states at u = 0 in one buffer, for :meth:`step_batch`.
+
+        Parameters
+        ----------
+        n : int
+            Number of independent states (>= 1).
+        N : None, float or array_like shape (n,)
+            Normal load [N] of each state (default ``N_ref``).
+
+        Returns
+        -------
+        ndarray, shape (n,), dtype :data:`STATE_DTYPE`
+            The flat C states (``iwan_state``) side by side; fields ``u``, ``N``,
+            ``w_diss`` (dissipated energy), ``z`` ... readable as numpy columns.
+        """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+            raise IwanInputError(f"n must be an integer >= 1, got {n!r}")
+        Nv = _normal(N, int(n), self.N_ref)
+        states = np.zeros(int(n), dtype=STATE_DTYPE)
+        first = {}
+        for i, Ni in enumerate(Nv):
+            key = float(Ni)
+            if key not in first:  # one C init per distinct load, copied to the others
+                raw = _State()
+                _check(_state_init(ct.byref(self._model), ct.byref(raw), key),
+                       "IwanElement.initial_states")
+                states[i] = np.frombuffer(raw, dtype=STATE_DTYPE)[0]
+                first[key] = i
+            else:
+                states[i] = states[first[key]]
+        return states
+
+    def step_batch(self, states: np.ndarray, u, N=None, out=None):
+        """Advance many independent states by one sample each, in one C call.
+
+        State i moves along the straight path to (u[i], N[i]), exactly as
+        :meth:`step` would move it (the same C code: the same bits). Every input
+        and state is checked before any state moves: on error nothing changes.
+
+        Parameters
+        ----------
+        states : ndarray, shape (n,), dtype :data:`STATE_DTYPE`
+            Buffer from :meth:`initial_states` (C-contiguous, writeable), updated in place.
+        u : array_like, shape (n,)
+            Displacement of each state [m].
+        N : None, float or array_like shape (n,)
+            Normal load [N]; None means ``N_ref`` for every state.
+        out : tuple (F, kt) of float64 arrays shape (n,), optional
+            Where to write the outputs (avoids allocating per call).
+
+        Returns
+        -------
+        F : ndarray, shape (n,)
+            Friction force [N].
+        kt : ndarray, shape (n,)
+            Tangent stiffness dF/du for continued motion [N/m].
+        """
+        if (not isinstance(states, np.ndarray) or states.dtype != STATE_DTYPE
+                or states.ndim != 1 or not states.flags.c_contiguous
+                or not states.flags.writeable or states.size == 0):
+            raise IwanInputError("states must be a writeable C-contiguous 1-D array of "
+                                 "STATE_DTYPE (from IwanElement.initial_states)")
+        n = states.size
+        u = _vec(u, "u", n)
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        if out is None:
+            F, kt = np.empty(n), np.empty(n)
+        else:
+            F, kt = out
+            for a in (F, kt):
+                if (not isinstance(a, np.ndarray) or a.dtype != np.float64 or a.shape != (n,)
+                        or not a.flags.c_contiguous or not a.flags.writeable):
+                    raise IwanInputError(f"out must be two writeable float64 arrays of shape ({n},)")
+        _check(_step_batch(self._mp, states.ctypes.data, n, u.ctypes.data,
+                           None if Nv is None else Nv.ctypes.data, F.ctypes.data,
+                           kt.ctypes.data), "IwanElement.step_batch")
+        return F, kt
 
     def series(self, u, N=None, state: IwanState | None = None) -> SeriesResult:
         """Whole history in one C call.

@@ -448,16 +448,11 @@ void iwanp_store(const iwan_output *o, size_t i, double *F, double *kt, double *
     if (W) W[i] = o->W;
 }
 
-iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
-                        const double *u, const double *N,
-                        double *F, double *kt, double *dFdN, double *W)
+/* The body of iwan_series on checked arguments (also one sample of iwan_step_batch). */
+static void series_run(const iwan_model *model, iwan_state *state, size_t n,
+                       const double *u, const double *N,
+                       double *F, double *kt, double *dFdN, double *W)
 {
-    iwan_status st = iwanp_check_model(model);
-    if (st != IWAN_OK) return st;
-    st = check_state(state);
-    if (st != IWAN_OK) return st;
-    if (!u || n == 0) return IWAN_ERR_BAD_PARAM;
-    if (iwanp_check_finite(u, n) || (N && iwanp_check_finite(N, n))) return IWAN_ERR_NONFINITE;
     size_t i = 0;
     while (i < n) {
         const double Ni = N ? N[i] : model->n_ref;
@@ -476,5 +471,43 @@ iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
             ++i;
         }
     }
+}
+
+iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
+                        const double *u, const double *N,
+                        double *F, double *kt, double *dFdN, double *W)
+{
+    iwan_status st = iwanp_check_model(model);
+    if (st != IWAN_OK) return st;
+    st = check_state(state);
+    if (st != IWAN_OK) return st;
+    if (!u || n == 0) return IWAN_ERR_BAD_PARAM;
+    if (iwanp_check_finite(u, n) || (N && iwanp_check_finite(N, n))) return IWAN_ERR_NONFINITE;
+    series_run(model, state, n, u, N, F, kt, dFdN, W);
+    return IWAN_OK;
+}
+
+/* ------------------------------------------------------------ batch of states */
+
+/* Every check first (model, each state, each input), so that a failure leaves all
+ * states untouched; then state i takes one sample of the time series (series_run
+ * with n = 1): at constant N the step's own pass (iwanp_run_const), otherwise the
+ * straight-path update and the outputs of the state, i.e. the code of iwan_step, so
+ * the bits are those of iwan_step on each state separately. */
+iwan_status iwan_step_batch(const iwan_model *model, iwan_state *states, size_t n_states,
+                            const double *u, const double *N, double *F, double *kt)
+{
+    iwan_status st = iwanp_check_model(model);
+    if (st != IWAN_OK) return st;
+    if (!states || !u || !F || n_states == 0) return IWAN_ERR_BAD_PARAM;
+    if (iwanp_check_finite(u, n_states) || (N && iwanp_check_finite(N, n_states)))
+        return IWAN_ERR_NONFINITE;
+    for (size_t i = 0; i < n_states; ++i) {
+        st = check_state(&states[i]);
+        if (st != IWAN_OK) return st;
+    }
+    for (size_t i = 0; i < n_states; ++i)
+        series_run(model, &states[i], 1, u + i, N ? N + i : NULL, F + i,
+                   kt ? kt + i : NULL, NULL, NULL);
     return IWAN_OK;
 }

@@ -132,6 +132,15 @@ iwan_status iwan_series(const iwan_model *model, iwan_state *state, size_t n,
                         const double *u, const double *N,
                         double *F, double *kt, double *dFdN, double *W);
 
+/* Many independent states of one model, each advanced by one sample: state i to
+ * (u[i], N[i]) (N == NULL: model->n_ref for all), writing F[i] and, when kt is not
+ * NULL, kt[i]. The same bits as iwan_step on each state separately (it runs the
+ * same code). Every state and input is checked before any state moves: on failure
+ * no state is modified. For vectorised time integration (one call per element per
+ * time step for all frequencies or parameter variants). */
+iwan_status iwan_step_batch(const iwan_model *model, iwan_state *states, size_t n_states,
+                            const double *u, const double *N, double *F, double *kt);
+
 /* Converged periodic loop of a periodic input sampled at n points per period
  * (sample n would equal sample 0). With constant N (N == NULL or all equal) the loop
  * is exact in one pass (the sweep starts at the maximum of u); otherwise periods are
