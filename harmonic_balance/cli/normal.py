@@ -24,20 +24,9 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "normal", help="normal contact (FE, condensation, active set): k_n, pressure, area",
         description=__doc__, formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
-    p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
-    p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
-    p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
-    p.add_argument("--width", type=float, help="flat-face width along x [m]")
-    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
-    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
-    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
-    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
+    add_body_options(p)
     p.add_argument("--model", choices=("real", "halfspace"), default="real",
                    help="real half-sphere/half-cylinder, or block on block with curvature in the gap")
-    p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
-    p.add_argument("--p-design", type=float, default=2000e6,
-                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
     load = p.add_mutually_exclusive_group(required=True)
     load.add_argument("--force", type=float, help="normal force [N] (force control)")
     load.add_argument("--approach", type=float, help="imposed approach [m] (displacement control)")
@@ -55,6 +44,22 @@ def register(subparsers) -> None:
     p.add_argument("--nodes", nargs=2, metavar=("BODY1", "BODY2"), default=None,
                    help="node files (.npz: coords (N,3), contact, distant[, sym_x0, sym_y0]) for --stiffness")
     p.set_defaults(func=run)
+
+
+def add_body_options(p) -> None:
+    """Body, material and contact-zone options (shared by ``damper normal`` and ``damper tangential``)."""
+    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
+    p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
+    p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
+    p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
+    p.add_argument("--width", type=float, help="flat-face width along x [m]")
+    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
+    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
+    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
+    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
+    p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
+    p.add_argument("--p-design", type=float, default=2000e6,
+                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
 
 
 def _radius(args) -> float | None:

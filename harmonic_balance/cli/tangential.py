@@ -17,12 +17,16 @@ from __future__ import annotations
 import argparse
 
 
+from .normal import add_body_options
+
 def register(subparsers) -> None:
     """Add the ``tangential`` subcommand."""
     p = subparsers.add_parser(
         "tangential", help="tangential contact: virgin curve, k_t, stick/slip maps",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_body_options(p)
+    p.add_argument("--eccentricity", type=float, default=None,
+                   help="flat face: x position of the normal resultant [m] (CNF only)")
     load = p.add_mutually_exclusive_group(required=True)
     load.add_argument("--force", type=float, help="normal force N [N] (constant normal force, CNF)")
     load.add_argument("--approach", type=float, help="normal approach [m] (constant normal displacement, CND)")
@@ -40,28 +44,6 @@ def register(subparsers) -> None:
     p.add_argument("--no-cache", action="store_true", help="do not use the condensation cache")
     p.add_argument("--cache-dir", default=None, help="condensation cache folder")
     p.set_defaults(func=run)
-
-
-def add_body_options(p) -> None:
-    """Body, material and grid options, with the meaning of ``damper normal``'s.
-
-    ``damper normal`` registers the same options inline; when it exposes them as
-    a helper this function should become that helper (no second list).
-    """
-    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
-    p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
-    p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
-    p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
-    p.add_argument("--width", type=float, help="flat-face width along x [m]")
-    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
-    p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
-    p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
-    p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
-    p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
-    p.add_argument("--p-design", type=float, default=2000e6,
-                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
-    p.add_argument("--eccentricity", type=float, default=None,
-                   help="flat face: x position of the normal resultant [m] (CNF only)")
 
 
 def spec_from_args(args):
