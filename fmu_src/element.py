@@ -27,7 +27,7 @@ import numpy as np
 
 __all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
            "ends_at_gross_slip", "with_flat_tail", "GROSS_SLIP_RTOL",
-           "MAX_SLIDERS", "STATE_DTYPE"]
+           "MAX_SLIDERS", "STATE_DTYPE", "BatchStepper"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
 _STATE_VERSION = 1         # IWAN_STATE_VERSION in iwan.h
@@ -244,6 +244,52 @@ class PeriodicResult:
     periods: int
 
 
+def _check_states(states) -> int:
+    """Number of states in a batch buffer; IwanInputError unless usable in place."""
+    if (not isinstance(states, np.ndarray) or states.dtype != STATE_DTYPE
+            or states.ndim != 1 or not states.flags.c_contiguous
+            or not states.flags.writeable or states.size == 0):
+        raise IwanInputError("states must be a writeable C-contiguous 1-D array of "
+                             "STATE_DTYPE (from IwanElement.initial_states)")
+    return states.size
+
+
+class BatchStepper:
+    """Repeated :meth:`IwanElement.step_batch` on one states buffer, with fixed buffers.
+
+    Fill :attr:`u` (and :attr:`N` when made with a normal load), call :meth:`step`;
+    the pointers are resolved once, so a call costs about 2 us plus ~25 ns per state
+    instead of ~9 us (time integration calls it once per element per time step).
+
+    Attributes
+    ----------
+    states : ndarray, shape (n,), dtype STATE_DTYPE (advanced in place)
+    u : ndarray, shape (n,)  displacement input [m]
+    N : ndarray, shape (n,) or None  normal load input [N] (None: N_ref)
+    F, kt : ndarray, shape (n,)  outputs of the last step [N], [N/m] (overwritten)
+    """
+
+    def __init__(self, element: "IwanElement", states: np.ndarray, N=None):
+        n = _check_states(states)
+        self.element, self.states = element, states
+        self.u = np.zeros(n)
+        self.N = None if N is None else _normal(N, n, element.N_ref).copy()
+        self.F, self.kt = np.zeros(n), np.zeros(n)
+        self._args = (element._mp, states.ctypes.data, n, self.u.ctypes.data,
+                      None if self.N is None else self.N.ctypes.data, self.F.ctypes.data,
+                      self.kt.ctypes.data)
+
+    def step(self, u=None) -> np.ndarray:
+        """Advance every state to (u, N); returns :attr:`F` (shape (n,), overwritten next call).
+
+        u : array_like shape (n,), optional -- copied into :attr:`u` first.
+        """
+        if u is not None:
+            np.copyto(self.u, u)
+        _check(_step_batch(*self._args), "BatchStepper.step")
+        return self.F
+
+
 class IwanElement:
     """Masing/Iwan element: parallel Jenkins sliders plus a residual spring.
 
@@ -429,12 +475,7 @@ class IwanElement:
         kt : ndarray, shape (n,)
             Tangent stiffness dF/du for continued motion [N/m].
         """
-        if (not isinstance(states, np.ndarray) or states.dtype != STATE_DTYPE
-                or states.ndim != 1 or not states.flags.c_contiguous
-                or not states.flags.writeable or states.size == 0):
-            raise IwanInputError("states must be a writeable C-contiguous 1-D array of "
-                                 "STATE_DTYPE (from IwanElement.initial_states)")
-        n = states.size
+        n = _check_states(states)
         u = _vec(u, "u", n)
         Nv = None if N is None else _normal(N, n, self.N_ref)
         if out is None:
@@ -449,6 +490,10 @@ class IwanElement:
                            None if Nv is None else Nv.ctypes.data, F.ctypes.data,
                            kt.ctypes.data), "IwanElement.step_batch")
         return F, kt
+
+    def batch_stepper(self, states: np.ndarray, N=None) -> "BatchStepper":
+        """A :class:`BatchStepper` on ``states`` (fixed buffers: the cheapest call per sample)."""
+        return BatchStepper(self, states, N)
 
     def series(self, u, N=None, state: IwanState | None = None) -> SeriesResult:
         """Whole history in one C call.
