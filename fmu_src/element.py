@@ -110,6 +110,8 @@ _series = _declare("iwan_series", _P, _P, _S, _P, _P, _P, _P, _P, _P)
 _periodic = _declare("iwan_periodic", _P, _S, _P, _P, _P, _P, _P, _P, _I, _D, _P)
 _periodic_jac = _declare("iwan_periodic_jac", _P, _S, _P, _P, _P, _P, _S, _P, _P, _P, _P,
                          _I, _D, _P)
+_eval = _declare("iwan_eval", ct.POINTER(_Model), ct.POINTER(_State), _D, _D, _P,
+                 ct.POINTER(_Output))
 _step_batch = _declare("iwan_step_batch", _P, _P, _S, _P, _P, _P, _P)
 _lib.iwan_status_text.argtypes = [ct.c_int]
 _lib.iwan_status_text.restype = ct.c_char_p
@@ -415,6 +417,19 @@ class IwanElement:
         out = _Output()
         _check(_step(ct.byref(self._model), ct.byref(state._raw), float(u),
                      self.N_ref if N is None else float(N), ct.byref(out)), "IwanElement.step")
+        return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
+
+    def eval(self, state: IwanState, u: float, N: float | None = None) -> StepOutput:
+        """Outputs at (u, N) reached from ``state`` by the straight path; ``state`` unchanged.
+
+        The trial of :meth:`step` (the same C code, the same bits), for integrators
+        that evaluate forces at points they may reject and commit accepted ones with
+        :meth:`step`.
+        """
+        out = _Output()
+        _check(_eval(ct.byref(self._model), ct.byref(state._raw), float(u),
+                     self.N_ref if N is None else float(N), None, ct.byref(out)),
+               "IwanElement.eval")
         return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
 
     def initial_states(self, n: int, N=None) -> np.ndarray:

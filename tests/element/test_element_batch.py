@@ -92,3 +92,32 @@ def test_bad_input_raises_value_error_and_leaves_states_untouched(el):
     with pytest.raises(ValueError, match="n must be"):
         el.initial_states(0)
     assert states.tobytes() == keep.tobytes()
+
+
+def test_batch_stepper_matches_step_batch_and_refuses_nan(el):
+    rng = np.random.default_rng(SEED + 2)
+    u = rng.uniform(-8e-6, 8e-6, (30, 6))
+    N = N_SPHERE * rng.uniform(0.5, 1.5, 6)
+    a, b = el.initial_states(6, N), el.initial_states(6, N)
+    stepper = el.batch_stepper(b, N)
+    for row in u:
+        F, kt = el.step_batch(a, row, N)
+        assert np.array_equal(stepper.step(row), F) and np.array_equal(stepper.kt, kt)
+    assert a.tobytes() == b.tobytes()
+    keep = b.copy()
+    stepper.u[:] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        stepper.step()
+    assert b.tobytes() == keep.tobytes()
+
+
+def test_eval_is_the_trial_of_step_and_leaves_the_state(el):
+    rng = np.random.default_rng(SEED + 3)
+    s = el.initial_state()
+    for x, n in zip(rng.uniform(-8e-6, 8e-6, 40), N_SPHERE * rng.uniform(-0.2, 1.5, 40)):
+        before = _as_bytes(s)
+        o = el.eval(s, x, n)
+        assert _as_bytes(s) == before
+        assert o == el.step(s, x, n)
+    with pytest.raises(ValueError, match="NaN"):
+        el.eval(s, np.nan)

@@ -18,3 +18,7 @@ def test_benchmark_smoke_runs_and_h3_is_close_to_the_reference(capsys):
     H, r, err = out["rows"][-1]
     assert H == 3 and abs(err) < 100 * SMOKE_RTOL and out["reference_error"] < SMOKE_RTOL
     assert out["sizes"][0][1].status == "complete"
+    # Table 3a: the vectorised time integration settled on every frequency of the
+    # HB curve and its peak agrees with the reference within the smoke tolerance
+    name, ns, tol, t_hb, t_ti, speedup, h1_dev, peak_err, settled = out["vectorised"][0]
+    assert settled and abs(peak_err) < 100 * SMOKE_RTOL and t_ti > 0 and t_hb > 0
