@@ -21,6 +21,10 @@ $(PY):
 
 $(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
 	$(PY) -m pip install -q -e '.[dev]' > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@# Optional accelerator, best effort: CHOLMOD when SuiteSparse's headers are there (make accel).
+	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
+	  $(PY) -m pip install -q 'scikit-sparse<0.5' >> $(VENV)/install.log 2>&1 \
+	  || echo "note: CHOLMOD accelerator not built (see $(VENV)/install.log); using scipy"; fi
 	touch $@
 
 $(CBUILD)/.built: $(C_ALL) | $(PY)
