@@ -27,8 +27,9 @@ Columns: h1_dev_% = worst first-harmonic difference to the HB curve over the cur
 peak_err_% = time-integration amplitude at the HB peak frequency against the Table 1
 reference (sdof) or against the HB peak (2-DOF: no separate reference), both in % of
 the peak; max_per = periods the slowest frequency needed.
-(b) scipy's LSODA (the solver of solve_ivp) to steady state at three frequencies
-(mean time, scaled to the HB curve's number of points), same steady-state test as
+(b) scipy's LSODA (the solver of solve_ivp) to steady state at every tenth point of
+the HB curve (mean time, scaled to the HB curve's number of points; each amplitude
+checked against march_curve at that frequency), same steady-state test as
 the reference march, two formulations: the exact C element, event-free and
 step-wise (trial force from the committed state, each accepted step committed, a
 velocity reversal inside a step committed first from the dense output); and the
@@ -179,15 +180,25 @@ def ti_curve_rate(model, steps, tol, n=5):
 #: Settings (steps per period, steady-state tol) of the vectorised time integration rows.
 TI_SETTINGS = ((128, 1e-5), (256, 1e-6), (512, 1e-8))
 SMOKE_TI_SETTINGS = ((64, 1e-4),)
+#: solve_ivp is run at every IVP_EVERY-th point of the HB curve (mean scaled to the curve).
+IVP_EVERY = 10
 #: Speed-up goals of issue 6.
 GOAL_TI, GOAL_IVP = 10.0, 1000.0
 
 
+#: HB curve timings repeated this often, the least kept (the run least disturbed by
+#: other processes; the time integrations run seconds and are timed once).
+HB_REPEAT = 3
+
+
 def hb_timed(model, spec, band):
     """HB curve and its wall time [s] (everything: setup, continuation, peak refinement)."""
-    t0 = time.perf_counter()
-    r = compute_frf(model, spec, band)
-    return r, time.perf_counter() - t0
+    best = np.inf
+    for _ in range(HB_REPEAT):
+        t0 = time.perf_counter()
+        r = compute_frf(model, spec, band)
+        best = min(best, time.perf_counter() - t0)
+    return r, best
 
 
 def table_vectorised(cases, settings, ref):
@@ -345,18 +356,24 @@ def main(argv=None) -> dict:
           f"{per_w * hb.points:.0f} s per curve: {per_w * hb.points / t_hb:.0f}x")
     ivp = {}
     if not (args.smoke or args.no_ivp):
-        # off the peak the transient decays more slowly: average ends and peak
+        # every IVP_EVERY-th point of the HB curve (its points are denser where the
+        # response changes fast, so this weights the frequencies as the curve does);
+        # each amplitude is checked against the vectorised reference there
+        ws = np.asarray(hb.omega)[::IVP_EVERY]
+        ti = march_curve(model, ws, steps, tol=tol).amplitude
         for label, fn in (("exact C element, step-wise", ivp_exact_one_frequency),
                           ("regularised rate-form Jenkins", ivp_one_frequency)):
-            runs = [fn(w, tol) for w in (BAND[0], hb.peak_omega, BAND[1])]
+            runs = [fn(w, tol) for w in ws]
             t_ivp = np.mean([r[0] for r in runs])
-            amp = runs[1][1]
+            dev = np.array([r[1] / a - 1 for r, a in zip(runs, ti)])
+            per = [r[2] for r in runs]
             ivp[label] = t_ivp * hb.points / t_hb
-            print(f"  solve_ivp LSODA, {label}: {t_ivp:.2f} s per frequency (mean at "
-                  f"{BAND[0]}, the peak, {BAND[1]}; periods {[r[2] for r in runs]}; peak "
-                  f"amplitude {amp:.6f}, {100 * (amp / ref - 1):+.4f} % vs reference) -> "
-                  f"{t_ivp * hb.points:.0f} s per curve: {ivp[label]:.0f}x (goal "
-                  f"{GOAL_IVP:.0f}x: {'met' if ivp[label] >= GOAL_IVP else 'NOT met'})")
+            print(f"  solve_ivp LSODA, {label}: {t_ivp:.2f} s per frequency (mean over "
+                  f"{ws.size} curve points, {min(per)}-{max(per)} periods; worst amplitude "
+                  f"vs march_curve {100 * dev[np.argmax(np.abs(dev))]:+.3f} % at omega = "
+                  f"{ws[np.argmax(np.abs(dev))]:.4f}) -> {t_ivp * hb.points:.0f} s per curve: "
+                  f"{ivp[label]:.0f}x (goal {GOAL_IVP:.0f}x: "
+                  f"{'met' if ivp[label] >= GOAL_IVP else 'NOT met'})")
     # the row whose accuracy is comparable with the HB curve's (256 steps/period:
     # peak error ~0.02 %, like H = 7..9); the smoke run has only its tiny setting
     ns_fair = 256 if any(v[1] == 256 for v in vec) else vec[0][1]

@@ -27,7 +27,7 @@ import numpy as np
 
 __all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
            "ends_at_gross_slip", "with_flat_tail", "GROSS_SLIP_RTOL",
-           "MAX_SLIDERS", "STATE_DTYPE", "BatchStepper"]
+           "MAX_SLIDERS"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
 _STATE_VERSION = 1         # IWAN_STATE_VERSION in iwan.h
@@ -64,14 +64,6 @@ class _State(ct.Structure):
     _fields_ = [("version", ct.c_int32), ("in_contact", ct.c_int32), ("u", ct.c_double),
                 ("N", ct.c_double), ("u_contact", ct.c_double), ("w_diss", ct.c_double),
                 ("z", ct.c_double * MAX_SLIDERS), ("dir", ct.c_double)]
-
-
-#: numpy view of ``iwan_state`` (one record per state; checked against ctypes below).
-STATE_DTYPE = np.dtype([("version", "<i4"), ("in_contact", "<i4"), ("u", "<f8"),
-                        ("N", "<f8"), ("u_contact", "<f8"), ("w_diss", "<f8"),
-                        ("z", "<f8", (MAX_SLIDERS,)), ("dir", "<f8")], align=True)
-assert STATE_DTYPE.itemsize == ct.sizeof(_State) and all(
-    STATE_DTYPE.fields[name][1] == getattr(_State, name).offset for name, _ in _State._fields_)
 
 
 class _Output(ct.Structure):
@@ -112,7 +104,6 @@ _periodic_jac = _declare("iwan_periodic_jac", _P, _S, _P, _P, _P, _P, _S, _P, _P
                          _I, _D, _P)
 _eval = _declare("iwan_eval", ct.POINTER(_Model), ct.POINTER(_State), _D, _D, _P,
                  ct.POINTER(_Output))
-_step_batch = _declare("iwan_step_batch", _P, _P, _S, _P, _P, _P, _P)
 _lib.iwan_status_text.argtypes = [ct.c_int]
 _lib.iwan_status_text.restype = ct.c_char_p
 
@@ -244,52 +235,6 @@ class PeriodicResult:
     dFdN: np.ndarray
     W_cycle: float
     periods: int
-
-
-def _check_states(states) -> int:
-    """Number of states in a batch buffer; IwanInputError unless usable in place."""
-    if (not isinstance(states, np.ndarray) or states.dtype != STATE_DTYPE
-            or states.ndim != 1 or not states.flags.c_contiguous
-            or not states.flags.writeable or states.size == 0):
-        raise IwanInputError("states must be a writeable C-contiguous 1-D array of "
-                             "STATE_DTYPE (from IwanElement.initial_states)")
-    return states.size
-
-
-class BatchStepper:
-    """Repeated :meth:`IwanElement.step_batch` on one states buffer, with fixed buffers.
-
-    Fill :attr:`u` (and :attr:`N` when made with a normal load), call :meth:`step`;
-    the pointers are resolved once, so a call costs about 2 us plus ~25 ns per state
-    instead of ~9 us (time integration calls it once per element per time step).
-
-    Attributes
-    ----------
-    states : ndarray, shape (n,), dtype STATE_DTYPE (advanced in place)
-    u : ndarray, shape (n,)  displacement input [m]
-    N : ndarray, shape (n,) or None  normal load input [N] (None: N_ref)
-    F, kt : ndarray, shape (n,)  outputs of the last step [N], [N/m] (overwritten)
-    """
-
-    def __init__(self, element: "IwanElement", states: np.ndarray, N=None):
-        n = _check_states(states)
-        self.element, self.states = element, states
-        self.u = np.zeros(n)
-        self.N = None if N is None else _normal(N, n, element.N_ref).copy()
-        self.F, self.kt = np.zeros(n), np.zeros(n)
-        self._args = (element._mp, states.ctypes.data, n, self.u.ctypes.data,
-                      None if self.N is None else self.N.ctypes.data, self.F.ctypes.data,
-                      self.kt.ctypes.data)
-
-    def step(self, u=None) -> np.ndarray:
-        """Advance every state to (u, N); returns :attr:`F` (shape (n,), overwritten next call).
-
-        u : array_like shape (n,), optional -- copied into :attr:`u` first.
-        """
-        if u is not None:
-            np.copyto(self.u, u)
-        _check(_step_batch(*self._args), "BatchStepper.step")
-        return self.F
 
 
 class IwanElement:
@@ -432,82 +377,20 @@ class IwanElement:
                "IwanElement.eval")
         return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
 
+    # batches of independent states (one C call per sample): fmu_src.element_batch
     def initial_states(self, n: int, N=None) -> np.ndarray:
-        """``n`` virgin states at u = 0 in one buffer, for :meth:`step_batch`.
-
-        Parameters
-        ----------
-        n : int
-            Number of independent states (>= 1).
-        N : None, float or array_like shape (n,)
-            Normal load [N] of each state (default ``N_ref``).
-
-        Returns
-        -------
-        ndarray, shape (n,), dtype :data:`STATE_DTYPE`
-            The flat C states (``iwan_state``) side by side; fields ``u``, ``N``,
-            ``w_diss`` (dissipated energy), ``z`` ... readable as numpy columns.
-        """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-            raise IwanInputError(f"n must be an integer >= 1, got {n!r}")
-        Nv = _normal(N, int(n), self.N_ref)
-        states = np.zeros(int(n), dtype=STATE_DTYPE)
-        first = {}
-        for i, Ni in enumerate(Nv):
-            key = float(Ni)
-            if key not in first:  # one C init per distinct load, copied to the others
-                raw = _State()
-                _check(_state_init(ct.byref(self._model), ct.byref(raw), key),
-                       "IwanElement.initial_states")
-                states[i] = np.frombuffer(raw, dtype=STATE_DTYPE)[0]
-                first[key] = i
-            else:
-                states[i] = states[first[key]]
-        return states
+        """``n`` virgin states in one buffer (:func:`fmu_src.element_batch.initial_states`)."""
+        from .element_batch import initial_states
+        return initial_states(self, n, N)
 
     def step_batch(self, states: np.ndarray, u, N=None, out=None):
-        """Advance many independent states by one sample each, in one C call.
+        """One sample for each state, one C call (:func:`fmu_src.element_batch.step_batch`)."""
+        from .element_batch import step_batch
+        return step_batch(self, states, u, N, out)
 
-        State i moves along the straight path to (u[i], N[i]), exactly as
-        :meth:`step` would move it (the same C code: the same bits). Every input
-        and state is checked before any state moves: on error nothing changes.
-
-        Parameters
-        ----------
-        states : ndarray, shape (n,), dtype :data:`STATE_DTYPE`
-            Buffer from :meth:`initial_states` (C-contiguous, writeable), updated in place.
-        u : array_like, shape (n,)
-            Displacement of each state [m].
-        N : None, float or array_like shape (n,)
-            Normal load [N]; None means ``N_ref`` for every state.
-        out : tuple (F, kt) of float64 arrays shape (n,), optional
-            Where to write the outputs (avoids allocating per call).
-
-        Returns
-        -------
-        F : ndarray, shape (n,)
-            Friction force [N].
-        kt : ndarray, shape (n,)
-            Tangent stiffness dF/du for continued motion [N/m].
-        """
-        n = _check_states(states)
-        u = _vec(u, "u", n)
-        Nv = None if N is None else _normal(N, n, self.N_ref)
-        if out is None:
-            F, kt = np.empty(n), np.empty(n)
-        else:
-            F, kt = out
-            for a in (F, kt):
-                if (not isinstance(a, np.ndarray) or a.dtype != np.float64 or a.shape != (n,)
-                        or not a.flags.c_contiguous or not a.flags.writeable):
-                    raise IwanInputError(f"out must be two writeable float64 arrays of shape ({n},)")
-        _check(_step_batch(self._mp, states.ctypes.data, n, u.ctypes.data,
-                           None if Nv is None else Nv.ctypes.data, F.ctypes.data,
-                           kt.ctypes.data), "IwanElement.step_batch")
-        return F, kt
-
-    def batch_stepper(self, states: np.ndarray, N=None) -> "BatchStepper":
-        """A :class:`BatchStepper` on ``states`` (fixed buffers: the cheapest call per sample)."""
+    def batch_stepper(self, states: np.ndarray, N=None):
+        """Fixed-buffer stepper on ``states`` (:class:`fmu_src.element_batch.BatchStepper`)."""
+        from .element_batch import BatchStepper
         return BatchStepper(self, states, N)
 
     def series(self, u, N=None, state: IwanState | None = None) -> SeriesResult:

@@ -16,6 +16,12 @@ with the previous period's; the march stops when the change, extrapolated
 geometrically to infinity (the transient decays like rho^p), is below ``tol``
 relative to the amplitude. Time-step convergence: :func:`steady_amplitude` runs two
 step sizes and reports their difference.
+
+:func:`march_curve` is the same scheme and test vectorised over the frequencies of
+a curve (state arrays (n_freq, n_dof), one batched C element call per element per
+time step, ``IwanElement.batch_stepper``); :func:`steady_curve` checks its step size.
+:func:`march` stays the independent frequency-by-frequency version (LU solve,
+one ``IwanElement.step`` per link per step) that the vectorised one is tested against.
 """
 from __future__ import annotations
 

@@ -277,8 +277,57 @@ static void test_fast_step_equals_straight_path(void)
     CHECK(iwan_state_init(&bad, &c, 1.0) == IWAN_ERR_BAD_PARAM, "hand-made model accepted");
 }
 
+/* iwan_step_batch: each of NB states takes the bits iwan_step gives it alone, over
+ * random (u, N) histories with constant-N runs and lift-off; a NaN or a bad state
+ * anywhere leaves every state untouched. */
+#define NB 5
+static void test_step_batch_equals_step(void)
+{
+    double ut[M_TAB], Tt[M_TAB];
+    sphere_table(ut, Tt);
+    iwan_model m;
+    iwan_model_init(&m, ut, Tt, M_TAB, 5.0, IWAN_FIT_REJECT);
+    iwan_state sb[NB], ss[NB], keep[NB];
+    double u[NB] = {0}, N[NB], F[NB], kt[NB];
+    uint64_t seed = 20261123u;
+    for (int i = 0; i < NB; ++i) {
+        N[i] = 5.0;
+        iwan_state_init(&m, &sb[i], N[i]);
+        ss[i] = sb[i];
+    }
+    int lifted = 0;
+    for (int t = 0; t < 300; ++t) {
+        for (int i = 0; i < NB; ++i) {
+            u[i] += (lcg(&seed) - 0.5) * 2e-6;
+            const double r = lcg(&seed);
+            if (r < 0.1) N[i] = -1.0;                 /* lift-off */
+            else if (r < 0.5) N[i] = 5.0 * (0.3 + lcg(&seed));
+        }                                             /* else: N held (fast path) */
+        CHECK(iwan_step_batch(&m, sb, NB, u, N, F, kt) == IWAN_OK, "batch at %d", t);
+        for (int i = 0; i < NB; ++i) {
+            iwan_output o;
+            CHECK(iwan_step(&m, &ss[i], u[i], N[i], &o) == IWAN_OK, "step");
+            CHECK(memcmp(&ss[i], &sb[i], sizeof ss[i]) == 0 && F[i] == o.F && kt[i] == o.kt,
+                  "batch differs from step: state %d at %d", i, t);
+            lifted += !sb[i].in_contact;
+        }
+    }
+    CHECK(lifted > 0, "no lift-off reached");
+    memcpy(keep, sb, sizeof sb);
+    u[NB - 1] = NAN;
+    CHECK(iwan_step_batch(&m, sb, NB, u, NULL, F, NULL) == IWAN_ERR_NONFINITE, "nan u");
+    u[NB - 1] = 0.0;
+    sb[NB - 1].version = 99;
+    CHECK(iwan_step_batch(&m, sb, NB, u, N, F, kt) == IWAN_ERR_BAD_STATE, "bad state");
+    sb[NB - 1].version = IWAN_STATE_VERSION;
+    CHECK(memcmp(keep, sb, sizeof sb) == 0, "states moved on failure");
+    CHECK(iwan_step_batch(&m, sb, 0, u, N, F, kt) == IWAN_ERR_BAD_PARAM, "empty batch");
+    CHECK(iwan_step_batch(&m, sb, NB, u, N, NULL, kt) == IWAN_ERR_BAD_PARAM, "null F");
+}
+
 int main(void)
 {
+    test_step_batch_equals_step();
     test_jenkins_loop_energy();
     test_table_and_masing_branches();
     test_bad_inputs();

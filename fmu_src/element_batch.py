@@ -1,0 +1,150 @@
+"""Batches of independent element states: one C call advances every state one sample.
+
+For vectorised time integration (every frequency of a curve, or every variant of a
+parameter study, marched together): the states of one element live side by side in
+one numpy buffer of :data:`STATE_DTYPE` (the C ``iwan_state``), and
+``iwan_step_batch`` advances state i to (u[i], N[i]) through the time series' own
+code, so each state gets the bits ``IwanElement.step`` would give it alone. Reached
+through :meth:`IwanElement.initial_states`, :meth:`IwanElement.step_batch` and
+:meth:`IwanElement.batch_stepper`. Symbols as in :mod:`fmu_src.element`.
+"""
+from __future__ import annotations
+
+import ctypes as ct
+
+import numpy as np
+
+from .element import (MAX_SLIDERS, IwanInputError, _check, _declare, _normal, _P, _S,
+                      _State, _state_init, _vec)
+
+__all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "step_batch"]
+
+_step_batch = _declare("iwan_step_batch", _P, _P, _S, _P, _P, _P, _P)
+
+#: numpy view of ``iwan_state`` (one record per state; checked against ctypes below).
+STATE_DTYPE = np.dtype([("version", "<i4"), ("in_contact", "<i4"), ("u", "<f8"),
+                        ("N", "<f8"), ("u_contact", "<f8"), ("w_diss", "<f8"),
+                        ("z", "<f8", (MAX_SLIDERS,)), ("dir", "<f8")], align=True)
+assert STATE_DTYPE.itemsize == ct.sizeof(_State) and all(
+    STATE_DTYPE.fields[name][1] == getattr(_State, name).offset for name, _ in _State._fields_)
+
+
+def _check_states(states) -> int:
+    """Number of states in a batch buffer; IwanInputError unless usable in place."""
+    if (not isinstance(states, np.ndarray) or states.dtype != STATE_DTYPE
+            or states.ndim != 1 or not states.flags.c_contiguous
+            or not states.flags.writeable or states.size == 0):
+        raise IwanInputError("states must be a writeable C-contiguous 1-D array of "
+                             "STATE_DTYPE (from IwanElement.initial_states)")
+    return states.size
+
+
+class BatchStepper:
+    """Repeated :meth:`IwanElement.step_batch` on one states buffer, with fixed buffers.
+
+    Fill :attr:`u` (and :attr:`N` when made with a normal load), call :meth:`step`;
+    the pointers are resolved once, so a call costs about 2 us plus ~25 ns per state
+    instead of ~9 us (time integration calls it once per element per time step).
+
+    Attributes
+    ----------
+    states : ndarray, shape (n,), dtype STATE_DTYPE (advanced in place)
+    u : ndarray, shape (n,)  displacement input [m]
+    N : ndarray, shape (n,) or None  normal load input [N] (None: N_ref)
+    F, kt : ndarray, shape (n,)  outputs of the last step [N], [N/m] (overwritten)
+    """
+
+    def __init__(self, element, states: np.ndarray, N=None):
+        n = _check_states(states)
+        self.element, self.states = element, states
+        self.u = np.zeros(n)
+        self.N = None if N is None else _normal(N, n, element.N_ref).copy()
+        self.F, self.kt = np.zeros(n), np.zeros(n)
+        self._args = (element._mp, states.ctypes.data, n, self.u.ctypes.data,
+                      None if self.N is None else self.N.ctypes.data, self.F.ctypes.data,
+                      self.kt.ctypes.data)
+
+    def step(self, u=None) -> np.ndarray:
+        """Advance every state to (u, N); returns :attr:`F` (shape (n,), overwritten next call).
+
+        u : array_like shape (n,), optional -- copied into :attr:`u` first.
+        """
+        if u is not None:
+            np.copyto(self.u, u)
+        _check(_step_batch(*self._args), "BatchStepper.step")
+        return self.F
+
+
+def initial_states(element, n: int, N=None) -> np.ndarray:
+    """``n`` virgin states at u = 0 in one buffer, for :func:`step_batch`.
+
+    Parameters
+    ----------
+    n : int
+        Number of independent states (>= 1).
+    N : None, float or array_like shape (n,)
+        Normal load [N] of each state (default ``N_ref``).
+
+    Returns
+    -------
+    ndarray, shape (n,), dtype :data:`STATE_DTYPE`
+        The flat C states (``iwan_state``) side by side; fields ``u``, ``N``,
+        ``w_diss`` (dissipated energy), ``z`` ... readable as numpy columns.
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise IwanInputError(f"n must be an integer >= 1, got {n!r}")
+    Nv = _normal(N, int(n), element.N_ref)
+    states = np.zeros(int(n), dtype=STATE_DTYPE)
+    first = {}
+    for i, Ni in enumerate(Nv):
+        key = float(Ni)
+        if key not in first:  # one C init per distinct load, copied to the others
+            raw = _State()
+            _check(_state_init(ct.byref(element._model), ct.byref(raw), key),
+                   "IwanElement.initial_states")
+            states[i] = np.frombuffer(raw, dtype=STATE_DTYPE)[0]
+            first[key] = i
+        else:
+            states[i] = states[first[key]]
+    return states
+
+def step_batch(element, states: np.ndarray, u, N=None, out=None):
+    """Advance many independent states by one sample each, in one C call.
+
+    State i moves along the straight path to (u[i], N[i]), exactly as
+    :meth:`step` would move it (the same C code: the same bits). Every input
+    and state is checked before any state moves: on error nothing changes.
+
+    Parameters
+    ----------
+    states : ndarray, shape (n,), dtype :data:`STATE_DTYPE`
+        Buffer from :func:`initial_states` (C-contiguous, writeable), updated in place.
+    u : array_like, shape (n,)
+        Displacement of each state [m].
+    N : None, float or array_like shape (n,)
+        Normal load [N]; None means ``N_ref`` for every state.
+    out : tuple (F, kt) of float64 arrays shape (n,), optional
+        Where to write the outputs (avoids allocating per call).
+
+    Returns
+    -------
+    F : ndarray, shape (n,)
+        Friction force [N].
+    kt : ndarray, shape (n,)
+        Tangent stiffness dF/du for continued motion [N/m].
+    """
+    n = _check_states(states)
+    u = _vec(u, "u", n)
+    Nv = None if N is None else _normal(N, n, element.N_ref)
+    if out is None:
+        F, kt = np.empty(n), np.empty(n)
+    else:
+        F, kt = out
+        for a in (F, kt):
+            if (not isinstance(a, np.ndarray) or a.dtype != np.float64 or a.shape != (n,)
+                    or not a.flags.c_contiguous or not a.flags.writeable):
+                raise IwanInputError(f"out must be two writeable float64 arrays of shape ({n},)")
+    _check(_step_batch(element._mp, states.ctypes.data, n, u.ctypes.data,
+                       None if Nv is None else Nv.ctypes.data, F.ctypes.data,
+                       kt.ctypes.data), "IwanElement.step_batch")
+    return F, kt
