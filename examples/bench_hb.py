@@ -22,7 +22,8 @@ marched at once from rest, one batched C element call per element per step) on
 exactly the HB curve's frequencies plus its peak frequency, at a few step sizes and
 steady-state tolerances; each row gives its accuracy (worst first-harmonic
 difference to the HB curve over the curve, peak error against the Table 1 reference)
-so that the fair row (accuracy comparable with the HB curve) can be read off.
+and the fair row is picked by rule: the coarsest setting whose worst deviation
+from the HB curve and peak error are within the issue's 0.5 %.
 Columns: h1_dev_% = worst first-harmonic difference to the HB curve over the curve,
 peak_err_% = time-integration amplitude at the HB peak frequency against the Table 1
 reference (sdof) or against the HB peak (2-DOF: no separate reference), both in % of
@@ -182,6 +183,9 @@ TI_SETTINGS = ((128, 1e-5), (256, 1e-6), (512, 1e-8))
 SMOKE_TI_SETTINGS = ((64, 1e-4),)
 #: solve_ivp is run at every IVP_EVERY-th point of the HB curve (mean scaled to the curve).
 IVP_EVERY = 10
+#: Accuracy [%] a time integration must reach to count as the same curve (issue 6:
+#: HB and the reference agree within 0.5 % of the peak amplitude).
+ACCURACY_PCT = 0.5
 #: Speed-up goals of issue 6.
 GOAL_TI, GOAL_IVP = 10.0, 1000.0
 
@@ -328,6 +332,48 @@ def ivp_exact_one_frequency(w, tol, rtol=1e-8, atol=1e-11):
     return time.perf_counter() - t0, amp, p + 1
 
 
+def table_ivp(model, hb, t_hb, steps, tol):
+    """solve_ivp (LSODA) to steady state, both formulations; returns speed-ups by label."""
+    ivp = {}
+    # every IVP_EVERY-th point of the HB curve (its points are denser where the
+    # response changes fast, so this weights the frequencies as the curve does);
+    # each amplitude is checked against the vectorised reference there
+    ws = np.asarray(hb.omega)[::IVP_EVERY]
+    ti = march_curve(model, ws, steps, tol=tol).amplitude
+    for label, fn in (("exact C element, step-wise", ivp_exact_one_frequency),
+                      ("regularised rate-form Jenkins", ivp_one_frequency)):
+        runs = [fn(w, tol) for w in ws]
+        t_ivp = np.mean([r[0] for r in runs])
+        dev = np.array([r[1] / a - 1 for r, a in zip(runs, ti)])
+        per = [r[2] for r in runs]
+        ivp[label] = t_ivp * hb.points / t_hb
+        print(f"  solve_ivp LSODA, {label}: {t_ivp:.2f} s per frequency (mean over "
+              f"{ws.size} curve points, {min(per)}-{max(per)} periods; worst amplitude "
+              f"vs march_curve {100 * dev[np.argmax(np.abs(dev))]:+.3f} % at omega = "
+              f"{ws[np.argmax(np.abs(dev))]:.4f}) -> {t_ivp * hb.points:.0f} s per curve: "
+              f"{ivp[label]:.0f}x (goal {GOAL_IVP:.0f}x: "
+              f"{'met' if ivp[label] >= GOAL_IVP else 'NOT met'})")
+    return ivp
+
+
+def summarise_vectorised(cases, vec):
+    """Speed-up over the fair row of Table 3a per case, against the goal."""
+    # the fair row per case: the coarsest time integration whose worst deviation
+    # from the HB curve and peak error are within the issue's 0.5 % (ACCURACY_PCT);
+    # a coarser one would be cheaper but not an equally accurate curve
+    for name, *_ in cases:
+        ok = [v for v in vec if v[0] == name and v[6] < ACCURACY_PCT
+              and abs(v[7]) < ACCURACY_PCT and v[8]]
+        if not ok:
+            print(f"  {name}: no time-integration setting within {ACCURACY_PCT} %")
+            continue
+        _, ns, ss, _, _, sp, dev, perr, _ = ok[0]
+        print(f"  {name}: coarsest time integration within {ACCURACY_PCT} % of the curve "
+              f"({ns} steps/period, tol {ss:.0e}: worst h1 deviation {dev:.3f} %, peak "
+              f"{perr:+.4f} %): HB {sp:.1f}x faster (goal {GOAL_TI:.0f}x: "
+              f"{'met' if sp >= GOAL_TI else 'NOT met'})")
+
+
 def main(argv=None) -> dict:
     """Print the tables; return their numbers (for the smoke test)."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -354,33 +400,8 @@ def main(argv=None) -> dict:
           f"{list(hb.harmonics)}, HB {t_hb:.3f} s):")
     print(f"  unvectorised march, {steps} steps/period: {per_w:.2f} s per frequency -> "
           f"{per_w * hb.points:.0f} s per curve: {per_w * hb.points / t_hb:.0f}x")
-    ivp = {}
-    if not (args.smoke or args.no_ivp):
-        # every IVP_EVERY-th point of the HB curve (its points are denser where the
-        # response changes fast, so this weights the frequencies as the curve does);
-        # each amplitude is checked against the vectorised reference there
-        ws = np.asarray(hb.omega)[::IVP_EVERY]
-        ti = march_curve(model, ws, steps, tol=tol).amplitude
-        for label, fn in (("exact C element, step-wise", ivp_exact_one_frequency),
-                          ("regularised rate-form Jenkins", ivp_one_frequency)):
-            runs = [fn(w, tol) for w in ws]
-            t_ivp = np.mean([r[0] for r in runs])
-            dev = np.array([r[1] / a - 1 for r, a in zip(runs, ti)])
-            per = [r[2] for r in runs]
-            ivp[label] = t_ivp * hb.points / t_hb
-            print(f"  solve_ivp LSODA, {label}: {t_ivp:.2f} s per frequency (mean over "
-                  f"{ws.size} curve points, {min(per)}-{max(per)} periods; worst amplitude "
-                  f"vs march_curve {100 * dev[np.argmax(np.abs(dev))]:+.3f} % at omega = "
-                  f"{ws[np.argmax(np.abs(dev))]:.4f}) -> {t_ivp * hb.points:.0f} s per curve: "
-                  f"{ivp[label]:.0f}x (goal {GOAL_IVP:.0f}x: "
-                  f"{'met' if ivp[label] >= GOAL_IVP else 'NOT met'})")
-    # the row whose accuracy is comparable with the HB curve's (256 steps/period:
-    # peak error ~0.02 %, like H = 7..9); the smoke run has only its tiny setting
-    ns_fair = 256 if any(v[1] == 256 for v in vec) else vec[0][1]
-    for name, *_ in cases:
-        sp = [v[5] for v in vec if v[0] == name and v[1] == ns_fair][0]
-        print(f"  {name}: vectorised time integration at {ns_fair} steps/period: {sp:.1f}x "
-              f"(goal {GOAL_TI:.0f}x: {'met' if sp >= GOAL_TI else 'NOT met'})")
+    ivp = {} if (args.smoke or args.no_ivp) else table_ivp(model, hb, t_hb, steps, tol)
+    summarise_vectorised(cases, vec)
     return {"rows": rows, "reference": ref, "reference_error": ref_err, "sizes": sizes,
             "vectorised": vec, "ivp_speedup": ivp}
 
