@@ -19,6 +19,7 @@ The scene file (``examples/default_scene.toml``) documents the parameters.
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import math
 import sys
@@ -95,9 +96,10 @@ def main(argv=None) -> int:
     summary: dict = {"scene": str(args.scene)}
 
     print("== 1. normal contact validation (FE vs Hertz)")
-    sys.path.insert(0, str(HERE))
-    import normal_validation  # examples/ is not a package: the script sits beside this one
-
+    # examples/ is not a package: load the script beside this one by path
+    spec = importlib.util.spec_from_file_location("normal_validation", HERE / "normal_validation.py")
+    normal_validation = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(normal_validation)
     summary["normal_validation"] = normal_validation.main(out / "normal")
 
     print("== 2. virgin curve of the default contact")
