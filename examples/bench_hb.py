@@ -139,14 +139,7 @@ def friction_band(model: Model):
     """From 0.9 x the free to 1.1 x the stuck first natural frequency [rad/s]."""
     import scipy.linalg as sla
 
-    K = model.linear.K.copy()
-    for link in model.links:
-        a, b = link.dof_a, link.dof_b
-        K[a, a] += link.k0
-        if b is not None:
-            K[b, b] += link.k0
-            K[a, b] -= link.k0
-            K[b, a] -= link.k0
+    K = model.stuck_stiffness()
     w_stuck = np.sqrt(sla.eigh(K, model.linear.M, eigvals_only=True)[0])
     return 0.9 * model.linear.w_r[0], 1.1 * w_stuck
 

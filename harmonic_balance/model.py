@@ -94,6 +94,18 @@ class Model:
     def n(self) -> int:
         return self.linear.n
 
+    def stuck_stiffness(self) -> np.ndarray:
+        """Stiffness (n, n) [N/m] with every friction link stuck at its initial stiffness k0."""
+        K = np.array(self.linear.K, dtype=float, copy=True)
+        for link in self.links:
+            a, b = link.dof_a, link.dof_b
+            K[a, a] += link.k0
+            if b is not None:
+                K[b, b] += link.k0
+                K[a, b] -= link.k0
+                K[b, a] -= link.k0
+        return K
+
     def forcing_coeffs(self, basis: FourierBasis) -> np.ndarray:
         """Excitation harmonics (n_b, n) in the basis ordering [N]."""
         F = np.zeros((basis.nb, self.n))

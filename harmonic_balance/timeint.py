@@ -62,14 +62,7 @@ def _link_stepper(link):
 
 def _stable_steps(model: Model, omega: float, steps: int) -> int:
     lin = model.linear
-    K = lin.K.copy()
-    for link in model.links:
-        a, b = link.dof_a, link.dof_b
-        K[a, a] += link.k0
-        if b is not None:
-            K[b, b] += link.k0
-            K[a, b] -= link.k0
-            K[b, a] -= link.k0
+    K = model.stuck_stiffness()
     w_max = np.sqrt(max(sla.eigh(K, lin.M, eigvals_only=True).max(), 0.0))
     need = int(np.ceil(2.0 * np.pi / omega * w_max / (2.0 * CFL)))
     return max(steps, need)
