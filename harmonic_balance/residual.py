@@ -106,14 +106,7 @@ class FullResidual(_Residual):
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
         A = self._K - omega**2 * self._M + omega * self._C
-        for link, ia, ib in self._ends:
-            J = link.k0 * np.eye(self.basis.nb)
-            A[np.ix_(ia, ia)] += J
-            if ib is not None:
-                A[np.ix_(ia, ib)] -= J
-                A[np.ix_(ib, ia)] -= J
-                A[np.ix_(ib, ib)] += J
-        return np.linalg.solve(A, self._f)
+        return np.linalg.solve(A + _stuck_links(self._ends, self.basis.nb, A.shape[0]), self._f)
 
     def displacements(self, x: np.ndarray, omega: float) -> np.ndarray:
         """Harmonics of all DOFs (n_b, n)."""
@@ -186,14 +179,7 @@ class CondensedResidual(_Residual):
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
         G, _, Xl, _ = self._operators(omega)
-        Kst = np.zeros((self.size, self.size))
-        for link, ia, ib in self._ends:
-            J = link.k0 * np.eye(self.basis.nb)
-            Kst[np.ix_(ia, ia)] += J
-            if ib is not None:
-                Kst[np.ix_(ia, ib)] -= J
-                Kst[np.ix_(ib, ia)] -= J
-                Kst[np.ix_(ib, ib)] += J
+        Kst = _stuck_links(self._ends, self.basis.nb, self.size)
         return np.linalg.solve(np.eye(self.size) + G @ Kst, Xl)
 
     def displacements(self, x: np.ndarray, omega: float, rows=None) -> np.ndarray:
@@ -232,3 +218,20 @@ def energy_per_cycle(model: Model, basis: FourierBasis, X: np.ndarray, omega: fl
         if C is not None:
             w_visc += np.pi * h**2 * omega * (a @ C @ a + b @ C @ b)
     return {"W_ext": float(w_ext), "W_visc": float(w_visc) if C is not None else None}
+
+
+def _stuck_links(ends, nb: int, size: int) -> np.ndarray:
+    """Stiffness (size, size) of every link stuck at k0, on its harmonic index blocks.
+
+    ``ends`` holds (link, ia, ib): index arrays (nb,) of the link's two ends in the
+    unknown vector (ib None for a link to the ground).
+    """
+    Kst = np.zeros((size, size))
+    J = np.eye(nb)
+    for link, ia, ib in ends:
+        Kst[np.ix_(ia, ia)] += link.k0 * J
+        if ib is not None:
+            Kst[np.ix_(ia, ib)] -= link.k0 * J
+            Kst[np.ix_(ib, ia)] -= link.k0 * J
+            Kst[np.ix_(ib, ib)] += link.k0 * J
+    return Kst
