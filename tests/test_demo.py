@@ -1,9 +1,5 @@
 """`make demo` end to end on a small scene: every stage runs and writes its results."""
-import importlib.util
 import json
-from pathlib import Path
-
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 SMALL_SCENE = """
 [contact]
@@ -30,11 +26,9 @@ loop_force_amplitude = 40.0
 """
 
 
-def test_demo_runs_every_stage_on_a_small_scene(tmp_path, monkeypatch):
+def test_demo_runs_every_stage_on_a_small_scene(tmp_path, monkeypatch, load_example):
     monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
-    spec = importlib.util.spec_from_file_location("demo", EXAMPLES / "demo.py")
-    demo = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(demo)
+    demo = load_example("demo")
     scene = tmp_path / "scene.toml"
     scene.write_text(SMALL_SCENE)
     out = tmp_path / "out"

@@ -1,25 +1,14 @@
 """Smoke versions of the normal-contact examples (the full runs are their own commands)."""
 from __future__ import annotations
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
-
-def _load(name):
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_palmgren_formula_matches_the_seed_units():
-    cyl = _load("cylinder_approach")
+def test_palmgren_formula_matches_the_seed_units(load_example):
+    cyl = load_example("cylinder_approach")
     # references.md: steel on steel, d[mm] = 3.84e-5 F^0.9 / L[mm]^0.8
     d = cyl.formulas(350.0, L=1.2e-3)["Palmgren/Harris"]
     assert d == pytest.approx(3.84e-5 * 350.0**0.9 / 1.2**0.8 * 1e-3, rel=1e-12)
@@ -37,16 +26,16 @@ def test_kosarev_half_width_is_hertz():
     assert b == pytest.approx(hertz.cylinder(F, L, R, hertz.contact_modulus(E, nu, E, nu))["b"], rel=1e-12)
 
 
-def test_bench_contact_quick_case_runs(tmp_path, monkeypatch):
-    bench = _load("bench_contact")
+def test_bench_contact_quick_case_runs(tmp_path, monkeypatch, load_example):
+    bench = load_example("bench_contact")
     assert bench.main(["--quick", "--out", str(tmp_path)]) == 0
     rows = json.loads((tmp_path / "bench_contact.json").read_text())
     assert not rows[0]["cold"]["cache_hit"] and rows[0]["cached"]["cache_hit"]
     assert rows[0]["cached"]["end_to_end"] < rows[0]["cold"]["end_to_end"]
 
 
-def test_normal_validation_writes_json_and_plots(tmp_path, contact_cache):
-    val = _load("normal_validation")
+def test_normal_validation_writes_json_and_plots(tmp_path, contact_cache, load_example):
+    val = load_example("normal_validation")
     summary = val.main(tmp_path, cache=contact_cache)
     data = json.loads((tmp_path / "normal_validation.json").read_text())
     assert set(data) == {"sphere", "cylinder"} == set(summary)

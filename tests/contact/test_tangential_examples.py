@@ -1,29 +1,16 @@
 """Smoke runs of the tangential examples (tiny grids): they run, print and save."""
-import importlib.util
-from pathlib import Path
-
-import pytest
-
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
-def load(name):
-    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_virgin_curves_example_smoke(tmp_path, capsys):
-    assert load("virgin_curves").main(["--smoke", "--out", str(tmp_path)]) == 0
+def test_virgin_curves_example_smoke(tmp_path, capsys, load_example):
+    assert load_example("virgin_curves").main(["--smoke", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "sphere CNF" in out and "cylinder CND" in out and "Masing" in out and "eq. 2.14" in out
     assert (tmp_path / "virgin_curves.png").exists()
     assert len(list(tmp_path.glob("*.json"))) == 4
 
 
-def test_bench_tangential_smoke(capsys):
-    assert load("bench_tangential").main(["--smoke"]) == 0
+def test_bench_tangential_smoke(capsys, load_example):
+    assert load_example("bench_tangential").main(["--smoke"]) == 0
     rows = [r.split() for r in capsys.readouterr().out.splitlines()[1:]]
     assert [r[:3] for r in rows] == [["bem", "9", "cold"], ["halfspace", "5", "cold"],
                                      ["halfspace", "5", "cached"]]

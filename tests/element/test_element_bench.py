@@ -1,21 +1,9 @@
 """Smoke test of examples/bench_element.py (tiny sizes; never gates on wall time)."""
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 
-BENCH = Path(__file__).resolve().parents[2] / "examples" / "bench_element.py"
-
-
-def load_bench():
-    spec = importlib.util.spec_from_file_location("bench_element", BENCH)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_bench_element_runs_and_its_numbers_agree(capsys):
-    bench = load_bench()
+def test_bench_element_runs_and_its_numbers_agree(capsys, load_example):
+    bench = load_example("bench_element")
     rows = bench.run([1, 5], n_samples=300, repeats=2)
     assert [r["sliders"] for r in rows] == [1, 5]
     for r in rows:

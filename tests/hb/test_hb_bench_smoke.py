@@ -1,17 +1,11 @@
 """Smoke run of examples/bench_hb.py with tiny settings (the full run is by hand)."""
-import importlib.util
-from pathlib import Path
-
 #: The smoke reference uses 64/128 steps per period and a loose steady-state
 #: tolerance (its own step error ~0.2 %): H = 3 must still land within 1 %.
 SMOKE_RTOL = 1e-2
 
 
-def test_benchmark_smoke_runs_and_h3_is_close_to_the_reference(capsys):
-    path = Path(__file__).resolve().parents[2] / "examples" / "bench_hb.py"
-    spec = importlib.util.spec_from_file_location("bench_hb", path)
-    bench = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(bench)
+def test_benchmark_smoke_runs_and_h3_is_close_to_the_reference(capsys, load_example):
+    bench = load_example("bench_hb")
     out = bench.main(["--smoke"])
     text = capsys.readouterr().out
     assert "Table 1" in text and "Table 2" in text and "Speed-up" in text
