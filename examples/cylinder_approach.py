@@ -98,7 +98,7 @@ def plot(fe: dict, lit: dict, path: Path) -> None:
 
 def main(out_dir="out/cylinder", table=False, grid=21, cache=None) -> dict:
     """Run the comparison; return {"fe": ..., "formulas": ..., "table_I": ...}."""
-    from harmonic_balance.cli.common import dumps
+    from damper.cli.common import dumps
 
     out_dir = Path(out_dir)
     fe = fe_curve(grid=grid, cache=cache)

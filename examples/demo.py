@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from harmonic_balance.cli import main as damper
-from harmonic_balance.cli.common import atomic_write, dumps
+from damper.cli import main as damper
+from damper.cli.common import atomic_write, dumps
 
 HERE = Path(__file__).resolve().parent
 

@@ -51,7 +51,7 @@ def run_case(name: str, spec: ContactSpec, force: float, out_dir: Path, cache=No
 
 def main(out_dir: str | Path = "out/normal", cache=None) -> dict:
     """Run every case; write ``normal_validation.json`` and plots; return the summary."""
-    from harmonic_balance.cli.common import dumps
+    from damper.cli.common import dumps
 
     out_dir = Path(out_dir)
     summary = {}

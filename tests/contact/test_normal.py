@@ -11,7 +11,7 @@ from scipy import optimize
 from contact_core import api, assembly, hertz, mesh, normal, report
 from contact_core.condense import condense
 from contact_core.spec import ContactSpec
-from harmonic_balance.cli import main as damper
+from damper.cli import main as damper
 
 F_SPHERE = 200.0
 F_CYL = 350.0

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from contact_core.curve import read_curve
-from harmonic_balance.cli import main
+from damper.cli import main
 
 SPHERE = ["tangential", "--body", "sphere", "--radius", "0.01", "--mu", "0.5", "--grid", "13",
           "--model", "bem"]

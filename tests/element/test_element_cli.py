@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from elcases import MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy
-from harmonic_balance.cli import main
+from damper.cli import main
 
 #: Cattaneo-Mindlin table of 128 segments: Mindlin-Deresiewicz energy to ~1e-3 (see
 #: test_mindlin_deresiewicz_energy_error_falls_with_refinement).

@@ -10,7 +10,7 @@ from fmu_helpers import MU, N_CURVE, VR, Slave, curve_table
 from contact_core.curve import VirginCurve, write_curve
 from fmu_src import fmu_build, fmu_xml
 from fmu_src.element import IwanElement
-from harmonic_balance.cli import main as damper_main
+from damper.cli import main as damper_main
 
 
 def _model_description(path) -> ET.Element:
@@ -129,7 +129,7 @@ def test_cli_fmu_continues_the_curve_past_its_end_like_damper_loop(tmp_path, mu)
     """A file whose T[-1] = mu N ends at gross slip: the FMU stays at mu N past the
     end (flat tail), as the loop CLI's element; without mu the last slope goes on.
     Both CLIs take the rule from fmu_src.element.ends_at_gross_slip."""
-    from harmonic_balance.cli.loop import build_element
+    from damper.cli.loop import build_element
 
     u, T = curve_table(11)                          # T[-1] = MU N_CURVE exactly
     curve = VirginCurve(u=u, T=T, N=N_CURVE, mu=mu)

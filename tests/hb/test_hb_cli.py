@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from contact_core.curve import VirginCurve, write_curve
-from harmonic_balance.cli import main
+from damper.cli import main
 
 SDOF = ["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.01",
         "--contact-stiffness", "1", "--slip-force", "0.05", "--force", "0.05"]

@@ -53,7 +53,7 @@ def spec_from_args(args):
     """
     import argparse as _argparse
 
-    from harmonic_balance.cli.normal import spec_from_args as normal_spec
+    from damper.cli.normal import spec_from_args as normal_spec
 
     fields = vars(args) | {"model": "halfspace" if args.model == "bem" else args.model, "curve": 0}
     return normal_spec(_argparse.Namespace(**fields))
@@ -67,7 +67,7 @@ def run(args) -> int:
     from contact_core import tangential_run
     from contact_core.curve import write_curve
     from contact_core.tangential_curve import CURVE_TOL
-    from harmonic_balance.cli.common import print_json
+    from damper.cli.common import print_json
 
     _check_finite(args)
     spec = spec_from_args(args)

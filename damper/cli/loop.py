@@ -89,7 +89,7 @@ def run(args) -> int:
     import numpy as np
 
     from contact_core.curve import read_curve
-    from harmonic_balance.cli.common import print_json
+    from damper.cli.common import print_json
 
     _check_args(args)
     curve = read_curve(args.curve)
@@ -131,7 +131,7 @@ def plot_loop(directory, el, u, F, N):
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from harmonic_balance.cli.common import atomic_write
+    from damper.cli.common import atomic_write
 
     a = float(np.max(np.abs(u)))
     uv = np.linspace(-1.3 * a, 1.3 * a, 401)
