@@ -13,7 +13,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild bench accel clean
+.PHONY: demo test pytest ctest cbuild lint bench accel clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -41,7 +41,10 @@ ctest: cbuild
 pytest: $(STAMP) cbuild
 	OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
 
-test: ctest pytest
+lint: $(STAMP)
+	$(VENV)/bin/ruff check .
+
+test: lint ctest pytest
 
 demo: $(STAMP)
 	$(PY) examples/demo.py --out out

@@ -166,8 +166,9 @@ def condense_bodies(K1, nodes1, K2, nodes2, directions=("z",), cache=None) -> Co
 
 def export_body(body, K: sp.spmatrix, stiffness_path, nodes_path, symmetry: str, h=None) -> None:
     """Write a built-in ``mesh.BodyMesh`` and its stiffness in the import format."""
-    from .fileio import atomic_write
     import io
+
+    from .fileio import atomic_write
 
     stiffness_path = Path(stiffness_path)
     if stiffness_path.suffix == ".mtx":

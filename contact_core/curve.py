@@ -110,7 +110,7 @@ class VirginCurve:
         return out
 
     @classmethod
-    def from_dict(cls, data: dict, source: str = "curve") -> "VirginCurve":
+    def from_dict(cls, data: dict, source: str = "curve") -> VirginCurve:
         """Validate a JSON object and build the curve; ValueError names what is wrong."""
         if not isinstance(data, dict):
             raise ValueError(f"{source}: expected a JSON object, got {type(data).__name__}")

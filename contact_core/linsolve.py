@@ -11,8 +11,8 @@ from __future__ import annotations
 import os
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.linalg as sla
+import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 #: Right-hand sides per block solve (bounds the dense work array).

@@ -231,7 +231,7 @@ def provenance(command: str | None = None) -> dict:
     except PackageNotFoundError:
         code = "unknown (package not installed)"
     return {"code_version": code,
-            "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
             "command": command if command is not None else " ".join(sys.argv)}
 
 

@@ -105,7 +105,8 @@ def solve_normal(contact, force: float | None = None, approach: float | None = N
 
 
 def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: float | None = None,
-        eccentricity: float | None = None, model: str = "real", cache=None, tol: float = CURVE_TOL, command: str | None = None) -> TangentialRun:
+        eccentricity: float | None = None, model: str = "real", cache=None, tol: float = CURVE_TOL,
+        command: str | None = None) -> TangentialRun:
     """Condense, solve the normal problem, and compute the virgin curve to gross slip.
 
     Parameters

@@ -24,9 +24,8 @@ import time
 
 import numpy as np
 
-from contact_core import hertz
+from contact_core import hertz, tangential_run
 from contact_core import tangential_reference as tr
-from contact_core import tangential_run
 from contact_core.spec import ContactSpec
 
 R, F, MU = 0.01, 200.0, 0.5

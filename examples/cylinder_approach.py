@@ -23,7 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_core import api
 from contact_core.condense import condense
 from contact_core.fileio import atomic_write
 from contact_core.spec import ContactSpec

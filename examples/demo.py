@@ -127,7 +127,8 @@ def main(argv=None) -> int:
     for force in r["forces"]:
         frf_json = out / f"frf_{force:g}N.json"
         run(["frf", "--model", str(model), "--elements", str(elements), "--force-scale", repr(float(force)),
-             "--harmonics", str(r["harmonics"]), "--omega", *w, "--out", str(frf_json), "--plot", str(out / f"frf_{force:g}N")])
+             "--harmonics", str(r["harmonics"]), "--omega", *w, "--out", str(frf_json),
+             "--plot", str(out / f"frf_{force:g}N")])
         d = json.loads(frf_json.read_text())
         summary["frf"][f"{force:g}"] = {k: d[k] for k in ("peak_omega", "peak_amplitude", "points", "time_s")}
         print(f"   P = {force:g} N: peak {d['peak_amplitude']:.3e} m at {d['peak_omega'] / (2 * math.pi):.1f} Hz "

@@ -19,10 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_core import hertz
+from contact_core import hertz, tangential_run
 from contact_core import tangential_curve as tc
 from contact_core import tangential_reference as tr
-from contact_core import tangential_run
 from contact_core.curve import write_curve
 from contact_core.spec import ContactSpec
 

@@ -191,7 +191,7 @@ class IwanState:
         self._raw = raw
         self._n = n_sliders
 
-    def copy(self) -> "IwanState":
+    def copy(self) -> IwanState:
         raw = _State()
         ct.pointer(raw)[0] = self._raw
         return IwanState(raw, self._n)
@@ -253,7 +253,7 @@ class IwanElement:
     # ------------------------------------------------------------ construction
     @classmethod
     def from_curve(cls, u, T, N_ref, fit: str = "reject", scale: float = 1.0,
-                   gross_slip: bool = False) -> "IwanElement":
+                   gross_slip: bool = False) -> IwanElement:
         """Element reproducing a concave piecewise-linear virgin curve exactly (Iwan).
 
         Parameters
@@ -285,7 +285,7 @@ class IwanElement:
         return cls._scaled(model, scale)
 
     @classmethod
-    def from_virgin_curve(cls, curve, fit: str = "reject", scale: float = 1.0) -> "IwanElement":
+    def from_virgin_curve(cls, curve, fit: str = "reject", scale: float = 1.0) -> IwanElement:
         """Element of a curve object (``.u``, ``.T``, ``.N``, ``.mu``; e.g. ``contact_core.curve.VirginCurve``).
 
         The one place where every tool (``damper loop``, ``damper fmu``, harmonic
@@ -298,7 +298,7 @@ class IwanElement:
                               gross_slip=ends_at_gross_slip(curve.T, curve.mu, curve.N))
 
     @classmethod
-    def from_sliders(cls, k, fs, k_res: float = 0.0, N_ref: float = 1.0) -> "IwanElement":
+    def from_sliders(cls, k, fs, k_res: float = 0.0, N_ref: float = 1.0) -> IwanElement:
         """Element from slider stiffnesses ``k`` [N/m] and strengths ``fs`` [N] (shape (n,))."""
         k = np.atleast_1d(np.asarray(k, dtype=np.float64)).copy()
         fs = np.atleast_1d(np.asarray(fs, dtype=np.float64)).copy()
@@ -310,12 +310,12 @@ class IwanElement:
         return cls(model)
 
     @classmethod
-    def jenkins(cls, k: float, fs: float) -> "IwanElement":
+    def jenkins(cls, k: float, fs: float) -> IwanElement:
         """One Jenkins element (spring k [N/m] in series with a slider fs [N]), N_ref = 1."""
         return cls.from_sliders([k], [fs], 0.0, 1.0)
 
     @classmethod
-    def _scaled(cls, model: _Model, scale: float) -> "IwanElement":
+    def _scaled(cls, model: _Model, scale: float) -> IwanElement:
         scale = float(scale)
         if not np.isfinite(scale) or scale < 0.0:
             raise IwanInputError(f"scale must be finite and >= 0, got {scale!r}")

@@ -14,8 +14,7 @@ import ctypes as ct
 
 import numpy as np
 
-from .element import (MAX_SLIDERS, IwanInputError, _check, _declare, _normal, _P, _S,
-                      _State, _state_init, _vec)
+from .element import _P, _S, MAX_SLIDERS, IwanInputError, _check, _declare, _normal, _State, _state_init, _vec
 
 __all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "step_batch"]
 

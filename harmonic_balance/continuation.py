@@ -37,7 +37,7 @@ CORRECTOR_ITER = 12
 class ContinuationError(RuntimeError):
     """Continuation stopped early; ``branch`` holds the points computed so far."""
 
-    def __init__(self, message: str, branch: "Branch"):
+    def __init__(self, message: str, branch: Branch):
         super().__init__(message)
         self.branch = branch
 

@@ -49,7 +49,7 @@ ALIAS_WARN = 1e-2
 class FRFError(RuntimeError):
     """The curve could not be completed; ``result`` holds the points computed so far."""
 
-    def __init__(self, message: str, result: "FRFResult"):
+    def __init__(self, message: str, result: FRFResult):
         super().__init__(message)
         self.result = result
 
@@ -77,7 +77,7 @@ class FRFResult:
     peaks: list = field(default_factory=list)
     status: str = "complete"
     extra: dict = field(default_factory=dict)
-    problem: "FRFProblem | None" = field(default=None, repr=False)
+    problem: FRFProblem | None = field(default=None, repr=False)
 
     @property
     def points(self) -> int:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import math
 
+
 def register(subparsers) -> None:
     """Add the ``loop`` subcommand."""
     p = subparsers.add_parser(

@@ -38,7 +38,8 @@ def register(subparsers) -> None:
     p.add_argument("--out", default=None, help="write the full result (with maps, curve) as JSON")
     p.add_argument("--plot", default=None, metavar="DIR", help="write pressure map, contact area, F-approach plots")
     p.add_argument("--no-cache", action="store_true", help="do not use the condensation cache")
-    p.add_argument("--cache-dir", default=None, help="condensation cache folder (default $DAMPER_CACHE_DIR or .damper_cache)")
+    p.add_argument("--cache-dir", default=None,
+                   help="condensation cache folder (default $DAMPER_CACHE_DIR or .damper_cache)")
     p.add_argument("--stiffness", nargs=2, metavar=("BODY1", "BODY2"), default=None,
                    help="bring your own bodies: stiffness matrices (.mtx or .npz), one per body")
     p.add_argument("--nodes", nargs=2, metavar=("BODY1", "BODY2"), default=None,
@@ -53,7 +54,8 @@ def add_body_options(p) -> None:
     p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
     p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
     p.add_argument("--width", type=float, help="flat-face width along x [m]")
-    p.add_argument("--E", type=float, default=200e9, help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
+    p.add_argument("--E", type=float, default=200e9,
+                   help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
     p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
     p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
     p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import argparse
 
-
 from .normal import add_body_options
+
 
 def register(subparsers) -> None:
     """Add the ``tangential`` subcommand."""

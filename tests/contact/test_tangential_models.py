@@ -8,10 +8,9 @@ import numpy as np
 import pytest
 
 from contact_core import halfspace_bem as hb
-from contact_core import hertz, normal
+from contact_core import hertz, normal, tangential_run
 from contact_core import tangential_curve as tc
 from contact_core import tangential_reference as tr
-from contact_core import tangential_run
 from contact_core.curve import read_curve, write_curve
 from contact_core.spec import ContactSpec
 from contact_core.tangential import TangentialProblem

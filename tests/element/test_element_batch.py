@@ -10,9 +10,9 @@ import ctypes as ct
 
 import numpy as np
 import pytest
-
 from elcases import N_SPHERE, SEED, cattaneo_table
-from fmu_src.element import IwanElement, IwanInputError
+
+from fmu_src.element import IwanElement
 from fmu_src.element_batch import STATE_DTYPE
 
 #: Independent states and samples of the random histories (small: a quick test).

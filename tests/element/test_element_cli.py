@@ -5,8 +5,8 @@ import json
 
 import numpy as np
 import pytest
-
 from elcases import MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy
+
 from damper.cli import main
 
 #: Cattaneo-Mindlin table of 128 segments: Mindlin-Deresiewicz energy to ~1e-3 (see

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from elcases import N_SPHERE, cattaneo_table
+
 from fmu_src.element import IwanElement
 
 U_TAB, T_TAB = cattaneo_table(20)

@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from elcases import N_SPHERE, SEED, cattaneo_table, random_reversal_history
-from fmu_src.element import IwanElement
 from iwan_ref import MasingRef, table_curve
+
+from fmu_src.element import IwanElement
 
 #: Agreement with the oracle and between samplings: round-off of sums over ~50
 #: sliders and a few hundred samples, relative to the gross-slip force.

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from elcases import N_SPHERE, SEED, cattaneo_table
+
 from fmu_src.element import IwanElement
 
 #: Central differences with step 1e-7 of the coefficient scale: truncation is zero

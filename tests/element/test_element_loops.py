@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from elcases import MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy, tanh_table
 
-from elcases import (MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy, tanh_table)
 from fmu_src.element import IwanElement
 
 #: Round-off of sums over a few hundred samples and sliders (relative).

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from elcases import MU, N_SPHERE, SEED, cattaneo_table, random_reversal_history
+
 from fmu_src.element import IwanElement
 
 #: Round-off of sums over ~40 sliders and a few hundred samples (relative to the force scale).

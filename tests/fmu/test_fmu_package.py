@@ -8,9 +8,9 @@ import pytest
 from fmu_helpers import MU, N_CURVE, VR, Slave, curve_table
 
 from contact_core.curve import VirginCurve, write_curve
+from damper.cli import main as damper_main
 from fmu_src import fmu_build, fmu_xml
 from fmu_src.element import IwanElement
-from damper.cli import main as damper_main
 
 
 def _model_description(path) -> ET.Element:

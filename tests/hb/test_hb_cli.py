@@ -65,7 +65,7 @@ def test_npz_and_toml_model_equals_the_same_model_built_in_python(tmp_path, caps
     from fmu_src.element import IwanElement
     from harmonic_balance.aft import FrictionLink
     from harmonic_balance.frf import compute_frf
-    from harmonic_balance.model import load_matrices, Model
+    from harmonic_balance.model import Model, load_matrices
 
     lin, forcing, resp = load_matrices(tmp_path / "m.npz")
     same = IwanElement.from_sliders([0.5, 0.3], [0.05, 0.03])

@@ -1,9 +1,9 @@
 """Fourier basis: DFT pair, derivative, peak search, sampling checks."""
 import numpy as np
 import pytest
+from hbcases import SEED
 
 from harmonic_balance.fourier import FourierBasis, default_samples, parse_harmonics
-from hbcases import SEED
 
 #: Round-off level of a DFT of a few hundred samples.
 DFT_TOL = 1e-12

@@ -1,12 +1,12 @@
 """Forced response of a Jenkins-damped oscillator against analytic references."""
 import numpy as np
 import pytest
+from hbcases import sdof
+from jenkins_ref import describing_function
 from scipy.optimize import brentq, minimize_scalar
 
 from harmonic_balance.frf import FRFProblem, compute_frf
 from harmonic_balance.newton import newton
-from hbcases import sdof
-from jenkins_ref import describing_function
 
 #: Describing-function agreement demanded by the issue (0.1 %); the AFT sampling
 #: error at n_t = 256 is ~0.02 % (fourier.MIN_SAMPLES).
@@ -70,7 +70,7 @@ def solve_at(model, spec, omegas):
     out = []
     x = prob.residual.linear_guess(omegas[0])
     for w in omegas:
-        x = newton(lambda z: prob(z, w)[:2], x, 1e-12 * P).x
+        x = newton(lambda z, w=w: prob(z, w)[:2], x, 1e-12 * P).x
         out.append(prob.amplitude(x, w))
     return np.array(out)
 

@@ -2,11 +2,11 @@
 import casadi as ca
 import numpy as np
 import pytest
+from hbcases import SEED, jenkins, sdof, two_dof
+from jenkins_ref import JenkinsRef
 
 from harmonic_balance.fourier import FourierBasis
 from harmonic_balance.residual import CondensedResidual, FullResidual
-from hbcases import SEED, jenkins, sdof, two_dof
-from jenkins_ref import JenkinsRef
 
 #: Central differences of a piecewise-smooth residual with step 1e-7 relative:
 #: truncation + round-off ~1e-8 of the entries, unless a stick/slip switch is

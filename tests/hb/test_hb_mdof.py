@@ -2,13 +2,13 @@
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from hbcases import jenkins, two_dof
 
 from harmonic_balance.aft import FrictionLink
 from harmonic_balance.frf import FRFError, FRFProblem, compute_frf
 from harmonic_balance.linear import LinearModel
 from harmonic_balance.model import Model
 from harmonic_balance.newton import newton
-from hbcases import jenkins, two_dof
 
 #: Condensation is exact algebra: the same solution at the same frequency to
 #: Newton tolerance (1e-10 relative).
@@ -41,8 +41,8 @@ def test_condensed_and_full_residuals_give_the_same_curve(make, band):
     full = FRFProblem(model, "odd:3", condensed=False)
     cond = FRFProblem(model, "odd:3", condensed=True)
     for w in (0.4, 0.7, 1.0, 1.3):
-        xf = newton(lambda z: full(z, w)[:2], full.residual.linear_guess(w), 1e-14).x
-        xc = newton(lambda z: cond(z, w)[:2], cond.residual.linear_guess(w), 1e-14).x
+        xf = newton(lambda z, w=w: full(z, w)[:2], full.residual.linear_guess(w), 1e-14).x
+        xc = newton(lambda z, w=w: cond(z, w)[:2], cond.residual.linear_guess(w), 1e-14).x
         X_full = xf.reshape(full.basis.nb, model.n)
         np.testing.assert_allclose(cond.residual.displacements(xc, w), X_full,
                                    atol=EXACT_RTOL * np.abs(X_full).max())
@@ -74,7 +74,7 @@ def test_condensed_solution_balances_energy_on_the_full_model():
 
 def solve(model, spec, w):
     prob = FRFProblem(model, spec, condensed=False)
-    x = newton(lambda z: prob(z, w)[:2], prob.residual.linear_guess(w), 1e-14).x
+    x = newton(lambda z, w=w: prob(z, w)[:2], prob.residual.linear_guess(w), 1e-14).x
     return x.reshape(prob.basis.nb, model.n)
 
 
@@ -108,5 +108,5 @@ def test_both_resonances_of_the_two_dof_model_are_refined():
     for p in r.peaks:  # each is a maximum of the curve: lower on both sides
         for dw in (-2e-3, 2e-3):
             w = p["omega"] * (1 + dw)
-            x = newton(lambda z: prob(z, w)[:2], prob.residual.linear_guess(w), 1e-14).x
+            x = newton(lambda z, w=w: prob(z, w)[:2], prob.residual.linear_guess(w), 1e-14).x
             assert prob.amplitude(x, w) < p["amplitude"]

@@ -1,10 +1,9 @@
 """Harmonic balance against a time integration of the same model to steady state."""
-import numpy as np
 import pytest
+from hbcases import sdof, two_dof
 
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, steady_amplitude
-from hbcases import sdof, two_dof
 
 #: Agreement demanded by the issue between the converged HB and the reference.
 TI_RTOL = 5e-3

@@ -6,10 +6,10 @@ frequencies leaving as they settle), and agree with the converged harmonic balan
 """
 import numpy as np
 import pytest
+from hbcases import jenkins, sdof, two_dof
 
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, march_curve, steady_curve
-from hbcases import jenkins, sdof, two_dof
 
 #: Agreement demanded by the issue between the converged HB and the reference.
 TI_RTOL = 5e-3
