@@ -114,6 +114,12 @@ class SectorHB:
         self.Fext = self.Fext.ravel()
         self.evaluations = 0
 
+    def set_f0(self, f0: float) -> None:
+        """Change the EO force amplitude (start homotopies) [N]."""
+        self.f0 = float(f0)
+        F = self.Fext.reshape(self.nb, N_DOF)
+        F[self.basis.index(1)[0], U_A] = self.f0
+
     # ------------------------------------------------------------ operators
     def _build_operators(self):
         s, b, nb, m = self.sector, self.basis, self.nb, self.m

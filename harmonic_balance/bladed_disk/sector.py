@@ -100,24 +100,31 @@ class Sector:
         S[7, 1] = S[8, 2] = np.exp(1j * psi)
         return S
 
-    def K_contact(self, psi: float) -> np.ndarray:
-        """Stuck contact stiffness (7, 7) complex Hermitian at phase psi [N/m]."""
+    def K_contact(self, psi: float, normal_only: bool = False) -> np.ndarray:
+        """Stuck contact stiffness (7, 7) complex Hermitian at phase psi [N/m]
+        (only the normal springs with ``normal_only``)."""
         QS = self.Q @ self.S(psi)
-        return QS.conj().T @ (self.k[:, None] * QS)
+        k = self.k.copy()
+        if normal_only:
+            k[1::2] = 0.0
+        return QS.conj().T @ (k[:, None] * QS)
 
     def matrices(self, psi: float, damper: str):
-        """(M, K, C) at phase psi for ``damper`` = 'free' (removed, blade DOFs only) or 'stuck'.
+        """(M, K, C) at phase psi for ``damper`` = 'free' (removed, blade DOFs only),
+        'stuck' (contacts stuck) or 'sliding' (mu = 0: normal springs only).
 
-        C = beta K_struct + beta_c K_contact (contact dashpots on stuck springs).
+        C = beta K_struct + beta_c K_contact (the contact dashpots act on both
+        directions in every state, so 'sliding' keeps the tangential ones).
         """
         Ks = self.K_struct(psi)
         if damper == "free":
             ix = np.ix_(BLADE, BLADE)
             return self.M[ix], Ks[ix], self.beta * Ks[ix]
-        if damper != "stuck":
-            raise ValueError(f"damper must be 'free' or 'stuck', got {damper!r}")
+        if damper not in ("stuck", "sliding"):
+            raise ValueError(f"damper must be 'free', 'stuck' or 'sliding', got {damper!r}")
         Kc = self.K_contact(psi)
-        return self.M, Ks + Kc, self.beta * Ks + self.beta_c * Kc
+        Kk = Kc if damper == "stuck" else self.K_contact(psi, normal_only=True)
+        return self.M, Ks + Kk, self.beta * Ks + self.beta_c * Kc
 
     def forcing(self, f0: float, damper: str = "stuck") -> np.ndarray:
         """Complex amplitude of the EO force on blade j (F0 on u_a), shape (7,) or (4,)."""

@@ -24,8 +24,10 @@ from .sector import N_DOF
 TOL_REL = 1e-10
 #: Bisection depth of a failed sweep step (2^-6 of a grid step).
 MAX_BISECT = 6
+#: Halvings of F0 at the start of the start-point homotopy.
+HOMOTOPY_LEVELS = 6
 #: Relative frequency tolerance of the peak search.
-PEAK_XTOL = 1e-7
+PEAK_XTOL = 1e-6
 
 
 class SolverError(RuntimeError):
@@ -57,6 +59,42 @@ def solve_point(hb: SectorHB, omega: float, x0: np.ndarray, max_iter: int = 40) 
     return newton(lambda z: hb(z, omega)[:2], x0, _tol(hb), max_iter).x
 
 
+def start_point(hb: SectorHB, omega: float) -> np.ndarray:
+    """First solution of a sweep: Newton from the stuck linear guess, else a homotopy.
+
+    The homotopy raises the EO force from F0 / 2^HOMOTOPY_LEVELS (nearly stuck, where
+    the stuck guess converges) to F0 in halving steps, bisected on failure.
+    """
+    try:
+        return solve_point(hb, omega, hb.stuck_guess(omega), max_iter=80)
+    except NewtonError:
+        pass
+    f0 = hb.f0
+    lam = [2.0 ** -k for k in range(HOMOTOPY_LEVELS, -1, -1)]
+    try:
+        hb.set_f0(f0 * lam[0])
+        x = solve_point(hb, omega, hb.stuck_guess(omega), max_iter=80)
+        done = lam[0]
+        for target in lam[1:]:
+            x, done = _ramp(hb, omega, x, f0, done, target), target
+    finally:
+        hb.set_f0(f0)
+    return solve_point(hb, omega, x)
+
+
+def _ramp(hb, omega, x, f0, a, b, depth=0):
+    """Solution at force scale b from the one at scale a (bisection on failure)."""
+    hb.set_f0(f0 * b)
+    try:
+        return solve_point(hb, omega, x * 1.0)
+    except NewtonError:
+        if depth >= MAX_BISECT:
+            raise
+    m = 0.5 * (a + b)
+    xm = _ramp(hb, omega, x, f0, a, m, depth + 1)
+    return _ramp(hb, omega, xm, f0, m, b, depth + 1)
+
+
 def _step(hb, w_a, x_a, dxdw, w_b, depth=0):
     """Solution at w_b from (w_a, x_a) with slope dxdw; bisects on failure."""
     try:
@@ -72,9 +110,8 @@ def _step(hb, w_a, x_a, dxdw, w_b, depth=0):
 def sweep(hb: SectorHB, omegas, x0: np.ndarray | None = None) -> list:
     """Solutions at every frequency of the grid (increasing or decreasing) [rad/s]."""
     omegas = np.asarray(omegas, dtype=float)
-    x = hb.stuck_guess(omegas[0]) if x0 is None else x0
     try:
-        x = solve_point(hb, omegas[0], x, max_iter=80)
+        x = start_point(hb, omegas[0]) if x0 is None else solve_point(hb, omegas[0], x0, 80)
     except NewtonError as err:
         raise SolverError(f"no solution at the start frequency {omegas[0] / 2 / np.pi:.6g} Hz "
                           f"({err}); start the band further from resonance") from None
