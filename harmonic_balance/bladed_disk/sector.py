@@ -165,9 +165,9 @@ def linear_response(sector: Sector, omegas, damper: str, f0: float | None = None
 def modal_response(sector: Sector, omegas, damper: str, f0: float | None = None) -> np.ndarray:
     """The same amplitudes by complex modal superposition of the first-order system.
 
-    State z = [u, i omega u]: A z' = B z with A = [[C, M], [M, 0]], B = -[[K, 0], [0, -M]];
-    eigenpairs (lambda_r, psi_r) and U = sum_r psi_r psi_r^T F / ((i omega - lambda_r) a_r),
-    a_r = psi_r^T A psi_r. Independent of :func:`linear_response` (no frequency solve).
+    State z = [u, u']: A z' = B z + [F, 0] with A = [[C, M], [M, 0]], B = [[-K, 0], [0, M]];
+    A^-1 B = V diag(lambda) V^-1 and z = V (i omega - lambda)^-1 V^-1 A^-1 [F, 0].
+    Independent of :func:`linear_response` (one eigendecomposition, no frequency solve).
     """
     f0 = sector.cfg.f0 if f0 is None else f0
     M, K, C = sector.matrices(sector.cfg.phi, damper)
@@ -175,17 +175,10 @@ def modal_response(sector: Sector, omegas, damper: str, f0: float | None = None)
     Z = np.zeros_like(M, dtype=complex)
     A = np.block([[C, M], [M, Z]])
     B = np.block([[-K, Z], [Z, M]])
-    lam, V = sla.eig(B, A)
+    lam, V = sla.eig(np.linalg.solve(A, B))
     F = np.concatenate([sector.forcing(f0, damper), np.zeros(n)])
-    # Left eigenvectors of the non-symmetric (complex Hermitian K, C) pencil.
-    lamL, W = sla.eig(B.conj().T, A.conj().T)
-    W = W[:, [int(np.argmin(abs(lamL.conj() - lr))) for lr in lam]]
-    a = np.einsum("ir,ij,jr->r", W.conj(), A, V)
-    out = []
-    for w in np.atleast_1d(omegas):
-        coef = (W.conj().T @ F) / ((1j * w - lam) * a)
-        out.append((V @ coef)[:n])
-    return np.array(out)
+    g = np.linalg.solve(V, np.linalg.solve(A, F))
+    return np.array([(V @ (g / (1j * w - lam)))[:n] for w in np.atleast_1d(omegas)])
 
 
 def peak_of(f_fun, lo: float, hi: float, n: int = 400) -> tuple[float, float]:
