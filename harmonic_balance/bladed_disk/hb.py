@@ -106,13 +106,19 @@ class SectorHB:
         self.static = prestress(sector, self.cf)
         self.nb, self.m = b.nb, 2 * sector.n_contacts
         self.size = self.nb * N_DOF
-        self.elements = [IwanElement.jenkins(c.kt, self.mu) for c in sector.points]
+        self._setup_contacts()
         self._build_operators()
         self.Fext = np.zeros((self.nb, N_DOF))
         self.Fext[b.index(1)[0], U_A] = self.f0
         self.Fext[b.index(0)[0], Y_D] = self.cf
         self.Fext = self.Fext.ravel()
         self.evaluations = 0
+
+    def _setup_contacts(self):
+        """Contact points, their C-core elements and static slips (one sector)."""
+        self.points = self.sector.points
+        self.elements = [IwanElement.jenkins(c.kt, self.mu) for c in self.points]
+        self.s_static = self.static["s"]
 
     def set_f0(self, f0: float) -> None:
         """Change the EO force amplitude (start homotopies) [N]."""
@@ -172,12 +178,12 @@ class SectorHB:
         out["W"] = np.empty(nc)
         Fh = np.empty((nb, m))
         dF = np.zeros((nb, m, nb, m)) if jac else None
-        for c, (pt, el) in enumerate(zip(self.sector.points, self.elements)):
+        for c, (pt, el) in enumerate(zip(self.points, self.elements)):
             p, s = wt[:, 2 * c], wt[:, 2 * c + 1]
             on = (p > 0.0).astype(float)
             N = pt.kn * p * on
             dN = (pt.kn * on)[:, None] * E
-            ft, dFs, dFp, Wc = el.periodic_jac(s - self.static["s"][c], E, N, dN)
+            ft, dFs, dFp, Wc = el.periodic_jac(s - self.s_static[c], E, N, dN)
             out["p"][:, c], out["s"][:, c], out["N"][:, c], out["f_t"][:, c] = p, s, N, ft
             out["W"][c] = Wc
             Fh[:, 2 * c], Fh[:, 2 * c + 1] = D @ N, D @ ft
@@ -232,7 +238,7 @@ class SectorHB:
         """Per contact point: mean and range of N [N], lift-off fraction of the period."""
         _, _, smp = self.contact_aft(self.L @ x, jac=False)
         N = smp["N"]
-        return {"names": [p.name for p in self.sector.points],
+        return {"names": [p.name for p in self.points],
                 "normal_load_mean": N.mean(axis=0).tolist(),
                 "normal_load_range": np.ptp(N, axis=0).tolist(),
                 "lift_off": (N <= 0.0).mean(axis=0).tolist(),
