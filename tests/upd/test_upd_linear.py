@@ -3,8 +3,15 @@ import numpy as np
 import pytest
 
 from harmonic_balance.bladed_disk.config import load_config
-from harmonic_balance.bladed_disk.sector import (U_A, Sector, linear_response, modal_response,
-                                                 modes_table, natural_frequencies, peak_of)
+from harmonic_balance.bladed_disk.sector import (
+    U_A,
+    Sector,
+    linear_response,
+    modal_response,
+    modes_table,
+    natural_frequencies,
+    peak_of,
+)
 
 #: Direct solve vs complex modal superposition; measured 2e-8 (free), 4e-7 (stuck).
 MODAL_RTOL = 1e-6
