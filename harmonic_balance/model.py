@@ -47,18 +47,21 @@ from pathlib import Path
 import numpy as np
 
 from .aft import FrictionLink
+from .forces import ForceElement
 from .fourier import FourierBasis
 from .linear import LinearModel
 
 
 @dataclass
 class Model:
-    """Linear structure + friction links + harmonic excitation.
+    """Linear structure + force elements + harmonic excitation.
 
     Parameters
     ----------
     linear : LinearModel
-    links : list of FrictionLink
+    links : list of ForceElement
+        Force elements (:mod:`.forces`): friction links, contacts, linear couplings
+        (the field keeps its historical name; :attr:`elements` is the same list).
     forcing : dict {h: (n,) complex}
         Complex excitation amplitude per harmonic, f = Re(F_h exp(i h omega t)) [N].
     response_dof : int
@@ -73,10 +76,12 @@ class Model:
     def __post_init__(self):
         n = self.linear.n
         for link in self.links:
+            if not isinstance(link, ForceElement):
+                raise TypeError(f"{type(link).__name__} is not a force element (harmonic_balance.forces)")
             for d in link.dofs:
                 if not 0 <= d < n:
                     raise ValueError(f"friction link {link.name!r} DOF {d} outside 0..{n - 1}")
-            if link.dof_b is not None and link.dof_b == link.dof_a:
+            if isinstance(link, FrictionLink) and link.dof_b is not None and link.dof_b == link.dof_a:
                 raise ValueError(f"friction link {link.name!r} joins DOF {link.dof_a} to itself")
         if not 0 <= self.response_dof < n:
             raise ValueError(f"response DOF {self.response_dof} outside 0..{n - 1}")
@@ -94,17 +99,37 @@ class Model:
     def n(self) -> int:
         return self.linear.n
 
+    @property
+    def elements(self) -> list:
+        """The force elements (the ``links`` list)."""
+        return self.links
+
     def stuck_stiffness(self) -> np.ndarray:
-        """Stiffness (n, n) [N/m] with every friction link stuck at its initial stiffness k0."""
+        """Stiffness (n, n) [N/m] with every element stuck (``ForceElement.stuck_stiffness``).
+
+        Non-cyclic elements only (a cyclic coupling has no single real matrix).
+        """
         K = np.array(self.linear.K, dtype=float, copy=True)
-        for link in self.links:
-            a, b = link.dof_a, link.dof_b
-            K[a, a] += link.k0
-            if b is not None:
-                K[b, b] += link.k0
-                K[a, b] -= link.k0
-                K[b, a] -= link.k0
+        for el in self.links:
+            if isinstance(el, FrictionLink):  # the historical assembly, bit for bit
+                a, b = el.dof_a, el.dof_b
+                K[a, a] += el.k0
+                if b is not None:
+                    K[b, b] += el.k0
+                    K[a, b] -= el.k0
+                    K[b, a] -= el.k0
+                continue
+            K += _on_dofs(el.kinematics, el.stuck_stiffness(), self.n)
         return K
+
+    def element_damping(self) -> np.ndarray:
+        """Viscous damping (n, n) [N s/m] of the elements' linear dashpots (``local_damping``)."""
+        C = np.zeros((self.n, self.n))
+        for el in self.links:
+            c = el.local_damping()
+            if c is not None:
+                C += _on_dofs(el.kinematics, c, self.n)
+        return C
 
     def forcing_coeffs(self, basis: FourierBasis) -> np.ndarray:
         """Excitation harmonics (n_b, n) in the basis ordering [N]."""
@@ -117,6 +142,16 @@ class Model:
             elif np.any(f.imag != 0):
                 raise ValueError("a static (h = 0) load must be real")
         return F
+
+
+def _on_dofs(kin, A_local: np.ndarray, n: int) -> np.ndarray:
+    """T A Q of a local matrix (m, m) on all n DOFs (non-cyclic kinematics)."""
+    if kin.cyclic:
+        raise ValueError("a cyclic element has no single (n, n) matrix: use the harmonic residual")
+    out = np.zeros((n, n))
+    idx = np.ix_(kin.dofs, kin.dofs)
+    out[idx] = kin.T @ A_local @ kin.Q
+    return out
 
 
 def jenkins_element(k: float, fs: float):

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from .aft import FrictionLink
 from .model import Model
 
 #: Fraction of the stability limit 2 / omega_max used as the largest step.
@@ -50,7 +51,13 @@ class SteadyState:
 
 
 def _link_stepper(link):
-    """One-sample force update of a link's element with its carried (virgin) state."""
+    """One-sample force update of an element with its carried (virgin) state.
+
+    A friction link returns a float (its historical path); any other force element
+    its ``stepper().force`` on local displacements (m,) -> local forces (m,).
+    """
+    if not isinstance(link, FrictionLink):
+        return link.stepper().force
     el = link.element
     state = el.initial_state()
 
@@ -86,7 +93,8 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     n, r = model.n, model.response_dof
     ns = _stable_steps(model, omega, steps_per_period)
     dt = 2.0 * np.pi / omega / ns
-    lhs = sla.lu_factor(lin.M / dt**2 + lin.C / (2 * dt))
+    C = lin.C + model.element_damping()  # contact dashpots are linear: implicit, with C
+    lhs = sla.lu_factor(lin.M / dt**2 + C / (2 * dt))
     forces = [_link_stepper(link) for link in model.links]
     th = 2.0 * np.pi * np.arange(ns) / ns
     fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
@@ -99,7 +107,7 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
         for j in range(ns):
             fnl = _friction(model, forces, x)
             rhs = (fext[j] - lin.K @ x - fnl + lin.M @ (2 * x - x_prev) / dt**2
-                   + lin.C @ x_prev / (2 * dt))
+                   + C @ x_prev / (2 * dt))
             x_prev, x = x, sla.lu_solve(lhs, rhs)
             hist[j] = x_prev[r]
         c = np.fft.rfft(hist)[:8] / ns
@@ -114,6 +122,10 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
 def _friction(model, forces, x):
     f = np.zeros(model.n)
     for link, force in zip(model.links, forces):
+        if not isinstance(link, FrictionLink):
+            kin = link.kinematics
+            f[list(kin.dofs)] += kin.T @ force(kin.Q @ x[list(kin.dofs)])
+            continue
         u = x[link.dof_a] - (0.0 if link.dof_b is None else x[link.dof_b])
         F = force(u)
         f[link.dof_a] += F
@@ -319,6 +331,8 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     """
     if model.linear.K is None:
         raise ValueError("time integration needs M, C, K matrices")
+    if not all(isinstance(el, FrictionLink) for el in model.links):
+        raise ValueError("march_curve handles friction links only; use march for other force elements")
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
         raise ValueError(f"omegas must be a non-empty 1-D array of positive numbers, got {omegas}")
