@@ -186,25 +186,78 @@ class ContactElement(ForceElement):
                     return np.array([N])
                 return np.array([el.step(state, q[0] - s0, kn * pen).F, N])
 
+            def dissipated(self) -> float:
+                """Cumulative friction energy [J] of the carried state."""
+                return 0.0 if state is None else state.W
+
         return _Contact()
 
 
-def frictionless_statics(model, tol: float = 1e-12, max_iter: int = 100):
+def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
     """Static solution with mu = 0 and the slip at each contact (prestress, tmdsimpy's convention).
 
-    Solves ``K x + sum_c T_c [0, N_c(x)] = f_0`` (f_0 the model's harmonic-0 load,
-    N_c from (C1), other force elements at their stuck stiffness) by an active-set
-    Newton iteration on the piecewise-linear normal law.
+    Solves ``K x + sum_c T_c [0, N_c(x)] + sum_l T_l K_l Q_l x = f_0`` (f_0 the model's
+    harmonic-0 load; N_c from (C1); friction carries no force, mu = 0; linear elements
+    with their K) by an active-set iteration on the piecewise-linear normal law: solve
+    with the contacts in the active set, update the set from the penetrations, until it
+    repeats. Cyclic kinematics enter with their h = 0 map ``Q + Q_next`` (the
+    neighbour's static state is the sector's).
 
     Parameters
     ----------
-    model : Model  (matrix model, non-cyclic contacts)
-    tol : float    relative change of x that ends the iteration
+    model : Model  (matrix model; force elements: ContactElement, LinearElement, FrictionLink)
+    apply : bool   set each contact's ``slip_ref`` to its static slip
     max_iter : int
 
     Returns
     -------
-    x : (n,) array                 static displacements [m]
-    slip : dict {index: float}     s_0 of each ContactElement with friction (model order)
+    x : (n,) array               static displacements [m]
+    slip : dict {index: float}   s_0 of each ContactElement with friction (index in model.elements)
     """
-    raise NotImplementedError("frictionless_statics: implemented in the next commit")
+    from .aft import FrictionLink
+    from .forces import LinearElement
+
+    K0 = model.linear.K
+    if K0 is None:
+        raise ValueError("frictionless statics needs the stiffness matrix K")
+    n = model.n
+    f0 = np.real(model.forcing.get(0, np.zeros(n))).astype(float)
+    Klin, rows = np.array(K0, dtype=float), []
+    for i, el in enumerate(model.elements):
+        kin = el.kinematics
+        Q = kin.Q if not kin.cyclic else kin.Q + kin.Q_next
+        T = kin.T if not kin.cyclic else kin.T + kin.T_next
+        idx = np.ix_(kin.dofs, kin.dofs)
+        if isinstance(el, ContactElement):
+            qn, tn = np.zeros(n), np.zeros(n)
+            qn[list(kin.dofs)], tn[list(kin.dofs)] = Q[-1], T[:, -1]
+            rows.append((i, el, Q, qn, tn))
+        elif isinstance(el, LinearElement):
+            Klin[idx] += T @ el.K @ Q
+        elif not isinstance(el, FrictionLink):
+            raise TypeError(f"frictionless statics does not know {type(el).__name__}")
+    active = np.ones(len(rows), dtype=bool)
+    for _ in range(max_iter):
+        A, b = Klin.copy(), f0.copy()
+        for on, (_, el, _, qn, tn) in zip(active, rows):
+            if on:  # N = k_n (p0 + qn . x): stiffness tn k_n qn^T, load -tn k_n p0
+                A += el.k_n * np.outer(tn, qn)
+                b -= el.k_n * el.preload * tn
+        try:
+            x = np.linalg.solve(A, b)
+        except np.linalg.LinAlgError:
+            raise ValueError("frictionless statics is singular: a body is held by friction only "
+                             "or floats (no contact in compression holds it)") from None
+        new = np.array([el.preload + qn @ x > 0.0 for _, el, _, qn, _ in rows], dtype=bool)
+        if np.array_equal(new, active):
+            break
+        active = new
+    else:
+        raise ValueError(f"frictionless statics: contact set still changing after {max_iter} iterations")
+    slip = {}
+    for i, el, Q, _, _ in rows:
+        if el.m == 2:
+            slip[i] = float(Q[0] @ x[list(el.kinematics.dofs)])
+            if apply:
+                el.slip_ref = slip[i]
+    return x, slip

@@ -48,6 +48,9 @@ class SteadyState:
     steps_per_period: int
     converged: bool
     x_last: np.ndarray    # (steps_per_period,) response over the last period
+    #: energy [J] dissipated by each force element's hysteresis over the last period
+    #: (C-element state; the elements' linear dashpots are part of C, not included)
+    W_elements: tuple | None = None
 
 
 def _link_stepper(link):
@@ -57,14 +60,17 @@ def _link_stepper(link):
     its ``stepper().force`` on local displacements (m,) -> local forces (m,).
     """
     if not isinstance(link, FrictionLink):
-        return link.stepper().force
+        st = link.stepper()
+        force = st.force
+        force_dissipated = getattr(st, "dissipated", lambda: 0.0)
+        return force, force_dissipated
     el = link.element
     state = el.initial_state()
 
     def force(u: float) -> float:
         return el.step(state, u).F
 
-    return force
+    return force, lambda: state.W
 
 
 def _stable_steps(model: Model, omega: float, steps: int) -> int:
@@ -95,7 +101,7 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     dt = 2.0 * np.pi / omega / ns
     C = lin.C + model.element_damping()  # contact dashpots are linear: implicit, with C
     lhs = sla.lu_factor(lin.M / dt**2 + C / (2 * dt))
-    forces = [_link_stepper(link) for link in model.links]
+    forces, dissipated = zip(*[_link_stepper(link) for link in model.links]) if model.links else ((), ())
     th = 2.0 * np.pi * np.arange(ns) / ns
     fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})
@@ -104,6 +110,7 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     x_prev = x - dt * v  # first-order start; the transient forgets it
     hist, prev, deltas = np.empty(ns), None, []
     for p in range(1, max_periods + 1):
+        w0 = [d() for d in dissipated]
         for j in range(ns):
             fnl = _friction(model, forces, x)
             rhs = (fext[j] - lin.K @ x - fnl + lin.M @ (2 * x - x_prev) / dt**2
@@ -114,9 +121,14 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
         if prev is not None:
             deltas.append(np.linalg.norm(c - prev) / max(np.linalg.norm(c), 1e-300))
             if _settled(deltas, tol):
-                return _result(omega, hist, p, ns, True)
+                return _result(omega, hist, p, ns, True, _worked(dissipated, w0))
         prev = c
-    return _result(omega, hist, max_periods, ns, False)
+    return _result(omega, hist, max_periods, ns, False, _worked(dissipated, w0))
+
+
+def _worked(dissipated, w0) -> tuple:
+    """Energy dissipated per element since w0 (the start of the last period) [J]."""
+    return tuple(d() - w for d, w in zip(dissipated, w0))
 
 
 def _friction(model, forces, x):
@@ -145,7 +157,7 @@ def _settled(deltas, tol) -> bool:
     return d2 * max(1.0, rho / (1.0 - rho)) < tol
 
 
-def _result(omega, hist, p, ns, ok):
+def _result(omega, hist, p, ns, ok, W=None):
     # Sample at the step ending each period: hist[j] = x at t = j dt (start of step j+1).
     c = np.fft.rfft(hist) / ns
     h1 = 2.0 * abs(c[1])
@@ -154,7 +166,7 @@ def _result(omega, hist, p, ns, ok):
     den = y0 - 2 * y1 + y2
     # Parabola through the three samples around the extreme: peak between samples.
     peak = y1 - 0.125 * (y2 - y0) ** 2 / den if den < 0 else y1
-    return SteadyState(omega, float(peak), float(h1), p, ns, ok, hist.copy())
+    return SteadyState(omega, float(peak), float(h1), p, ns, ok, hist.copy(), W)
 
 
 def steady_amplitude(model: Model, omega: float, steps_per_period: int = 512, **kw):
