@@ -20,6 +20,9 @@ FD_RTOL_U = 3e-9
 FD_RTOL_W = 1.4e-8
 #: Residual Jacobians (products with Q, T, receptances): measured at most 1.3e-9.
 FD_RTOL_RES = 2e-9
+#: Sector against ring HB solutions (both Newton-converged to |R| < 1e-12, quadratic
+#: convergence leaves round-off): measured 1.5e-15 of the largest coefficient.
+SECTOR_RING_RTOL = 1e-14
 #: Round-off of sums over n_t samples (closed forms, invariances): measured <= 6.2e-15.
 ROUND = 1e-14
 
@@ -228,3 +231,54 @@ def test_frictionless_statics_of_a_wedge_in_closed_form():
         p = el.kinematics.Q[-1] @ x
         assert abs(kn * p - CF / (2 * np.cos(g))) < ROUND * CF
     assert slip[0] == els[0].slip_ref and abs(slip[0] + slip[1]) < ROUND * abs(slip[0])
+
+
+def ring_and_sector(n_r=4, eo=1, F0=0.24):
+    """Blades (x, y) on springs, a pressed Jenkins contact between neighbours, EO forcing.
+
+    The ring has n_r blades joined periodically; the sector is one blade with the
+    contact on its neighbour through the cyclic phase phi = 2 pi EO / n_r.
+    """
+    phi = 2 * np.pi * eo / n_r
+    n, t = [0.6, 0.8], [0.8, -0.6]
+    law = dict(k_n=5.0, preload=0.05, beta_c=0.01)
+    M, K, C = np.eye(2), np.diag([1.0, 2.0]), 0.02 * np.eye(2)
+
+    sector = Model(LinearModel(M=M, C=C, K=K),
+                   [ContactElement(Kinematics.contact([0, 1], n, t, np.eye(2), delta_next=-np.eye(2),
+                                                      phase=phi), friction=IwanElement.jenkins(3.0, 0.3),
+                                   **law)], {1: np.array([F0, 0.0])})
+    els = []
+    for j in range(n_r):
+        k = (j + 1) % n_r
+        kin = Kinematics.contact([2 * j, 2 * j + 1, 2 * k, 2 * k + 1], n, t,
+                                 np.hstack([np.eye(2), -np.eye(2)]))
+        els.append(ContactElement(kin, friction=IwanElement.jenkins(3.0, 0.3), **law))
+    f = np.zeros(2 * n_r, complex)
+    f[0::2] = F0 * np.exp(1j * phi * np.arange(n_r))
+    ring = Model(LinearModel(M=np.kron(np.eye(n_r), M), C=np.kron(np.eye(n_r), C),
+                             K=np.kron(np.eye(n_r), K)), els, {1: f})
+    return sector, ring, phi
+
+
+def test_cyclic_sector_equals_the_ring():
+    """HB of the sector with the cyclic contact = HB of the whole ring (travelling wave)."""
+    from harmonic_balance.newton import newton
+
+    b, w = FourierBasis("all:5"), 1.05
+    x = [None, None]
+    for F0 in np.linspace(0.03, 0.24, 8):  # homotopy in the forcing level
+        sector, ring, phi = ring_and_sector(F0=F0)
+        for i, model in enumerate((sector, ring)):
+            res = FullResidual(model, b)
+            x0 = res.linear_guess(w) if x[i] is None else x[i]
+            x[i] = newton(lambda z, r=res: r(z, w)[:2], x0, 1e-12).x
+    Xs, Xr = x[0].reshape(b.nb, 2), x[1].reshape(b.nb, 8)
+    res = FullResidual(sector, b)
+    loop = res.evaluate(Xs.ravel(), w)[0]
+    assert np.any(np.abs(loop.f[:, 0]) >= 0.3 * loop.f[:, 1] * (1 - 1e-12))  # it slips
+    P = phase_operator(b, phi)
+    scale = np.abs(Xs).max()
+    for j in range(4):  # blade j = sector advanced by j phi
+        Pj = np.linalg.matrix_power(P, j)
+        assert np.abs(Xr[:, 2 * j:2 * j + 2] - Pj @ Xs).max() < SECTOR_RING_RTOL * scale
