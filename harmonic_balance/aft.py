@@ -84,7 +84,7 @@ class FrictionLink(ForceElement):
         """:func:`aft_link` on U (n_b, 1); the Jacobian is always computed (one C call)."""
         U = np.asarray(U, dtype=float).reshape(basis.nb)
         Fh, dFh, W, F = aft_link(self, U, basis)
-        return LocalForce(Fh[:, None], dFh if jac else None, None, W,
+        return LocalForce(Fh[:, None], dFh if jac else None, None, W, 0.0,
                           (basis.E @ U)[:, None], F[:, None])
 
     def stuck_stiffness(self) -> np.ndarray:

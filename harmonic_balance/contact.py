@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .forces import ForceElement, LocalForce, _damping_terms
+from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
 
@@ -49,21 +49,6 @@ from .kinematics import Kinematics
 CLOSURE_TOL = 1e-10
 #: Default largest number of periods marched until the loop closes.
 MAX_PERIODS = 400
-
-
-def viscous_work(C: np.ndarray, U: np.ndarray, basis: FourierBasis, omega: float) -> float:
-    """Energy [J] dissipated per cycle by dashpots C (m, m) on local harmonics U (n_b, m).
-
-    For q = a cos(h theta) + b sin(h theta): ``pi h^2 omega (a.C a + b.C b)``.
-    """
-    w = 0.0
-    for h in basis.harmonics:
-        if h == 0:
-            continue
-        ic, isn = basis.index(h)
-        a, b = U[ic], U[isn]
-        w += np.pi * h**2 * omega * (a @ C @ a + b @ C @ b)
-    return float(w)
 
 
 class ContactElement(ForceElement):
@@ -140,17 +125,17 @@ class ContactElement(ForceElement):
         """AFT of (C1)-(C3) on local harmonics U (n_b, m); exact Jacobian."""
         nb, m, E, D = basis.nb, self.m, basis.E, basis.D
         U = np.asarray(U, dtype=float).reshape(nb, m)
-        p = self.preload + E @ U[:, -1]
+        pl = E @ U[:, -1]
+        p = self.preload + pl
         on = p > 0.0
-        N = self.k_n * np.where(on, p, 0.0)
-        f = np.zeros((basis.n_t, m))
-        f[:, -1] = N
-        J = np.zeros((nb, m, nb, m)) if jac else None
-        if jac:
-            J[:, -1, :, -1] = D @ (self.k_n * on[:, None] * E)
-        W = 0.0
         q = np.empty((basis.n_t, m))
-        q[:, -1] = p - self.preload
+        f = np.empty((basis.n_t, m))
+        q[:, -1] = pl
+        f[:, -1] = self.k_n * np.where(on, p, 0.0)
+        dF = np.zeros((nb * m, nb * m)) if jac else None
+        if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
+            dF[m - 1::m, m - 1::m] = (D * (self.k_n * on)) @ E
+        W = 0.0
         if m == 2:
             s = E @ U[:, 0]
             q[:, 0] = s
@@ -159,19 +144,26 @@ class ContactElement(ForceElement):
                 max_periods=self.max_periods, tol=self.tol)
             f[:, 0] = Ft
             if jac:
-                J[:, 0, :, 0] = D @ dFs
-                J[:, 0, :, 1] = D @ dFp
+                dF[0::2, 0::2] = D @ dFs
+                dF[0::2, 1::2] = D @ dFp
         F = D @ f
-        dF = J.reshape(nb * m, nb * m) if jac else None
-        dw = None
+        dw, Wv = None, 0.0
         C = self.local_damping()
         if C is not None:
-            Fc, dFc, dw = _damping_terms(C, U, basis, omega)
-            F = F + Fc.reshape(nb, m)
+            op = self._damping_operator(basis)
+            dw = op @ U.ravel()
+            F += omega * dw.reshape(nb, m)
             if jac:
-                dF = dF + dFc
-            W += viscous_work(C, U, basis, omega)
-        return LocalForce(F, dF, dw, float(W), q, f)
+                dF += omega * op
+            Wv = viscous_work(C, U, basis, omega)
+        return LocalForce(F, dF, dw, float(W) + Wv, Wv, q, f)
+
+    def _damping_operator(self, basis: FourierBasis) -> np.ndarray:
+        """D_theta (x) C_local (n_b m, n_b m), cached per basis."""
+        key = (basis.harmonics, self.beta_c, self.k_t, self.k_n)
+        if getattr(self, "_dop", (None,))[0] != key:
+            self._dop = (key, np.kron(basis.dtheta, self.local_damping()))
+        return self._dop[1]
 
     def stepper(self):
         """Time-domain law: one C-element step per call at N = k_n (p_0 + p)."""

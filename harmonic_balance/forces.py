@@ -42,6 +42,7 @@ class LocalForce:
     dF_domega : (n_b m,) array or None
         d F / d omega at fixed U [N s] (None: rate-independent, zero)
     W : float                   energy dissipated per cycle by the element [J]
+    W_viscous : float           the part of W done by the element's linear dashpots [J]
     q : (n_t, m) array or None  local displacements over the period (AFT samples) [m]
     f : (n_t, m) array or None  local forces over the period [N]
     """
@@ -50,6 +51,7 @@ class LocalForce:
     dF: np.ndarray | None
     dF_domega: np.ndarray | None = None
     W: float = 0.0
+    W_viscous: float = 0.0
     q: np.ndarray | None = None
     f: np.ndarray | None = None
 
@@ -105,6 +107,34 @@ class ForceElement:
         raise NotImplementedError(f"{type(self).__name__} has no time-domain law")
 
 
+def viscous_work(C: np.ndarray, U: np.ndarray, basis: FourierBasis, omega: float) -> float:
+    """Energy [J] dissipated per cycle by dashpots C (m, m) on local harmonics U (n_b, m).
+
+    For q = a cos(h theta) + b sin(h theta): ``pi h^2 omega (a.C a + b.C b)``; summed
+    over the coefficient rows (the mean, h = 0, does no work).
+    """
+    quad = np.einsum("ij,jk,ik->i", U, C, U)
+    return float(np.pi * omega * (basis.order.astype(float) ** 2) @ quad)
+
+
+def harmonic_work(U: np.ndarray, F: np.ndarray, basis: FourierBasis) -> float:
+    """Work per cycle [J] of local forces F on local displacements U (both (n_b, m) harmonics).
+
+    ``oint f . dq = pi sum_h h (F_a . b - F_b . a)`` for q = a cos + b sin, f = F_a cos +
+    F_b sin (harmonic h). At an HB solution the excitation's work equals the linear
+    damping's plus every element's harmonic work (to the residual), which makes it the
+    consistent dissipation for energy balances; ``LocalForce.W`` is the work of the
+    sampled loop (differs by the AFT sampling).
+    """
+    w = 0.0
+    for h in basis.harmonics:
+        if h == 0:
+            continue
+        ic, isn = basis.index(h)
+        w += np.pi * h * (F[ic] @ U[isn] - F[isn] @ U[ic])
+    return float(w)
+
+
 def _damping_terms(C: np.ndarray, U: np.ndarray, basis: FourierBasis, omega: float):
     """Viscous force harmonics omega (D_theta (x) C) U, its Jacobian and d/domega."""
     op = np.kron(basis.dtheta, C)
@@ -138,13 +168,14 @@ class LinearElement(ForceElement):
         U = np.asarray(U, dtype=float).reshape(basis.nb, self.m)
         F = U @ self.K.T
         dF = np.kron(np.eye(basis.nb), self.K) if jac else None
-        dw = None
+        dw, W = None, 0.0
         if self.C is not None:
             Fc, dFc, dw = _damping_terms(self.C, U, basis, omega)
             F = F + Fc.reshape(basis.nb, self.m)
             if jac:
                 dF = dF + dFc
-        return LocalForce(F, dF, dw, 0.0)
+            W = viscous_work(self.C, U, basis, omega)
+        return LocalForce(F, dF, dw, W, W)
 
     def stuck_stiffness(self) -> np.ndarray:
         return self.K
