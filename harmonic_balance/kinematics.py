@@ -142,7 +142,8 @@ class Kinematics:
             Unit normal n of the contact in a k-dimensional frame (k = 2 or 3), pointing
             from body 2 into body 1 (the direction of the normal force on body 1).
         tangents : array_like, shape (n_t, k) or (k,)
-            Unit tangent(s), orthogonal to n; the slip ``s_i = t_i . Delta``.
+            Unit tangent(s), orthogonal to n; the slip ``s_i = t_i . Delta``; shape
+            (0, k) for a normal-only contact.
         delta : array_like, shape (k, d)
             Relative displacement ``Delta = x_point,1 - x_point,2`` of the contact point
             from the sector's DOFs (body 1 minus body 2).
@@ -162,7 +163,8 @@ class Kinematics:
         t = np.atleast_2d(np.asarray(tangents, dtype=float))
         if t.shape[1] != n.size or abs(np.linalg.norm(n) - 1.0) > 1e-12:
             raise ValueError("normal must be a unit vector and tangents (n_t, k) with its k")
-        if np.abs(t @ n).max() > 1e-12 or np.abs(np.linalg.norm(t, axis=1) - 1.0).max() > 1e-12:
+        if t.size and (np.abs(t @ n).max() > 1e-12
+                       or np.abs(np.linalg.norm(t, axis=1) - 1.0).max() > 1e-12):
             raise ValueError("tangents must be unit vectors orthogonal to the normal")
         L = np.vstack([t, -n])  # (m, k): local coordinates of Delta
         d = len(np.atleast_1d(dofs))

@@ -35,6 +35,19 @@ File formats
     fs = [1.0, 2.0]
     k_res = 0.0
 
+    [[element]]
+    type = "contact"         # penalty normal with lift-off + friction following N
+    dofs = [0, 1]            # DOFs of the contact point's relative displacement Delta
+    normal = [0.0, 1.0]      # unit normal n from body 2 into body 1 (k = 2 or 3 entries)
+    tangent = [1.0, 0.0]     # unit tangent (omit it, and the friction, for normal only)
+    delta = [[1, 0], [0, 1]] # (k, len(dofs)): Delta = delta @ x[dofs]; default identity
+    k_n = 1.0e8              # normal penalty stiffness [N/m]
+    k_t = 8.0e7              # Jenkins friction k_t [N/m] and mu, or instead
+    mu = 0.5                 #   curve = "curves/flat.json" (Iwan, scaled by N / N_ref)
+    preload = 0.0            # static penetration at x = 0 [m]
+    slip_ref = 0.0           # prestress slip where the sliders are virgin [m]
+    beta_c = 0.0             # contact dashpots beta_c k_n, beta_c k_t [s]
+
 DOFs are 0-based. Symbols as in :mod:`harmonic_balance.fourier` and
 :mod:`harmonic_balance.linear`.
 """
@@ -198,8 +211,8 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
     return lin, forcing, resp
 
 
-def load_elements(path) -> list[FrictionLink]:
-    """Read an ``elements.toml`` file into friction links (format in the module docstring)."""
+def load_elements(path) -> list[ForceElement]:
+    """Read an ``elements.toml`` file into force elements (format in the module docstring)."""
     path = Path(path)
     try:
         spec = tomllib.loads(path.read_text())
@@ -211,10 +224,12 @@ def load_elements(path) -> list[FrictionLink]:
     return [_element_link(t, i, path.parent) for i, t in enumerate(tables)]
 
 
-def _element_link(t: dict, i: int, base: Path) -> FrictionLink:
-    """One [[element]] table -> FrictionLink."""
+def _element_link(t: dict, i: int, base: Path) -> ForceElement:
+    """One [[element]] table -> FrictionLink (or ContactElement)."""
     from fmu_src.element import IwanElement
 
+    if t.get("type") == "contact":
+        return _contact_element(t, i, base)
     dofs = t.get("dofs")
     if not isinstance(dofs, list) or len(dofs) not in (1, 2):
         raise ValueError(f"element {i}: 'dofs' must be [a] or [a, b]")
@@ -236,6 +251,40 @@ def _element_link(t: dict, i: int, base: Path) -> FrictionLink:
         raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")
     b = int(dofs[1]) if len(dofs) == 2 else None
     return FrictionLink(el, int(dofs[0]), b, name)
+
+
+_CONTACT_KEYS = {"type", "name", "dofs", "normal", "tangent", "delta", "k_n", "k_t", "mu", "curve",
+                 "fit", "scale", "preload", "slip_ref", "beta_c"}
+
+
+def _contact_element(t: dict, i: int, base: Path):
+    """One [[element]] table of type "contact" -> ContactElement (format in the module docstring)."""
+    from .contact import ContactElement
+    from .kinematics import Kinematics
+
+    unknown = set(t) - _CONTACT_KEYS
+    if unknown:
+        raise ValueError(f"element {i}: unknown contact keys {sorted(unknown)}")
+    try:
+        dofs = [int(d) for d in t["dofs"]]
+        normal = np.asarray(t["normal"], dtype=float)
+        delta = np.asarray(t["delta"], dtype=float) if "delta" in t else np.eye(normal.size, len(dofs))
+        tangent = np.asarray(t["tangent"], dtype=float) if "tangent" in t else np.zeros((0, normal.size))
+        kin = Kinematics.contact(dofs, normal, tangent, delta)
+        kw = {k: float(t.get(k, 0.0)) for k in ("preload", "slip_ref", "beta_c")}
+        kw["name"] = t.get("name", f"element{i}")
+        if "tangent" not in t:
+            return ContactElement(kin, float(t["k_n"]), **kw)
+        if "curve" in t:  # the curve element exactly as a "curve" friction link reads it
+            spec = {k: t[k] for k in ("fit", "scale") if k in t}
+            el = _element_link({"dofs": [0], "type": "curve", "path": t["curve"], **spec}, i, base)
+            return ContactElement(kin, float(t["k_n"]), el.element, **kw)
+        return ContactElement.jenkins(kin, float(t["k_n"]), float(t["k_t"]), float(t["mu"]), **kw)
+    except KeyError as err:
+        raise ValueError(f"element {i}: contact needs key {err.args[0]!r}") from None
+    except (TypeError, ValueError) as err:
+        msg = str(err)
+        raise ValueError(msg if msg.startswith(f"element {i}:") else f"element {i}: {msg}") from None
 
 
 def load_model(matrices, elements) -> Model:
