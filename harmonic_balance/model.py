@@ -135,6 +135,30 @@ class Model:
             K += _on_dofs(el.kinematics, el.stuck_stiffness(), self.n)
         return K
 
+    def harmonic_stiffness(self, h: int, stuck: bool = True) -> np.ndarray:
+        """Complex stiffness (n, n) [N/m] acting on harmonic h, cyclic couplings included.
+
+        ``K + sum_e T_h k_e Q_h`` with ``Q_h = Q + exp(i h phi) Q_next`` and
+        ``T_h = T + exp(-i h phi) T_next`` (:mod:`.kinematics`), k_e the element's
+        ``stuck_stiffness`` (``stuck=False``: linear elements only, the contacts and
+        friction links removed). Hermitian for conservative kinematics; its
+        eigenvalues with M give the stuck / free natural frequencies of the nodal
+        diameter whose phase is h phi.
+        """
+        from .forces import LinearElement
+
+        K = np.array(self.linear.K, dtype=complex, copy=True)
+        for el in self.links:
+            if not stuck and not isinstance(el, LinearElement):
+                continue
+            kin = el.kinematics
+            Q, T = kin.Q.astype(complex), kin.T.astype(complex)
+            if kin.cyclic:
+                Q = Q + np.exp(1j * h * kin.phase) * kin.Q_next
+                T = T + np.exp(-1j * h * kin.phase) * kin.T_next
+            K[np.ix_(kin.dofs, kin.dofs)] += T @ el.stuck_stiffness() @ Q
+        return K
+
     def element_damping(self) -> np.ndarray:
         """Viscous damping (n, n) [N s/m] of the elements' linear dashpots (``local_damping``)."""
         C = np.zeros((self.n, self.n))

@@ -88,6 +88,24 @@ def test_phase_operator_advances_the_time_history():
     assert np.abs(P.T @ P - np.eye(b.nb)).max() < ROUND
 
 
+def test_harmonic_stiffness_of_the_sector_matches_the_residual_jacobian():
+    """Model.harmonic_stiffness(h) is the stuck HB operator's harmonic-h block (complex form).
+
+    Entries up to 18 N/m: measured 3.6e-15 absolute, bound 1e-13.
+    """
+    model, b = cyclic_sector("all:3")
+    res = FullResidual(model, b)
+    Kst = res.stuck_operator() + np.kron(np.eye(b.nb), model.linear.K)
+    n = model.n
+    for h in (1, 2, 3):
+        ic, isn = b.index(h)
+        Kh = model.harmonic_stiffness(h)
+        # real block [[Re, Im], [-Im, Re]] on (a, b) for U = a - i b (kinematics.py)
+        assert np.abs(Kst[ic * n:(ic + 1) * n, ic * n:(ic + 1) * n] - Kh.real).max() < ROUND * 10
+        assert np.abs(Kst[ic * n:(ic + 1) * n, isn * n:(isn + 1) * n] - Kh.imag).max() < ROUND * 10
+        assert np.abs(Kh - Kh.conj().T).max() < ROUND * 10
+
+
 def test_cyclic_spring_gives_the_harmonic_coupling_stiffness():
     """k_c (u_j - u_(j+1)) with u_(j+1) = exp(i h phi) u_j adds 2 k_c (1 - cos h phi) per harmonic."""
     kc, phi = 3.0, 2 * np.pi * 5 / 24
