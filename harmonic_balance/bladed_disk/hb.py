@@ -1,23 +1,22 @@
 """Nonlinear harmonic balance of one UPD sector under cyclic symmetry.
 
-Unknowns: harmonics X (n_b, 7) of the sector DOFs (ordering of :mod:`..fourier`),
-harmonics 0..H. Residual (symbols in :mod:`config`, :mod:`sector`)::
+The sector is a standard :class:`~harmonic_balance.model.Model` solved by the package's
+:class:`~harmonic_balance.residual.FullResidual` (harmonics 0..H):
 
-    R = (A0 - omega^2 A2 + omega A1) x + L^T F_c(L x) - F_ext
+* linear part: M, K_struct(0) (blade with the hub spring k_g), C = beta K_struct(0);
+* the rim coupling: a cyclic :class:`~harmonic_balance.forces.LinearElement`
+  (q = u_r - u_r of blade j+1, stiffness k_c, dashpot beta k_c), which adds
+  k_g + 2 k_c (1 - cos h phi) per harmonic, so the structure is K_struct(h phi)
+  with damping beta K_struct(h phi);
+* one :class:`~harmonic_balance.contact.ContactElement` per contact point (penalty
+  normal spring with lift-off, the C core's Jenkins element with slip force mu N,
+  dashpots beta_c k_n, beta_c k_t), its kinematics from :class:`~.sector.Sector`
+  (the flat's points with ``Q_next`` on blade j+1's platform and phase phi);
+* forcing: F0 on the harmonic-1 cosine of u_a, CF on the mean of y_d.
 
-* A0 = blockdiag_h K_struct(h phi), A2 = blockdiag_h h^2 M,
-  A1 = beta K_struct(h phi) on d/dtheta + L^T (d/dtheta (x) beta_c diag(k)) L
-  (structural damping and the contact dashpots, linear, always active);
-* ``L`` maps x to the harmonics W (n_b, 2 n_c) of every contact point's penetration p
-  and slip s: W = Q [X, X_platform of blade j+1], with blade j+1's cos/sin pair of
-  harmonic h the rotation of blade j's by h phi (u_(j+1)(theta) = u_j(theta + phi));
-  L^T brings the neighbour's force back (rotation by -h phi);
-* F_c: AFT per contact point, N = k_n max(p, 0), friction f_t from the C core's
-  Jenkins element (slip force mu N, ``IwanElement.periodic_jac`` with the varying N and
-  its exact derivatives, dF/dN included); the tangential input is s - s_static, so
-  the sliders start at the frictionless prestress state (z = s_static) and a loop
-  that never slips is the line k_t (s - s_static) (the C core's periodic convention);
-* F_ext: F0 on the cos coefficient of harmonic 1 of u_a, CF on the mean of y_d.
+The sliders start at the frictionless (mu = 0) prestress state
+(:func:`~harmonic_balance.contact.frictionless_statics`, which sets each contact's
+``slip_ref``): a loop that never slips is k_t (s - s_static).
 
 Time samples: n_t is a multiple of N_r = N_b / gcd(N_b, EO), so phi is a whole number
 of samples and the neighbour's sampled history equals blade j's shifted exactly.
@@ -26,10 +25,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from fmu_src.element import IwanElement
-
+from ..contact import ContactElement, frictionless_statics
+from ..forces import LinearElement
 from ..fourier import FourierBasis, default_samples
-from .sector import N_DOF, U_A, Y_D, Sector
+from ..kinematics import Kinematics, phase_operator
+from ..linear import LinearModel
+from ..model import Model
+from ..residual import FullResidual
+from .sector import N_DOF, PLATFORM, U_A, Y_D, Sector
 
 
 def sector_basis(sector: Sector, H: int, n_t: int = 0) -> FourierBasis:
@@ -41,47 +44,58 @@ def sector_basis(sector: Sector, H: int, n_t: int = 0) -> FourierBasis:
     return FourierBasis(tuple(range(H + 1)), n_t)
 
 
-def prestress(sector: Sector, cf: float) -> dict:
-    """Frictionless (mu = 0) static state under CF with every contact closed.
-
-    Solves (K_struct(0) + Q0^T diag(k_n) Q0) q = CF e_yd, Q0 the penetration rows at
-    phase 0 (the mean is in phase on all blades). Determinate: the damper has three
-    equilibrium equations for three normal loads.
-
-    Returns
-    -------
-    dict: q (7,) static displacements [m], N (n_c,) normal loads [N], p, s (n_c,)
-    penetrations and slips [m].
-    """
-    Q0 = (sector.Q @ sector.S(0.0)).real
-    Qp, Qs = Q0[0::2], Q0[1::2]
-    kn = sector.k[0::2]
-    K = sector.K_struct(0.0) + Qp.T @ (kn[:, None] * Qp)
-    f = np.zeros(N_DOF)
-    f[Y_D] = cf
-    q = np.linalg.solve(K, f)
-    p, s = Qp @ q, Qs @ q
-    if cf > 0 and np.any(p <= 0):
-        raise ValueError("the frictionless prestress opens a contact: check the geometry "
-                         "(normals must press the damper against both platforms)")
-    return {"q": q, "N": kn * np.maximum(p, 0.0), "p": p, "s": s}
-
-
 def neighbour_map(basis: FourierBasis, psi: float) -> np.ndarray:
     """Coefficients (n_b, n_b) of u(theta + psi) from those of u(theta)."""
-    P = np.zeros((basis.nb, basis.nb))
-    for h in basis.harmonics:
-        ic, isn = basis.index(h)
-        if isn is None:
-            P[ic, ic] = 1.0
-            continue
-        c, s = np.cos(h * psi), np.sin(h * psi)
-        P[ic, ic], P[ic, isn], P[isn, ic], P[isn, isn] = c, s, -s, c
-    return P
+    return phase_operator(basis, psi)
+
+
+def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: int | None = None):
+    """ContactElements of one damper (cylinder line + the flat's two end points).
+
+    Their kinematics are the sector's rows of slip and penetration (``Sector.Q``, the
+    only copy of the contact geometry), local order [s, p].
+
+    Parameters
+    ----------
+    sector : Sector
+    mu : float
+    offset : int
+        First DOF of the sector (blade j) in the model (7 j in a ring).
+    next_offset : int or None
+        First DOF of blade j+1 in a ring model; None: cyclic sector (blade j+1 through
+        ``Q_next`` and the phase phi).
+    """
+    els = []
+    for i, c in enumerate(sector.points):
+        rows = sector.Q[[2 * i + 1, 2 * i]]  # local q = [s, p] (ContactElement order)
+        own, nxt = rows[:, :N_DOF], rows[:, N_DOF:]  # nxt: blade j+1's (u_p, v_p)
+        if not c.neighbour:
+            kin = Kinematics(offset + np.arange(N_DOF), own)
+        elif next_offset is None:
+            Qn = np.zeros_like(own)
+            Qn[:, list(PLATFORM)] = nxt
+            kin = Kinematics(np.arange(N_DOF), own, Q_next=Qn, phase=sector.cfg.phi)
+        else:
+            dofs = np.r_[offset + np.arange(N_DOF), next_offset + np.array(PLATFORM)]
+            kin = Kinematics(dofs, np.hstack([own, nxt]))
+        els.append(ContactElement.jenkins(kin, c.kn, c.kt, mu, beta_c=sector.beta_c, name=c.name))
+    return els
+
+
+def sector_model(sector: Sector, cf: float, f0: float, mu: float) -> Model:
+    """The cyclic sector as a Model (module docstring)."""
+    K0 = sector.K_struct(0.0)
+    lin = LinearModel(M=sector.M, C=sector.beta * K0, K=K0)
+    kc = float(sector.cfg["blade.k_c"])
+    rim = LinearElement(Kinematics([0], [[1.0]], Q_next=[[-1.0]], phase=sector.cfg.phi),
+                        [[kc]], [[sector.beta * kc]], name="rim")
+    f_static, f_eo = np.zeros(N_DOF), np.zeros(N_DOF, dtype=complex)
+    f_static[Y_D], f_eo[U_A] = cf, f0
+    return Model(lin, [rim] + contact_elements(sector, mu), {0: f_static, 1: f_eo}, U_A)
 
 
 class SectorHB:
-    """Residual of the UPD sector (module docstring) with its exact Jacobian.
+    """HB residual of the UPD sector with its exact Jacobian, and its outputs.
 
     Parameters
     ----------
@@ -91,6 +105,8 @@ class SectorHB:
     mu : float         friction coefficient (default: config)
     n_t : int          AFT samples (rounded up to a multiple of N_r)
     """
+
+    blades = 1
 
     def __init__(self, sector: Sector, H: int = 7, cf=None, f0=None, mu=None, n_t: int = 0):
         cfg = sector.cfg
@@ -102,144 +118,95 @@ class SectorHB:
             raise ValueError(f"CF and F0 must be finite and > 0, got CF={self.cf}, F0={self.f0}")
         if not (np.isfinite(self.mu) and self.mu >= 0):
             raise ValueError(f"mu must be finite and >= 0, got {self.mu}")
-        self.basis = b = sector_basis(sector, self.H, n_t)
-        self.static = prestress(sector, self.cf)
-        self.nb, self.m = b.nb, 2 * sector.n_contacts
-        self.size = self.nb * N_DOF
-        self._setup_contacts()
-        self._build_operators()
-        self.Fext = np.zeros((self.nb, N_DOF))
-        self.Fext[b.index(1)[0], U_A] = self.f0
-        self.Fext[b.index(0)[0], Y_D] = self.cf
-        self.Fext = self.Fext.ravel()
+        self.basis = sector_basis(sector, self.H, n_t)
+        self.model = self._build_model()
+        self.x_static, _ = frictionless_statics(self.model, apply=True)
+        self.contacts = [i for i, e in enumerate(self.model.elements) if isinstance(e, ContactElement)]
+        self.residual = FullResidual(self.model, self.basis)
+        self.nb, self.ndof = self.basis.nb, self.model.n
+        self.size = self.residual.size
         self.evaluations = 0
 
-    def _setup_contacts(self):
-        """Contact points, their C-core elements and static slips (one sector)."""
-        self.points = self.sector.points
-        self.elements = [IwanElement.jenkins(c.kt, self.mu) for c in self.points]
-        self.s_static = self.static["s"]
+    def _build_model(self) -> Model:
+        return sector_model(self.sector, self.cf, self.f0, self.mu)
+
+    @property
+    def points(self):
+        return [self.model.elements[i] for i in self.contacts]
+
+    @property
+    def static(self) -> dict:
+        """Frictionless prestress: q (n,) [m], N (n_c,) normal loads [N], s (n_c,) slips [m]."""
+        N, s = [], []
+        for el in self.points:
+            kin = el.kinematics
+            Q = kin.Q + kin.Q_next if kin.cyclic else kin.Q
+            q = Q @ self.x_static[list(kin.dofs)]
+            N.append(el.k_n * max(el.preload + q[-1], 0.0))
+            s.append(q[0])
+        return {"q": self.x_static, "N": np.array(N), "s": np.array(s)}
 
     def set_f0(self, f0: float) -> None:
         """Change the EO force amplitude (start homotopies) [N]."""
         self.f0 = float(f0)
-        F = self.Fext.reshape(self.nb, N_DOF)
-        F[self.basis.index(1)[0], U_A] = self.f0
+        self.model.forcing[1] = self._eo_forcing()
+        self.residual = FullResidual(self.model, self.basis)
 
-    # ------------------------------------------------------------ operators
-    def _build_operators(self):
-        s, b, nb, m = self.sector, self.basis, self.nb, self.m
-        phi = s.cfg.phi
-        P = neighbour_map(b, phi)
-        Qown, Qnb = s.Q[:, :N_DOF], s.Q[:, N_DOF:]
-        L = np.kron(np.eye(nb), Qown)
-        # Neighbour platform columns (u_p', v_p') <- rotated (u_p, v_p) of blade j.
-        Lnb = np.kron(P, Qnb)  # (nb m, nb 2) on the platform DOFs of every coefficient
-        L4 = L.reshape(nb, m, nb, N_DOF)
-        L4[:, :, :, 1:3] += Lnb.reshape(nb, m, nb, 2)
-        self.L = L4.reshape(nb * m, nb * N_DOF)
-        A0 = np.zeros((nb, N_DOF, nb, N_DOF))
-        A1 = np.zeros_like(A0)
-        for h in b.harmonics:
-            idx = [i for i in b.index(h) if i is not None]
-            Kh = s.K_struct(h * phi)
-            for i in idx:
-                A0[i, :, i, :] = Kh
-                for j in idx:
-                    A1[i, :, j, :] = b.dtheta[i, j] * s.beta * Kh
-        shape = (self.size, self.size)
-        self.A0 = A0.reshape(shape)
-        self.A2 = np.kron(np.diag(b.order.astype(float) ** 2), s.M)
-        self.C_contact = self.L.T @ np.kron(b.dtheta, np.diag(s.beta_c * s.k)) @ self.L
-        self.A1 = A1.reshape(shape) + self.C_contact
+    def _eo_forcing(self) -> np.ndarray:
+        f = np.zeros(self.ndof, dtype=complex)
+        f[U_A] = self.f0
+        return f
 
-    def linear_operator(self, omega: float) -> np.ndarray:
-        return self.A0 - omega**2 * self.A2 + omega * self.A1
+    @property
+    def Fext(self) -> np.ndarray:
+        return self.residual.Fext.ravel()
 
-    # ------------------------------------------------------------ contact AFT
-    def contact_aft(self, w: np.ndarray, jac: bool = True):
-        """Harmonics of the contact forces (N, f_t per point) and d/dW.
-
-        Parameters
-        ----------
-        w : (n_b m,) harmonics of (p, s) per contact point, coefficient-major
-
-        Returns
-        -------
-        Fh : (n_b m,);  dF : (n_b m, n_b m) or None;  samples : dict of (n_t, n_c)
-        arrays p, s, N, f_t and W (n_c,) friction energy per cycle of the sampled loops.
-        """
-        b, nb, m = self.basis, self.nb, self.m
-        E, D = b.E, b.D
-        W = w.reshape(nb, m)
-        wt = E @ W  # (n_t, m)
-        nc = m // 2
-        out = {k: np.empty((b.n_t, nc)) for k in ("p", "s", "N", "f_t")}
-        out["W"] = np.empty(nc)
-        Fh = np.empty((nb, m))
-        dF = np.zeros((nb, m, nb, m)) if jac else None
-        for c, (pt, el) in enumerate(zip(self.points, self.elements)):
-            p, s = wt[:, 2 * c], wt[:, 2 * c + 1]
-            on = (p > 0.0).astype(float)
-            N = pt.kn * p * on
-            dN = (pt.kn * on)[:, None] * E
-            ft, dFs, dFp, Wc = el.periodic_jac(s - self.s_static[c], E, N, dN)
-            out["p"][:, c], out["s"][:, c], out["N"][:, c], out["f_t"][:, c] = p, s, N, ft
-            out["W"][c] = Wc
-            Fh[:, 2 * c], Fh[:, 2 * c + 1] = D @ N, D @ ft
-            if jac:
-                dF[:, 2 * c, :, 2 * c] = D @ dN
-                dF[:, 2 * c + 1, :, 2 * c + 1] = D @ dFs
-                dF[:, 2 * c + 1, :, 2 * c] = D @ dFp
-        return Fh.ravel(), None if dF is None else dF.reshape(nb * m, nb * m), out
-
-    # ------------------------------------------------------------ residual
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         """R (size,), dR/dx (size, size), dR/domega (size,)."""
         self.evaluations += 1
-        A = self.linear_operator(omega)
-        Fh, dF, _ = self.contact_aft(self.L @ x, jac)
-        R = A @ x + self.L.T @ Fh - self.Fext
-        if not jac:
-            return R
-        return R, A + self.L.T @ dF @ self.L, (-2.0 * omega * self.A2 + self.A1) @ x
+        return self.residual(x, omega, jac)
 
+    # ------------------------------------------------------------ starts
     def static_guess(self) -> np.ndarray:
         """The prestress state in the mean, no vibration."""
-        x = np.zeros((self.nb, N_DOF))
-        x[self.basis.index(0)[0]] = self.static["q"]
+        x = np.zeros((self.nb, self.ndof))
+        x[self.basis.index(0)[0]] = self.x_static
         return x.ravel()
 
     def stuck_guess(self, omega: float) -> np.ndarray:
         """Prestress mean + the linear stuck response at harmonic 1 (a Newton start)."""
         from .sector import linear_response
 
-        x = self.static_guess().reshape(self.nb, N_DOF)
+        x = self.static_guess().reshape(self.nb, self.ndof)
         U = linear_response(self.sector, [omega], "stuck", self.f0)[0]
         ic, isn = self.basis.index(1)
-        x[ic], x[isn] = U.real, -U.imag
+        for j in range(self.blades):
+            Uj = U * np.exp(1j * j * self.sector.cfg.phi)
+            x[ic, N_DOF * j:N_DOF * (j + 1)], x[isn, N_DOF * j:N_DOF * (j + 1)] = Uj.real, -Uj.imag
         return x.ravel()
 
     # ------------------------------------------------------------ outputs
     def response(self, x: np.ndarray, dof: int = U_A) -> np.ndarray:
-        return x.reshape(self.nb, N_DOF)[:, dof]
+        return x.reshape(self.nb, self.ndof)[:, dof]
 
     def amplitude_h1(self, x, omega=None) -> float:
         """First-harmonic magnitude of u_a [m]."""
         return float(self.basis.magnitude(self.response(x), 1))
 
     def amplitude_max(self, x, omega=None) -> float:
-        """max |u_a(t)| over the period (oscillation about the mean) [m]."""
+        """max |u_a(t) - mean| over the period [m]."""
         c = self.response(x).copy()
         c[self.basis.index(0)[0]] = 0.0
         return self.basis.peak_abs(c)
 
-    def contact_summary(self, x: np.ndarray) -> dict:
-        """Per contact point: mean and range of N [N], lift-off fraction of the period."""
-        _, _, smp = self.contact_aft(self.L @ x, jac=False)
-        N = smp["N"]
-        return {"names": [p.name for p in self.points],
+    def contact_summary(self, x: np.ndarray, omega: float = 0.0) -> dict:
+        """Per contact point: mean and range of N [N], lift-off fraction of the period,
+        friction energy per cycle of the sampled loop [J]."""
+        res = self.residual.evaluate(x, omega, jac=False)
+        lf = [res[i] for i in self.contacts]
+        N = np.column_stack([r.f[:, -1] for r in lf])
+        return {"names": [e.name for e in self.points],
                 "normal_load_mean": N.mean(axis=0).tolist(),
                 "normal_load_range": np.ptp(N, axis=0).tolist(),
                 "lift_off": (N <= 0.0).mean(axis=0).tolist(),
-                "friction_energy": smp["W"].tolist()}
+                "friction_energy": [r.W - r.W_viscous for r in lf]}

@@ -15,9 +15,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ..contact import ContactElement
+from ..forces import harmonic_work
 from ..newton import NewtonError, newton
+from ..residual import energy_per_cycle
 from .hb import SectorHB
-from .sector import N_DOF
 
 #: Newton tolerance on |R| relative to max(F0, CF) [-]: far below the 1e-6 energy
 #: balance asked for (measured balance ~1e-11 at this tolerance).
@@ -171,43 +173,30 @@ def frf(hb: SectorHB, omegas, refine: bool = True) -> Curve:
     return c
 
 
-def _pair_work(basis, f, u) -> float:
-    """Work per cycle of a force f on the motion u, from harmonics (n_b, ...) [J].
-
-    For f = a_f cos h theta + b_f sin h theta and u likewise:
-    integral of f du/dtheta over 2 pi = pi h (a_f b_u - b_f a_u) (summed over h and columns).
-    """
-    w = 0.0
-    for h in basis.harmonics:
-        if h == 0:
-            continue
-        ic, isn = basis.index(h)
-        w += np.pi * h * np.sum(f[ic] * u[isn] - f[isn] * u[ic])
-    return float(w)
-
-
 def energy_balance(hb: SectorHB, x: np.ndarray, omega: float) -> dict:
     """Work per cycle [J] of the excitation and every dissipation, from the harmonics.
 
-    W_ext = W_struct + W_dashpot + W_friction + W_normal holds exactly at a solution
-    (Galerkin projection); W_normal (the normal springs' work, zero for the exact
-    signal) is the AFT's sampling error, and W_friction_loops the C core's area of the
-    sampled friction loops (differs from W_friction by the AFT quadrature, O(n_t^-2)).
+    W_ext = W_struct + W_dashpot + W_friction holds exactly at a solution (Galerkin
+    projection; ``forces.harmonic_work``): W_struct = beta K_struct (the linear C and the
+    rim element's dashpot), W_dashpot the contact dashpots (exact in harmonics), and
+    W_friction the contacts' remaining harmonic work (friction, plus the normal springs'
+    AFT sampling error). W_friction_loops is the C core's area of the sampled friction
+    loops: it differs from W_friction by the AFT quadrature, O(n_t^-2).
     """
-    b, nb = hb.basis, hb.nb
-    X = x.reshape(nb, N_DOF)
-    Fext = hb.Fext.reshape(nb, N_DOF)
-    w_ext = _pair_work(b, Fext, X)
-    # structural: the force beta K_h omega dX/dtheta
-    Fs = (hb.A1 - hb.C_contact) @ x * omega
-    w_struct = _pair_work(b, Fs.reshape(nb, N_DOF), X)
-    w_dash = _pair_work(b, (hb.C_contact @ x * omega).reshape(nb, N_DOF), X)
-    W = hb.L @ x
-    Fh, _, smp = hb.contact_aft(W, jac=False)
-    Wm, Fm = W.reshape(nb, hb.m), Fh.reshape(nb, hb.m)
-    w_fric = _pair_work(b, Fm[:, 1::2], Wm[:, 1::2])
-    w_norm = _pair_work(b, Fm[:, 0::2], Wm[:, 0::2])
-    total = w_struct + w_dash + w_fric + w_norm
-    return {"W_ext": w_ext, "W_struct": w_struct, "W_dashpot": w_dash, "W_friction": w_fric,
-            "W_normal": w_norm, "W_friction_loops": float(np.sum(smp["W"])),
-            "imbalance": (w_ext - total) / w_ext}
+    b, res = hb.basis, hb.residual
+    X = x.reshape(hb.nb, hb.ndof)
+    e = energy_per_cycle(hb.model, b, X, omega)
+    lfs = res.evaluate(x, omega, jac=False)
+    w_struct, w_dash, w_fric, w_loops = e["W_visc"], 0.0, 0.0, 0.0
+    for el, lf in zip(res.elements, lfs):
+        U = (el.kinematics.operators(b, res.dofs)[0] @ x).reshape(b.nb, el.m)
+        w = harmonic_work(U, lf.F, b)
+        if isinstance(el, ContactElement):
+            w_dash += lf.W_viscous
+            w_fric += w - lf.W_viscous
+            w_loops += lf.W - lf.W_viscous
+        else:
+            w_struct += w
+    total = w_struct + w_dash + w_fric
+    return {"W_ext": e["W_ext"], "W_struct": w_struct, "W_dashpot": w_dash, "W_friction": w_fric,
+            "W_friction_loops": w_loops, "imbalance": (e["W_ext"] - total) / e["W_ext"]}

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from harmonic_balance.bladed_disk.config import load_config
-from harmonic_balance.bladed_disk.hb import SectorHB, prestress
+from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.sector import U_A, Sector, linear_response, peak_of
 from harmonic_balance.bladed_disk.solve import energy_balance, frf, start_point, sweep
 
@@ -25,7 +25,7 @@ def sector():
 def test_frictionless_statics_closed_form(sector):
     cf = 120.0
     g = np.radians(45.0)
-    st = prestress(sector, cf)
+    st = SectorHB(sector, 1, cf=cf).static
     expect = [cf / (2 * np.cos(g)), cf / (4 * np.cos(g)), cf / (4 * np.cos(g))]
     assert st["N"] == pytest.approx(expect, rel=STATIC_RTOL)
 
