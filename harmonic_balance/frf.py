@@ -24,8 +24,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import find_peaks
 
-from .continuation import ContinuationError, continuation, refine_max
+from .continuation import Branch, ContinuationError, continuation, refine_max
 from .fourier import FourierBasis, parse_harmonics
+from .homotopy import HomotopyError, homotopy_start
 from .model import Model
 from .residual import FullResidual, energy_per_cycle, make_residual
 
@@ -170,7 +171,11 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     t0 = time.perf_counter()
     prob = FRFProblem(model, harmonics, n_t, condensed)
     tol = TOL_REL * max(prob.reference(w0), 1e-300)
-    x0 = prob.residual.linear_guess(w0)
+    try:
+        x0, start = homotopy_start(prob, w0, tol)
+    except HomotopyError as err:
+        result = _collect(prob, Branch(status=str(err)), t0)
+        raise FRFError(f"continuation stopped before the first point: {err}", result) from None
     try:
         branch = continuation(prob, x0, w0, w1, tol, ds_max=ds_max, max_points=max_points)
     except ContinuationError as err:
@@ -178,6 +183,7 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
         result.status = str(err)
         raise FRFError(str(err), result) from None
     result = _collect(prob, branch, t0)
+    result.extra["start"] = start
     if refine:
         _refine_peak(prob, branch, result, tol)
     result.alias_ratio = prob.alias_ratio(result.peak_solution)

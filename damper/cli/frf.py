@@ -112,7 +112,17 @@ def _emit(args, summary, print_json, atomic_write, dumps):
         print_json(summary)
         return
     print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
-          f"{summary['time_s']:.3f} s, harmonics {summary['harmonics']}, n_t {summary['n_t']}")
-    print(f"peak: omega = {summary['peak_omega']:.9g} rad/s, amplitude = "
-          f"{summary['peak_amplitude']:.9g} m (first harmonic {summary['peak_amplitude_h1']:.9g} m)")
+          f"{_num(summary['time_s'], '.3f')} s, harmonics {summary['harmonics']}, "
+          f"n_t {summary['n_t']}")
+    print(f"peak: omega = {_num(summary['peak_omega'])} rad/s, amplitude = "
+          f"{_num(summary['peak_amplitude'])} m (first harmonic "
+          f"{_num(summary['peak_amplitude_h1'])} m)")
+    if summary.get("stable") is not None:
+        n_unst = sum(1 for s in summary["stable"] if s is False)
+        print(f"stability (Hill): {n_unst} of {summary['points']} points unstable")
     print(f"status: {summary['status']}")
+
+
+def _num(v, fmt=".9g") -> str:
+    """A number for the text summary; 'none' when undefined (no converged point)."""
+    return "none" if v is None else format(v, fmt)
