@@ -49,7 +49,9 @@ def register(subparsers) -> None:
 
 def add_body_options(p) -> None:
     """Body, material and contact-zone options (shared by ``damper normal`` and ``damper tangential``)."""
-    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
+    from contact_core import bodies
+
+    p.add_argument("--body", choices=bodies.names(), required=True)
     p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
     p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
     p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
@@ -64,6 +66,10 @@ def add_body_options(p) -> None:
                    help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
 
 
+#: Geometry fields of a ContactSpec and the options that give them.
+_GEOMETRY_FLAGS = {"radius": "--radius or --diameter", "length": "--length", "width": "--width"}
+
+
 def _radius(args) -> float | None:
     if args.radius is not None and args.diameter is not None:
         raise ValueError("give --radius or --diameter, not both")
@@ -74,15 +80,14 @@ def _radius(args) -> float | None:
 
 def spec_from_args(args):
     """A ``ContactSpec`` from the options; ValueError for missing or bad values."""
+    from contact_core import bodies
     from contact_core.spec import ContactSpec
 
     radius = _radius(args)
-    if args.body in ("sphere", "cylinder") and radius is None:
-        raise ValueError(f"--body {args.body} needs --radius or --diameter")
-    if args.body in ("cylinder", "flat") and args.length is None:
-        raise ValueError(f"--body {args.body} needs --length")
-    if args.body == "flat" and args.width is None:
-        raise ValueError("--body flat needs --width")
+    given = {"radius": radius, "length": args.length, "width": args.width}
+    for name, flag in _GEOMETRY_FLAGS.items():  # the body kind says what it needs
+        if name in bodies.get(args.body).required and given[name] is None:
+            raise ValueError(f"--body {args.body} needs {flag}")
     if args.force is not None and not args.force > 0:
         raise ValueError(f"--force must be positive, got {args.force}")
     if args.approach is not None and not args.approach > 0:
@@ -108,7 +113,8 @@ def run(args) -> int:
     cache = False if args.no_cache else args.cache_dir
     if args.stiffness or args.nodes:
         from contact_core import byo
-        result = byo.run_from_files(args, cache)
+        result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,
+                                    args.approach, cache)
     else:
         spec = spec_from_args(args)
         result = api.run_normal(spec, force=args.force, approach=args.approach,
