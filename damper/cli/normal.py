@@ -56,6 +56,8 @@ def add_body_options(p) -> None:
     p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
     p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
     p.add_argument("--width", type=float, help="flat-face width along x [m]")
+    p.add_argument("--height", type=float, default=None,
+                   help="flat face: height of the damper body above the face [m] (default max(W, L/2))")
     p.add_argument("--E", type=float, default=200e9,
                    help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
     p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
@@ -98,7 +100,8 @@ def spec_from_args(args):
                        width=args.width or 0.0, E1=args.E, nu1=args.nu,
                        E2=args.E if args.E2 is None else args.E2,
                        nu2=args.nu if args.nu2 is None else args.nu2, model=args.model,
-                       grid=args.grid, p_design=args.p_design, load_hint=args.force or 0.0)
+                       grid=args.grid, p_design=args.p_design, load_hint=args.force or 0.0,
+                       height=getattr(args, "height", None) or 0.0)
 
 
 def _brief(result: dict) -> dict:

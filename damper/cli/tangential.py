@@ -105,7 +105,7 @@ def _check_finite(args) -> None:
     import math
 
     for name in ("force", "approach", "mu", "tangential_force", "loop_amplitude", "tol",
-                 "radius", "diameter", "length", "width", "E", "nu", "E2", "nu2",
+                 "radius", "diameter", "length", "width", "height", "E", "nu", "E2", "nu2",
                  "eccentricity", "p_design"):
         v = getattr(args, name, None)
         if v is not None and not math.isfinite(v):

@@ -29,6 +29,7 @@ def test_json_has_the_interface_keys(capsys):
     assert out["load_case"] == "CNF" and out["k_t"] > 0 and out["iterations"] >= 0
 
 
+@pytest.mark.slow
 def test_out_writes_a_curve_file_and_plots(tmp_path, capsys):
     curve_path, plots = tmp_path / "curve.json", tmp_path / "plots"
     assert main(CYLINDER + ["--force", "120", "--out", str(curve_path), "--plot", str(plots)]) == 0
@@ -46,6 +47,7 @@ def test_constant_normal_displacement(capsys):
     assert out["T"][-1] == pytest.approx(0.5 * out["normal_force"], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_force_control_and_loop(capsys, tmp_path):
     out = run_json(capsys, SPHERE + ["--force", "200", "--tangential-force", "50",
                                      "--loop-amplitude", "1e-6", "--plot", str(tmp_path)])
