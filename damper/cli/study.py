@@ -43,7 +43,7 @@ def run(args) -> int:
         from damper.studies import cylinders as study
     result = study.run(quick=args.quick, cache_dir=args.cache_dir, workers=args.workers)
     if args.name == "compression":
-        result = {"quick": result["quick"], "grid": result["grid"], "models": result["compression"],
+        result = {"quick": result["quick"], "grids": result["grids"], "models": result["compression"],
                   "wall_time_s": result["wall_time_s"]}
     if args.plot:
         from damper.studies import plots

@@ -14,10 +14,16 @@ here are shares of the half-width W/2 chosen to span full and partial contact.
 """
 from __future__ import annotations
 
+import multiprocessing
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+
+#: Worker processes are spawned, not forked: a fork of a process whose BLAS or
+#: other libraries already run threads can deadlock on a lock held at the fork
+#: (seen: the study test hung inside the full test session).
+SPAWN = multiprocessing.get_context("spawn")
 
 #: The thesis's damper face width DW (section 3.1) and a face length [m].
 WIDTH, LENGTH = 1.2e-3, 5e-3
@@ -57,7 +63,7 @@ def run(quick: bool = False, cache_dir=None, workers: int = 2) -> dict:
     t0 = time.perf_counter()
     jobs = [(k, s * WIDTH / 2, cfg["grid"], cfg["height"], cache_dir) for k, s in enumerate(SHARES)]
     if workers > 1:
-        with ProcessPoolExecutor(workers) as pool:
+        with ProcessPoolExecutor(workers, mp_context=SPAWN) as pool:
             cases = list(pool.map(run_case, *zip(*jobs)))
     else:
         cases = [run_case(*job) for job in jobs]

@@ -50,3 +50,14 @@ def test_eccentric_study_quick_equilibrium_and_trend(cache_dir, capsys):
 def test_study_refuses_bad_workers(capsys):
     assert damper(["study", "eccentric", "--workers", "0"]) == 2
     assert "--workers" in capsys.readouterr().err
+
+
+def test_richardson_recovers_a_power_law_limit():
+    from damper.studies.convergence import richardson
+
+    h = [1 / 6, 1 / 12, 1 / 24]
+    f = [2.0 + 0.3 * x**1.7 for x in h]          # converged value 2, order 1.7
+    r = richardson(f, h)
+    assert r["value"] == pytest.approx(2.0, rel=1e-12) and r["order"] == pytest.approx(1.7, rel=1e-9)
+    r = richardson([1.0, 1.2, 1.1], h)            # oscillating: no order, finest value kept
+    assert r["order"] is None and r["value"] == 1.1 and not r["monotone"]
