@@ -27,7 +27,8 @@ the Cholesky form of the QP takes over (``fallback``), or RuntimeError.
 
 Library alternatives measured (``examples/bench_contact.py --qp``): scipy's
 ``nnls`` and ``lsq_linear`` need the Cholesky factor of the whole K and have no
-warm start, so every force-control Newton step restarts from scratch.
+warm start, so every force-control Newton step restarts from scratch; measured
+numbers in ``contact_core.normal``.
 
 Every result is checked by :func:`check_kkt` (RuntimeError with the violation).
 """
