@@ -340,3 +340,21 @@ def test_energy_balance_of_the_cyclic_sector():
     assert loop.W_viscous > 0.0 and loop.W > loop.W_viscous
     assert abs(E["W_ext"] - E["W_visc"] - W_el) <= ENERGY_BALANCE_RTOL * E["W_ext"]
     assert abs(W_el - loop.W) <= AFT_WORK_RTOL * loop.W
+
+
+def test_contact_batch_stepper_gives_the_single_stepper_bits():
+    """Vectorised histories (one C call per step) equal separate steppers bit for bit."""
+    el = plane_contact(FRICTIONS["iwan"](), preload=0.05, slip_ref=0.01)
+    rng = np.random.default_rng(SEED)
+    q = np.cumsum(rng.normal(scale=0.03, size=(400, 3, 2)), axis=0)  # random walks, lift-offs
+    single = [el.stepper() for _ in range(3)]
+    batch = el.batch_stepper(3)
+    for k in range(200):
+        fb = batch.force(q[k]).copy()
+        assert np.array_equal(fb, np.array([s.force(q[k, i]) for i, s in enumerate(single)]))
+    assert np.array_equal(batch.dissipated(), [s.dissipated() for s in single])
+    assert np.any(q[:200, :, 1] + 0.05 < 0) and batch.dissipated().min() > 0
+    kept = batch.keep([2, 0])
+    for k in range(200, 400):
+        fb = kept.force(q[k, [2, 0]]).copy()
+        assert np.array_equal(fb, np.array([single[i].force(q[k, i]) for i in (2, 0)]))
