@@ -106,6 +106,22 @@ class _Residual:
             Kst += Te @ np.kron(eye, el.stuck_stiffness()) @ Qe
         return Kst
 
+    def viscous_operator(self) -> np.ndarray:
+        """Elements' linear dashpots on the unknowns, V (size, size) [N s/m].
+
+        ``sum_e T_e (I (x) C_e) Q_e`` with C_e = ``local_damping()``: the elements' viscous
+        forces are ``omega (D_theta (x) I) V x`` (already in the residual); a method that
+        needs the dashpots apart from the rate-independent forces (Hill's method: velocity
+        ``(omega D_theta + lambda) x``) adds ``lambda V``.
+        """
+        V = np.zeros((self.size, self.size))
+        eye = np.eye(self.basis.nb)
+        for el, (Qe, Te) in zip(self.elements, self._ops):
+            C = el.local_damping()
+            if C is not None:
+                V += Te @ np.kron(eye, C) @ Qe
+        return V
+
     def static_load(self) -> np.ndarray:
         """Element forces (size,) at x = 0 (preloads), zero for unloaded elements."""
         return self._T @ self._static if np.any(self._static) else np.zeros(self.size)
