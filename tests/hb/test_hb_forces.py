@@ -280,6 +280,9 @@ def test_frictionless_statics_of_a_wedge_in_closed_form():
         p = el.kinematics.Q[-1] @ x
         assert abs(kn * p - CF / (2 * np.cos(g))) < ROUND * CF
     assert slip[0] == els[0].slip_ref and abs(slip[0] + slip[1]) < ROUND * abs(slip[0])
+    pulled = Model(lin, els, {0: np.array([0.0, -CF]), 1: np.array([1.0, 0.0])})
+    with pytest.raises(ValueError, match="singular"):  # pulled away: both faces lift off
+        frictionless_statics(pulled)
 
 
 def ring_and_sector(n_r=4, eo=1, F0=0.24):
