@@ -40,7 +40,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .forces import ForceElement, LocalForce, viscous_work
+from .aft import FrictionLink
+from .forces import ForceElement, LinearElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
 
@@ -248,9 +249,6 @@ def _static_parts(model):
     (index, element, Q_0 (m, d), q_n (n,), t_n (n,)): its h = 0 kinematics and the
     normal row / column on all DOFs (penetration p = p_0 + q_n . x, force t_n N).
     """
-    from .aft import FrictionLink
-    from .forces import LinearElement
-
     if model.linear.K is None:
         raise ValueError("frictionless statics needs the stiffness matrix K")
     n = model.n

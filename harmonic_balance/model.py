@@ -60,8 +60,10 @@ from pathlib import Path
 import numpy as np
 
 from .aft import FrictionLink
-from .forces import ForceElement
+from .contact import ContactElement
+from .forces import ForceElement, LinearElement
 from .fourier import FourierBasis
+from .kinematics import Kinematics
 from .linear import LinearModel
 
 
@@ -145,8 +147,6 @@ class Model:
         eigenvalues with M give the stuck / free natural frequencies of the nodal
         diameter whose phase is h phi.
         """
-        from .forces import LinearElement
-
         K = np.array(self.linear.K, dtype=complex, copy=True)
         for el in self.links:
             if not stuck and not isinstance(el, LinearElement):
@@ -283,9 +283,6 @@ _CONTACT_KEYS = {"type", "name", "dofs", "normal", "tangent", "delta", "k_n", "k
 
 def _contact_element(t: dict, i: int, base: Path):
     """One [[element]] table of type "contact" -> ContactElement (format in the module docstring)."""
-    from .contact import ContactElement
-    from .kinematics import Kinematics
-
     unknown = set(t) - _CONTACT_KEYS
     if unknown:
         raise ValueError(f"element {i}: unknown contact keys {sorted(unknown)}")
