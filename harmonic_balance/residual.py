@@ -6,11 +6,13 @@ Full residual (all n DOFs; unknowns X (n_b, n), flattened as in :mod:`fourier`):
     A(omega) = I (x) K - omega^2 diag(h^2) (x) M + omega D_theta (x) C
 
 where ``D_theta`` is d/dtheta in coefficient space (so omega D_theta X are the velocity
-harmonics) and ``(x)`` the Kronecker product. F_nl comes from the AFT (:mod:`aft`);
-being rate-independent it does not depend on omega, so
-``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X``.
+harmonics) and ``(x)`` the Kronecker product. F_nl = T F(Q X) comes from the force
+elements (:mod:`forces`: each maps its local harmonics Q X to force harmonics, by AFT
+or in closed form); rate-independent elements do not depend on omega, dashpots in
+elements add their omega-derivative ``dF_nl/domega``, so
+``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X + dF_nl/domega``.
 
-Condensed residual (unknowns: the harmonics of the m DOFs the friction links touch,
+Condensed residual (unknowns: the harmonics of the m DOFs the force elements touch,
 set J)::
 
     R = X_J - G_JJ(omega) F_ext - ... = X_J - X_lin,J(omega) + G_JJ(omega) F_nl,J(X_J)
