@@ -44,7 +44,7 @@ def run(args) -> int:
     result = study.run(quick=args.quick, cache_dir=args.cache_dir, workers=args.workers)
     if args.name == "compression":
         result = {"quick": result["quick"], "grids": result["grids"], "models": result["compression"],
-                  "wall_time_s": result["wall_time_s"]}
+                  "sphere": result["compression_sphere"], "wall_time_s": result["wall_time_s"]}
     if args.plot:
         from damper.studies import plots
 
@@ -52,12 +52,19 @@ def run(args) -> int:
     if args.json:
         print_json(result)
     elif args.name == "compression":
-        for m in result["models"]:
-            far = [v for v in m["body1_share_far"] if v is not None]
-            print(f"cylinder {m['cylinder']} D {m['D'] * 1e3:g} mm L {m['L'] * 1e3:g} mm: "
-                  f"share at centre {100 * min(m['body1_share']):.0f}-{100 * max(m['body1_share']):.0f} %, "
-                  f"outside the contact {100 * min(far, default=float('nan')):.0f}-"
-                  f"{100 * max(far, default=float('nan')):.0f} %")
+        _print_compression(result)
     else:
         print(study.table(result))
     return 0
+
+
+def _print_compression(result: dict) -> None:
+    """Body-1 shares of the approach: at the centre, and outside the contact (~3 b)."""
+    for m in [*result["models"], result["sphere"]]:
+        name = f"cylinder {m['cylinder']}" if "cylinder" in m else "sphere"
+        size = f"D {m['D'] * 1e3:g} mm" + (f" L {m['L'] * 1e3:g} mm" if "L" in m else "")
+        far = [v for v in m["body1_share_far"] if v is not None]
+        print(f"{name} {size}: "
+              f"share at centre {100 * min(m['body1_share']):.0f}-{100 * max(m['body1_share']):.0f} %, "
+              f"outside the contact {100 * min(far, default=float('nan')):.0f}-"
+              f"{100 * max(far, default=float('nan')):.0f} % (forces {m['force'][0]:g}-{m['force'][-1]:g} N)")

@@ -31,6 +31,9 @@ def test_cylinder_study_quick_exponents(cache_dir, capsys, tmp_path):
     for m in out["compression"]:
         for far, centre in zip(m["body1_share_far"], m["body1_share"]):
             assert far is None or 0 < far < centre
+    # the sphere of the same diameter: its own compression is small (thesis Fig. 17: < 8 %)
+    sphere = [v for v in out["compression_sphere"]["body1_share_far"] if v is not None]
+    assert sphere and all(0 < v < 0.08 for v in sphere)
 
 
 @pytest.mark.slow
