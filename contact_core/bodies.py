@@ -111,6 +111,7 @@ class Body:
     curved = True
     size_key: str | None = None
     peak_key = "p_max"
+    zone_from_load = False
 
     # -- options ---------------------------------------------------------------
     def validate(self, spec) -> None:
@@ -205,6 +206,10 @@ class Sphere(Body):
     name = "sphere"
     required = ("radius",)
     size_key = "contact_radius"
+    #: Hertz sizes a tiny load's zone well (1e-6 N, R 10 mm: a within 0.3 % at
+    #: 9 nodes per side). Not the cylinder: at tiny loads its contact is set by
+    #: the end effect, and a 2D-Hertz-sized zone puts contact on its edge.
+    zone_from_load = True
 
     def validate(self, spec):
         super().validate(spec)

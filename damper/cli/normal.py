@@ -66,8 +66,10 @@ def add_body_options(p) -> None:
     p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
     p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
     p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
-    p.add_argument("--p-design", type=float, default=2000e6,
-                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
+    p.add_argument("--p-design", type=float, default=None,
+                   help="peak pressure [Pa] sizing the potential contact zone (default: the thesis's "
+                   "2000 MPa, or, when the Hertz contact of --force would fit inside one grid cell "
+                   "of that zone, the Hertz peak pressure of --force)")
 
 
 #: Geometry fields of a ContactSpec and the options that give them.
@@ -98,12 +100,47 @@ def spec_from_args(args):
         raise ValueError(f"--approach must be positive, got {args.approach}")
     if args.curve < 0:
         raise ValueError("--curve must be >= 0")
-    return ContactSpec(body=args.body, radius=radius or 0.0, length=args.length or 0.0,
+    spec = ContactSpec(body=args.body, radius=radius or 0.0, length=args.length or 0.0,
                        width=args.width or 0.0, E1=args.E, nu1=args.nu,
                        E2=args.E if args.E2 is None else args.E2,
                        nu2=args.nu if args.nu2 is None else args.nu2, model=args.model,
-                       grid=args.grid, p_design=args.p_design, load_hint=args.force or 0.0,
-                       height=getattr(args, "height", None) or 0.0)
+                       grid=args.grid, p_design=args.p_design or DEFAULT_P_DESIGN,
+                       load_hint=args.force or 0.0, height=getattr(args, "height", None) or 0.0)
+    if args.p_design is None and args.force:
+        spec = zone_for_load(spec, args.force)
+    return spec
+
+
+#: The thesis's design peak pressure sizing the potential contact zone [Pa].
+DEFAULT_P_DESIGN = 2000e6
+#: A zone sized from a load holds the Hertz contact of this many times the load:
+#: coarse grids spread the discrete contact a cell beyond Hertz's edge (sized
+#: for the load itself, 3-5 nodes per side put contact on the zone's edge).
+LOAD_ZONE_FACTOR = 3.0
+
+
+def zone_for_load(spec, force: float):
+    """``spec`` with its zone sized from the Hertz contact of ``force`` if that contact
+    would fit inside one grid cell of the design pressure's zone.
+
+    Loads that the default zone resolves, even roughly (flagged
+    ``under_resolved`` below MIN_NODES_ACROSS spacings), keep it, so their
+    results and cached models are unchanged; a load whose contact would fall
+    between grid nodes (a 1e-6 N load on a 10 mm sphere came out 45x Hertz's
+    radius) gets a zone of its own, sized by its Hertz peak pressure (the zone
+    is then ``zone_margin`` times the contact of LOAD_ZONE_FACTOR times the load).
+    """
+    from dataclasses import replace
+
+    kind = spec.kind
+    ref = kind.reference(spec, force) if kind.zone_from_load else None
+    if ref is None:
+        return spec
+    zx, _ = spec.zone()
+    spacing = zx / (spec.n_side // 2)
+    if kind.reference_size(ref) >= spacing:
+        return spec
+    return replace(spec, p_design=kind.reference(spec, LOAD_ZONE_FACTOR * force)["p0"])
 
 
 def _brief(result: dict) -> dict:

@@ -37,6 +37,23 @@ def test_load_at_the_limit_meshes():
 
 
 def test_under_resolved_contact_is_flagged_in_the_text_output(capsys):
+    """An explicit design pressure far too high for the load: the warning is printed."""
     assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "1e-6", "--grid", "5",
-                   "--model", "halfspace", "--no-cache"]) == 0
+                   "--model", "halfspace", "--no-cache", "--p-design", "2e9"]) == 0
     assert "warning: under-resolved" in capsys.readouterr().out
+
+
+#: A 1e-6 N load on the 10 mm sphere, zone sized from the Hertz contact of 3x
+#: the load, 13 nodes per side: contact radius -0.78 % against Hertz (measured;
+#: 45x Hertz with the design-pressure zone).
+TINY_LOAD_RTOL = 0.012
+
+
+def test_default_zone_follows_a_tiny_load(capsys):
+    import json
+
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "1e-6", "--grid", "13",
+                   "--model", "halfspace", "--no-cache", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert not out["under_resolved"]
+    assert abs(out["hertz"]["error_size"]) < TINY_LOAD_RTOL

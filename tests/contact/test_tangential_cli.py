@@ -95,7 +95,8 @@ def test_eccentricity_needs_a_flat_face(capsys):
 
 def test_a_contact_on_one_node_is_refused(capsys):
     # 1 mN on a zone sized for 2000 MPa: the contact falls inside one grid cell
-    assert main(SPHERE + ["--force", "1e-3"]) == 2
+    # (explicit --p-design: by default such a load now gets a zone of its own)
+    assert main(SPHERE + ["--force", "1e-3", "--p-design", "2e9"]) == 2
     assert "too few" in capsys.readouterr().err
 
 
