@@ -68,7 +68,7 @@ def _check_version(fmi_version: int) -> None:
         raise ValueError(f"--fmi-version must be 2 or 3, not {fmi_version!r}")
 
 
-def check_curve(u, T, n_ref: float, fit: str = "reject"):
+def check_curve(u, T, n_ref: float, fit: str = "reject", tail: str = "slope"):
     """Validate a virgin curve by building the element from it.
 
     Parameters
@@ -79,6 +79,8 @@ def check_curve(u, T, n_ref: float, fit: str = "reject"):
         Normal load the curve was computed at [N], > 0.
     fit : {"reject", "concave"}
         A non-concave table is an error, or is replaced by its concave majorant.
+    tail : {"slope", "flat"}
+        What follows the last point (see :meth:`IwanElement.from_curve`).
 
     Returns
     -------
@@ -98,11 +100,12 @@ def check_curve(u, T, n_ref: float, fit: str = "reject"):
     T = np.asarray(T, dtype=float).ravel()
     if u.shape != T.shape or u.size < 2:
         raise ValueError(f"curve needs u and T of equal length >= 2, got {u.size}, {T.size}")
-    if u.size > 4096:  # FMU_MAX_CURVE_POINTS in fmu_instance.h
-        raise ValueError(f"curve has {u.size} points; the FMU reads at most 4096")
+    if u.size + (tail == "flat") > 4096:  # FMU_MAX_CURVE_POINTS in fmu_instance.h
+        raise ValueError(f"curve has {u.size} points; the FMU reads at most 4096 "
+                         "(reduce it: fmu_src.curve_fit.prepare_table)")
     if not (np.isfinite(n_ref) and n_ref > 0):
         raise ValueError(f"reference normal load must be finite and > 0, got {n_ref!r}")
-    IwanElement.from_curve(u, T, float(n_ref), fit=fit)
+    IwanElement.from_curve(u, T, float(n_ref), fit=fit, tail=tail)
     return u, T
 
 
@@ -173,7 +176,7 @@ def _zip_dir(root: Path) -> bytes:
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
               fit: str = "reject", model: str = "iwan", description: str = "",
               compiler: str | None = None, curve_json: str | None = None,
-              gross_slip: bool = False) -> Path:
+              tail: str = "slope") -> Path:
     """Write a co-simulation FMU of the friction element for one contact.
 
     Parameters
@@ -196,22 +199,22 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
     curve_json : str, optional
         Text of the source curve file, kept as ``resources/curve.json`` for
         provenance (the binary reads ``resources/curve.txt``).
-    gross_slip : bool
-        The curve ends at gross slip (:func:`fmu_src.element.ends_at_gross_slip`):
-        ``resources/curve.txt`` gets the flat tail of
-        :func:`fmu_src.element.with_flat_tail`, so the FMU stays at T[-1] past the
-        end of the curve, as ``IwanElement.from_curve(..., gross_slip=True)``.
+    tail : {"slope", "flat"}
+        Beyond u[-1] (the curve file's ``tail``): ``"flat"`` writes the flat tail of
+        :func:`fmu_src.element.flat_tail` into ``resources/curve.txt``, so the FMU
+        stays at T[-1] past the end (gross slip), as ``IwanElement.from_curve(...,
+        tail="flat")``; ``"slope"`` continues the last slope.
 
     Returns
     -------
     Path of the written FMU.
     """
     _check_version(fmi_version)
-    if gross_slip:
-        from fmu_src.element import with_flat_tail
+    u, T = check_curve(u, T, n_ref, fit, tail)
+    if tail == "flat":
+        from fmu_src.element import flat_tail
 
-        u, T = with_flat_tail(u, T)
-    u, T = check_curve(u, T, n_ref, fit)
+        u, T = flat_tail(u, T)
     with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
         root = Path(tmp) / "fmu"
         names = _copy_sources(root / "sources", fmi_version, model)
