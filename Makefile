@@ -8,7 +8,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 CBUILD := build/c
-C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h)
+C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h) fmu_src/core/cflags.txt
 C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in) CMakeLists.txt $(wildcard fmu_src/*/CMakeLists.txt)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake

@@ -50,9 +50,18 @@ _WRAPPER_HEADERS = ("fmu_instance.h", "model.h", "damper_vr.h")
 #: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
 CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
 CORE_HEADERS = ("iwan.h", "iwan_internal.h", "iwan_sweep.h")
-#: Flags of the binary inside the FMU (the same as the CMake build's).
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-          "-Wall", "-Wextra", "-Werror", "-Wl,--no-undefined")
+#: The one compile-flag list shared with CMake and the pip extension (one flag a line).
+CFLAGS_FILE = CORE_DIR / "cflags.txt"
+
+
+def shared_cflags() -> tuple[str, ...]:
+    """Flags of ``fmu_src/core/cflags.txt`` (comments and blank lines skipped)."""
+    lines = (line.strip() for line in CFLAGS_FILE.read_text().splitlines())
+    return tuple(line for line in lines if line and not line.startswith("#"))
+
+
+#: Flags of the binary inside the FMU: the shared list plus those of a shared library.
+CFLAGS = (*shared_cflags(), "-fPIC", "-shared", "-fvisibility=hidden", "-Wl,--no-undefined")
 
 
 def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
