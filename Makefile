@@ -13,7 +13,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel clean
+.PHONY: demo test pytest ctest cbuild lint bench accel clean locale
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -44,7 +44,20 @@ pytest: $(STAMP) cbuild
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 
-test: lint ctest pytest
+test: lint locale ctest pytest
+
+# A decimal-comma locale for the FMU locale tests (tests/fmu/test_fmu_trust.py):
+# generated with localedef when missing; as root on a fresh Debian/Ubuntu machine the
+# `locales` package (localedef and the locale sources) is installed first. Without
+# root or apt-get the step is skipped and the tests skip with a reason.
+TEST_LOCALE := de_DE.UTF-8
+locale:
+	@if locale -a 2>/dev/null | grep -qi '^de_DE\.utf-\?8$$'; then exit 0; fi; \
+	if [ ! -f /usr/share/i18n/locales/de_DE ] && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	  apt-get install -y -qq locales >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq locales) >/dev/null 2>&1; fi; \
+	if [ -f /usr/share/i18n/locales/de_DE ] && [ "$$(id -u)" = 0 ]; then \
+	  localedef -i de_DE -f UTF-8 $(TEST_LOCALE) && echo "generated locale $(TEST_LOCALE)"; \
+	else echo "note: locale $(TEST_LOCALE) not available (needs root and the locales package): its tests skip"; fi
 
 demo: $(STAMP)
 	$(PY) examples/demo.py --out out

@@ -251,11 +251,7 @@ static const char *set_refusal(const fmu_instance *inst, unsigned int vr, double
     if (!isfinite(v)) return "value is NaN or infinite";
     switch (damper_causality_of[vr]) {
     case CAUS_INPUT:
-        if (inst->h.mode & MODE_TERMINATED) return "inputs cannot be set after Terminate";
-        if (inst->model_ready && fabs(v) > model_input_bound(inst->model, vr))
-            return "beyond the input bound stated in the FMU's documentation (double "
-                   "precision cannot represent the element's slip distances there)";
-        return NULL;
+        return (inst->h.mode & MODE_TERMINATED) ? "inputs cannot be set after Terminate" : NULL;
     case CAUS_PARAMETER:
         if (!(inst->h.mode & (MODE_INSTANTIATED | MODE_INIT)))
             return "fixed parameters can only be set before initialization ends";
@@ -283,6 +279,14 @@ fmu_status fmu_set(fmu_instance *inst, const unsigned int *vr, size_t n, const d
             return fmu_log(inst, FMU_ERROR, "cannot set value reference %u (%s) to %g: %s",
                            vr[i], vr[i] < DAMPER_N_VARIABLES ? damper_name_of[vr[i]] : "?",
                            v[i], why);
+        if (damper_causality_of[vr[i]] == CAUS_INPUT && inst->model_ready) {
+            double bound = model_input_bound(inst->model, vr[i]);
+            if (fabs(v[i]) > bound)
+                return fmu_log(inst, FMU_ERROR, "cannot set %s to %g: beyond the bound |%s| <= "
+                               "%.17g of this FMU (stated in its documentation: double precision "
+                               "cannot represent the element's slip distances there)",
+                               damper_name_of[vr[i]], v[i], damper_name_of[vr[i]], bound);
+        }
     }
     for (i = 0; i < n; i++) {
         inst->h.value[vr[i]] = v[i];
