@@ -9,11 +9,15 @@
  * inputs rejected with a logged message; rollback (get/set FMU state) and
  * serialization giving bit-identical continuations, also in another instance;
  * directional derivatives against finite differences; several instances side by
- * side giving the results of one instance alone. Exit status 0 when all pass.
+ * side giving the results of one instance alone; a state restored into a fresh
+ * instance (straight after instantiation, or during initialization) continuing
+ * bit-identically; the same results under a decimal-comma locale (when the process
+ * can switch to de_DE.UTF-8 or fr_FR.UTF-8). Exit status 0 when all pass.
  * Meant to run under valgrind as well (ctest fmu_harness_valgrind).
  */
 #define _POSIX_C_SOURCE 200809L
 #include <dlfcn.h>
+#include <locale.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -185,6 +189,68 @@ static void test_rollback_and_serialization(const api *a)
     free(bytes);
     release(&x);
     release(&y);
+}
+
+/* A state restored into a fresh instance continues bit-identically: straight after
+ * instantiation (the state brings step mode and its time), and during initialization
+ * (Exit Initialization Mode keeps the restored history instead of a virgin one). */
+static void test_restore_into_fresh_instances(const api *a)
+{
+    double first[2 * N_HIST], again[2 * N_HIST];
+    inst x = start(a, "orig"), y = {a, NULL, 0.0};
+    void *s = NULL, *s2 = NULL;
+    unsigned char *bytes = NULL;
+    size_t size = 0;
+    int init;
+    if (!x.c) return;
+    run(&x, 0, 40, first);
+    CHECK(get_state(&x, &s) == 0 && serialize(&x, s, &bytes, &size) == 0, "FMI %d: save", a->v);
+    run(&x, 40, N_HIST - 40, first);
+    for (init = 0; init < 2; init++) {
+        y.c = instantiate(a, "fresh", DAMPER_TOKEN, a->resources);
+        y.t = 0.0;
+        if (!y.c) break;
+        if (init) CHECK(enter_init(&y) == 0, "FMI %d: enter init", a->v);
+        CHECK(deserialize(&y, bytes, size, &s2) == 0 && set_state(&y, s2) == 0,
+              "FMI %d: restore %s: %s", a->v, init ? "in init" : "after instantiation", g_last_log);
+        if (init) CHECK(exit_init(&y) == 0, "FMI %d: exit init after restore", a->v);
+        y.t = 40 * 1e-3;
+        run(&y, 40, N_HIST - 40, again);
+        CHECK(memcmp(first, again, 2 * (N_HIST - 40) * sizeof(double)) == 0,
+              "FMI %d: restored %s: continuation differs", a->v,
+              init ? "during initialization" : "after instantiation");
+        free_state(&y, &s2);
+        release(&y);
+    }
+    free_state(&x, &s);
+    free(bytes);
+    release(&x);
+}
+
+/* Instantiation and results under a decimal-comma locale equal those in "C". */
+static void test_decimal_comma_locale(const api *a)
+{
+    static const char *const names[2] = {"de_DE.UTF-8", "fr_FR.UTF-8"};
+    double plain[2 * N_HIST], comma[2 * N_HIST];
+    inst x = start(a, "C locale");
+    int i;
+    if (!x.c) return;
+    run(&x, 0, N_HIST, plain);
+    release(&x);
+    for (i = 0; i < 2 && !setlocale(LC_ALL, names[i]); i++) {}
+    if (i == 2) {
+        printf("FMI %d: no decimal-comma locale (make locale generates one): skipped\n", a->v);
+        return;
+    }
+    CHECK(strcmp(localeconv()->decimal_point, ",") == 0, "%s has no decimal comma", names[i]);
+    x = start(a, "comma locale");
+    if (x.c) {
+        run(&x, 0, N_HIST, comma);
+        CHECK(memcmp(plain, comma, sizeof plain) == 0, "FMI %d: results differ under %s",
+              a->v, names[i]);
+        release(&x);
+    }
+    setlocale(LC_ALL, "C");
 }
 
 static void check_fd(inst *x, unsigned int known, double base, double delta, const char *what)
@@ -361,6 +427,8 @@ int main(int argc, char **argv)
             test_state_machine(apis[i]);
             test_nonfinite_inputs(apis[i]);
             test_rollback_and_serialization(apis[i]);
+            test_restore_into_fresh_instances(apis[i]);
+            test_decimal_comma_locale(apis[i]);
             test_directional_derivatives(apis[i]);
             test_side_by_side(apis[i], apis[1 - i]);
             test_unsupported(apis[i]);
