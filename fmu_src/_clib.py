@@ -1,10 +1,9 @@
 """The one ctypes layer over the C core (``fmu_src/core/iwan.h``): library, structs, signatures.
 
 Every C function the Python side calls is declared here once, with typed
-arguments: the structs by pointer to their ctypes mirror, arrays as typed pointers
-(:class:`DoubleArray`, :class:`StateArray`) that accept a numpy array of the right
-dtype (C-contiguous) or ``None`` for a NULL pointer, scalar outputs as
-``POINTER(c_double)`` / ``POINTER(c_int)``. ``tests/element/test_clib_header.py``
+arguments: the structs by pointer to their ctypes mirror, arrays as
+``POINTER(c_double)`` / ``POINTER(State)`` (:func:`arr` turns a numpy array into
+one, ``None`` is NULL), scalar outputs as ``POINTER(c_double)`` / ``POINTER(c_int)``. ``tests/element/test_clib_header.py``
 parses ``iwan.h`` and checks every declaration (and every struct field) against it.
 
 :mod:`fmu_src.element` and :mod:`fmu_src.element_batch` both import this module and
@@ -19,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MAX_SLIDERS", "STATE_VERSION", "Model", "State", "Output", "STATE_DTYPE",
-           "DoubleArray", "StateArray", "FUNCTIONS", "lib", "check", "IwanInputError",
+           "DoubleArray", "StateArray", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
            "IwanNotConvergedError", "vec", "normal"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h (the header test checks it)
@@ -60,32 +59,33 @@ class Output(ct.Structure):
 STATE_DTYPE = np.dtype(State)
 
 
-# ------------------------------------------------------------------ typed array pointers
-def _array_pointer(ctype, dtype, what: str):
-    """A pointer type to ``ctype`` whose arguments may be numpy arrays of ``dtype``."""
-
-    class ArrayPointer(ct._Pointer):
-        _type_ = ctype
-
-        @classmethod
-        def from_param(cls, obj):
-            if obj is None:
-                return None
-            if isinstance(obj, np.ndarray):
-                if obj.dtype != dtype or not obj.flags.c_contiguous:
-                    raise TypeError(f"expected a C-contiguous {what} array, got {obj.dtype} "
-                                    f"(contiguous: {obj.flags.c_contiguous})")
-                return ct.c_void_p(obj.ctypes.data)
-            return type(cls).from_param(cls, obj)   # a ctypes pointer of this very type
-
-    ArrayPointer.__name__ = f"{ctype.__name__}_array"
-    return ArrayPointer
+# ------------------------------------------------------------------ typed pointers
+#: ``double *``: arrays are passed as ``arr(x)`` (a float64 C-contiguous numpy array).
+DoubleArray = ct.POINTER(ct.c_double)
+#: ``iwan_state *``: one state (``ct.byref``) or a batch (``arr(states, StateArray)``).
+StateArray = ct.POINTER(State)
 
 
-#: ``double *`` / ``const double *``: a float64 numpy array, a pointer of this type, or None.
-DoubleArray = _array_pointer(ct.c_double, np.dtype(np.float64), "float64")
-#: ``iwan_state *`` for batches: a numpy array of :data:`STATE_DTYPE`, or a pointer.
-StateArray = _array_pointer(State, STATE_DTYPE, "STATE_DTYPE")
+def arr(a, kind=DoubleArray):
+    """Typed pointer to the data of numpy array ``a`` (None -> NULL).
+
+    ``a`` must be C-contiguous with the pointer's dtype (float64, or
+    :data:`STATE_DTYPE` for ``StateArray``); the callers make it so (``vec``).
+    The conversion happens here (``byref`` of the buffer when writeable, the cheapest
+    typed form; a cast pointer otherwise), so that ctypes checks only the pointer type,
+    a C-level test, at the call; a fixed argument list resolved once (``BatchStepper``)
+    can be reused for every call.
+    """
+    if a is None:
+        return None
+    want = STATE_DTYPE if kind is StateArray else np.float64
+    if a.dtype != want or not a.flags.c_contiguous:
+        raise TypeError(f"expected a C-contiguous {np.dtype(want)} array, got {a.dtype} "
+                        f"(contiguous: {a.flags.c_contiguous})")
+    if a.flags.writeable:
+        return ct.byref(kind._type_.from_buffer(a))
+    return a.ctypes.data_as(kind)
+
 
 _S, _D, _I = ct.c_size_t, ct.c_double, ct.c_int
 _PM, _PS, _PO = ct.POINTER(Model), ct.POINTER(State), ct.POINTER(Output)

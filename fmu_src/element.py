@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _clib
-from ._clib import MAX_SLIDERS, IwanInputError, IwanNotConvergedError, Model, Output, State
+from ._clib import MAX_SLIDERS, IwanInputError, IwanNotConvergedError, Model, Output, State, arr
 from ._clib import check as _check
 from ._clib import normal as _normal
 from ._clib import vec as _vec
@@ -159,7 +159,8 @@ class IwanElement:
         if tail == "flat":
             u, T = flat_tail(u, T)
         model = Model()
-        status = _lib.iwan_model_init(ct.byref(model), u, T, u.size, float(N_ref), _FIT_CODE[fit])
+        status = _lib.iwan_model_init(ct.byref(model), arr(u), arr(T), u.size, float(N_ref),
+                                      _FIT_CODE[fit])
         if status == 2:    # every other table rule was checked above: the slider limit
             raise IwanInputError(f"IwanElement.from_curve: the curve has more than {MAX_SLIDERS} "
                                  "slope changes (the element's limit); reduce it with "
@@ -194,7 +195,7 @@ class IwanElement:
         if k.ndim != 1 or k.shape != fs.shape or k.size > MAX_SLIDERS:
             raise IwanInputError(f"k and fs must have the same shape (n,), n <= {MAX_SLIDERS}")
         model = Model()
-        _check(_lib.iwan_model_from_sliders(ct.byref(model), k, fs, k.size, float(k_res),
+        _check(_lib.iwan_model_from_sliders(ct.byref(model), arr(k), arr(fs), k.size, float(k_res),
                                             float(N_ref)), "IwanElement.from_sliders")
         return cls(model)
 
@@ -307,8 +308,8 @@ class IwanElement:
         else:
             st = state.copy()
         out = np.empty((4, n))
-        _check(_lib.iwan_series(self._mp, ct.byref(st._raw), n, u, Nv, out[0], out[1], out[2],
-                                out[3]), "IwanElement.series")
+        _check(_lib.iwan_series(self._mp, ct.byref(st._raw), n, arr(u), arr(Nv), arr(out[0]),
+                                arr(out[1]), arr(out[2]), arr(out[3])), "IwanElement.series")
         return SeriesResult(out[0], out[1], out[2], out[3], st)
 
     def periodic(self, u, N=None, max_periods: int = 100, tol: float = 1e-12) -> PeriodicResult:
@@ -324,7 +325,8 @@ class IwanElement:
         out = np.empty((3, n))
         w = ct.c_double()
         p = ct.c_int()
-        _check(_lib.iwan_periodic(self._mp, n, u, Nv, out[0], out[1], out[2], ct.byref(w),
+        _check(_lib.iwan_periodic(self._mp, n, arr(u), arr(Nv), arr(out[0]), arr(out[1]),
+                                  arr(out[2]), ct.byref(w),
                                   int(max_periods), float(tol), ct.byref(p)),
                "IwanElement.periodic")
         return PeriodicResult(out[0], out[1], out[2], w.value, p.value)
@@ -366,7 +368,8 @@ class IwanElement:
         dFdXN = None if ENa is None else np.empty((n, nb))
         w = ct.c_double()
         p = ct.c_int()
-        _check(_lib.iwan_periodic_jac(self._mp, n, u, Nv, Eu, ENa, nb, F, dFdX, dFdXN,
+        _check(_lib.iwan_periodic_jac(self._mp, n, arr(u), arr(Nv), arr(Eu), arr(ENa), nb, arr(F),
+                                      arr(dFdX), arr(dFdXN),
                                       ct.byref(w), int(max_periods), float(tol), ct.byref(p)),
                "IwanElement.periodic_jac")
         return F, dFdX, dFdXN, w.value

@@ -168,6 +168,24 @@ static void test_rollback_and_serialization(const api *a)
     CHECK(memcmp(first, other, sizeof first) == 0,
           "FMI %d: deserialized continuation not bit-identical", a->v);
     expect_error(&y, deserialize(&y, junk, sizeof junk, &s2), "deserializing 16 junk bytes");
+    {   /* 1000 states with 1..4 bytes changed at random places: every one refused */
+        unsigned char *bad = (unsigned char *)malloc(size);
+        unsigned int seed = 20261123u, k, j, refused = 0;
+        void *s3 = NULL;
+        for (k = 0; bad && k < 1000; k++) {
+            size_t pos;
+            memcpy(bad, bytes, size);
+            seed = seed * 1103515245u + 12345u;
+            pos = (seed >> 8) % size;
+            for (j = 0; j <= k % 4; j++) {  /* distinct bytes, each really changed */
+                seed = seed * 1103515245u + 12345u;
+                bad[(pos + 97u * j) % size] ^= (unsigned char)(1u + (seed >> 20) % 255u);
+            }
+            refused += deserialize(&y, bad, size, &s3) == 3;
+        }
+        CHECK(refused == 1000, "FMI %d: %u of 1000 corrupted states refused", a->v, refused);
+        free(bad);
+    }
     memset(bytes, 0xAB, 8);  /* corrupt the magic and version */
     expect_error(&y, deserialize(&y, bytes, size, &s2), "deserializing a corrupted state");
     /* An importer passing an uninitialized FMUstate (FMI4j 0.38 does) gets a new
