@@ -4,7 +4,8 @@ Every C function the Python side calls is declared here once, with typed
 arguments: the structs by pointer to their ctypes mirror, arrays as
 ``POINTER(c_double)`` / ``POINTER(State)`` (:func:`arr` turns a numpy array into
 one, ``None`` is NULL), scalar outputs as ``POINTER(c_double)`` / ``POINTER(c_int)``.
-``tests/element/test_clib_header.py`` parses ``iwan.h`` and checks every declaration (and every struct field) against it.
+``tests/element/test_clib_header.py`` parses ``iwan.h`` and checks every declaration
+(and every struct field) against it.
 
 :mod:`fmu_src.element` and :mod:`fmu_src.element_batch` both import this module and
 never each other both ways. Symbols as in :mod:`fmu_src.element`.
