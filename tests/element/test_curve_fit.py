@@ -114,3 +114,27 @@ def test_damper_loop_names_the_bad_point(tmp_path, capsys):
     path = write_curve(VirginCurve(u=u, T=T, N=N_SPHERE), tmp_path / "bad.json")
     assert main(["loop", "--curve", str(path), "--amplitude", "1e-6"]) == 2
     assert "not concave at point 3" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_damper_fmu_reduces_a_long_curve_like_the_element(tmp_path, capsys):
+    """damper fmu: the same reduced curve as IwanElement.from_virgin_curve, error printed."""
+    from fmpy import simulate_fmu
+
+    u, T = cattaneo_table(600)
+    curve = VirginCurve(u=u[:-1], T=T[:-1], N=N_SPHERE, mu=MU, tail="flat")
+    path = write_curve(curve, tmp_path / "long.json")
+    out = tmp_path / "long.fmu"
+    assert main(["fmu", "--curve", str(path), "-o", str(out)]) == 0
+    err = capsys.readouterr().err
+    el = IwanElement.from_virgin_curve(curve)
+    assert f"{el.fit_error:.3g} N" in err and el.fit_error > 0.0
+    t = np.arange(40) * 1e-3
+    hist = 1.5 * u[-2] * np.sin(0.3 * np.arange(40))
+    res = simulate_fmu(str(out), start_time=0.0, stop_time=t[-1], output_interval=1e-3,
+                       input=np.array(list(zip(t, hist)), dtype=[("time", float), ("u", float)]),
+                       output=["F"])
+    ref = el.series(hist).F
+    # fmpy records each output one sample late (it applies the next input after recording)
+    np.testing.assert_allclose(res["F"][1:len(ref)], ref[:-1][: len(res["F"]) - 1], rtol=0,
+                               atol=1e-12 * MU * N_SPHERE)
