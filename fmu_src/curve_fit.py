@@ -37,8 +37,9 @@ TAILS = ("slope", "flat")
 #: A slope may exceed the previous one by this fraction of the largest slope (round-off
 #: of collinear points) before the table counts as not concave (IWAN_CONCAVE_RTOL in iwan.c).
 CONCAVE_RTOL = 1e-9
-#: Bisection on the reduction error stops at this fraction of the one-chord error.
-_BISECT_RTOL = 1e-12
+#: Bisection on the reduction error stops at this relative width: the fit is optimal to
+#: this fraction (its reported error is exact, measured on the kept chords).
+_BISECT_RTOL = 1e-6
 
 
 def check_table(u, T, fit: str = "reject") -> tuple[np.ndarray, np.ndarray]:

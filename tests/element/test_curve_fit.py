@@ -64,11 +64,13 @@ def test_reduction_is_min_max_optimal_and_its_error_exact(m, K):
     assert len(ur) - 1 <= K and ur[0] == 0.0 and ur[-1] == u[-1] and Tr[-1] == T[-1]
     # reported error = measured error of the fit on every point (both are linear between points)
     assert error == pytest.approx(np.max(np.abs(np.interp(u, ur, Tr) - T)), rel=1e-12)
-    # optimal: the brute-force min-max over all subsets with K chords, to the bisection's 1e-12
-    assert error == pytest.approx(_exact_minmax(u, T, K), rel=1e-9)
+    # optimal: the brute-force min-max over all subsets with K chords, to the bisection's
+    # relative width (1e-6)
+    assert error == pytest.approx(_exact_minmax(u, T, K), rel=1.5e-6)
     assert np.all(np.diff(np.diff(Tr) / np.diff(ur)) <= 0.0)    # still concave
 
 
+@pytest.mark.slow
 def test_long_curve_is_reduced_to_the_element_limit_with_its_error():
     u, T = cattaneo_table(2000)
     curve = VirginCurve(u=u[:-1], T=T[:-1], N=N_SPHERE, mu=MU, tail="flat")
@@ -79,8 +81,8 @@ def test_long_curve_is_reduced_to_the_element_limit_with_its_error():
     # the element's virgin curve is the fit: its force differs from the table by <= error
     F = el.virgin(curve.u)
     assert np.max(np.abs(F - curve.T)) <= error * (1 + 1e-9) + 1e-12 * MU * N_SPHERE
-    # 2000 uniform-T segments of Cattaneo-Mindlin, 256 chords: measured 3.4e-4 N (of 50 N)
-    assert 0.0 < error < 5e-4
+    # 2000 uniform-T segments of Cattaneo-Mindlin, 256 chords: measured 1.43e-4 N (of 50 N)
+    assert 0.0 < error < 2.2e-4
     small = VirginCurve(u=U_TAB, T=T_TAB, N=N_SPHERE)
     assert reduce_virgin_curve(small) == (small, 0.0)
 
