@@ -365,7 +365,7 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     if (check_bounds(inst, inst->h.value, "DoStep") != FMU_OK
         || (moves && check_bounds(inst, end, "DoStep (extrapolated input)") != FMU_OK))
         return FMU_ERROR;
-    memcpy(inst->trial, inst->history, model_history_size());
+    model_copy_history(inst->model, inst->trial, inst->history);
     why = model_commit(inst->model, inst->trial, inst->h.value, inst->out);
     if (!why && moves) why = model_commit(inst->model, inst->trial, end, inst->out);
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";

@@ -29,6 +29,10 @@ typedef struct {
 size_t model_size(void);          /* bytes of a built model */
 size_t model_history_size(void);  /* bytes of a committed history */
 
+/* Copy history `src` to `dst` (only what the model uses: doStep copies the history
+ * once per step to stay all-or-nothing, so this is on the hot path). */
+void model_copy_history(const void *model, void *dst, const void *src);
+
 /* Build `model` from the table and the parameters in `value`. */
 const char *model_build(void *model, const model_table *table, const double *value);
 

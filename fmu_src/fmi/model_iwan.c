@@ -6,6 +6,7 @@
  * k (u - z) at large |u| could exceed it by a few ulps of k |u|). */
 #include <float.h>
 #include <math.h>
+#include <stddef.h>
 #include <string.h>
 
 #include "damper_vr.h"
@@ -29,6 +30,16 @@ typedef struct {
 
 size_t model_size(void) { return sizeof(iwan_fmu_model); }
 size_t model_history_size(void) { return sizeof(iwan_state); }
+
+/* Header, the n sliders in use and dir: the rest of z stays zero in every history. */
+void model_copy_history(const void *model, void *dst, const void *src)
+{
+    const int32_t n = ((const iwan_fmu_model *)model)->m.n;
+    iwan_state *d = (iwan_state *)dst;
+    const iwan_state *s = (const iwan_state *)src;
+    memcpy(d, s, offsetof(iwan_state, z) + (size_t)n * sizeof(double));
+    d->dir = s->dir;
+}
 
 const char *model_build(void *model, const model_table *t, const double *value)
 {
