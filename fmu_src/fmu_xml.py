@@ -279,7 +279,13 @@ def render_vr_header() -> str:
     lines += [f"    START_{v.start.upper()},  /* {v.name} */" for v in VARIABLES]
     lines += ["};", "static const char *const damper_name_of[DAMPER_N_VARIABLES] = {"]
     lines += [f'    "{escape(v.name)}",' for v in VARIABLES]
-    lines += ["};", "", "/* log categories */",
+    lines += ["};", "", "/* value references of the inputs and of the outputs */"]
+    for caus in ("input", "output"):
+        vrs = [str(v.vr) for v in by_causality(caus)]
+        lines += [f"#define DAMPER_N_{caus.upper()}S {len(vrs)}",
+                  f"static const unsigned int damper_{caus}s[DAMPER_N_{caus.upper()}S] = "
+                  "{" + ", ".join(vrs) + "};"]
+    lines += ["", "/* log categories */",
               f"#define DAMPER_N_LOG_CATEGORIES {len(LOG_CATEGORIES)}",
               "static const char *const damper_log_categories[DAMPER_N_LOG_CATEGORIES] = {"]
     lines += [f'    "{n}",' for n, _ in LOG_CATEGORIES]

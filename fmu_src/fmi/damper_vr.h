@@ -61,6 +61,12 @@ static const char *const damper_name_of[DAMPER_N_VARIABLES] = {
     "stored_energy",
 };
 
+/* value references of the inputs and of the outputs */
+#define DAMPER_N_INPUTS 2
+static const unsigned int damper_inputs[DAMPER_N_INPUTS] = {1, 2};
+#define DAMPER_N_OUTPUTS 5
+static const unsigned int damper_outputs[DAMPER_N_OUTPUTS] = {3, 4, 5, 6, 9};
+
 /* log categories */
 #define DAMPER_N_LOG_CATEGORIES 2
 static const char *const damper_log_categories[DAMPER_N_LOG_CATEGORIES] = {

@@ -159,12 +159,15 @@ void fmu_reset(fmu_instance *inst)
 fmu_status fmu_ensure_model(fmu_instance *inst)
 {
     const char *why;
+    int i;
     if (inst->model_ready) return FMU_OK;
     why = model_build(inst->model, &inst->table, inst->h.value);
     if (!why && !inst->h.has_history) why = model_reset(inst->model, inst->history, inst->h.value);
     if (why)
         return fmu_log(inst, FMU_ERROR, "cannot build the model (scale = %g, N_ref = %g N): %s",
                        inst->h.value[VR_SCALE], inst->h.value[VR_N_REF], why);
+    for (i = 0; i < DAMPER_N_INPUTS; i++)
+        inst->bound[damper_inputs[i]] = model_input_bound(inst->model, damper_inputs[i]);
     inst->model_ready = 1;
     inst->out_valid = 0;
     return FMU_OK;
@@ -173,25 +176,23 @@ fmu_status fmu_ensure_model(fmu_instance *inst)
 /* Error (logged) if an input of `value` lies beyond the model's bound. */
 static fmu_status check_bounds(fmu_instance *inst, const double *value, const char *what)
 {
-    int vr;
-    for (vr = 0; vr < DAMPER_N_VARIABLES; vr++) {
-        double bound;
-        if (damper_causality_of[vr] != CAUS_INPUT) continue;
-        bound = model_input_bound(inst->model, (unsigned int)vr);
-        if (fabs(value[vr]) > bound)
+    int i;
+    for (i = 0; i < DAMPER_N_INPUTS; i++) {
+        const unsigned int vr = damper_inputs[i];
+        if (fabs(value[vr]) > inst->bound[vr])
             return fmu_log(inst, FMU_ERROR, "%s: input %s = %g is beyond the bound |%s| <= %.17g "
                            "of this FMU (see its documentation: beyond it double precision "
                            "cannot represent the element's slip distances)", what,
-                           damper_name_of[vr], value[vr], damper_name_of[vr], bound);
+                           damper_name_of[vr], value[vr], damper_name_of[vr], inst->bound[vr]);
     }
     return FMU_OK;
 }
 
 static int outputs_finite(const double *out)
 {
-    int vr;
-    for (vr = 0; vr < DAMPER_N_VARIABLES; vr++)
-        if (damper_causality_of[vr] == CAUS_OUTPUT && !isfinite(out[vr])) return 0;
+    int i;
+    for (i = 0; i < DAMPER_N_OUTPUTS; i++)
+        if (!isfinite(out[damper_outputs[i]])) return 0;
     return 1;
 }
 
@@ -199,8 +200,8 @@ static int outputs_finite(const double *out)
 static fmu_status ensure_outputs(fmu_instance *inst)
 {
     const char *why;
+    if (inst->out_valid) return FMU_OK;  /* implies model_ready */
     if (fmu_ensure_model(inst) != FMU_OK) return FMU_ERROR;
-    if (inst->out_valid) return FMU_OK;
     if (check_bounds(inst, inst->h.value, "evaluating the outputs") != FMU_OK) return FMU_ERROR;
     why = model_eval(inst->model, inst->history, inst->h.value, inst->out);
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
@@ -280,7 +281,7 @@ fmu_status fmu_set(fmu_instance *inst, const unsigned int *vr, size_t n, const d
                            vr[i], vr[i] < DAMPER_N_VARIABLES ? damper_name_of[vr[i]] : "?",
                            v[i], why);
         if (damper_causality_of[vr[i]] == CAUS_INPUT && inst->model_ready) {
-            double bound = model_input_bound(inst->model, vr[i]);
+            double bound = inst->bound[vr[i]];
             if (fabs(v[i]) > bound)
                 return fmu_log(inst, FMU_ERROR, "cannot set %s to %g: beyond the bound |%s| <= "
                                "%.17g of this FMU (stated in its documentation: double precision "
@@ -344,7 +345,7 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     double end[DAMPER_N_VARIABLES];
     const char *why = NULL;
     unsigned char *swap;
-    int vr, moves = 0;
+    int i, moves = 0;
     if (fmu_check_mode(inst, MODE_STEP, "DoStep")) return FMU_ERROR;
     if (!isfinite(t) || !isfinite(h) || !(h > 0.0))
         return fmu_log(inst, FMU_ERROR, "DoStep: bad step t = %g, h = %g (the step size must "
@@ -353,14 +354,16 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
         return fmu_log(inst, FMU_ERROR, "DoStep at t = %.17g, but the FMU is at t = %.17g",
                        t, inst->h.time);
     if (fmu_ensure_model(inst) != FMU_OK) return FMU_ERROR;
-    memcpy(end, inst->h.value, sizeof end);
-    for (vr = 0; vr < DAMPER_N_VARIABLES; vr++) {
-        if (damper_causality_of[vr] != CAUS_INPUT || inst->h.deriv[vr] == 0.0) continue;
-        end[vr] += inst->h.deriv[vr] * h;
-        moves = 1;
-        if (!isfinite(end[vr]))
-            return fmu_log(inst, FMU_ERROR, "DoStep: extrapolated input %s overflows",
-                           damper_name_of[vr]);
+    for (i = 0; i < DAMPER_N_INPUTS; i++) moves |= inst->h.deriv[damper_inputs[i]] != 0.0;
+    if (moves) {  /* FMI 2 input derivatives: the inputs' values at t + h */
+        memcpy(end, inst->h.value, sizeof end);
+        for (i = 0; i < DAMPER_N_INPUTS; i++) {
+            const unsigned int vr = damper_inputs[i];
+            end[vr] += inst->h.deriv[vr] * h;
+            if (!isfinite(end[vr]))
+                return fmu_log(inst, FMU_ERROR, "DoStep: extrapolated input %s overflows",
+                               damper_name_of[vr]);
+        }
     }
     if (check_bounds(inst, inst->h.value, "DoStep") != FMU_OK
         || (moves && check_bounds(inst, end, "DoStep (extrapolated input)") != FMU_OK))
@@ -371,14 +374,17 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
     if (why) {
         inst->out_valid = 0;
-        return fmu_log(inst, FMU_ERROR, "DoStep to u = %g m, N = %g N refused: %s", end[VR_U],
-                       end[VR_N], why);
+        return fmu_log(inst, FMU_ERROR, "DoStep to u = %g m, N = %g N refused: %s",
+                       (moves ? end : inst->h.value)[VR_U], (moves ? end : inst->h.value)[VR_N],
+                       why);
     }
     swap = inst->history;
     inst->history = inst->trial;
     inst->trial = swap;
-    memcpy(inst->h.value, end, sizeof end);
-    memset(inst->h.deriv, 0, sizeof inst->h.deriv);  /* valid for one step only */
+    if (moves) {
+        memcpy(inst->h.value, end, sizeof end);
+        memset(inst->h.deriv, 0, sizeof inst->h.deriv);  /* valid for one step only */
+    }
     inst->out_valid = 1;
     inst->h.time = t + h;
     return FMU_OK;

@@ -20,6 +20,7 @@ struct fmu_instance {
                                    history) match the parameters */
     int out_valid;              /* `out` holds the outputs at the current inputs */
     double out[DAMPER_N_VARIABLES];
+    double bound[DAMPER_N_VARIABLES];  /* model_input_bound of each input (model_ready) */
     model_table table;          /* resources/curve.txt */
     void **states;              /* FMU states this instance handed out */
     size_t n_states, cap_states;
