@@ -53,10 +53,9 @@ demo: $(STAMP)
 	$(PY) examples/demo.py --out out
 
 # Benchmarks print tables (case, size, error, time, memory); long, never in CI.
-BENCHES := contact tangential element fmu hb
+# One report of every stage (out/bench/bench.html, bench.json), sparse back ends included.
 bench: $(STAMP) cbuild
-	@for b in $(BENCHES); do echo "== examples/bench_$$b.py"; \
-	  $(PY) examples/bench_$$b.py || exit 1; done
+	nice $(VENV)/bin/damper bench --solvers --out out/bench
 
 # Optional accelerator: the system's CHOLMOD (scikit-sparse) for the FE condensation, same
 # answers as PARDISO and the scipy fallback, as fast as PARDISO. Needs root for apt-get.

@@ -105,4 +105,23 @@ def write(out: Path, result: dict) -> tuple[Path, Path]:
     parts.append("</body></html>")
     j = atomic_write(out / "bench.json", json.dumps(result, indent=1) + "\n")
     h = atomic_write(out / "bench.html", "\n".join(parts))
+    atomic_write(out / "bench.md", markdown(result))
     return j, h
+
+
+def markdown(result: dict) -> str:
+    """Markdown tables of every stage (what the README quotes), with the run's stamp."""
+    s = result["stamp"]
+    out = [f"Run {s['date_utc']}, revision {s['revision']}, {s['cores']} cores, {s['machine']}, "
+           f"load average {s['load_average'][0]:.1f}, sparse back ends {', '.join(s['sparse_solvers'])}.", ""]
+    for stage, rows in result["stages"].items():
+        size_label, err_label = LEGEND.get(stage, ("size", "error"))
+        out += [f"**{stage}** (size: {size_label}; error: {err_label})", "",
+                "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
+        for r in rows:
+            err = "-" if r["error"] is None else f"{r['error']:.2e}"
+            star = " (default)" if r.get("default") else ""
+            out.append(f"| {r['case']}{star} | {r['size']:g} | {err} | {r['time_s']:.2f} | {r['memory_mb']:.0f} | "
+                       f"{'yes' if r['cached'] else 'no'} |")
+        out.append("")
+    return "\n".join(out)

@@ -50,7 +50,7 @@ def _cli_json(argv, log, timeout=TIMEOUT_S, env=None):
 def contact(quick: bool, work: Path, log=print) -> list[Row]:
     """Normal contact of the sphere: grid against Hertz error, cold and cached (default: real, grid 21)."""
     cases = [("halfspace", 5), ("halfspace", 9)] if quick else \
-        [("halfspace", g) for g in (11, 21, 31, 41)] + [("real", g) for g in (11, 21, 31, 41)]
+        [("halfspace", g) for g in (11, 21, 41)] + [("real", g) for g in (11, 21, 31)]  # real 41: stage "solvers"
     rows = []
     for model, grid in cases:
         cache = work / f"cache_{model}_{grid}"

@@ -10,6 +10,9 @@ import math
 
 import numpy as np
 
+#: Contact size off Hertz by more than this without the ``under_resolved`` flag is a
+#: silently wrong number: grids of 11 nodes resolve a Hertz contact to ~5-10 %.
+HERTZ_SIZE_TOL = 0.25
 #: Largest relative violation of an invariant that counts as round-off. The
 #: solvers stop at ~1e-9 relative (normal active set, tangential march); 1e-6
 #: leaves three decades of margin and still catches any real error.
@@ -46,6 +49,9 @@ def normal(out: dict, req: dict) -> tuple[float, str]:
          (max(-out.get("min_force", 0.0), 0.0) / max(abs(out["force"]), 1e-300), "tensile contact force")]
     if out["approach"] < 0 or out["k_n"] <= 0:
         p.append((1.0, "negative approach or k_n"))
+    err = abs((out.get("hertz") or {}).get("error_size") or 0.0)
+    if err > HERTZ_SIZE_TOL and not out.get("under_resolved"):
+        p.append((err, "contact size off Hertz without the under_resolved flag"))
     return _worst(p)
 
 
