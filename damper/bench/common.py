@@ -11,6 +11,7 @@ import json
 import os
 import platform
 import resource
+import signal
 import subprocess
 import sys
 import time
@@ -80,18 +81,22 @@ def run_child(argv: list[str], timeout: float, env: dict | None = None, python_c
     full_env.update(env or {})
     cmd = [sys.executable, "-c", wrapper, sys.executable, "-c", python_code, *map(str, argv)]
     t0 = time.perf_counter()
+    # own session: on a timeout the whole group (wrapper and command) is killed, no orphan left running
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=full_env, cwd=cwd,
+                         start_new_session=True)
     try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=full_env, cwd=cwd)
-    except subprocess.TimeoutExpired as err:
-        out = err.stdout.decode() if isinstance(err.stdout, bytes) else (err.stdout or "")
-        return ChildResult(None, out, "", time.perf_counter() - t0, float("nan"))
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        out, _ = p.communicate()
+        return ChildResult(None, out or "", "", time.perf_counter() - t0, float("nan"))
     wall = time.perf_counter() - t0
-    stderr, _, tail = p.stderr.rpartition("\n@@maxrss ")
+    stderr, _, tail = err.rpartition("\n@@maxrss ")
     try:
         mem = int(tail.strip()) / 1024.0  # kB -> MB (Linux)
     except ValueError:
-        stderr, mem = p.stderr, float("nan")
-    return ChildResult(p.returncode, p.stdout, stderr, wall, mem)
+        stderr, mem = err, float("nan")
+    return ChildResult(p.returncode, out, stderr, wall, mem)
 
 
 def self_peak_mb() -> float:

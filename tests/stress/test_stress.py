@@ -46,3 +46,11 @@ def test_fmu_check_uses_trapezoid_slack():
     assert checks.check("fmu", dict(base, stored=-1e-6, slack=2e-6), {})[0] == "converged"
     assert checks.check("fmu", dict(base, stored=-1e-5, slack=2e-6), {})[0] == "wrong"
     assert np.isfinite(checks.fmu(dict(base, stored=0.0, slack=0.0), {})[0])
+
+
+def test_a_hang_is_detected_and_killed():
+    from damper.bench.common import run_child
+
+    t0 = __import__("time").perf_counter()
+    r = run_child([], timeout=2.0, python_code="import time; time.sleep(60)")
+    assert r.code is None and __import__("time").perf_counter() - t0 < 20.0
