@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core import tangential_reference as tr
+
 from .common import Row, run_child
 
 R, N0, MU = 0.01, 200.0, 0.5
@@ -68,8 +70,15 @@ def contact(quick: bool, work: Path, log=print) -> list[Row]:
     return rows
 
 
+#: Steel on steel G* [Pa] and the Hertz radius [m] that put Mindlin's gross slip at U_SLIP.
+GS = tr.shear_modulus_star(2e11, 0.3, 2e11, 0.3)
+A_HERTZ = 3.0 * MU * N0 / (16.0 * GS * U_SLIP)
+
+
 def _mindlin(u, u_slip, muN):
-    return muN * (1.0 - (1.0 - np.minimum(u, u_slip) / u_slip) ** 1.5)
+    """Mindlin's virgin curve with gross slip at u_slip (contact_core's law, G* a chosen to match)."""
+    a = 3.0 * muN / (16.0 * GS * u_slip)  # u_s = 3 mu N / (16 G* a)
+    return tr.mindlin_force(u, muN / MU, MU, a, GS)
 
 
 def tangential(quick: bool, work: Path, log=print) -> list[Row]:
@@ -99,10 +108,9 @@ def _curve_file(path: Path, n: int) -> Path:
 
 
 def _masing_exact(a: float) -> float:
-    """Loop energy of the exact Mindlin curve: 8 int_0^a g du - 4 a g(a) [J]."""
-    muN = MU * N0
-    integral = muN * (a - U_SLIP / 2.5 * (1.0 - (1.0 - a / U_SLIP) ** 2.5))
-    return 8.0 * integral - 4.0 * a * _mindlin(a, U_SLIP, muN)
+    """Loop energy of the exact Mindlin curve at displacement amplitude a: Mindlin-Deresiewicz's
+    energy at the force amplitude T(a) [J] (= Masing's 8 int_0^a g du - 4 a g(a))."""
+    return float(tr.mindlin_deresiewicz_energy(float(_mindlin(a, U_SLIP, MU * N0)), N0, MU, A_HERTZ, GS))
 
 
 def element(quick: bool, work: Path, log=print) -> list[Row]:
