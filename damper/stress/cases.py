@@ -46,7 +46,8 @@ def _normal() -> list[Case]:
         Case("normal", "coarsest grid 3", ["normal", *SPHERE, "--force", "200", "--model", "halfspace", "--grid", "3",
                                            "--json", "--no-cache"], {"force": N0}),
         Case("normal", "finest grid 81 halfspace", ["normal", *SPHERE, "--force", "200", "--model", "halfspace",
-                                                    "--grid", "81", "--json", "--no-cache"], {"force": N0}),
+                                                    "--grid", "81", "--json", "--no-cache"], {"force": N0},
+             timeout=1800.0),  # MAX_GRID: ~4 GB and minutes on a busy 2-core machine
         Case("normal", "radius 10 um, real", ["normal", "--body", "sphere", "--radius", "1e-5", "--force", "200",
                                               "--model", "real", "--grid", "11", "--json", "--no-cache"],
              {"force": N0}, quick=True),
