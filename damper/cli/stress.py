@@ -18,6 +18,7 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="the quick subset (about a minute or two)")
     p.add_argument("--stage", action="append", choices=("normal", "tangential", "loop", "fmu", "frf"),
                    help="only these stages (repeatable)")
+    p.add_argument("--case", help="only the cases whose name contains this text")
     p.add_argument("--out", default="out/stress", help="folder for stress.json and stress.md")
     p.add_argument("--json", action="store_true", help="print one JSON object with `cases`")
     p.set_defaults(func=run)
@@ -28,7 +29,9 @@ def run(args) -> int:
     from damper.stress import runner
 
     log = (lambda s: print(s, file=sys.stderr, flush=True)) if args.json else (lambda s: print(s, flush=True))
-    rows = runner.run(quick=args.quick, stages=args.stage, log=log)
+    rows = runner.run(quick=args.quick, stages=args.stage, log=log, match=args.case)
+    if not rows:
+        raise ValueError("no stress case matches --stage/--case")
     summ = runner.summary(rows)
     out = Path(args.out)
     result = {"cases": rows, "summary": summ, "quick": args.quick}
