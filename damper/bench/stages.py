@@ -82,20 +82,25 @@ def _mindlin(u, u_slip, muN):
 
 
 def tangential(quick: bool, work: Path, log=print) -> list[Row]:
-    """Virgin curve of the sphere (BEM): grid against Mindlin error (default grid 21)."""
-    grids = (7, 11) if quick else (11, 21, 41, 61)
+    """Virgin curve of the sphere: grid against Mindlin error; BEM, and FE real bodies cold and cached
+    (default: real, grid 21)."""
+    cases = [("bem", 7), ("bem", 11)] if quick else [("bem", g) for g in (11, 21, 41, 61)] + \
+        [("real", g) for g in (11, 21)]
     rows = []
-    for grid in grids:
-        out, r = _cli_json(["tangential", *SPHERE, "--mu", str(MU), "--model", "bem", "--grid", str(grid),
-                            "--no-cache", "--json"], log)
-        if out is None:
-            continue
-        muN = out["mu"] * out["normal_force"]
-        u, T = np.asarray(out["u"]), np.asarray(out["T"])
-        err = float(np.max(np.abs(T - _mindlin(u, out["mindlin"]["u_slip"], muN))) / muN)
-        rows.append(Row("sphere bem", grid, err, r.time_s, r.memory_mb, False,
-                        {"default": grid == 21, "curve_points": len(u)}))
-        log(f"  tangential bem {grid:3d} err {err:.2e} {r.time_s:6.1f} s, {len(u)} curve points")
+    for model, grid in cases:
+        cache = work / f"cache_{model}_{grid}"
+        for cached in (False, True) if model != "bem" else (False,):  # the BEM has no cache
+            out, r = _cli_json(["tangential", *SPHERE, "--mu", str(MU), "--model", model, "--grid", str(grid),
+                                "--cache-dir", str(cache), "--json"], log)
+            if out is None:
+                continue
+            muN = out["mu"] * out["normal_force"]
+            u, T = np.asarray(out["u"]), np.asarray(out["T"])
+            err = float(np.max(np.abs(T - _mindlin(u, out["mindlin"]["u_slip"], muN))) / muN)
+            rows.append(Row(f"sphere {model}", grid, err, r.time_s, r.memory_mb, cached,
+                            {"default": (model, grid) == ("real", 21), "curve_points": len(u)}))
+            log(f"  tangential {model:4s} {grid:3d} {'cached' if cached else 'cold':6s} err {err:.2e} "
+                f"{r.time_s:6.1f} s, {len(u)} curve points")
     return rows
 
 

@@ -33,17 +33,28 @@ def inputs(kind: str, steps: int, amplitude: float, per_cycle: int = POINTS_PER_
 def simulate(fmu_path: Path, dt: float, u: np.ndarray, workdir: Path, per_cycle: int = POINTS_PER_CYCLE) -> dict:
     """Drive the FMI 2 co-simulation FMU step by step; return the invariants' raw numbers."""
     from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
 
     md = read_model_description(str(fmu_path))
     vr = {v.name: v.valueReference for v in md.modelVariables}
-    unzip = extract(str(fmu_path), unzipdir=str(workdir / "unzip"))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName="stress")
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    fmu.exitInitializationMode()
+    unzip = extract(str(fmu_path), unzipdir=str(workdir / f"unzip{md.fmiVersion[0]}"))
+    ident = md.coSimulation.modelIdentifier
+    if md.fmiVersion.startswith("3"):
+        from fmpy.fmi3 import FMU3Slave
+
+        fmu = FMU3Slave(guid=md.instantiationToken, unzipDirectory=unzip, modelIdentifier=ident,
+                        instanceName="stress")
+        fmu.instantiate()
+        fmu.enterInitializationMode(startTime=0.0)
+        fmu.exitInitializationMode()
+        fmu.setReal, fmu.getReal = fmu.setFloat64, fmu.getFloat64
+    else:
+        from fmpy.fmi2 import FMU2Slave
+
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=ident, instanceName="stress")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
     out_vr = [vr["F"], vr["W"]] + ([vr["stored_energy"]] if "stored_energy" in vr else [])
     F_prev, u_prev, W_prev = 0.0, 0.0, 0.0
     work = slack = 0.0
