@@ -37,7 +37,7 @@ def _normal() -> list[Case]:
         for model, grid, quick in (("halfspace", 11, q), ("real", 11, False)):
             cases.append(Case("normal", f"load {f:g} x nominal, {model} {grid}",
                               ["normal", *SPHERE, "--force", f"{f * N0:g}", "--model", model, "--grid", str(grid),
-                               "--json", "--no-cache"], {"force": f * N0}, quick=quick))
+                               "--json", "--no-cache"], {"force": f * N0, "radius": R}, quick=quick))
     for ratio, q in ((1e-3, False), (1e-1, False), (1e3, False), (1e6, True)):
         cases.append(Case("normal", f"E2/E1 = {ratio:g}",
                           ["normal", *SPHERE, "--force", f"{N0:g}", "--E", "2e11", "--E2", f"{2e11 * ratio:g}",
@@ -61,7 +61,7 @@ def _normal() -> list[Case]:
                                                 "--grid", "11", "--json", "--no-cache"], {"force": N0}),
         Case("normal", "refused: nu = 0.5", ["normal", *SPHERE, "--force", "200", "--nu", "0.5", "--json",
                                              "--no-cache"], expect="clear_error", quick=True),
-        Case("normal", "refused: negative E", ["normal", *SPHERE, "--force", "200", "--E", "-2e11", "--json",
+        Case("normal", "refused: negative E", ["normal", *SPHERE, "--force", "200", "--E=-2e11", "--json",
                                                "--no-cache"], expect="clear_error"),
     ]
     return cases
@@ -77,7 +77,7 @@ def _tangential() -> list[Case]:
     for f, q in ((1e-6, False), (1e6, False)):
         cases.append(Case("tangential", f"load {f:g} x nominal, bem 11", [*base, "--force", f"{f * N0:g}", "--mu",
                                                                           "0.5", "--model", "bem", "--grid", "11"],
-                          {"force": f * N0}, quick=q))
+                          {"force": f * N0, "radius": R}, quick=q))
     cases += [
         Case("tangential", "real 11, nominal", [*base, "--force", "200", "--mu", "0.5", "--model", "real", "--grid",
                                                 "11"], {"force": N0}),

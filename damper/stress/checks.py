@@ -13,6 +13,9 @@ import numpy as np
 #: Contact size off Hertz by more than this without the ``under_resolved`` flag is a
 #: silently wrong number: grids of 11 nodes resolve a Hertz contact to ~5-10 %.
 HERTZ_SIZE_TOL = 0.25
+#: A contact radius beyond this fraction of the body radius is outside what Hertz and a
+#: half-space model represent (a/R small): accepted without a refusal it is a wrong number.
+CONTACT_SIZE_LIMIT = 0.5
 #: Largest relative violation of an invariant that counts as round-off. The
 #: solvers stop at ~1e-9 relative (normal active set, tangential march); 1e-6
 #: leaves three decades of margin and still catches any real error.
@@ -41,6 +44,15 @@ def _worst(pairs) -> tuple[float, str]:
     return worst, (what if worst > TOL else "")
 
 
+def _size_check(a, req: dict) -> tuple[float, str]:
+    """Contact radius a against CONTACT_SIZE_LIMIT x the body radius (when the case gives one)."""
+    R = req.get("radius")
+    if not R or a is None:
+        return 0.0, ""
+    what = f"contact radius {a:.3g} m above {CONTACT_SIZE_LIMIT} R accepted"
+    return max(a / (CONTACT_SIZE_LIMIT * R) - 1.0, 0.0), what
+
+
 def normal(out: dict, req: dict) -> tuple[float, str]:
     """Force equilibrium against the request, no penetration, no tensile contact force."""
     F = req.get("force")
@@ -49,6 +61,7 @@ def normal(out: dict, req: dict) -> tuple[float, str]:
          (max(-out.get("min_force", 0.0), 0.0) / max(abs(out["force"]), 1e-300), "tensile contact force")]
     if out["approach"] < 0 or out["k_n"] <= 0:
         p.append((1.0, "negative approach or k_n"))
+    p.append(_size_check(out.get("contact_radius"), req))
     err = abs((out.get("hertz") or {}).get("error_size") or 0.0)
     if err > HERTZ_SIZE_TOL and not out.get("under_resolved"):
         p.append((err, "contact size off Hertz without the under_resolved flag"))
@@ -65,6 +78,7 @@ def tangential(out: dict, req: dict) -> tuple[float, str]:
          (abs(out["gross_slip_force"] / muN - 1.0), "gross slip force != mu N")]
     if req.get("force"):
         p.append((abs(out["normal_force"] / req["force"] - 1.0), "normal force equilibrium"))
+    p.append(_size_check((out.get("mindlin") or {}).get("contact_radius"), req))
     return _worst(p)
 
 
