@@ -30,6 +30,8 @@ KNOWN: dict[tuple[str, str], str] = {
     ("normal", "load 1e+06 x nominal, real 11"): "finding 1 (contact): degenerate mesh instead of a load limit",
     ("normal", "load 1000 x nominal, real 11"): "finding 1 (contact): degenerate mesh instead of a load limit",
     ("normal", "radius 10 um, real"): "finding 1 (contact): degenerate mesh instead of a load limit",
+    ("normal", "load 1e+06 x nominal, halfspace 11"): "finding 4 (contact): contact beyond the body accepted",
+    ("tangential", "load 1e+06 x nominal, bem 11"): "finding 4 (contact): contact beyond the body accepted",
     ("loop", "1000-point curve, partial slip"): "finding 2 (fmu): long curves refused, rule not named",
     ("loop", "1000-point curve, full slip 1 m"): "finding 2 (fmu): long curves refused, rule not named",
     ("loop", "10000-point curve, partial slip"): "finding 2 (fmu): long curves refused, rule not named",
