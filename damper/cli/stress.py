@@ -18,7 +18,7 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="the quick subset (about a minute or two)")
     p.add_argument("--stage", action="append", choices=("normal", "tangential", "loop", "fmu", "frf"),
                    help="only these stages (repeatable)")
-    p.add_argument("--case", help="only the cases whose name contains this text")
+    p.add_argument("--case", action="append", help="only the cases whose name contains this text (repeatable)")
     p.add_argument("--out", default="out/stress", help="folder for stress.json and stress.md")
     p.add_argument("--json", action="store_true", help="print one JSON object with `cases`")
     p.set_defaults(func=run)

@@ -124,10 +124,10 @@ def run_case(case: Case, curves: dict[str, Path], work: Path) -> dict:
             "command": "damper " + " ".join(argv) if case.stage != "fmu" else "fmu_child " + " ".join(argv)}
 
 
-def run(quick: bool = False, stages=None, log=print, match: str | None = None) -> list[dict]:
-    """Run the grid (``quick``: the marked subset; ``match``: cases whose name contains it); one row per case."""
+def run(quick: bool = False, stages=None, log=print, match=None) -> list[dict]:
+    """Run the grid (``quick``: the marked subset; ``match``: cases whose name contains one of these texts)."""
     cases = [c for c in all_cases() if (c.quick or not quick) and (stages is None or c.stage in stages)
-             and (match is None or match in c.name)]
+             and (not match or any(m in c.name for m in match))]
     work = Path(tempfile.mkdtemp(prefix="damper_stress_"))
     rows = []
     try:
