@@ -112,7 +112,7 @@ def run_case(case: Case, curves: dict[str, Path], work: Path) -> dict:
         r = run_child(argv, case.timeout)
     outcome, message, worst = classify(case, r.code, r.stdout, r.stderr)
     return judge({"stage": case.stage, "case": case.name, "outcome": outcome, "expected": case.expect,
-            "known": known, "message": message, "worst_residual": None if np.isnan(worst) else worst,
+            "message": message, "worst_residual": None if np.isnan(worst) else worst,
             "time_s": round(time.perf_counter() - t0, 3),
             "command": "damper " + " ".join(argv) if case.stage != "fmu" else "fmu_child " + " ".join(argv)})
 
