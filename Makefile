@@ -21,6 +21,9 @@ $(PY):
 
 $(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
 	$(PY) -m pip install -q -e '.[dev]' > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@# Fast sparse solver without root (MKL PARDISO from pip), best effort: scipy otherwise.
+	@$(PY) -m pip install -q -e '.[fast]' >> $(VENV)/install.log 2>&1 \
+	  || echo "note: fast solver (pypardiso) not installed (see $(VENV)/install.log); using scipy"
 	@# Optional accelerator, best effort: CHOLMOD when SuiteSparse's headers are there (make accel).
 	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
 	  $(PY) -m pip install -q 'scikit-sparse<0.5' >> $(VENV)/install.log 2>&1 \
@@ -63,13 +66,12 @@ demo: $(STAMP)
 	$(PY) examples/demo.py --out out
 
 # Benchmarks print tables (case, size, error, time, memory); long, never in CI.
-BENCHES := contact tangential element fmu hb
+# One report of every stage (out/bench/bench.html, bench.json), sparse back ends included.
 bench: $(STAMP) cbuild
-	@for b in $(BENCHES); do echo "== examples/bench_$$b.py"; \
-	  $(PY) examples/bench_$$b.py || exit 1; done
+	nice $(VENV)/bin/damper bench --solvers --out out/bench
 
-# Optional accelerator: CHOLMOD (scikit-sparse) for the FE condensation, same answers
-# as the scipy fallback, 3-5x faster. Needs root for apt-get.
+# Optional accelerator: the system's CHOLMOD (scikit-sparse) for the FE condensation, same
+# answers as PARDISO and the scipy fallback, as fast as PARDISO. Needs root for apt-get.
 accel: $(STAMP)
 	apt-get update -qq && apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread
 	$(PY) -m pip install -q 'scikit-sparse<0.5'
