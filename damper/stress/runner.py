@@ -32,12 +32,6 @@ KNOWN: dict[tuple[str, str], str] = {
     ("normal", "radius 10 um, real"): "finding 1 (contact): degenerate mesh instead of a load limit",
     ("normal", "load 1e+06 x nominal, halfspace 11"): "finding 4 (contact): contact beyond the body accepted",
     ("tangential", "load 1e+06 x nominal, bem 11"): "finding 4 (contact): contact beyond the body accepted",
-    ("loop", "1000-point curve, partial slip"): "finding 2 (fmu): long curves refused, rule not named",
-    ("loop", "1000-point curve, full slip 1 m"): "finding 2 (fmu): long curves refused, rule not named",
-    ("loop", "10000-point curve, partial slip"): "finding 2 (fmu): long curves refused, rule not named",
-    ("loop", "10000-point curve, full slip 1 m"): "finding 2 (fmu): long curves refused, rule not named",
-    ("loop", "10000-point curve, stick"): "finding 2 (fmu): long curves refused, rule not named",
-    ("loop", "1000-point curve, stick"): "finding 2 (fmu): long curves refused, rule not named",
 }
 #: Words of a message that tells the user what to change (a "clear" error).
 ADVICE = re.compile(r"\b(use|refine|lower|raise|increase|reduce|decrease|must|should|give|set|try|at least|"
