@@ -31,6 +31,22 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "frf", help="forced-response curve of a friction-damped model (harmonic balance)",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_model_arguments(p)
+    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
+    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
+                   help="frequency range [rad/s]")
+    p.add_argument("--max-step", type=float, default=0.1,
+                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
+    p.add_argument("--max-points", type=int, default=2000)
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", help="also write the JSON to this file")
+    p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
+    p.set_defaults(func=run)
+
+
+def add_model_arguments(p) -> None:
+    """Model options shared by ``damper frf`` and ``damper backbone``."""
     p.add_argument("--model", required=True, help="'sdof' or a matrices .npz file")
     p.add_argument("--elements", help="friction elements .toml (with a .npz model)")
     g = p.add_argument_group("sdof model (SI units)")
@@ -43,17 +59,6 @@ def register(subparsers) -> None:
     p.add_argument("--force-scale", type=float, default=1.0,
                    help="multiply the .npz excitation by this factor")
     p.add_argument("--response-dof", type=int, help="DOF reported (default: the file's, or 0)")
-    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
-    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
-    p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
-                   help="frequency range [rad/s]")
-    p.add_argument("--max-step", type=float, default=0.1,
-                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
-    p.add_argument("--max-points", type=int, default=2000)
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", help="also write the JSON to this file")
-    p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
-    p.set_defaults(func=run)
 
 
 def build_model(args):
