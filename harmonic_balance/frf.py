@@ -269,9 +269,11 @@ def _stability(prob: FRFProblem, branch, mode):
         return None
     if full is None:
         full = FullResidual(prob.model, prob.basis)
+    V = full.viscous_operator()
+    V = V if np.any(V) else None
     out = []
     for x, w in zip(branch.x, branch.lam):
         X = prob.residual.displacements(x, w).ravel() if full is not prob.residual else x
         _, J, _ = full(X, w)
-        out.append(is_stable(J, lin, prob.basis, w)[0])
+        out.append(is_stable(J, lin, prob.basis, w, V)[0])
     return out

@@ -30,12 +30,18 @@ import scipy.linalg as sla
 STABLE_TOL = 1e-6
 
 
-def hill_matrices(linear, basis, omega: float):
-    """Delta_1, Delta_2 (N, N) of Hill's problem for a matrix model (module docstring)."""
+def hill_matrices(linear, basis, omega: float, V=None):
+    """Delta_1, Delta_2 (N, N) of Hill's problem for a matrix model (module docstring).
+
+    V : (N, N) array or None, the force elements' linear dashpots on the unknowns
+        (``FullResidual.viscous_operator()``): their velocity term adds ``lam V``.
+    """
     if linear.M is None:
         raise ValueError("Hill's method needs the mass matrix (a matrix model)")
     I = np.eye(basis.nb)
     d1 = 2.0 * omega * np.kron(basis.dtheta, linear.M) + np.kron(I, linear.C)
+    if V is not None:
+        d1 = d1 + V
     d2 = np.kron(I, linear.M)
     return d1, d2
 
@@ -61,9 +67,9 @@ def floquet_exponents(J, d1, d2, n: int, omega: float) -> np.ndarray:
     return lam[order[:2 * n]]
 
 
-def is_stable(J, linear, basis, omega: float) -> tuple[bool, float]:
+def is_stable(J, linear, basis, omega: float, V=None) -> tuple[bool, float]:
     """(stable, largest real part of the retained Floquet exponents [1/s])."""
-    d1, d2 = hill_matrices(linear, basis, omega)
+    d1, d2 = hill_matrices(linear, basis, omega, V)
     lam = floquet_exponents(J, d1, d2, linear.n, omega)
     worst = float(lam.real.max())
     return bool(worst <= STABLE_TOL * omega), worst
