@@ -6,6 +6,8 @@ a known unstable branch; plugs into :class:`aft.FrictionLink` as an element
 """
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 
 
@@ -27,3 +29,11 @@ class CubicSpring:
         """Force samples (n_t,), exact dF/dU (n_t, n_b), None, energy per cycle (0)."""
         u = np.asarray(u, dtype=float)
         return self.k3 * u**3, (3.0 * self.k3 * u**2)[:, None] * np.asarray(Eu), None, 0.0
+
+    def initial_state(self, N=None):
+        """Time-domain state (the spring has no history; ``W`` stays 0)."""
+        return SimpleNamespace(W=0.0)
+
+    def step(self, state, u, N=None):
+        """Force at displacement u (state untouched: elastic)."""
+        return SimpleNamespace(F=self.k3 * float(u) ** 3)

@@ -12,26 +12,21 @@ on a parameter through a factory ``model_at(lam) -> Model``:
 * Ready-made factories: :func:`forcing_level` and :func:`slip_scale` (every friction
   slider's strength times lam, for Iwan/Jenkins links).
 
-The first point is solved like an FRF's (Newton from the stuck guess, else the
-excitation homotopy), so the curve does not depend on where it starts.
+Curves over a parameter: :func:`frf.parameter_curve`; the contact-stiffness factory
+also serves the start of stiff models (:mod:`start`).
 """
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from .aft import FrictionLink
-from .continuation import ContinuationError, continuation
 from .fourier import FourierBasis, parse_harmonics
-from .homotopy import HomotopyError, homotopy_start
-from .residual import FullResidual, make_residual
+from .residual import make_residual
 
 #: Relative step of the central difference in lam.
 FD_STEP = 1e-6
-#: Newton tolerance relative to the stuck response's size (as frf.TOL_REL).
-TOL_REL = 1e-10
 
 
 def forcing_level(model):
@@ -56,17 +51,26 @@ def slip_scale(model):
     return at
 
 
-@dataclass
-class ParameterCurve:
-    """Solutions along lam at fixed omega: lam, amplitude (peak |x| of the response DOF)."""
+def contact_stiffness_scale(model):
+    """Factory lam -> the model with every friction slider's stiffness (and residual
+    stiffness) times 10**lam, slip strengths unchanged (lam = 0: the model itself).
 
-    lam: np.ndarray
-    amplitude: np.ndarray
-    solutions: list
-    newton_iterations: int
-    time_s: float
-    stable: list | None = None
-    status: str = "complete"
+    The logarithmic parameter lets one continuation run over decades of stiffness.
+    """
+    from fmu_src.element import IwanElement
+
+    def at(lam):
+        s = 10.0**lam
+        links = []
+        for link in model.links:
+            el = link.element
+            if not isinstance(link, FrictionLink) or not isinstance(el, IwanElement):
+                links.append(link)
+                continue
+            new = IwanElement.from_sliders(el.k * s, el.fs * el.scale, el.k_res * s, el.N_ref)
+            links.append(FrictionLink(new, link.dof_a, link.dof_b, link.name))
+        return replace(model, links=links)
+    return at
 
 
 class ParameterProblem:
@@ -88,6 +92,15 @@ class ParameterProblem:
         return self._cache[key]
 
     def __call__(self, x, lam):
+        """R, dR/dx, dR/dlam; a parameter the factory refuses (a predictor that left the
+        model's range) gives a non-finite residual, which Newton's line search rejects."""
+        try:
+            return self._eval(x, lam)
+        except (ValueError, ArithmeticError):
+            n = np.size(x)
+            return np.full(n, np.nan), np.eye(n), np.zeros(n)
+
+    def _eval(self, x, lam):
         R, J, _ = self.residual(lam)(x, self.omega)
         h = FD_STEP * max(abs(lam), 1.0)
         if self.affine:  # R(x; lam) = N(x) - lam f: the difference is exact at any step
@@ -97,58 +110,3 @@ class ParameterProblem:
                   - self.residual(lam - h)(x, self.omega, jac=False)) / (2 * h)
         return R, J, dl
 
-
-def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
-                    condensed=None, affine: bool = False, ds_max: float = 0.1,
-                    max_points: int = 2000, stability: bool = True) -> ParameterCurve:
-    """Continuation in lam over ``lam_range = (start, end)`` at fixed ``omega`` [rad/s].
-
-    Parameters
-    ----------
-    model_at : callable float -> Model (e.g. :func:`forcing_level`, :func:`slip_scale`)
-    affine : bool, True when R is affine in lam (the excitation level): exact dR/dlam
-
-    Raises
-    ------
-    RuntimeError (ContinuationError or HomotopyError) with the reason; the points so far
-    are on ``err.branch`` for a ContinuationError.
-    """
-    from .frf import FRFProblem
-
-    l0, l1 = (float(v) for v in lam_range)
-    if not (np.isfinite(l0) and np.isfinite(l1)) or l0 == l1:
-        raise ValueError(f"parameter range must be two different finite numbers, got {lam_range}")
-    t0 = time.perf_counter()
-    pp = ParameterProblem(model_at, harmonics, omega, n_t, condensed, affine)
-    start = FRFProblem(model_at(l0), harmonics, n_t, condensed)
-    tol = TOL_REL * max(float(np.linalg.norm(start.residual.linear_guess(omega))), 1e-300)
-    x0, _ = homotopy_start(start, omega, tol)
-    status = "complete"
-    try:
-        br = continuation(pp, x0, l0, l1, tol, ds_max=ds_max, max_points=max_points)
-    except ContinuationError as err:
-        br, status = err.branch, str(err)
-    amp = np.array([FRFProblem(model_at(l), harmonics, n_t, condensed).amplitude(x, omega)
-                    for x, l in zip(br.x, br.lam)])
-    stable = _stable(pp, br) if stability else None
-    return ParameterCurve(np.asarray(br.lam), amp, list(br.x), int(sum(br.iterations)),
-                          time.perf_counter() - t0, stable, status)
-
-
-def _stable(pp, br):
-    from .stability import is_stable
-
-    out = []
-    for x, lam in zip(br.x, br.lam):
-        res = pp.residual(lam)
-        model = res.model
-        if model.linear.M is None or model.linear.K is None:
-            return None
-        full = res if isinstance(res, FullResidual) else FullResidual(model, pp.basis)
-        X = x if full is res else res.displacements(x, pp.omega).ravel()
-        _, J, _ = full(X, pp.omega)
-        out.append(is_stable(J, model.linear, pp.basis, pp.omega)[0])
-    return out
-
-
-__all__ = ["forcing_level", "slip_scale", "parameter_curve", "ParameterCurve", "HomotopyError"]

@@ -2,9 +2,9 @@
 import numpy as np
 from hbcases import two_dof
 
-from harmonic_balance.frf import compute_frf
+from harmonic_balance.frf import compute_frf, parameter_curve
 from harmonic_balance.model import sdof_model
-from harmonic_balance.parameter import forcing_level, parameter_curve, slip_scale
+from harmonic_balance.parameter import forcing_level, slip_scale
 
 
 def test_forcing_level_curve_ends_on_the_frf_solution():
