@@ -17,9 +17,14 @@ JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of 
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
 ``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``points``,
-``newton_iterations`` (corrector iterations), ``time_s`` and ``status``. A run that
-fails part-way prints the points computed so far (``status`` says where and why)
-and exits with code 3.
+``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
+(per point, Hill's method; null for models above 200 full unknowns or modal-only
+ones; unstable stretches are dashed in frf.png). The first point does not depend
+on where the sweep starts: Newton from the stuck linear guess, else a homotopy in
+the excitation level or in the contact stiffness (harmonic_balance.start). A run
+that fails part-way prints the points computed so far (``status`` says where and
+why) and exits with code 3, with or without --json. Nonlinear modes (backbones):
+``damper backbone``.
 """
 from __future__ import annotations
 
