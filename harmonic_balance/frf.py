@@ -191,15 +191,19 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     except HomotopyError as err:
         result = _collect(prob, Branch(status=str(err)), t0)
         raise FRFError(f"continuation stopped before the first point: {err}", result) from None
-    try:
-        branch = continuation(prob, x0, w0, w1, tol, ds_max=ds_max, max_points=max_points)
-    except ContinuationError as err:
-        result = _collect(prob, err.branch, t0)
-        result.status = str(err)
-        result.stable = _stability(prob, err.branch, stability)
-        raise FRFError(str(err), result) from None
+    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points)
+    if error is not None:
+        result = _collect(prob, branch, t0)
+        result.status = branch.status = error
+        result.extra["gaps"] = gaps
+        result.stable = _stability(prob, branch, stability)
+        raise FRFError(error, result)
     result = _collect(prob, branch, t0)
     result.extra["start"] = start
+    result.extra["gaps"] = gaps
+    if gaps:
+        result.status = (f"complete; {len(gaps)} restart(s) by homotopy after a stalled corrector, "
+                         "no points in omega " + ", ".join(f"{a:.6g}-{b:.6g}" for a, b in gaps))
     result.stable = _stability(prob, branch, stability)
     if refine:
         _refine_peak(prob, branch, result, tol)
@@ -211,6 +215,64 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.evaluations = prob.evaluations
     result.time_s = time.perf_counter() - t0
     return result
+
+
+#: Restarts allowed per curve after a stalled corrector (:func:`_sweep`).
+MAX_RESTARTS = 100
+#: Frequency jumps tried for a restart, as fractions of the range: the smallest
+#: that gives a first point by :func:`start.homotopy_start` is taken.
+RESTART_JUMPS = (1e-3, 4e-3, 1.6e-2)
+
+
+def _sweep(prob, x0, w0, w1, tol, ds_max, max_points):
+    """Continuation from (x0, w0) to w1 with restarts: (Branch, gaps, error or None).
+
+    When the corrector stalls ("step below minimum": on a stiff contact the residual
+    is a staircase of AFT-sample kinks with local minima of |R|), the curve is
+    restarted a small jump further by the start strategies (Newton, excitation and
+    contact-stiffness homotopies), which do not depend on the previous point. The
+    skipped interval is reported (``gaps``); a friction FRF is single-valued there,
+    so no branch is lost, but a fold inside a gap would be (the status names it).
+    """
+    merged, gaps = Branch(), []
+    sign = 1.0 if w1 > w0 else -1.0
+    for _ in range(MAX_RESTARTS + 1):
+        try:
+            br = continuation(prob, x0, w0, w1, tol, ds_max=ds_max,
+                              max_points=max_points - len(merged.lam))
+            error = None
+        except ContinuationError as err:
+            br, error = err.branch, str(err)
+        _extend(merged, br)
+        if error is None:
+            merged.status = "complete"
+            return merged, gaps, None
+        if "step below minimum" not in error:
+            return merged, gaps, error
+        w_last = merged.lam[-1] if merged.lam else w0
+        for jump in RESTART_JUMPS:
+            w_try = w_last + sign * jump * abs(w1 - w0)
+            if sign * (w_try - w1) > 0:
+                w_try = w1
+            try:
+                x0, _ = homotopy_start(prob, w_try, tol)
+            except HomotopyError:
+                continue
+            gaps.append((w_last, w_try))
+            w0 = w_try
+            break
+        else:
+            return merged, gaps, error + "; no restart within " + f"{RESTART_JUMPS[-1]:g} of the range"
+        if w0 == w1:
+            _extend(merged, Branch(x=[x0], lam=[w1], iterations=[0]))
+            merged.status = "complete"
+            return merged, gaps, None
+    return merged, gaps, f"more than {MAX_RESTARTS} restarts"
+
+
+def _extend(merged, br):
+    for x, w, it in zip(br.x, br.lam, br.iterations):
+        merged.append(x, w, it)
 
 
 def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
@@ -235,6 +297,9 @@ def _refine_peak(prob, branch, result, tol):
     the highest refined one becomes the result's peak. Updates ``result`` in place."""
     amp = result.amplitude
     idx, _ = find_peaks(amp, prominence=PEAK_PROMINENCE * amp.max())
+    # a peak next to a restart gap has no continuous neighbours to refine between
+    edges = {w for gap in result.extra.get("gaps", ()) for w in gap}
+    idx = [i for i in idx if not edges & {result.omega[i - 1], result.omega[i], result.omega[i + 1]}]
     peaks, nfev = [], 0
     for i in idx:
         try:
