@@ -100,6 +100,7 @@ def run(args) -> int:
     if args.max_step <= 0 or args.max_points < 2 or args.samples < 0:
         raise ValueError("--max-step must be > 0, --max-points >= 2, --samples >= 0")
     model = build_model(args)
+    _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
                              ds_max=args.max_step, max_points=args.max_points)
@@ -113,6 +114,17 @@ def run(args) -> int:
         plot_frf(result, args.plot)
     _emit(args, summary, print_json, atomic_write, dumps)
     return 0
+
+
+def _report_curve_fits(model) -> None:
+    """Say on stderr which element curves were reduced to the C element's slider limit."""
+    import sys
+
+    for link in model.links:
+        err = getattr(getattr(link, "element", None), "fit_error", 0.0)
+        if err > 0.0:
+            print(f"note: element {link.name!r}: its curve was reduced to the element's slider "
+                  f"limit; largest force error of the fit {err:.3g} N", file=sys.stderr)
 
 
 def _emit(args, summary, print_json, atomic_write, dumps):
