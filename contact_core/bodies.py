@@ -229,7 +229,7 @@ class Sphere(Body):
             raise ValueError(f"a force of {force:.4g} N gives a Hertz contact radius of {a:.3g} m, "
                              f"{100 * a / spec.radius:.0f} % of the sphere radius {spec.radius:.3g} m: "
                              f"beyond what the contact model represents (a <= {MAX_CONTACT_SHARE:g} R); "
-                             f"the largest force for this sphere is {f_max:.4g} N")
+                             f"use a force of at most {f_max:.4g} N for this sphere, or a larger radius")
 
     def zone(self, spec):
         Es, R = spec.Estar, spec.radius
@@ -332,7 +332,7 @@ class Cylinder(Body):
             raise ValueError(f"a force of {force:.4g} N gives a 2D Hertz contact half-width of {b:.3g} m, "
                              f"{100 * b / spec.radius:.0f} % of the cylinder radius {spec.radius:.3g} m: "
                              f"beyond what the contact model represents (b <= {MAX_CONTACT_SHARE:g} R); "
-                             f"the largest force for this cylinder is {f_max:.4g} N")
+                             f"use a force of at most {f_max:.4g} N for this cylinder, or a larger diameter or length")
 
     def zone(self, spec):
         Es, R = spec.Estar, spec.radius
