@@ -40,7 +40,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .forces import ForceElement, LocalForce, viscous_work
+from .aft import FrictionLink
+from .forces import ForceElement, LinearElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
 
@@ -49,6 +50,9 @@ from .kinematics import Kinematics
 CLOSURE_TOL = 1e-10
 #: Default largest number of periods marched until the loop closes.
 MAX_PERIODS = 400
+#: Condition number above which the static stiffness counts as singular (a floating
+#: body): 1e-3 / machine epsilon leaves ~3 significant digits in the solve.
+SINGULAR_COND = 1e-3 / np.finfo(float).eps
 
 
 class ContactElement(ForceElement):
@@ -184,6 +188,85 @@ class ContactElement(ForceElement):
 
         return _Contact()
 
+    def batch_stepper(self, n: int) -> ContactBatchStepper:
+        """``n`` independent virgin histories advanced together (:class:`ContactBatchStepper`)."""
+        return ContactBatchStepper(self, n)
+
+
+class ContactBatchStepper:
+    """``n`` independent time histories of one ContactElement, one C call per step.
+
+    For vectorised time integration (many frequencies or variants marched together):
+    ``force(q)`` advances history i to the local displacement ``q[i]`` exactly as
+    :meth:`ContactElement.stepper` would (the C core's ``iwan_step_batch`` runs the
+    same code as ``iwan_step``: the same bits), at ``N = k_n (p_0 + p)``.
+
+    Attributes
+    ----------
+    n : int                 number of histories
+    f : (n, m) array        local forces of the last step [N] (overwritten each call)
+    """
+
+    def __init__(self, element: ContactElement, n: int, states=None):
+        self.element, self.n = element, int(n)
+        el, kn, p0 = element.friction, element.k_n, element.preload
+        self.f = np.zeros((self.n, element.m))
+        self._st = None
+        if el is not None:
+            if states is None:
+                states = el.initial_states(self.n, kn * p0 if p0 > 0 else None)
+            self._st = el.batch_stepper(states, N=np.zeros(self.n))
+
+    def force(self, q: np.ndarray) -> np.ndarray:
+        """Advance every history to q (n, m); returns the local forces (n, m)."""
+        e = self.element
+        q = np.asarray(q, dtype=float).reshape(self.n, e.m)
+        pen = e.preload + q[:, -1]
+        self.f[:, -1] = e.k_n * np.maximum(pen, 0.0)
+        if self._st is not None:
+            np.subtract(q[:, 0], e.slip_ref, out=self._st.u)
+            np.multiply(pen, e.k_n, out=self._st.N)
+            self.f[:, 0] = self._st.step()
+        return self.f
+
+    def dissipated(self) -> np.ndarray:
+        """Cumulative friction energy [J] of each history, shape (n,)."""
+        if self._st is None:
+            return np.zeros(self.n)
+        return self._st.states["w_diss"].copy()
+
+    def keep(self, idx) -> ContactBatchStepper:
+        """A stepper continuing only the histories ``idx`` (e.g. those not yet settled)."""
+        idx = np.asarray(idx, dtype=int)
+        states = None if self._st is None else np.ascontiguousarray(self._st.states[idx])
+        return ContactBatchStepper(self.element, idx.size, states)
+
+
+def _static_parts(model):
+    """Linear static stiffness (n, n) and the contacts' h = 0 normal rows, for the statics.
+
+    Returns ``K + sum T K_l Q`` of the linear elements and, per ContactElement,
+    (index, element, Q_0 (m, d), q_n (n,), t_n (n,)): its h = 0 kinematics and the
+    normal row / column on all DOFs (penetration p = p_0 + q_n . x, force t_n N).
+    """
+    if model.linear.K is None:
+        raise ValueError("frictionless statics needs the stiffness matrix K")
+    n = model.n
+    Klin, rows = np.array(model.linear.K, dtype=float), []
+    for i, el in enumerate(model.elements):
+        kin = el.kinematics
+        Q = kin.Q if not kin.cyclic else kin.Q + kin.Q_next
+        T = kin.T if not kin.cyclic else kin.T + kin.T_next
+        if isinstance(el, ContactElement):
+            qn, tn = np.zeros(n), np.zeros(n)
+            qn[list(kin.dofs)], tn[list(kin.dofs)] = Q[-1], T[:, -1]
+            rows.append((i, el, Q, qn, tn))
+        elif isinstance(el, LinearElement):
+            Klin[np.ix_(kin.dofs, kin.dofs)] += T @ el.K @ Q
+        elif not isinstance(el, FrictionLink):
+            raise TypeError(f"frictionless statics does not know {type(el).__name__}")
+    return Klin, rows
+
 
 def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
     """Static solution with mu = 0 and the slip at each contact (prestress, tmdsimpy's convention).
@@ -206,28 +289,9 @@ def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
     x : (n,) array               static displacements [m]
     slip : dict {index: float}   s_0 of each ContactElement with friction (index in model.elements)
     """
-    from .aft import FrictionLink
-    from .forces import LinearElement
-
-    K0 = model.linear.K
-    if K0 is None:
-        raise ValueError("frictionless statics needs the stiffness matrix K")
+    Klin, rows = _static_parts(model)
     n = model.n
     f0 = np.real(model.forcing.get(0, np.zeros(n))).astype(float)
-    Klin, rows = np.array(K0, dtype=float), []
-    for i, el in enumerate(model.elements):
-        kin = el.kinematics
-        Q = kin.Q if not kin.cyclic else kin.Q + kin.Q_next
-        T = kin.T if not kin.cyclic else kin.T + kin.T_next
-        idx = np.ix_(kin.dofs, kin.dofs)
-        if isinstance(el, ContactElement):
-            qn, tn = np.zeros(n), np.zeros(n)
-            qn[list(kin.dofs)], tn[list(kin.dofs)] = Q[-1], T[:, -1]
-            rows.append((i, el, Q, qn, tn))
-        elif isinstance(el, LinearElement):
-            Klin[idx] += T @ el.K @ Q
-        elif not isinstance(el, FrictionLink):
-            raise TypeError(f"frictionless statics does not know {type(el).__name__}")
     active = np.ones(len(rows), dtype=bool)
     for _ in range(max_iter):
         A, b = Klin.copy(), f0.copy()
@@ -235,11 +299,10 @@ def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
             if on:  # N = k_n (p0 + qn . x): stiffness tn k_n qn^T, load -tn k_n p0
                 A += el.k_n * np.outer(tn, qn)
                 b -= el.k_n * el.preload * tn
-        try:
-            x = np.linalg.solve(A, b)
-        except np.linalg.LinAlgError:
+        if np.linalg.cond(A) > SINGULAR_COND:
             raise ValueError("frictionless statics is singular: a body is held by friction only "
-                             "or floats (no contact in compression holds it)") from None
+                             "or floats (no contact in compression holds it)")
+        x = np.linalg.solve(A, b)
         new = np.array([el.preload + qn @ x > 0.0 for _, el, _, qn, _ in rows], dtype=bool)
         if np.array_equal(new, active):
             break

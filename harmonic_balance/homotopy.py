@@ -106,39 +106,5 @@ def _first_level(fun_lam, x_stuck, tol):
                         f"at level {START_LEVELS[-1]:g}")
 
 
-def homotopy_start(prob, omega, tol, x_stuck=None):
-    """First solution of an FRF problem at ``omega``: Newton from the stuck guess, else homotopy.
-
-    Parameters
-    ----------
-    prob : harmonic_balance.frf.FRFProblem
-    omega : float [rad/s]
-    tol : float, absolute tolerance on |R|_2
-
-    Returns
-    -------
-    x : (N,) array; info : dict (``method`` 'newton' or 'homotopy', and the homotopy's counts)
-    """
-    from .residual import make_residual
-
-    x0 = prob.residual.linear_guess(omega) if x_stuck is None else x_stuck
-    fun = lambda z: prob(z, omega)[:2]  # noqa: E731
-    try:
-        res = newton(fun, x0, tol)
-        return res.x, {"method": "newton", "iterations": res.iterations}
-    except NewtonError as err:
-        first_error = err
-    cond = prob.residual.__class__.__name__ == "CondensedResidual"
-    f = forcing_vector(lambda m: make_residual(m, prob.basis, cond), prob.model, x0, omega)
-    try:
-        x, info = solve_with_homotopy(fun, x0, f, tol)
-    except HomotopyError as err:
-        raise HomotopyError(f"no solution at fixed parameter {omega:.6g}: from the stuck "
-                            f"linear guess: {first_error}; {err}") from None
-    info["method"] = "homotopy"
-    return x, info
-
-
-
 def _rms(x):
     return float(np.sqrt(np.mean(np.square(x))))

@@ -60,8 +60,10 @@ from pathlib import Path
 import numpy as np
 
 from .aft import FrictionLink
-from .forces import ForceElement
+from .contact import ContactElement
+from .forces import ForceElement, LinearElement
 from .fourier import FourierBasis
+from .kinematics import Kinematics
 from .linear import LinearModel
 
 
@@ -145,8 +147,6 @@ class Model:
         eigenvalues with M give the stuck / free natural frequencies of the nodal
         diameter whose phase is h phi.
         """
-        from .forces import LinearElement
-
         K = np.array(self.linear.K, dtype=complex, copy=True)
         for el in self.links:
             if not stuck and not isinstance(el, LinearElement):
@@ -269,7 +269,8 @@ def _element_link(t: dict, i: int, base: Path) -> ForceElement:
 
         c = read_curve(base / t["path"])
         # Same rule as damper loop / damper fmu: N_ref = the curve's N (1 if none),
-        # flat beyond the end when the curve ends at gross slip (T = mu N).
+        # the curve file's own tail (flat at gross slip or last slope), reduced to
+        # the element's limit when longer (el.fit_error).
         el = IwanElement.from_virgin_curve(c, fit=t.get("fit", "reject"), scale=float(t.get("scale", 1.0)))
     else:
         raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")
@@ -283,9 +284,6 @@ _CONTACT_KEYS = {"type", "name", "dofs", "normal", "tangent", "delta", "k_n", "k
 
 def _contact_element(t: dict, i: int, base: Path):
     """One [[element]] table of type "contact" -> ContactElement (format in the module docstring)."""
-    from .contact import ContactElement
-    from .kinematics import Kinematics
-
     unknown = set(t) - _CONTACT_KEYS
     if unknown:
         raise ValueError(f"element {i}: unknown contact keys {sorted(unknown)}")

@@ -6,11 +6,13 @@ Full residual (all n DOFs; unknowns X (n_b, n), flattened as in :mod:`fourier`):
     A(omega) = I (x) K - omega^2 diag(h^2) (x) M + omega D_theta (x) C
 
 where ``D_theta`` is d/dtheta in coefficient space (so omega D_theta X are the velocity
-harmonics) and ``(x)`` the Kronecker product. F_nl comes from the AFT (:mod:`aft`);
-being rate-independent it does not depend on omega, so
-``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X``.
+harmonics) and ``(x)`` the Kronecker product. F_nl = T F(Q X) comes from the force
+elements (:mod:`forces`: each maps its local harmonics Q X to force harmonics, by AFT
+or in closed form); rate-independent elements do not depend on omega, dashpots in
+elements add their omega-derivative ``dF_nl/domega``, so
+``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X + dF_nl/domega``.
 
-Condensed residual (unknowns: the harmonics of the m DOFs the friction links touch,
+Condensed residual (unknowns: the harmonics of the m DOFs the force elements touch,
 set J)::
 
     R = X_J - G_JJ(omega) F_ext - ... = X_J - X_lin,J(omega) + G_JJ(omega) F_nl,J(X_J)
@@ -105,6 +107,22 @@ class _Residual:
         for el, (Qe, Te) in zip(self.elements, self._ops):
             Kst += Te @ np.kron(eye, el.stuck_stiffness()) @ Qe
         return Kst
+
+    def viscous_operator(self) -> np.ndarray:
+        """Elements' linear dashpots on the unknowns, V (size, size) [N s/m].
+
+        ``sum_e T_e (I (x) C_e) Q_e`` with C_e = ``local_damping()``: the elements' viscous
+        forces are ``omega (D_theta (x) I) V x`` (already in the residual); a method that
+        needs the dashpots apart from the rate-independent forces (Hill's method: velocity
+        ``(omega D_theta + lambda) x``) adds ``lambda V``.
+        """
+        V = np.zeros((self.size, self.size))
+        eye = np.eye(self.basis.nb)
+        for el, (Qe, Te) in zip(self.elements, self._ops):
+            C = el.local_damping()
+            if C is not None:
+                V += Te @ np.kron(eye, C) @ Qe
+        return V
 
     def static_load(self) -> np.ndarray:
         """Element forces (size,) at x = 0 (preloads), zero for unloaded elements."""

@@ -171,6 +171,21 @@ def test_residual_jacobian_with_cyclic_contact_matches_finite_differences(Res):
     assert np.abs(Jw - Jw_fd).max() <= FD_RTOL_RES * np.abs(Jw).max()
 
 
+def test_viscous_operator_gives_the_dashpot_forces():
+    """omega-derivative of the element forces = (D_theta (x) I) V x (cyclic dashpots included).
+
+    Measured 1.3e-16 relative (symmetry of V: 5e-17).
+    """
+    model, b = cyclic_sector()
+    res = FullResidual(model, b)
+    x = np.random.default_rng(SEED).normal(scale=0.08, size=res.size)
+    res.nonlinear(x, jac=False, omega=1.1)
+    V = res.viscous_operator()
+    assert np.abs(V - V.T).max() < ROUND * np.abs(V).max()  # conservative kinematics
+    ref = np.kron(b.dtheta, np.eye(res.m)) @ V @ x
+    assert np.abs(res.dF_domega - ref).max() < ROUND * np.abs(ref).max()
+
+
 def test_condensed_and_full_residuals_agree_with_contacts():
     model, b = cyclic_sector()
     full, cond = FullResidual(model, b), CondensedResidual(model, b)
@@ -265,6 +280,9 @@ def test_frictionless_statics_of_a_wedge_in_closed_form():
         p = el.kinematics.Q[-1] @ x
         assert abs(kn * p - CF / (2 * np.cos(g))) < ROUND * CF
     assert slip[0] == els[0].slip_ref and abs(slip[0] + slip[1]) < ROUND * abs(slip[0])
+    pulled = Model(lin, els, {0: np.array([0.0, -CF]), 1: np.array([1.0, 0.0])})
+    with pytest.raises(ValueError, match="singular"):  # pulled away: both faces lift off
+        frictionless_statics(pulled)
 
 
 def ring_and_sector(n_r=4, eo=1, F0=0.24):
@@ -340,3 +358,21 @@ def test_energy_balance_of_the_cyclic_sector():
     assert loop.W_viscous > 0.0 and loop.W > loop.W_viscous
     assert abs(E["W_ext"] - E["W_visc"] - W_el) <= ENERGY_BALANCE_RTOL * E["W_ext"]
     assert abs(W_el - loop.W) <= AFT_WORK_RTOL * loop.W
+
+
+def test_contact_batch_stepper_gives_the_single_stepper_bits():
+    """Vectorised histories (one C call per step) equal separate steppers bit for bit."""
+    el = plane_contact(FRICTIONS["iwan"](), preload=0.05, slip_ref=0.01)
+    rng = np.random.default_rng(SEED)
+    q = np.cumsum(rng.normal(scale=0.03, size=(400, 3, 2)), axis=0)  # random walks, lift-offs
+    single = [el.stepper() for _ in range(3)]
+    batch = el.batch_stepper(3)
+    for k in range(200):
+        fb = batch.force(q[k]).copy()
+        assert np.array_equal(fb, np.array([s.force(q[k, i]) for i, s in enumerate(single)]))
+    assert np.array_equal(batch.dissipated(), [s.dissipated() for s in single])
+    assert np.any(q[:200, :, 1] + 0.05 < 0) and batch.dissipated().min() > 0
+    kept = batch.keep([2, 0])
+    for k in range(200, 400):
+        fb = kept.force(q[k, [2, 0]]).copy()
+        assert np.array_equal(fb, np.array([single[i].force(q[k, i]) for i in (2, 0)]))
