@@ -9,7 +9,9 @@ refined peak handles directly; see the README.)
 """
 from __future__ import annotations
 
+import multiprocessing
 import time
+from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 from scipy.optimize import minimize_scalar
@@ -24,6 +26,14 @@ CF_XTOL = 1e-3
 NARROW = 0.03
 #: Points of that grid (3 % / 8 = 0.4 % of the peak frequency apart).
 NARROW_POINTS = 17
+#: The CF list is cut into this many contiguous chunks, each swept by its own
+#: :class:`_Peaks` (full band at the chunk's first load, then the narrow grid). The
+#: chunks are fixed whatever the number of worker processes, so a serial run and a
+#: parallel one do the same arithmetic and give identical results.
+CHUNKS = 2
+#: Worker processes are spawned, not forked: a fork of a process whose BLAS or
+#: OpenMP threads are running can deadlock (as in damper/studies).
+SPAWN = multiprocessing.get_context("spawn")
 
 
 def peak_at(sector: Sector, cf: float, H: int, omegas, f0=None, mu=None) -> tuple[float, float]:
@@ -55,8 +65,25 @@ class _Peaks:
         return w, a
 
 
+def _chunk_peaks(sector, H, omegas, f0, cfs) -> list:
+    """Refined peaks (omega, amplitude) of one contiguous chunk of loads, in order."""
+    peak = _Peaks(sector, H, omegas, f0)
+    return [peak(float(cf)) for cf in cfs]
+
+
+def load_curve(sector: Sector, cfs, H: int, omegas, f0=None, workers: int = 1) -> list:
+    """Refined peaks at every load of ``cfs`` (the :data:`CHUNKS` chunks on ``workers``
+    spawned processes; ``workers = 1`` runs them in this process, same results)."""
+    chunks = [c for c in np.array_split(np.asarray(cfs, float), CHUNKS) if len(c)]
+    if workers <= 1 or len(chunks) == 1:
+        return [p for c in chunks for p in _chunk_peaks(sector, H, omegas, f0, c)]
+    with ProcessPoolExecutor(min(workers, len(chunks)), mp_context=SPAWN) as pool:
+        futures = [pool.submit(_chunk_peaks, sector, H, omegas, f0, c) for c in chunks]
+        return [p for f in futures for p in f.result()]
+
+
 def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz=None,
-                 grid: int = 40, f0=None) -> dict:
+                 grid: int = 40, f0=None, workers: int = 1) -> dict:
     """Peak amplitude against CF and the optimum CF.
 
     Parameters
@@ -66,6 +93,7 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     H : int, highest harmonic
     band_hz : (2,) frequency band [Hz] (default the config's)
     grid : int, frequency points per curve before the peak refinement
+    workers : int, processes for the load grid (results do not depend on it)
 
     Returns
     -------
@@ -79,8 +107,9 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     band = sector.cfg["load.band_hz"] if band_hz is None else band_hz
     omegas = 2 * np.pi * np.linspace(band[0], band[1], grid)
     cfs = np.geomspace(lo, hi, points)
+    peaks = load_curve(sector, cfs, H, omegas, f0, workers)
+    t_grid = time.perf_counter() - t0
     peak = _Peaks(sector, H, omegas, f0)
-    peaks = [peak(cf) for cf in cfs]
     amp = np.array([p[1] for p in peaks])
     i = int(np.argmin(amp))
     interior = 0 < i < points - 1
@@ -99,4 +128,5 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
                    method="bounded scalar search (Brent, log CF) on the refined peak",
                    interior=True, search_evaluations=int(res.nfev))
     out["time_s"] = time.perf_counter() - t0
+    out["time_grid_s"], out["workers"] = t_grid, int(workers)
     return out
