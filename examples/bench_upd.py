@@ -72,6 +72,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/bench_upd")
     ap.add_argument("--quick", action="store_true", help="smoke version (seconds)")
     ap.add_argument("--periods", type=int, default=150, help="TI periods per load")
+    ap.add_argument("--workers", type=int, default=2, help="processes for the load grid")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -79,7 +80,8 @@ def main(argv=None):
     q = a.quick
     rows = {"curve": curve_case(sector, 3 if q else 7, 20 if q else 200)}
     print(rows["curve"], flush=True)
-    opt = optimal_load(sector, (30, 3000), 4 if q else 20, 3 if q else 7, grid=15 if q else 40)
+    opt = optimal_load(sector, (30, 3000), 4 if q else 20, 3 if q else 7, grid=15 if q else 40,
+                       workers=a.workers)
     rows["optimize"] = opt
     print({k: opt[k] for k in ("optimum_cf", "optimum_peak_amplitude", "time_s", "method")}, flush=True)
     Hs = (1, 3) if q else (1, 3, 5, 7, 9)
@@ -98,7 +100,8 @@ def _table(rows):
     c = rows["curve"]
     print(f"{c['case']} | {c['evaluations']} evaluations | - | {c['time_s']:.2f}")
     o = rows["optimize"]
-    print(f"optimal-load curve | {len(o['cf'])} loads | - | {o['time_s']:.1f}")
+    print(f"optimal-load curve | {len(o['cf'])} loads, {o['workers']} workers | - | "
+          f"{o['time_s']:.1f} (load grid {o['time_grid_s']:.1f})")
     for r in rows["ti"]:
         for k, v in r.items():
             if k.startswith("H"):

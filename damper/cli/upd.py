@@ -37,6 +37,8 @@ def register(sub) -> None:
     o.add_argument("--points", type=int, default=20, help="number of CF values (log-spaced)")
     o.add_argument("--harmonics", type=int, default=7)
     o.add_argument("--grid", type=int, default=40, help="frequency points per curve")
+    o.add_argument("--workers", type=int, default=2,
+                   help="processes for the load grid (results do not depend on it)")
     o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
     o.set_defaults(func=run_optimize)
 
@@ -134,7 +136,8 @@ def run_optimize(args) -> int:
 
     from .common import print_json
 
-    out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid)
+    out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
+                       workers=args.workers)
     if args.plot:
         _plot_optimize(out, args.plot)
     if args.json:

@@ -103,6 +103,8 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     lo, hi = (float(v) for v in cf_range)
     if not (0 < lo < hi and np.isfinite(hi)) or points < 3:
         raise ValueError(f"--cf-range needs 0 < low < high and --points >= 3, got {cf_range}, {points}")
+    if workers < 1:
+        raise ValueError(f"--workers needs at least 1 process, got {workers}")
     t0 = time.perf_counter()
     band = sector.cfg["load.band_hz"] if band_hz is None else band_hz
     omegas = 2 * np.pi * np.linspace(band[0], band[1], grid)
