@@ -32,7 +32,7 @@ class SweepRecord:
 
     params: list
     rows: list = field(default_factory=list)
-    computations: dict = field(default_factory=dict)   # stage key -> times computed
+    computations: dict = field(default_factory=dict)   # stage key -> {"stage": name, "count": times computed}
     shared: list = field(default_factory=list)         # names of the shared stages (first variant)
     outputs: dict = field(default_factory=dict)
 
@@ -97,7 +97,7 @@ def run_task(text: str, source: str, overrides: dict, folder: str, max_bytes: in
         if s.name in rec.results:
             for k, v in s.kind.scalars(s, rec.results[s.name]).items():
                 scalars[f"{s.name}.{k}"] = v
-    return {"computed": [s.key for s in plan.stages if s.action == "compute"], "scalars": scalars}
+    return {"computed": [(s.name, s.key) for s in plan.stages if s.action == "compute"], "scalars": scalars}
 
 
 def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bool = True,
@@ -143,8 +143,9 @@ def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bo
 
 
 def _tally(rec: SweepRecord, r: dict) -> None:
-    for k in r["computed"]:
-        rec.computations[k] = rec.computations.get(k, 0) + 1
+    for name, key in r["computed"]:
+        entry = rec.computations.setdefault(key, {"stage": name, "count": 0})
+        entry["count"] += 1
 
 
 def _waves(plans, shared) -> list[list[tuple[int, str]]]:

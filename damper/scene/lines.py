@@ -51,10 +51,10 @@ def key_lines(text: str) -> dict[tuple, int]:
                 for delim in ('"""', "'''"):
                     if rest.count(delim) % 2 == 1:
                         in_string = delim
-                depth += _brackets(rest)
+                depth = max(depth + _brackets(rest), 0)
                 continue
         else:
-            depth += _brackets(line)
+            depth = max(depth + _brackets(line), 0)
     return lines
 
 
@@ -73,7 +73,7 @@ def _brackets(text: str) -> int:
             net += 1
         elif c in "]}":
             net -= 1
-    return max(net, 0)
+    return net
 
 
 def line_of(lines: dict[tuple, int], path: tuple) -> int | None:
