@@ -19,7 +19,8 @@ table { border-collapse: collapse; margin: 0.5em 0; } td, th { padding: 0.2em 0.
 tr:nth-child(even) { background: #f4f4f4; } th { background: #e4e4e4; }
 td.num { text-align: right; font-family: monospace; }
 .compute { color: #a40; } .cached { color: #070; } .skip { color: #888; }
-figure { display: inline-block; margin: 0.4em; } figure img { width: 28em; border: 1px solid #ddd; }
+figure { display: inline-block; margin: 0.4em; vertical-align: top; }
+figure img { max-width: 44em; max-height: 22em; border: 1px solid #ddd; }
 figcaption { font-size: 0.85em; color: #555; } .meta { color: #555; font-size: 0.9em; }
 """
 
@@ -30,11 +31,11 @@ def _fmt(v) -> str:
     return "-" if v is None else html.escape(str(v))
 
 
-def _table(head: list, rows: list, num_from: int = 1, classes=None) -> str:
+def _table(head: list, rows: list, num_cols=(1,), classes=None) -> str:
     out = ["<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in head) + "</tr>"]
     for i, row in enumerate(rows):
         cls = f' class="{classes[i]}"' if classes else ""
-        cells = "".join(f'<td class="num">{_fmt(v)}</td>' if j >= num_from else f"<td>{_fmt(v)}</td>"
+        cells = "".join(f'<td class="num">{_fmt(v)}</td>' if j in num_cols else f"<td>{_fmt(v)}</td>"
                         for j, v in enumerate(row))
         out.append(f"<tr{cls}>{cells}</tr>")
     return "\n".join(out + ["</table>"])
@@ -58,7 +59,7 @@ def render(rec, out_dir: Path) -> str:
                  f"{sum(rec.times.values()):.2f} s in the stages.</p>")
     parts.append(_table(["stage", "action", "time [s]", "reason"],
                         [[s.name, s.action, rec.times.get(s.name), s.reason] for s in plan.stages],
-                        num_from=2, classes=[s.action for s in plan.stages]))
+                        num_cols=(2,), classes=[s.action for s in plan.stages]))
     parts.append("<h2>Results</h2>")
     for s in plan.stages:
         if s.name not in rec.results or s.kind.name == "condense":
