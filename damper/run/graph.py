@@ -70,6 +70,9 @@ class Stage:
     contact : str or None
         The scene's name of the contact a per-contact stage belongs to (not part of
         the key: two contacts with equal inputs share their cache entries).
+    extra : dict
+        What the stage needs but its key must not hold (a file's path, whose content
+        hash is in ``params``).
     """
 
     name: str
@@ -78,6 +81,7 @@ class Stage:
     deps: tuple = ()
     products: tuple = ()
     contact: str | None = None
+    extra: dict = field(default_factory=dict)
     key: str = ""
     action: str = ""
     reason: str = ""

@@ -42,6 +42,19 @@ def two_dof_model(s: dict, force: float, element):
     return Model(lin, [FrictionLink(element, 1, None, "element0")], forcing, 0)
 
 
+def matrices_model(path: str, dofs: list, scale: float, element):
+    """A matrices file's structure (``harmonic_balance.model`` format) with the element on
+    ``dofs`` ([a]: to the ground, [a, b]: between two DOFs) and the file's excitation times
+    ``scale``."""
+    from harmonic_balance.aft import FrictionLink
+    from harmonic_balance.model import Model, load_matrices
+
+    lin, forcing, resp = load_matrices(path)
+    forcing = {h: scale * np.asarray(f, dtype=complex) for h, f in forcing.items()}
+    b = dofs[1] if len(dofs) == 2 else None
+    return Model(lin, [FrictionLink(element, dofs[0], b, "element0")], forcing, resp)
+
+
 class FRF(Kind):
     """Forced-response curve by multi-harmonic balance and arc-length continuation."""
 
@@ -52,8 +65,11 @@ class FRF(Kind):
         el, s, ex, sw = (data.get(k) for k in ("element", "structure", "excitation", "sweep"))
         if not (el and s and ex and sw):
             return []
-        return [Stage(f"frf:{F:g}N", self, {"structure": s, "force": F, "sweep": sw},
-                      deps=(f"tangential:{el['contact']}",), products=("frf",)) for F in ex["forces"]]
+        label = "frf:{:g}N" if s["model"] == "two_dof" else "frf:x{:g}"
+        structure = {k: v for k, v in s.items() if k != "matrices"}     # the file enters by its hash
+        return [Stage(label.format(F), self, {"structure": structure, "force": F, "sweep": sw},
+                      deps=(f"tangential:{el['contact']}",), products=("frf",),
+                      extra={"matrices": s.get("matrices")}) for F in ex["forces"]]
 
     def compute(self, stage, inputs, ctx):
         from fmu_src.element import IwanElement
@@ -62,7 +78,10 @@ class FRF(Kind):
 
         p = stage.params
         element = IwanElement.from_virgin_curve(curve_of(inputs[stage.deps[0]]))
-        model = two_dof_model(p["structure"], p["force"], element)
+        if p["structure"]["model"] == "two_dof":
+            model = two_dof_model(p["structure"], p["force"], element)
+        else:
+            model = matrices_model(stage.extra["matrices"], p["structure"]["element_dofs"], p["force"], element)
         sw = p["sweep"]
         omega = (2 * math.pi * sw["f_min"], 2 * math.pi * sw["f_max"])
         try:
@@ -79,12 +98,14 @@ class FRF(Kind):
 
     def lines(self, stage, result):
         s = result.data
+        level = (f"P = {stage.params['force']:g} N" if stage.params["structure"]["model"] == "two_dof"
+                 else f"force x {stage.params['force']:g}")
         return [f"{s['points']} points, {s['newton_iterations']} Newton iterations, "
                 f"{s['time_s']:.3f} s, harmonics {s['harmonics']}, n_t {s['n_t']}",
                 f"peak: omega = {s['peak_omega']:.9g} rad/s, amplitude = "
                 f"{s['peak_amplitude']:.9g} m (first harmonic {s['peak_amplitude_h1']:.9g} m)",
                 f"status: {s['status']}",
-                f"   P = {stage.params['force']:g} N: peak {s['peak_amplitude']:.3e} m at "
+                f"   {level}: peak {s['peak_amplitude']:.3e} m at "
                 f"{s['peak_omega'] / (2 * math.pi):.1f} Hz ({s['points']} points, {s['time_s']:.2f} s)"]
 
     def scalars(self, stage, result):

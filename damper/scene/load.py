@@ -64,11 +64,13 @@ def load_scene(path: str | Path, overrides: dict | None = None) -> Scene:
         text = path.read_text()
     except OSError as err:
         raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror}")]) from None
-    return parse_scene(text, str(path), overrides)
+    return parse_scene(text, str(path), overrides, base=path.parent)
 
 
-def parse_scene(text: str, source: str = "<scene>", overrides: dict | None = None) -> Scene:
-    """Validate the scene TOML ``text`` (``source`` names it in messages)."""
+def parse_scene(text: str, source: str = "<scene>", overrides: dict | None = None,
+                base: str | Path | None = None) -> Scene:
+    """Validate the scene TOML ``text`` (``source`` names it in messages; files it names are
+    relative to ``base``, default the working directory)."""
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
@@ -78,7 +80,7 @@ def parse_scene(text: str, source: str = "<scene>", overrides: dict | None = Non
     for key, value in (overrides or {}).items():
         set_path(raw, key, value, source)
     problems: list[tuple[tuple, str]] = []
-    data = _validate(raw, problems)
+    data = _validate(raw, problems, Path(base) if base is not None else Path.cwd())
     if problems:
         raise SceneError(source, [(".".join(map(str, p)), line_of(lines, p), m) for p, m in problems])
     return Scene(source, raw, data)
@@ -110,7 +112,7 @@ def _fields_of(parts: list[str]):
     return fields.get(parts[1]) if len(parts) == 2 else None
 
 
-def _validate(raw: dict, problems: list) -> dict:
+def _validate(raw: dict, problems: list, base: Path) -> dict:
     data = _check_fields(raw, schema.TOP, (), problems, skip=set(schema.TABLES))
     for name, (fields, named) in schema.TABLES.items():
         if name not in raw:
@@ -130,8 +132,30 @@ def _validate(raw: dict, problems: list) -> dict:
             data[name] = _check_fields(table, fields, (name,), problems)
     if not problems:
         _check_contacts(data, problems)
+        _check_structure(data, problems, base)
         _check_wants(data, problems)
     return data
+
+
+def _check_structure(data: dict, problems: list, base: Path) -> None:
+    s = data.get("structure")
+    if s is None:
+        return
+    for key in schema.STRUCTURE_NEEDS[s["model"]]:
+        if key not in s:
+            problems.append((("structure", key), f"missing: structure model {s['model']!r} needs it"))
+    unused = [k for k in s if k != "model" and k not in schema.STRUCTURE_NEEDS[s["model"]]]
+    for key in unused:
+        problems.append((("structure", key), f"not used by structure model {s['model']!r}"))
+    if s["model"] == "matrices" and "matrices" in s:
+        path = (base / s["matrices"]).resolve()
+        try:
+            s["matrices_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError as err:
+            problems.append((("structure", "matrices"), f"cannot read {path}: {err.strerror}"))
+        s["matrices"] = str(path)
+        if "element_dofs" in s and len(s["element_dofs"]) not in (1, 2):
+            problems.append((("structure", "element_dofs"), "must be [a] (to the ground) or [a, b]"))
 
 
 def _check_fields(table: dict, fields: dict, path: tuple, problems: list, skip=()) -> dict:

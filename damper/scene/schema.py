@@ -19,8 +19,9 @@ A scene (TOML, SI units) is one analysis a user asks for::
     fmi_versions = [2, 3]
 
     [structure]                # the forced response (frf)
-    model = "two_dof"          # the bundled 2-DOF blade-damper model
-    ...
+    model = "two_dof"          # the bundled 2-DOF blade-damper model (m_tip, m_platform,
+    ...                        # k_blade, k_disk, zeta), or "matrices" (matrices = "file.npz",
+                               # element_dofs = [a] or [a, b])
     [excitation]
     forces = [10.0, 20.0]      # tip force amplitudes [N], one curve each
     [sweep]
@@ -105,16 +106,23 @@ ELEMENT = {
 }
 
 STRUCTURE = {
-    "model": Field("str", "two_dof: the bundled blade-damper model", default="two_dof", choices=("two_dof",)),
-    "m_tip": Field("float", "blade tip mass [kg]", required=True, gt=0),
-    "m_platform": Field("float", "platform mass [kg]", required=True, gt=0),
-    "k_blade": Field("float", "blade stiffness tip-platform [N/m]", required=True, gt=0),
-    "k_disk": Field("float", "disk stiffness platform-ground [N/m]", required=True, gt=0),
-    "zeta": Field("float", "damping ratio at the first free mode (Rayleigh beta K)", required=True, ge=0),
+    "model": Field("str", "two_dof: the bundled blade-damper model; matrices: a matrices file",
+                   default="two_dof", choices=("two_dof", "matrices")),
+    "m_tip": Field("float", "two_dof: blade tip mass [kg]", gt=0),
+    "m_platform": Field("float", "two_dof: platform mass [kg]", gt=0),
+    "k_blade": Field("float", "two_dof: blade stiffness tip-platform [N/m]", gt=0),
+    "k_disk": Field("float", "two_dof: disk stiffness platform-ground [N/m]", gt=0),
+    "zeta": Field("float", "two_dof: damping ratio at the first free mode (Rayleigh beta K)", ge=0),
+    "matrices": Field("str", "matrices: the .npz file (harmonic_balance.model's format; relative to the scene)"),
+    "element_dofs": Field("list[int]", "matrices: DOF [a] (to the ground) or [a, b] the element links", ge=0),
 }
+#: Keys each structure model needs.
+STRUCTURE_NEEDS = {"two_dof": ("m_tip", "m_platform", "k_blade", "k_disk", "zeta"),
+                   "matrices": ("matrices", "element_dofs")}
 
 EXCITATION = {
-    "forces": Field("list[float]", "tip force amplitudes [N], one forced response each", required=True, gt=0),
+    "forces": Field("list[float]", "two_dof: tip force amplitudes [N]; matrices: factors on the file's "
+                    "force; one forced response each", required=True, gt=0),
 }
 
 SWEEP = {

@@ -104,3 +104,26 @@ def test_run_json_outputs_times_and_provenance(small_run, tmp_path, capsys):
     assert prov["from_cache"] and prov["scene_hash"] == first.scene.hash()
     assert prov["inputs"]["structure"]["zeta"] == 0.002 and len(prov["code_version"]) == 16
     assert rec["provenance"]["git"]["commit"] is None or len(rec["provenance"]["git"]["commit"]) == 40
+
+
+def test_structure_from_a_matrices_file_equals_the_bundled_model(small_run, tmp_path):
+    import math
+
+    import numpy as np
+
+    store, out, first = small_run
+    M, K = np.diag([0.5, 0.05]), np.array([[4e7, -4e7], [-4e7, 8e7]])
+    beta = 2 * 0.002 / math.sqrt(min(np.linalg.eigvals(np.linalg.solve(M, K)).real))
+    np.savez(tmp_path / "blade.npz", M=M, K=K, C=beta * K, force=np.array([1.0, 0.0]), response_dof=0)
+    structure = ('[structure]\nmodel = "matrices"\nmatrices = "blade.npz"\nelement_dofs = [1]\n')
+    head, tail = TEXT.split("[structure]")
+    text = head + structure + tail[tail.index("[excitation]"):]
+    scene = parse_scene(text, "m.toml", base=tmp_path)
+    rec = run_scene(scene, store, tmp_path / "out", **QUIET)
+    assert rec.computed == ["frf:x30"]                   # the element and curve come from the cache
+    assert rec.results["frf:x30"].data["peak_amplitude"] == first.results["frf:30N"].data["peak_amplitude"]
+    np.savez(tmp_path / "blade.npz", M=M, K=K, C=2 * beta * K, force=np.array([1.0, 0.0]), response_dof=0)
+    again = plan_scene(parse_scene(text, "m.toml", base=tmp_path), store)
+    assert plan_actions(again)["frf:x30"] == "compute"   # new file content, new key
+    with pytest.raises(ValueError, match=r"m.toml:\d+: structure.matrices: cannot read"):
+        parse_scene(text, "m.toml", base=tmp_path / "elsewhere")
