@@ -87,7 +87,7 @@ class FRF(Kind):
         try:
             result = compute_frf(model, str(sw["harmonics"]), omega, ds_max=sw["max_step"], max_points=MAX_POINTS)
         except FRFError as err:
-            raise RuntimeError(f"{stage.name}: {err} ({err.result.points} points kept)") from None
+            raise RuntimeError(f"{err} ({err.result.points} points kept)") from None
         with tempfile.TemporaryDirectory() as tmp:
             plot_frf(result, tmp)
             files = collect_files(Path(tmp))

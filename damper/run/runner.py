@@ -104,8 +104,13 @@ def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progres
 
 
 def _compute(s, rec: RunRecord, ctx: Context) -> Result:
+    """Run one stage; its errors keep their type (exit 2 bad input, 3 solver) and name the stage."""
     inputs = {d: rec.results[d] for d in s.deps if d in rec.results}
-    return s.kind.compute(s, inputs, ctx)
+    try:
+        return s.kind.compute(s, inputs, ctx)
+    except (ValueError, RuntimeError) as err:
+        base = ValueError if isinstance(err, ValueError) else RuntimeError
+        raise base(f"stage {s.name}: {err}") from err
 
 
 def _load(s, store: Store) -> Result | None:
