@@ -85,6 +85,7 @@ class Stage:
     key: str = ""
     action: str = ""
     reason: str = ""
+    forced: bool = False
 
 
 class Kind:
@@ -177,6 +178,7 @@ def build_plan(data: dict, kinds, store: Store, force=(), previous: dict | None 
         s.key = s.kind.key(s, [by_name[d].key for d in s.deps])
         if s.name in force or s.kind.name in force or forced & set(s.deps):
             forced.add(s.name)
+            s.forced = True
             s.action, s.reason = "compute", "forced" + ("" if s.name in force or s.kind.name in force
                                                          else f" (depends on {_first(forced, s.deps)})")
         elif s.kind.is_cached(s, store):

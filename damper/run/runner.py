@@ -74,10 +74,10 @@ def print_plan(plan: Plan, echo) -> None:
         echo(f"  {s.name:{width}s}  {s.action:7s}  {s.reason}")
 
 
-def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progress, force=()) -> RunRecord:
+def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progress) -> RunRecord:
     """Compute or load every stage of ``plan`` in order; write the output folder if ``out``."""
     rec = RunRecord(scene, plan, out=Path(out) if out is not None else None)
-    ctx = Context(store, scene, {s.name for s in plan.stages if s.action == "compute" and "forced" in s.reason})
+    ctx = Context(store, scene, {s.name for s in plan.stages if s.forced})
     rec.provenance = record(scene=scene.source, scene_hash=scene.hash(), scene_content=scene.raw,
                             cache=str(store.folder.resolve()))
     try:
@@ -170,7 +170,7 @@ def run_scene(scene, store: Store, out: Path | None = None, force=(), dry_run: b
         progress = Progress(len(active))
     progress.total = len(active)
     try:
-        rec = execute(scene, plan, store, out, progress, force)
+        rec = execute(scene, plan, store, out, progress)
     finally:
         progress.close()
     computed = rec.computed
