@@ -6,6 +6,7 @@ browser. Plots are the PNG files of the stages, referenced relative to the repor
 from __future__ import annotations
 
 import html
+import json
 import math
 import os
 from pathlib import Path
@@ -83,6 +84,8 @@ def render(rec, out_dir: Path) -> str:
                 rel = os.path.relpath(Path(f).resolve(), out_dir.resolve())
                 rows.append(f"<li>{html.escape(k)}: <a href='{html.escape(str(rel))}'>{html.escape(str(rel))}</a></li>")
         parts.append("<ul>" + "".join(rows) + "</ul>")
+    parts.append("<h2>Scene</h2><details><summary>validated content (defaults filled in)</summary><pre>"
+                 + html.escape(json.dumps(scene.data, indent=1, sort_keys=True)) + "</pre></details>")
     parts.append("</body></html>")
     return "\n".join(parts)
 

@@ -89,3 +89,30 @@ def test_cache_cli_info_and_clear(tmp_path, capsys):
     assert "removed 1" in capsys.readouterr().out
     assert Store(tmp_path).info()["entries"] == 0
     assert damper(["cache", "info", "--cache-max-mb", "-1", "--cache-dir", str(tmp_path)]) == 2
+
+
+@pytest.mark.slow
+def test_two_concurrent_runs_of_one_scene_share_the_cache_safely(tmp_path):
+    import subprocess
+    import sys
+
+    from apphelpers import SMALL
+
+    scene = tmp_path / "s.toml"
+    scene.write_text(SMALL.read_text().replace('want = ["virgin_curve", "k_t", "loop", "frf", "report"]',
+                                               'want = ["virgin_curve", "loop"]'))
+    code = "import sys; from damper.cli import main; sys.exit(main(sys.argv[1:]))"
+    cmd = [sys.executable, "-c", code, "run", str(scene), "--json", "--cache-dir", str(tmp_path / "cache")]
+    procs = [subprocess.Popen(cmd + ["--out", str(tmp_path / f"out{i}")], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for i in range(2)]
+    outs = [p.communicate(timeout=600) for p in procs]
+    assert all(p.returncode == 0 for p in procs), [e for _, e in outs]
+    curves = [(tmp_path / f"out{i}" / "tangential_damper" / "curve.json").read_text() for i in range(2)]
+    assert curves[0] == curves[1]
+    store = Store(tmp_path / "cache")
+    for path, _ in store.entries():                   # every entry whole and readable
+        assert store.get(path.stem) is not None
+    assert not list((tmp_path / "cache").glob(".*.tmp"))
+    third = json.loads(subprocess.run(cmd + ["--out", str(tmp_path / "out3")], capture_output=True,
+                                      text=True, check=True).stdout)
+    assert {s["action"] for s in third["stages"]} <= {"cached", "skip"}
