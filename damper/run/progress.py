@@ -17,12 +17,14 @@ REFRESH_S = 0.2
 
 
 class Progress:
-    """Stage progress on ``stream`` (a live bar when ``live``; default: whether it is a terminal)."""
+    """Stage progress on ``stream`` (a live bar when ``live``; default: whether it is a terminal);
+    result lines go to ``emit`` (default: print on ``out``, standard output)."""
 
-    def __init__(self, total: int, stream=None, live: bool | None = None, out=None):
+    def __init__(self, total: int, stream=None, live: bool | None = None, out=None, emit=None):
         self.total, self.done = total, 0
         self.stream = stream or sys.stderr
         self.out = out or sys.stdout
+        self.emit = emit or (lambda text: print(text, file=self.out, flush=True))
         self.live = self.stream.isatty() if live is None else live
         self.current, self.t0 = None, 0.0
         self._lock = threading.Lock()
@@ -55,7 +57,7 @@ class Progress:
             if self.live:
                 self.stream.write("\r\033[K")
                 self.stream.flush()
-            print(text, file=self.out, flush=True)
+            self.emit(text)
         if self.live and self.current:
             self._draw()
 

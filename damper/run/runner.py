@@ -167,7 +167,7 @@ def run_scene(scene, store: Store, out: Path | None = None, force=(), dry_run: b
         return RunRecord(scene, plan)
     active = [s for s in plan.stages if s.action != "skip"]
     if progress is None:
-        progress = Progress(len(active))
+        progress = Progress(len(active), emit=echo)
     progress.total = len(active)
     try:
         rec = execute(scene, plan, store, out, progress)
