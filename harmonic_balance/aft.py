@@ -30,12 +30,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .forces import ForceElement, LocalForce
 from .fourier import FourierBasis
+from .kinematics import Kinematics
 
 
 @dataclass
-class FrictionLink:
+class FrictionLink(ForceElement):
     """A friction element between two DOFs, or a DOF and the ground.
+
+    A :class:`~.forces.ForceElement` on ``Kinematics.link(dof_a, dof_b)`` (m = 1) at
+    the element's reference normal load.
 
     Parameters
     ----------
@@ -65,6 +70,36 @@ class FrictionLink:
     @property
     def dofs(self) -> tuple[int, ...]:
         return (self.dof_a,) if self.dof_b is None else (self.dof_a, self.dof_b)
+
+    @property
+    def kinematics(self) -> Kinematics:
+        """``q = x_a - x_b`` (built on use: a link joining a DOF to itself is refused by Model)."""
+        return Kinematics.link(self.dof_a, self.dof_b)
+
+    @property
+    def m(self) -> int:
+        return 1
+
+    def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
+        """:func:`aft_link` on U (n_b, 1); the Jacobian is always computed (one C call)."""
+        U = np.asarray(U, dtype=float).reshape(basis.nb)
+        Fh, dFh, W, F = aft_link(self, U, basis)
+        return LocalForce(Fh[:, None], dFh if jac else None, None, W, 0.0,
+                          (basis.E @ U)[:, None], F[:, None])
+
+    def stuck_stiffness(self) -> np.ndarray:
+        return np.array([[self.k0]])
+
+    def stepper(self):
+        """One C-element step per call on the carried (virgin) state."""
+        el = self.element
+        state = el.initial_state()
+
+        class _Link:
+            def force(self, q):
+                return np.array([el.step(state, q[0]).F])
+
+        return _Link()
 
 
 def initial_stiffness(element) -> float:

@@ -35,6 +35,19 @@ File formats
     fs = [1.0, 2.0]
     k_res = 0.0
 
+    [[element]]
+    type = "contact"         # penalty normal with lift-off + friction following N
+    dofs = [0, 1]            # DOFs of the contact point's relative displacement Delta
+    normal = [0.0, 1.0]      # unit normal n from body 2 into body 1 (k = 2 or 3 entries)
+    tangent = [1.0, 0.0]     # unit tangent (omit it, and the friction, for normal only)
+    delta = [[1, 0], [0, 1]] # (k, len(dofs)): Delta = delta @ x[dofs]; default identity
+    k_n = 1.0e8              # normal penalty stiffness [N/m]
+    k_t = 8.0e7              # Jenkins friction k_t [N/m] and mu, or instead
+    mu = 0.5                 #   curve = "curves/flat.json" (Iwan, scaled by N / N_ref)
+    preload = 0.0            # static penetration at x = 0 [m]
+    slip_ref = 0.0           # prestress slip where the sliders are virgin [m]
+    beta_c = 0.0             # contact dashpots beta_c k_n, beta_c k_t [s]
+
 DOFs are 0-based. Symbols as in :mod:`harmonic_balance.fourier` and
 :mod:`harmonic_balance.linear`.
 """
@@ -47,18 +60,23 @@ from pathlib import Path
 import numpy as np
 
 from .aft import FrictionLink
+from .contact import ContactElement
+from .forces import ForceElement, LinearElement
 from .fourier import FourierBasis
+from .kinematics import Kinematics
 from .linear import LinearModel
 
 
 @dataclass
 class Model:
-    """Linear structure + friction links + harmonic excitation.
+    """Linear structure + force elements + harmonic excitation.
 
     Parameters
     ----------
     linear : LinearModel
-    links : list of FrictionLink
+    links : list of ForceElement
+        Force elements (:mod:`.forces`): friction links, contacts, linear couplings
+        (the field keeps its historical name; :attr:`elements` is the same list).
     forcing : dict {h: (n,) complex}
         Complex excitation amplitude per harmonic, f = Re(F_h exp(i h omega t)) [N].
     response_dof : int
@@ -73,10 +91,12 @@ class Model:
     def __post_init__(self):
         n = self.linear.n
         for link in self.links:
+            if not isinstance(link, ForceElement):
+                raise TypeError(f"{type(link).__name__} is not a force element (harmonic_balance.forces)")
             for d in link.dofs:
                 if not 0 <= d < n:
                     raise ValueError(f"friction link {link.name!r} DOF {d} outside 0..{n - 1}")
-            if link.dof_b is not None and link.dof_b == link.dof_a:
+            if isinstance(link, FrictionLink) and link.dof_b is not None and link.dof_b == link.dof_a:
                 raise ValueError(f"friction link {link.name!r} joins DOF {link.dof_a} to itself")
         if not 0 <= self.response_dof < n:
             raise ValueError(f"response DOF {self.response_dof} outside 0..{n - 1}")
@@ -94,17 +114,59 @@ class Model:
     def n(self) -> int:
         return self.linear.n
 
+    @property
+    def elements(self) -> list:
+        """The force elements (the ``links`` list)."""
+        return self.links
+
     def stuck_stiffness(self) -> np.ndarray:
-        """Stiffness (n, n) [N/m] with every friction link stuck at its initial stiffness k0."""
+        """Stiffness (n, n) [N/m] with every element stuck (``ForceElement.stuck_stiffness``).
+
+        Non-cyclic elements only (a cyclic coupling has no single real matrix).
+        """
         K = np.array(self.linear.K, dtype=float, copy=True)
-        for link in self.links:
-            a, b = link.dof_a, link.dof_b
-            K[a, a] += link.k0
-            if b is not None:
-                K[b, b] += link.k0
-                K[a, b] -= link.k0
-                K[b, a] -= link.k0
+        for el in self.links:
+            if isinstance(el, FrictionLink):  # the historical assembly, bit for bit
+                a, b = el.dof_a, el.dof_b
+                K[a, a] += el.k0
+                if b is not None:
+                    K[b, b] += el.k0
+                    K[a, b] -= el.k0
+                    K[b, a] -= el.k0
+                continue
+            K += _on_dofs(el.kinematics, el.stuck_stiffness(), self.n)
         return K
+
+    def harmonic_stiffness(self, h: int, stuck: bool = True) -> np.ndarray:
+        """Complex stiffness (n, n) [N/m] acting on harmonic h, cyclic couplings included.
+
+        ``K + sum_e T_h k_e Q_h`` with ``Q_h = Q + exp(i h phi) Q_next`` and
+        ``T_h = T + exp(-i h phi) T_next`` (:mod:`.kinematics`), k_e the element's
+        ``stuck_stiffness`` (``stuck=False``: linear elements only, the contacts and
+        friction links removed). Hermitian for conservative kinematics; its
+        eigenvalues with M give the stuck / free natural frequencies of the nodal
+        diameter whose phase is h phi.
+        """
+        K = np.array(self.linear.K, dtype=complex, copy=True)
+        for el in self.links:
+            if not stuck and not isinstance(el, LinearElement):
+                continue
+            kin = el.kinematics
+            Q, T = kin.Q.astype(complex), kin.T.astype(complex)
+            if kin.cyclic:
+                Q = Q + np.exp(1j * h * kin.phase) * kin.Q_next
+                T = T + np.exp(-1j * h * kin.phase) * kin.T_next
+            K[np.ix_(kin.dofs, kin.dofs)] += T @ el.stuck_stiffness() @ Q
+        return K
+
+    def element_damping(self) -> np.ndarray:
+        """Viscous damping (n, n) [N s/m] of the elements' linear dashpots (``local_damping``)."""
+        C = np.zeros((self.n, self.n))
+        for el in self.links:
+            c = el.local_damping()
+            if c is not None:
+                C += _on_dofs(el.kinematics, c, self.n)
+        return C
 
     def forcing_coeffs(self, basis: FourierBasis) -> np.ndarray:
         """Excitation harmonics (n_b, n) in the basis ordering [N]."""
@@ -117,6 +179,16 @@ class Model:
             elif np.any(f.imag != 0):
                 raise ValueError("a static (h = 0) load must be real")
         return F
+
+
+def _on_dofs(kin, A_local: np.ndarray, n: int) -> np.ndarray:
+    """T A Q of a local matrix (m, m) on all n DOFs (non-cyclic kinematics)."""
+    if kin.cyclic:
+        raise ValueError("a cyclic element has no single (n, n) matrix: use the harmonic residual")
+    out = np.zeros((n, n))
+    idx = np.ix_(kin.dofs, kin.dofs)
+    out[idx] = kin.T @ A_local @ kin.Q
+    return out
 
 
 def jenkins_element(k: float, fs: float):
@@ -163,8 +235,8 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
     return lin, forcing, resp
 
 
-def load_elements(path) -> list[FrictionLink]:
-    """Read an ``elements.toml`` file into friction links (format in the module docstring)."""
+def load_elements(path) -> list[ForceElement]:
+    """Read an ``elements.toml`` file into force elements (format in the module docstring)."""
     path = Path(path)
     try:
         spec = tomllib.loads(path.read_text())
@@ -176,10 +248,12 @@ def load_elements(path) -> list[FrictionLink]:
     return [_element_link(t, i, path.parent) for i, t in enumerate(tables)]
 
 
-def _element_link(t: dict, i: int, base: Path) -> FrictionLink:
-    """One [[element]] table -> FrictionLink."""
+def _element_link(t: dict, i: int, base: Path) -> ForceElement:
+    """One [[element]] table -> FrictionLink (or ContactElement)."""
     from fmu_src.element import IwanElement
 
+    if t.get("type") == "contact":
+        return _contact_element(t, i, base)
     dofs = t.get("dofs")
     if not isinstance(dofs, list) or len(dofs) not in (1, 2):
         raise ValueError(f"element {i}: 'dofs' must be [a] or [a, b]")
@@ -201,6 +275,37 @@ def _element_link(t: dict, i: int, base: Path) -> FrictionLink:
         raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")
     b = int(dofs[1]) if len(dofs) == 2 else None
     return FrictionLink(el, int(dofs[0]), b, name)
+
+
+_CONTACT_KEYS = {"type", "name", "dofs", "normal", "tangent", "delta", "k_n", "k_t", "mu", "curve",
+                 "fit", "scale", "preload", "slip_ref", "beta_c"}
+
+
+def _contact_element(t: dict, i: int, base: Path):
+    """One [[element]] table of type "contact" -> ContactElement (format in the module docstring)."""
+    unknown = set(t) - _CONTACT_KEYS
+    if unknown:
+        raise ValueError(f"element {i}: unknown contact keys {sorted(unknown)}")
+    try:
+        dofs = [int(d) for d in t["dofs"]]
+        normal = np.asarray(t["normal"], dtype=float)
+        delta = np.asarray(t["delta"], dtype=float) if "delta" in t else np.eye(normal.size, len(dofs))
+        tangent = np.asarray(t["tangent"], dtype=float) if "tangent" in t else np.zeros((0, normal.size))
+        kin = Kinematics.contact(dofs, normal, tangent, delta)
+        kw = {k: float(t.get(k, 0.0)) for k in ("preload", "slip_ref", "beta_c")}
+        kw["name"] = t.get("name", f"element{i}")
+        if "tangent" not in t:
+            return ContactElement(kin, float(t["k_n"]), **kw)
+        if "curve" in t:  # the curve element exactly as a "curve" friction link reads it
+            spec = {k: t[k] for k in ("fit", "scale") if k in t}
+            el = _element_link({"dofs": [0], "type": "curve", "path": t["curve"], **spec}, i, base)
+            return ContactElement(kin, float(t["k_n"]), el.element, **kw)
+        return ContactElement.jenkins(kin, float(t["k_n"]), float(t["k_t"]), float(t["mu"]), **kw)
+    except KeyError as err:
+        raise ValueError(f"element {i}: contact needs key {err.args[0]!r}") from None
+    except (TypeError, ValueError) as err:
+        msg = str(err)
+        raise ValueError(msg if msg.startswith(f"element {i}:") else f"element {i}: {msg}") from None
 
 
 def load_model(matrices, elements) -> Model:

@@ -6,11 +6,13 @@ Full residual (all n DOFs; unknowns X (n_b, n), flattened as in :mod:`fourier`):
     A(omega) = I (x) K - omega^2 diag(h^2) (x) M + omega D_theta (x) C
 
 where ``D_theta`` is d/dtheta in coefficient space (so omega D_theta X are the velocity
-harmonics) and ``(x)`` the Kronecker product. F_nl comes from the AFT (:mod:`aft`);
-being rate-independent it does not depend on omega, so
-``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X``.
+harmonics) and ``(x)`` the Kronecker product. F_nl = T F(Q X) comes from the force
+elements (:mod:`forces`: each maps its local harmonics Q X to force harmonics, by AFT
+or in closed form); rate-independent elements do not depend on omega, dashpots in
+elements add their omega-derivative ``dF_nl/domega``, so
+``dR/domega = (-2 omega diag(h^2) (x) M + D_theta (x) C) X + dF_nl/domega``.
 
-Condensed residual (unknowns: the harmonics of the m DOFs the friction links touch,
+Condensed residual (unknowns: the harmonics of the m DOFs the force elements touch,
 set J)::
 
     R = X_J - G_JJ(omega) F_ext - ... = X_J - X_lin,J(omega) + G_JJ(omega) F_nl,J(X_J)
@@ -23,61 +25,113 @@ from __future__ import annotations
 
 import numpy as np
 
-from .aft import aft_link
 from .fourier import FourierBasis
 from .model import Model
 
 
 class _Residual:
-    """Shared AFT assembly over the links, on a set of 'active' DOFs."""
+    """Shared assembly of the force elements (:mod:`.forces`) on a set of 'active' DOFs.
+
+    Element e has harmonic operators Q_e (n_b m_e, size), T_e (size, n_b m_e) from its
+    kinematics; they are stacked element by element into Q (sum n_b m_e, size) and
+    T (size, sum n_b m_e), so U = Q x, F_nl = T F and dF_nl/dx = T blockdiag(dF_e/dU_e) Q:
+    three dense products, no scatter loop. When every element is conservative,
+    Q is T's transpose (a view).
+    """
 
     def __init__(self, model: Model, basis: FourierBasis, dofs):
         self.model, self.basis = model, basis
         self.dofs = np.asarray(dofs, dtype=int)
         self.m = self.dofs.size
-        pos = {int(d): i for i, d in enumerate(self.dofs)}
-        nb = basis.nb
-        # Coefficient-major indices (c * m + local DOF) of each link's two ends.
-        self._ends = []
-        for link in model.links:
-            ia = np.arange(nb) * self.m + pos[link.dof_a]
-            ib = None if link.dof_b is None else np.arange(nb) * self.m + pos[link.dof_b]
-            self._ends.append((link, ia, ib))
-        self.size = nb * self.m
+        self.size = basis.nb * self.m
         self.Fext = model.forcing_coeffs(basis)  # (nb, n)
-        # Signed incidence B (size, L n_b): column block l maps link l's harmonics
-        # to its two ends (+1 at a, -1 at b), so U = B^T x, F_nl = B F_h and
-        # dF_nl/dx = B blockdiag(dF_h/dU) B^T: three dense products, no scatter loop.
-        L = len(self._ends)
-        self._B = np.zeros((self.size, L * nb))
-        for l, (_, ia, ib) in enumerate(self._ends):
-            self._B[ia, l * nb + np.arange(nb)] = 1.0
-            if ib is not None:
-                self._B[ib, l * nb + np.arange(nb)] = -1.0
+        self.elements = list(model.elements)
+        ops = [el.kinematics.operators(basis, self.dofs) for el in self.elements]
+        self._slices, start = [], 0
+        for Qe, _ in ops:
+            self._slices.append(slice(start, start + Qe.shape[0]))
+            start += Qe.shape[0]
+        self._T = np.zeros((self.size, start))
+        for sl, (_, Te) in zip(self._slices, ops):
+            self._T[:, sl] = Te
+        if all(el.kinematics.conservative for el in self.elements):
+            self._Q = self._T.T
+        else:
+            self._Q = np.zeros((start, self.size))
+            for sl, (Qe, _) in zip(self._slices, ops):
+                self._Q[sl] = Qe
+        self._ops = ops
+        self._static = np.concatenate(
+            [np.tile(el.static_force(), basis.nb) * _mean_mask(basis, el.m)
+             for el in self.elements]) if self.elements else np.zeros(0)
 
-    def nonlinear(self, x: np.ndarray, jac: bool = True):
-        """Internal friction forces (size,) on the active DOFs, Jacobian, energies."""
-        nb, L = self.basis.nb, len(self._ends)
-        U = (self._B.T @ x).reshape(L, nb)
-        Fh = np.empty((L, nb))
-        J = np.zeros((L * nb, L * nb)) if jac else None
-        W = []
-        for l, (link, _, _) in enumerate(self._ends):
-            Fh[l], Jl, w, _ = aft_link(link, U[l], self.basis)
-            W.append(w)
-            if jac:
-                J[l * nb:(l + 1) * nb, l * nb:(l + 1) * nb] = Jl
-        Fnl = self._B @ Fh.ravel()
-        return Fnl, (self._B @ J @ self._B.T if jac else None), W
+    def evaluate(self, x: np.ndarray, omega: float | None = None, jac: bool = True):
+        """Every element's :class:`~.forces.LocalForce` at unknowns x (size,)."""
+        U = self._Q @ x
+        nb = self.basis.nb
+        w = 0.0 if omega is None else float(omega)
+        return [el.evaluate(U[sl].reshape(nb, el.m), self.basis, w, jac)
+                for el, sl in zip(self.elements, self._slices)]
 
-    def link_samples(self, x: np.ndarray):
-        """Per link: relative displacement and force over one period, (n_t,) each."""
-        out = []
-        for link, ia, ib in self._ends:
-            U = x[ia] if ib is None else x[ia] - x[ib]
-            _, _, w, F = aft_link(link, U, self.basis)
-            out.append((self.basis.E @ U, F, w))
-        return out
+    def nonlinear(self, x: np.ndarray, jac: bool = True, omega: float | None = None):
+        """Element forces (size,) on the active DOFs, Jacobian, energies per element.
+
+        ``omega`` is needed by elements with dashpots (None counts as 0); the
+        derivative of the forces with respect to omega is left in ``self.dF_domega``.
+        """
+        res = self.evaluate(x, omega, jac)
+        Fh = np.concatenate([r.F.ravel() for r in res]) if res else np.zeros(0)
+        Fnl = self._T @ Fh
+        dF = None
+        if jac:
+            J = np.zeros((Fh.size, Fh.size))
+            for sl, r in zip(self._slices, res):
+                J[sl, sl] = r.dF
+            dF = self._T @ J @ self._Q
+        dw = [r.dF_domega for r in res]
+        self.dF_domega = None
+        if any(d is not None for d in dw):
+            dw = np.concatenate([np.zeros(sl.stop - sl.start) if d is None else d
+                                 for sl, d in zip(self._slices, dw)])
+            self.dF_domega = self._T @ dw
+        return Fnl, dF, [r.W for r in res]
+
+    def link_samples(self, x: np.ndarray, omega: float | None = None):
+        """Per element: first local displacement, its force over one period (n_t,) each, and W."""
+        return [(r.q[:, 0], r.f[:, 0], r.W) for r in self.evaluate(x, omega, jac=False)]
+
+    def stuck_operator(self) -> np.ndarray:
+        """Stiffness (size, size) of every element stuck (``stuck_stiffness``), element by element."""
+        Kst = np.zeros((self.size, self.size))
+        eye = np.eye(self.basis.nb)
+        for el, (Qe, Te) in zip(self.elements, self._ops):
+            Kst += Te @ np.kron(eye, el.stuck_stiffness()) @ Qe
+        return Kst
+
+    def viscous_operator(self) -> np.ndarray:
+        """Elements' linear dashpots on the unknowns, V (size, size) [N s/m].
+
+        ``sum_e T_e (I (x) C_e) Q_e`` with C_e = ``local_damping()``: the elements' viscous
+        forces are ``omega (D_theta (x) I) V x`` (already in the residual); a method that
+        needs the dashpots apart from the rate-independent forces (Hill's method: velocity
+        ``(omega D_theta + lambda) x``) adds ``lambda V``.
+        """
+        V = np.zeros((self.size, self.size))
+        eye = np.eye(self.basis.nb)
+        for el, (Qe, Te) in zip(self.elements, self._ops):
+            C = el.local_damping()
+            if C is not None:
+                V += Te @ np.kron(eye, C) @ Qe
+        return V
+
+    def static_load(self) -> np.ndarray:
+        """Element forces (size,) at x = 0 (preloads), zero for unloaded elements."""
+        return self._T @ self._static if np.any(self._static) else np.zeros(self.size)
+
+
+def _mean_mask(basis: FourierBasis, m: int) -> np.ndarray:
+    """(n_b m,) mask of the zeroth-harmonic rows (a static force lives only there)."""
+    return np.repeat((basis.order == 0).astype(float), m)
 
 
 class FullResidual(_Residual):
@@ -97,16 +151,17 @@ class FullResidual(_Residual):
 
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         A = self._K - omega**2 * self._M + omega * self._C
-        Fnl, dF, _ = self.nonlinear(x, jac)
+        Fnl, dF, _ = self.nonlinear(x, jac, omega)
         R = A @ x + Fnl - self._f
         if not jac:
             return R
-        return R, A + dF, (-2.0 * omega * self._M + self._C) @ x
+        Rw = (-2.0 * omega * self._M + self._C) @ x
+        return R, A + dF, Rw if self.dF_domega is None else Rw + self.dF_domega
 
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
         A = self._K - omega**2 * self._M + omega * self._C
-        return np.linalg.solve(A + _stuck_links(self._ends, self.basis.nb, A.shape[0]), self._f)
+        return np.linalg.solve(A + self.stuck_operator(), self._f - self.static_load())
 
     def displacements(self, x: np.ndarray, omega: float) -> np.ndarray:
         """Harmonics of all DOFs (n_b, n)."""
@@ -117,9 +172,9 @@ class CondensedResidual(_Residual):
     """HB residual condensed onto the friction DOFs through the receptance."""
 
     def __init__(self, model: Model, basis: FourierBasis):
-        dofs = sorted({d for link in model.links for d in link.dofs})
+        dofs = sorted({d for el in model.elements for d in el.dofs})
         if not dofs:
-            raise ValueError("the condensed residual needs at least one friction link")
+            raise ValueError("the condensed residual needs at least one force element")
         super().__init__(model, basis, dofs)
         self._cache = (None, None)
 
@@ -170,22 +225,23 @@ class CondensedResidual(_Residual):
 
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         G, dG, Xl, dXl = self._operators(omega)
-        Fnl, dF, _ = self.nonlinear(x, jac)
+        Fnl, dF, _ = self.nonlinear(x, jac, omega)
         R = x - Xl + G @ Fnl
         if not jac:
             return R
-        return R, np.eye(self.size) + G @ dF, -dXl + dG @ Fnl
+        Rw = -dXl + dG @ Fnl
+        return R, np.eye(self.size) + G @ dF, Rw if self.dF_domega is None else Rw + G @ self.dF_domega
 
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
         G, _, Xl, _ = self._operators(omega)
-        Kst = _stuck_links(self._ends, self.basis.nb, self.size)
-        return np.linalg.solve(np.eye(self.size) + G @ Kst, Xl)
+        return np.linalg.solve(np.eye(self.size) + G @ self.stuck_operator(),
+                               Xl - G @ self.static_load())
 
     def displacements(self, x: np.ndarray, omega: float, rows=None) -> np.ndarray:
         """Harmonics (n_b, len(rows)) of any DOFs, recovered through the receptance."""
         rows = np.arange(self.model.n) if rows is None else np.asarray(rows)
-        Fnl, _, _ = self.nonlinear(x, jac=False)
+        Fnl, _, _ = self.nonlinear(x, jac=False, omega=omega)
         G, _ = self._real_block(rows, self.dofs, omega, False)
         X, _ = self._linear_response(rows, omega, False)
         return X - (G @ Fnl).reshape(self.basis.nb, len(rows))
@@ -194,7 +250,7 @@ class CondensedResidual(_Residual):
 def make_residual(model: Model, basis: FourierBasis, condensed: bool | None = None):
     """Pick the residual: condensed when the model is modal-only or larger than the link DOFs."""
     if condensed is None:
-        m = len({d for link in model.links for d in link.dofs})
+        m = len({d for el in model.elements for d in el.dofs})
         condensed = model.linear.K is None or (0 < m < model.n)
     return CondensedResidual(model, basis) if condensed else FullResidual(model, basis)
 
@@ -218,20 +274,3 @@ def energy_per_cycle(model: Model, basis: FourierBasis, X: np.ndarray, omega: fl
         if C is not None:
             w_visc += np.pi * h**2 * omega * (a @ C @ a + b @ C @ b)
     return {"W_ext": float(w_ext), "W_visc": float(w_visc) if C is not None else None}
-
-
-def _stuck_links(ends, nb: int, size: int) -> np.ndarray:
-    """Stiffness (size, size) of every link stuck at k0, on its harmonic index blocks.
-
-    ``ends`` holds (link, ia, ib): index arrays (nb,) of the link's two ends in the
-    unknown vector (ib None for a link to the ground).
-    """
-    Kst = np.zeros((size, size))
-    J = np.eye(nb)
-    for link, ia, ib in ends:
-        Kst[np.ix_(ia, ia)] += link.k0 * J
-        if ib is not None:
-            Kst[np.ix_(ia, ib)] -= link.k0 * J
-            Kst[np.ix_(ib, ia)] -= link.k0 * J
-            Kst[np.ix_(ib, ib)] += link.k0 * J
-    return Kst

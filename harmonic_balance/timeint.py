@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from .aft import FrictionLink
 from .model import Model
 
 #: Fraction of the stability limit 2 / omega_max used as the largest step.
@@ -47,17 +48,29 @@ class SteadyState:
     steps_per_period: int
     converged: bool
     x_last: np.ndarray    # (steps_per_period,) response over the last period
+    #: energy [J] dissipated by each force element's hysteresis over the last period
+    #: (C-element state; the elements' linear dashpots are part of C, not included)
+    W_elements: tuple | None = None
 
 
 def _link_stepper(link):
-    """One-sample force update of a link's element with its carried (virgin) state."""
+    """One-sample force update of an element with its carried (virgin) state.
+
+    A friction link returns a float (its historical path); any other force element
+    its ``stepper().force`` on local displacements (m,) -> local forces (m,).
+    """
+    if not isinstance(link, FrictionLink):
+        st = link.stepper()
+        force = st.force
+        force_dissipated = getattr(st, "dissipated", lambda: 0.0)
+        return force, force_dissipated
     el = link.element
     state = el.initial_state()
 
     def force(u: float) -> float:
         return el.step(state, u).F
 
-    return force
+    return force, lambda: state.W
 
 
 def _stable_steps(model: Model, omega: float, steps: int) -> int:
@@ -86,8 +99,9 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     n, r = model.n, model.response_dof
     ns = _stable_steps(model, omega, steps_per_period)
     dt = 2.0 * np.pi / omega / ns
-    lhs = sla.lu_factor(lin.M / dt**2 + lin.C / (2 * dt))
-    forces = [_link_stepper(link) for link in model.links]
+    C = lin.C + model.element_damping()  # contact dashpots are linear: implicit, with C
+    lhs = sla.lu_factor(lin.M / dt**2 + C / (2 * dt))
+    forces, dissipated = zip(*[_link_stepper(link) for link in model.links]) if model.links else ((), ())
     th = 2.0 * np.pi * np.arange(ns) / ns
     fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})
@@ -96,24 +110,34 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     x_prev = x - dt * v  # first-order start; the transient forgets it
     hist, prev, deltas = np.empty(ns), None, []
     for p in range(1, max_periods + 1):
+        w0 = [d() for d in dissipated]
         for j in range(ns):
             fnl = _friction(model, forces, x)
             rhs = (fext[j] - lin.K @ x - fnl + lin.M @ (2 * x - x_prev) / dt**2
-                   + lin.C @ x_prev / (2 * dt))
-            x_prev, x = x, sla.lu_solve(lhs, rhs)
+                   + C @ x_prev / (2 * dt))
+            x_prev, x = x, sla.lu_solve(lhs, rhs, check_finite=False)
             hist[j] = x_prev[r]
         c = np.fft.rfft(hist)[:8] / ns
         if prev is not None:
             deltas.append(np.linalg.norm(c - prev) / max(np.linalg.norm(c), 1e-300))
             if _settled(deltas, tol):
-                return _result(omega, hist, p, ns, True)
+                return _result(omega, hist, p, ns, True, _worked(dissipated, w0))
         prev = c
-    return _result(omega, hist, max_periods, ns, False)
+    return _result(omega, hist, max_periods, ns, False, _worked(dissipated, w0))
+
+
+def _worked(dissipated, w0) -> tuple:
+    """Energy dissipated per element since w0 (the start of the last period) [J]."""
+    return tuple(d() - w for d, w in zip(dissipated, w0))
 
 
 def _friction(model, forces, x):
     f = np.zeros(model.n)
     for link, force in zip(model.links, forces):
+        if not isinstance(link, FrictionLink):
+            kin = link.kinematics
+            f[list(kin.dofs)] += kin.T @ force(kin.Q @ x[list(kin.dofs)])
+            continue
         u = x[link.dof_a] - (0.0 if link.dof_b is None else x[link.dof_b])
         F = force(u)
         f[link.dof_a] += F
@@ -133,7 +157,7 @@ def _settled(deltas, tol) -> bool:
     return d2 * max(1.0, rho / (1.0 - rho)) < tol
 
 
-def _result(omega, hist, p, ns, ok):
+def _result(omega, hist, p, ns, ok, W=None):
     # Sample at the step ending each period: hist[j] = x at t = j dt (start of step j+1).
     c = np.fft.rfft(hist) / ns
     h1 = 2.0 * abs(c[1])
@@ -142,7 +166,7 @@ def _result(omega, hist, p, ns, ok):
     den = y0 - 2 * y1 + y2
     # Parabola through the three samples around the extreme: peak between samples.
     peak = y1 - 0.125 * (y2 - y0) ** 2 / den if den < 0 else y1
-    return SteadyState(omega, float(peak), float(h1), p, ns, ok, hist.copy())
+    return SteadyState(omega, float(peak), float(h1), p, ns, ok, hist.copy(), W)
 
 
 def steady_amplitude(model: Model, omega: float, steps_per_period: int = 512, **kw):
@@ -319,6 +343,8 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     """
     if model.linear.K is None:
         raise ValueError("time integration needs M, C, K matrices")
+    if not all(isinstance(el, FrictionLink) for el in model.links):
+        raise ValueError("march_curve handles friction links only; use march for other force elements")
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
         raise ValueError(f"omegas must be a non-empty 1-D array of positive numbers, got {omegas}")

@@ -1,0 +1,318 @@
+"""Contact element: penalty normal spring with lift-off and friction that follows N.
+
+Local displacements (from :meth:`.kinematics.Kinematics.contact`): ``q = [s, p]``,
+the slip ``s = t . Delta`` and the penetration ``p = -n . Delta`` of a contact point
+(Delta = body 1 minus body 2, n from body 2 into body 1). Local forces ``f = [f_t, N]``
+(conjugate to q; the internal force on body 1 is ``f_t t - N n``)::
+
+    N(theta)   = k_n max(p_0 + p(theta), 0)                              (C1)
+    f_t(theta) = Iwan/Jenkins element at slip s - s_0, slip limits x N/N_ref   (C2)
+    + dashpots beta_c k_t ds/dt and beta_c k_n dp/dt (linear, always on)  (C3)
+
+p_0 [m] is a static penetration (preload offset: the contact at x = 0 already
+carries ``k_n p_0``); with the zeroth harmonic retained the static loads may instead
+come from the same solve (e.g. a centrifugal load in harmonic 0). ``N <= 0`` is
+lift-off: f_t = 0, the sliders are released and follow the slip; at re-contact the
+element restarts virgin from the slip there (C core, ``iwan.h``).
+
+Friction with N varying in time (C2) is evaluated by the C core's periodic path
+(``IwanElement.periodic_jac`` with N and its basis EN): periods are marched until the
+element's state recurs (closure to ``tol`` of the force range, ``max_periods`` at
+most, else ``IwanNotConvergedError``); with N constant over the period the loop is
+exact in one pass. It returns dF/dU_s and dF/dU_p exactly, including the
+dependence of each sticking slider on N where it stuck and of the re-contact point.
+The C core gets the *unclamped* ``k_n (p_0 + p)``, linear in the harmonics
+(EN = k_n E): it treats N <= 0 as lift-off and locates re-contact on the straight
+path between samples; (C1) itself is clamped.
+
+Starting (prestress) state of the sliders
+-----------------------------------------
+``s_0`` [m] is the slip at the prestress state, e.g. the frictionless (mu = 0) static
+solution (tmdsimpy's convention; :func:`frictionless_statics` computes it): there the
+sliders are virgin (tangential force zero). A periodic loop is then placed by the C
+core's convention (``iwan_periodic``): starting from that virgin state, each slider is
+moved by the least amount that keeps it within its slip limits over the loop. So a
+contact that stays stuck with ``|s - s_0|`` below the slip radii has the defined mean
+force ``k_t (mean(s) - s_0)``; a slider that slips in every cycle forgets s_0.
+Two tangential directions are not supported (the C element is one-dimensional).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .aft import FrictionLink
+from .forces import ForceElement, LinearElement, LocalForce, viscous_work
+from .fourier import FourierBasis
+from .kinematics import Kinematics
+
+#: Default closure tolerance of the periodic march with varying N, relative to the
+#: force range of the period (the C core's measure).
+CLOSURE_TOL = 1e-10
+#: Default largest number of periods marched until the loop closes.
+MAX_PERIODS = 400
+#: Condition number above which the static stiffness counts as singular (a floating
+#: body): 1e-3 / machine epsilon leaves ~3 significant digits in the solve.
+SINGULAR_COND = 1e-3 / np.finfo(float).eps
+
+
+class ContactElement(ForceElement):
+    """Penalty normal spring with lift-off, friction following N, optional dashpots.
+
+    Parameters
+    ----------
+    kinematics : Kinematics
+        Local q = [s, p] (m = 2) or [p] (m = 1, normal only); see
+        :meth:`Kinematics.contact`.
+    k_n : float
+        Normal penalty stiffness [N/m] (> 0).
+    friction : object, optional
+        Tangential element with ``periodic_jac``, ``step``, ``initial_state``, ``k``,
+        ``k_res``, ``N_ref`` (``fmu_src.element.IwanElement``); its slip strengths
+        scale with N / N_ref. Required when m = 2. See :meth:`jenkins`.
+    preload : float
+        Static penetration p_0 [m] at x = 0 (C1).
+    slip_ref : float
+        Prestress slip s_0 [m] where the sliders are virgin (module docstring).
+    beta_c : float
+        Contact damping [s]: dashpots beta_c k_t and beta_c k_n in parallel (C3),
+        k_t the friction element's stuck stiffness.
+    max_periods, tol : int, float
+        Periodic march with varying N (module docstring).
+    name : str
+    """
+
+    def __init__(self, kinematics: Kinematics, k_n: float, friction=None, *, preload: float = 0.0,
+                 slip_ref: float = 0.0, beta_c: float = 0.0, max_periods: int = MAX_PERIODS,
+                 tol: float = CLOSURE_TOL, name: str = ""):
+        m = kinematics.m
+        if m not in (1, 2):
+            raise ValueError(f"contact kinematics must give [p] or [s, p] (m = 1 or 2), got m = {m}; "
+                             "two tangential directions are not supported")
+        if (m == 2) != (friction is not None):
+            raise ValueError("a contact with a slip coordinate (m = 2) needs a friction element, "
+                             "a normal-only contact (m = 1) none")
+        for label, v, lo in (("k_n", k_n, 0.0), ("beta_c", beta_c, None)):
+            if not np.isfinite(v) or v < 0 or (lo is not None and v <= lo):
+                raise ValueError(f"{label} must be finite and {'> 0' if lo is not None else '>= 0'}, "
+                                 f"got {v}")
+        if not (np.isfinite(preload) and np.isfinite(slip_ref)):
+            raise ValueError("preload and slip_ref must be finite")
+        self.kinematics, self.name = kinematics, name
+        self.k_n, self.friction = float(k_n), friction
+        self.preload, self.slip_ref, self.beta_c = float(preload), float(slip_ref), float(beta_c)
+        self.max_periods, self.tol = int(max_periods), float(tol)
+        self.k_t = 0.0 if friction is None else float(np.sum(friction.k) + friction.k_res)
+
+    @classmethod
+    def jenkins(cls, kinematics: Kinematics, k_n: float, k_t: float, mu: float, **kw):
+        """Contact with a Jenkins friction element: spring k_t [N/m], slip force mu N."""
+        from fmu_src.element import IwanElement
+
+        if not (np.isfinite(k_t) and np.isfinite(mu)) or k_t <= 0 or mu < 0:
+            raise ValueError(f"Jenkins contact needs k_t > 0 and mu >= 0, got k_t={k_t}, mu={mu}")
+        return cls(kinematics, k_n, IwanElement.jenkins(k_t, mu), **kw)
+
+    # ------------------------------------------------------------ ForceElement
+    def stuck_stiffness(self) -> np.ndarray:
+        """diag(k_t, k_n): in contact and stuck."""
+        return np.diag([self.k_t, self.k_n][2 - self.m:])
+
+    def local_damping(self):
+        if self.beta_c == 0.0:
+            return None
+        return self.beta_c * self.stuck_stiffness()
+
+    def static_force(self) -> np.ndarray:
+        return np.array([0.0, self.k_n * max(self.preload, 0.0)][2 - self.m:])
+
+    def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
+        """AFT of (C1)-(C3) on local harmonics U (n_b, m); exact Jacobian."""
+        nb, m, E, D = basis.nb, self.m, basis.E, basis.D
+        U = np.asarray(U, dtype=float).reshape(nb, m)
+        pl = E @ U[:, -1]
+        p = self.preload + pl
+        on = p > 0.0
+        q = np.empty((basis.n_t, m))
+        f = np.empty((basis.n_t, m))
+        q[:, -1] = pl
+        f[:, -1] = self.k_n * np.where(on, p, 0.0)
+        dF = np.zeros((nb * m, nb * m)) if jac else None
+        if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
+            dF[m - 1::m, m - 1::m] = (D * (self.k_n * on)) @ E
+        W = 0.0
+        if m == 2:
+            s = E @ U[:, 0]
+            q[:, 0] = s
+            Ft, dFs, dFp, W = self.friction.periodic_jac(
+                s - self.slip_ref, E, N=self.k_n * p, EN=self.k_n * E,
+                max_periods=self.max_periods, tol=self.tol)
+            f[:, 0] = Ft
+            if jac:
+                dF[0::2, 0::2] = D @ dFs
+                dF[0::2, 1::2] = D @ dFp
+        F = D @ f
+        dw, Wv = None, 0.0
+        C = self.local_damping()
+        if C is not None:
+            op = self._damping_operator(basis)
+            dw = op @ U.ravel()
+            F += omega * dw.reshape(nb, m)
+            if jac:
+                dF += omega * op
+            Wv = viscous_work(C, U, basis, omega)
+        return LocalForce(F, dF, dw, float(W) + Wv, Wv, q, f)
+
+    def _damping_operator(self, basis: FourierBasis) -> np.ndarray:
+        """D_theta (x) C_local (n_b m, n_b m), cached per basis."""
+        key = (basis.harmonics, self.beta_c, self.k_t, self.k_n)
+        if getattr(self, "_dop", (None,))[0] != key:
+            self._dop = (key, np.kron(basis.dtheta, self.local_damping()))
+        return self._dop[1]
+
+    def stepper(self):
+        """Time-domain law: one C-element step per call at N = k_n (p_0 + p)."""
+        el, kn, p0, s0, m = self.friction, self.k_n, self.preload, self.slip_ref, self.m
+        state = None if el is None else el.initial_state(kn * p0 if p0 > 0 else None)
+
+        class _Contact:
+            def force(self, q):
+                pen = p0 + q[-1]
+                N = kn * max(pen, 0.0)
+                if m == 1:
+                    return np.array([N])
+                return np.array([el.step(state, q[0] - s0, kn * pen).F, N])
+
+            def dissipated(self) -> float:
+                """Cumulative friction energy [J] of the carried state."""
+                return 0.0 if state is None else state.W
+
+        return _Contact()
+
+    def batch_stepper(self, n: int) -> ContactBatchStepper:
+        """``n`` independent virgin histories advanced together (:class:`ContactBatchStepper`)."""
+        return ContactBatchStepper(self, n)
+
+
+class ContactBatchStepper:
+    """``n`` independent time histories of one ContactElement, one C call per step.
+
+    For vectorised time integration (many frequencies or variants marched together):
+    ``force(q)`` advances history i to the local displacement ``q[i]`` exactly as
+    :meth:`ContactElement.stepper` would (the C core's ``iwan_step_batch`` runs the
+    same code as ``iwan_step``: the same bits), at ``N = k_n (p_0 + p)``.
+
+    Attributes
+    ----------
+    n : int                 number of histories
+    f : (n, m) array        local forces of the last step [N] (overwritten each call)
+    """
+
+    def __init__(self, element: ContactElement, n: int, states=None):
+        self.element, self.n = element, int(n)
+        el, kn, p0 = element.friction, element.k_n, element.preload
+        self.f = np.zeros((self.n, element.m))
+        self._st = None
+        if el is not None:
+            if states is None:
+                states = el.initial_states(self.n, kn * p0 if p0 > 0 else None)
+            self._st = el.batch_stepper(states, N=np.zeros(self.n))
+
+    def force(self, q: np.ndarray) -> np.ndarray:
+        """Advance every history to q (n, m); returns the local forces (n, m)."""
+        e = self.element
+        q = np.asarray(q, dtype=float).reshape(self.n, e.m)
+        pen = e.preload + q[:, -1]
+        self.f[:, -1] = e.k_n * np.maximum(pen, 0.0)
+        if self._st is not None:
+            np.subtract(q[:, 0], e.slip_ref, out=self._st.u)
+            np.multiply(pen, e.k_n, out=self._st.N)
+            self.f[:, 0] = self._st.step()
+        return self.f
+
+    def dissipated(self) -> np.ndarray:
+        """Cumulative friction energy [J] of each history, shape (n,)."""
+        if self._st is None:
+            return np.zeros(self.n)
+        return self._st.states["w_diss"].copy()
+
+    def keep(self, idx) -> ContactBatchStepper:
+        """A stepper continuing only the histories ``idx`` (e.g. those not yet settled)."""
+        idx = np.asarray(idx, dtype=int)
+        states = None if self._st is None else np.ascontiguousarray(self._st.states[idx])
+        return ContactBatchStepper(self.element, idx.size, states)
+
+
+def _static_parts(model):
+    """Linear static stiffness (n, n) and the contacts' h = 0 normal rows, for the statics.
+
+    Returns ``K + sum T K_l Q`` of the linear elements and, per ContactElement,
+    (index, element, Q_0 (m, d), q_n (n,), t_n (n,)): its h = 0 kinematics and the
+    normal row / column on all DOFs (penetration p = p_0 + q_n . x, force t_n N).
+    """
+    if model.linear.K is None:
+        raise ValueError("frictionless statics needs the stiffness matrix K")
+    n = model.n
+    Klin, rows = np.array(model.linear.K, dtype=float), []
+    for i, el in enumerate(model.elements):
+        kin = el.kinematics
+        Q = kin.Q if not kin.cyclic else kin.Q + kin.Q_next
+        T = kin.T if not kin.cyclic else kin.T + kin.T_next
+        if isinstance(el, ContactElement):
+            qn, tn = np.zeros(n), np.zeros(n)
+            qn[list(kin.dofs)], tn[list(kin.dofs)] = Q[-1], T[:, -1]
+            rows.append((i, el, Q, qn, tn))
+        elif isinstance(el, LinearElement):
+            Klin[np.ix_(kin.dofs, kin.dofs)] += T @ el.K @ Q
+        elif not isinstance(el, FrictionLink):
+            raise TypeError(f"frictionless statics does not know {type(el).__name__}")
+    return Klin, rows
+
+
+def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
+    """Static solution with mu = 0 and the slip at each contact (prestress, tmdsimpy's convention).
+
+    Solves ``K x + sum_c T_c [0, N_c(x)] + sum_l T_l K_l Q_l x = f_0`` (f_0 the model's
+    harmonic-0 load; N_c from (C1); friction carries no force, mu = 0; linear elements
+    with their K) by an active-set iteration on the piecewise-linear normal law: solve
+    with the contacts in the active set, update the set from the penetrations, until it
+    repeats. Cyclic kinematics enter with their h = 0 map ``Q + Q_next`` (the
+    neighbour's static state is the sector's).
+
+    Parameters
+    ----------
+    model : Model  (matrix model; force elements: ContactElement, LinearElement, FrictionLink)
+    apply : bool   set each contact's ``slip_ref`` to its static slip
+    max_iter : int
+
+    Returns
+    -------
+    x : (n,) array               static displacements [m]
+    slip : dict {index: float}   s_0 of each ContactElement with friction (index in model.elements)
+    """
+    Klin, rows = _static_parts(model)
+    n = model.n
+    f0 = np.real(model.forcing.get(0, np.zeros(n))).astype(float)
+    active = np.ones(len(rows), dtype=bool)
+    for _ in range(max_iter):
+        A, b = Klin.copy(), f0.copy()
+        for on, (_, el, _, qn, tn) in zip(active, rows):
+            if on:  # N = k_n (p0 + qn . x): stiffness tn k_n qn^T, load -tn k_n p0
+                A += el.k_n * np.outer(tn, qn)
+                b -= el.k_n * el.preload * tn
+        if np.linalg.cond(A) > SINGULAR_COND:
+            raise ValueError("frictionless statics is singular: a body is held by friction only "
+                             "or floats (no contact in compression holds it)")
+        x = np.linalg.solve(A, b)
+        new = np.array([el.preload + qn @ x > 0.0 for _, el, _, qn, _ in rows], dtype=bool)
+        if np.array_equal(new, active):
+            break
+        active = new
+    else:
+        raise ValueError(f"frictionless statics: contact set still changing after {max_iter} iterations")
+    slip = {}
+    for i, el, Q, _, _ in rows:
+        if el.m == 2:
+            slip[i] = float(Q[0] @ x[list(el.kinematics.dofs)])
+            if apply:
+                el.slip_ref = slip[i]
+    return x, slip
