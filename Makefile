@@ -8,12 +8,12 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 CBUILD := build/c
-C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h)
+C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h) fmu_src/core/cflags.txt
 C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in) CMakeLists.txt $(wildcard fmu_src/*/CMakeLists.txt)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel browser clean
+.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -21,6 +21,9 @@ $(PY):
 
 $(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
 	$(PY) -m pip install -q -e '.[dev]' > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
+	@# Fast sparse solver without root (MKL PARDISO from pip), best effort: scipy otherwise.
+	@$(PY) -m pip install -q -e '.[fast]' >> $(VENV)/install.log 2>&1 \
+	  || echo "note: fast solver (pypardiso) not installed (see $(VENV)/install.log); using scipy"
 	@# Optional accelerator, best effort: CHOLMOD when SuiteSparse's headers are there (make accel).
 	@if [ -f /usr/include/suitesparse/cholmod.h ]; then \
 	  $(PY) -m pip install -q 'scikit-sparse<0.5' >> $(VENV)/install.log 2>&1 \
@@ -44,7 +47,20 @@ pytest: $(STAMP) cbuild browser
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 
-test: lint ctest pytest
+test: lint locale ctest pytest
+
+# A decimal-comma locale for the FMU locale tests (tests/fmu/test_fmu_trust.py):
+# generated with localedef when missing; as root on a fresh Debian/Ubuntu machine the
+# `locales` package (localedef and the locale sources) is installed first. Without
+# root or apt-get the step is skipped and the tests skip with a reason.
+TEST_LOCALE := de_DE.UTF-8
+locale:
+	@if locale -a 2>/dev/null | grep -qi '^de_DE\.utf-\?8$$'; then exit 0; fi; \
+	if [ ! -f /usr/share/i18n/locales/de_DE ] && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	  apt-get install -y -qq locales >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq locales) >/dev/null 2>&1; fi; \
+	if [ -f /usr/share/i18n/locales/de_DE ] && [ "$$(id -u)" = 0 ]; then \
+	  localedef -i de_DE -f UTF-8 $(TEST_LOCALE) && echo "generated locale $(TEST_LOCALE)"; \
+	else echo "note: locale $(TEST_LOCALE) not available (needs root and the locales package): its tests skip"; fi
 
 # The bundled default scene through `damper run`; a second run loads every stage from
 # the cache (.damper_cache) and says so.
@@ -60,13 +76,12 @@ browser:
 	  echo "note: no chromium (needs root and apt-get): the HTML report browser test will skip"
 
 # Benchmarks print tables (case, size, error, time, memory); long, never in CI.
-BENCHES := contact tangential element fmu hb
+# One report of every stage (out/bench/bench.html, bench.json), sparse back ends included.
 bench: $(STAMP) cbuild
-	@for b in $(BENCHES); do echo "== examples/bench_$$b.py"; \
-	  $(PY) examples/bench_$$b.py || exit 1; done
+	nice $(VENV)/bin/damper bench --solvers --out out/bench
 
-# Optional accelerator: CHOLMOD (scikit-sparse) for the FE condensation, same answers
-# as the scipy fallback, 3-5x faster. Needs root for apt-get.
+# Optional accelerator: the system's CHOLMOD (scikit-sparse) for the FE condensation, same
+# answers as PARDISO and the scipy fallback, as fast as PARDISO. Needs root for apt-get.
 accel: $(STAMP)
 	apt-get update -qq && apt-get install -y -qq libsuitesparse-dev libopenblas0-pthread
 	$(PY) -m pip install -q 'scikit-sparse<0.5'

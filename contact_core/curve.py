@@ -3,16 +3,18 @@
 The virgin curve T(u) is the tangential force T [N] of a contact loaded
 monotonically from zero, against the rigid tangential displacement u [m] of the
 distant faces, at a fixed normal load N [N] and friction coefficient mu [-].
-Its initial slope is the tangential contact stiffness k_t [N/m]; it ends at
-gross slip, T = mu N. Later stages (the hysteresis element, the FMU, harmonic
-balance) read it.
+Its initial slope is the tangential contact stiffness k_t [N/m]; a computed
+curve ends at gross slip, T = mu N. Later stages (the hysteresis element, the
+FMU, harmonic balance) read it.
 
 File format (JSON, ``schema`` = ``SCHEMA``)::
 
     {
-      "schema": "damper-virgin-curve/1",
+      "schema": "damper-virgin-curve/2",
       "u": [0.0, ...],          # m, strictly increasing, u[0] = 0
       "T": [0.0, ...],          # N, T[0] = 0, finite, non-negative
+      "tail": "flat",           # beyond u[-1]: "flat" (T stays T[-1]: gross slip) or
+                                # "slope" (the last segment's slope continues)
       "N": 200.0,               # normal load [N] (optional)
       "mu": 0.5,                # friction coefficient (optional)
       "k_t": 1.2e8,             # initial tangential stiffness [N/m] (optional)
@@ -22,8 +24,15 @@ File format (JSON, ``schema`` = ``SCHEMA``)::
       "provenance": {"code_version": "...", "date": "...", "command": "..."}
     }
 
-Only ``u`` and ``T`` are required, so a hand-made table works too. Unknown
-keys are kept in ``extra`` and written back unchanged.
+Only ``u`` and ``T`` (and, in version 2, ``tail``) are required, so a
+hand-made table works too. Unknown keys are kept in ``extra`` and written back
+unchanged.
+
+Version 1 files (``"damper-virgin-curve/1"`` or no ``schema`` key) carry no tail:
+it is decided once, here, by the rule every reader used to guess (:func:`_v1_tail`):
+flat when mu and N are declared and T[-1] = mu N to ``V1_GROSS_SLIP_RTOL``, else
+slope. Version 2 files state it, written by the producer that knows it
+(``contact_core.tangential_curve.to_virgin_curve``: flat, the curve ends at gross slip).
 """
 from __future__ import annotations
 
@@ -37,7 +46,14 @@ import numpy as np
 from contact_core.fileio import atomic_write
 
 #: Schema tag written to every curve file.
-SCHEMA = "damper-virgin-curve/1"
+SCHEMA = "damper-virgin-curve/2"
+#: Older schema still read (no ``tail`` key: :func:`_v1_tail` decides it).
+SCHEMA_V1 = "damper-virgin-curve/1"
+#: What the curve does beyond its last point (see the module docstring).
+TAILS = ("flat", "slope")
+#: Version 1 only: a curve ends at gross slip when T[-1] = mu N to this relative
+#: tolerance (the file stores mu N rounded; the flat tail's force is T[-1] itself).
+V1_GROSS_SLIP_RTOL = 1e-6
 _KNOWN_SCALARS = ("N", "mu", "k_t", "k_n")
 _KNOWN_TEXT = ("load_case",)
 _KNOWN_DICTS = ("geometry", "materials", "grid", "provenance")
@@ -58,6 +74,9 @@ class VirginCurve:
         normal contact stiffness [N/m].
     load_case : str or None
         ``"CNF"`` or ``"CND"``.
+    tail : {"slope", "flat"}
+        Beyond ``u[-1]``: the last slope continues, or T stays at ``T[-1]`` (gross
+        slip). A producer whose curve ends at gross slip says ``"flat"``.
     geometry, materials, grid, provenance, extra : dict
         Descriptive metadata, written back unchanged.
     """
@@ -69,6 +88,7 @@ class VirginCurve:
     k_t: float | None = None
     k_n: float | None = None
     load_case: str | None = None
+    tail: str = "slope"
     geometry: dict = field(default_factory=dict)
     materials: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
@@ -94,12 +114,14 @@ class VirginCurve:
             raise ValueError(f"curve: normal load N must be > 0, got {self.N}")
         if self.mu is not None and self.mu < 0:
             raise ValueError(f"curve: friction coefficient mu must be >= 0, got {self.mu}")
+        if self.tail not in TAILS:
+            raise ValueError(f"curve: tail must be one of {TAILS}, got {self.tail!r}")
         if self.load_case not in (None, "CNF", "CND"):
             raise ValueError(f"curve: load_case must be CNF or CND, got {self.load_case!r}")
 
     def to_dict(self) -> dict:
         """The file's JSON object (plain Python types)."""
-        out = {"schema": SCHEMA, "u": self.u.tolist(), "T": self.T.tolist()}
+        out = {"schema": SCHEMA, "u": self.u.tolist(), "T": self.T.tolist(), "tail": self.tail}
         for name in _KNOWN_SCALARS + _KNOWN_TEXT:
             if getattr(self, name) is not None:
                 out[name] = getattr(self, name)
@@ -114,11 +136,14 @@ class VirginCurve:
         """Validate a JSON object and build the curve; ValueError names what is wrong."""
         if not isinstance(data, dict):
             raise ValueError(f"{source}: expected a JSON object, got {type(data).__name__}")
-        schema = data.get("schema", SCHEMA)
+        schema = data.get("schema", SCHEMA_V1)   # schema-less tables predate version 2
         if not str(schema).startswith("damper-virgin-curve/"):
             raise ValueError(f"{source}: unknown schema {schema!r} (expected {SCHEMA!r})")
-        if schema != SCHEMA:
+        if schema not in (SCHEMA, SCHEMA_V1):
             raise ValueError(f"{source}: schema {schema!r} is newer than this code reads ({SCHEMA!r})")
+        if schema == SCHEMA and data.get("tail") not in TAILS:
+            raise ValueError(f"{source}: schema {SCHEMA!r} needs \"tail\": one of {TAILS}, "
+                             f"got {data.get('tail')!r}")
         for key in ("u", "T"):
             if key not in data:
                 raise ValueError(f"{source}: missing required array {key!r}")
@@ -130,30 +155,52 @@ class VirginCurve:
         for name in _KNOWN_SCALARS + _KNOWN_TEXT + _KNOWN_DICTS:
             if name in data:
                 kwargs[name] = data[name]
-        known = {"schema", "u", "T", *_KNOWN_SCALARS, *_KNOWN_TEXT, *_KNOWN_DICTS}
+        known = {"schema", "u", "T", "tail", *_KNOWN_SCALARS, *_KNOWN_TEXT, *_KNOWN_DICTS}
         kwargs["extra"] = {k: v for k, v in data.items() if k not in known}
         try:
+            if schema == SCHEMA:
+                kwargs["tail"] = data["tail"]
+            else:
+                kwargs["tail"] = _v1_tail(cls(**kwargs))
             return cls(**kwargs)
         except (TypeError, ValueError) as err:
             raise ValueError(f"{source}: {err}") from None
 
 
+def _v1_tail(curve: VirginCurve) -> str:
+    """Tail of a version 1 curve (the only place the old guess survives): "flat" when
+    mu and N are declared and T[-1] = mu N to ``V1_GROSS_SLIP_RTOL``, else "slope"."""
+    mu, N = curve.mu, curve.N
+    if mu is None or N is None or not mu > 0.0:
+        return "slope"
+    return "flat" if abs(float(curve.T[-1]) - mu * N) <= V1_GROSS_SLIP_RTOL * mu * N else "slope"
+
+
 def _check_table(u: np.ndarray, T: np.ndarray) -> None:
-    """Raise ValueError unless (u, T) is a usable virgin-curve table."""
+    """Raise ValueError unless (u, T) is a usable virgin-curve table.
+
+    The message names the rule and the first point (0-based index) that breaks it.
+    """
     if u.ndim != 1 or T.ndim != 1:
         raise ValueError("u and T must be one-dimensional arrays")
     if u.size != T.size:
         raise ValueError(f"u and T differ in length ({u.size} vs {T.size})")
     if u.size < 2:
-        raise ValueError(f"a virgin curve needs at least 2 points, got {u.size}")
-    if not (np.all(np.isfinite(u)) and np.all(np.isfinite(T))):
-        raise ValueError("u and T must be finite (no NaN or infinity)")
+        raise ValueError(f"a virgin curve needs at least 2 points, got {u.size}"
+                         + (" (empty)" if u.size == 0 else ""))
+    for name, x in (("u", u), ("T", T)):
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise ValueError(f"u and T must be finite (no NaN or infinity): {name}[{bad[0]}] = {x[bad[0]]}")
     if u[0] != 0.0 or T[0] != 0.0:
-        raise ValueError(f"a virgin curve starts at (0, 0), got ({u[0]}, {T[0]})")
-    if np.any(np.diff(u) <= 0.0):
-        raise ValueError("u must be strictly increasing")
-    if np.any(T < 0.0):
-        raise ValueError("T must be non-negative")
+        raise ValueError(f"a virgin curve starts at (0, 0), got ({u[0]}, {T[0]}) at point 0")
+    bad = np.flatnonzero(np.diff(u) <= 0.0)
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise ValueError(f"u must be strictly increasing: u[{i}] = {u[i]} <= u[{i - 1}] = {u[i - 1]}")
+    bad = np.flatnonzero(T < 0.0)
+    if bad.size:
+        raise ValueError(f"T must be non-negative: T[{bad[0]}] = {T[bad[0]]}")
 
 
 def read_curve(path: str | Path) -> VirginCurve:

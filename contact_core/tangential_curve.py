@@ -242,7 +242,7 @@ def to_virgin_curve(path: TangentialPath, problem: TangentialProblem, *, load_ca
     """The virgin curve as the project's curve file object (``contact_core.curve``)."""
     u, T = path.u, path.T
     keep = np.concatenate([[True], np.diff(u) > 0])  # drop repeated u (zero steps)
-    return VirginCurve(u=u[keep], T=np.maximum(T[keep], 0.0), N=problem.N, mu=problem.mu,
+    return VirginCurve(u=u[keep], T=np.maximum(T[keep], 0.0), N=problem.N, mu=problem.mu, tail="flat",
                        k_t=problem.k_t, k_n=k_n, load_case=load_case,
                        geometry=geometry or {}, materials=materials or {}, grid=grid or {},
                        provenance=provenance(command))

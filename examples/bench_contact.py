@@ -90,8 +90,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="out/bench")
     ap.add_argument("--quick", action="store_true", help="one tiny case (smoke test)")
-    ap.add_argument("--solver", choices=("scipy",), default=None,
-                    help="force the scipy (SuperLU) fallback instead of CHOLMOD")
+    ap.add_argument("--solver", choices=("cholmod", "pardiso", "scipy"), default=None,
+                    help="force one sparse back end (default: the first available of cholmod, pardiso, scipy)")
     ap.add_argument("--child", nargs=5, metavar=("BODY", "MODEL", "GRID", "FORCE", "CACHE"),
                     help=argparse.SUPPRESS)
     args = ap.parse_args(argv)

@@ -19,158 +19,34 @@ Slip strengths are ``fs_j * scale * N / N_ref`` (same curve shape at every N);
 from __future__ import annotations
 
 import ctypes as ct
-import importlib.machinery
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from . import _clib
+from ._clib import MAX_SLIDERS, IwanInputError, IwanNotConvergedError, Model, Output, State, arr
+from ._clib import check as _check
+from ._clib import normal as _normal
+from ._clib import vec as _vec
+from .curve_fit import FITS, TAILS, check_table, prepare_table
+
 __all__ = ["IwanElement", "IwanState", "IwanInputError", "IwanNotConvergedError",
-           "ends_at_gross_slip", "with_flat_tail", "GROSS_SLIP_RTOL",
-           "MAX_SLIDERS"]
+           "MAX_SLIDERS", "flat_tail"]
 
-MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h
-_STATE_VERSION = 1         # IWAN_STATE_VERSION in iwan.h
-_FITS = {"reject": 0, "concave": 1}
-_STATUS = {1: "NaN or infinite input", 2: "bad curve table (fewer than 2 points, "
-           "not starting at (0, 0), u not strictly increasing, T decreasing, no "
-           f"stiffness, or more than {MAX_SLIDERS} slope changes)",
-           3: "curve table is not concave (a slope exceeds the previous one); pass "
-           "fit='concave' to use its least concave majorant",
-           4: "bad parameter (k <= 0, fs < 0, k_res < 0, N_ref <= 0, scale < 0, "
-           "empty array, ...)",
-           5: "periodic loop did not close within max_periods",
-           6: "bad state (other version or corrupted)"}
+_FIT_CODE = {"reject": 0, "concave": 1}   # iwan_fit
+_lib = _clib.lib
 
 
-class IwanInputError(ValueError):
-    """Bad input to the element (NaN, bad table, bad parameter or state)."""
-
-
-class IwanNotConvergedError(RuntimeError):
-    """The periodic loop did not close within the allowed number of periods."""
-
-
-class _Model(ct.Structure):
-    _fields_ = [("n", ct.c_int32), ("k", ct.c_double * MAX_SLIDERS),
-                ("fs", ct.c_double * MAX_SLIDERS), ("k_res", ct.c_double),
-                ("n_ref", ct.c_double), ("scale", ct.c_double),
-                # derived by the init functions (appended in iwan.h)
-                ("rad", ct.c_double * MAX_SLIDERS), ("fs_sum", ct.c_double),
-                ("derived_n", ct.c_int32)]
-
-
-class _State(ct.Structure):
-    _fields_ = [("version", ct.c_int32), ("in_contact", ct.c_int32), ("u", ct.c_double),
-                ("N", ct.c_double), ("u_contact", ct.c_double), ("w_diss", ct.c_double),
-                ("z", ct.c_double * MAX_SLIDERS), ("dir", ct.c_double)]
-
-
-class _Output(ct.Structure):
-    _fields_ = [(name, ct.c_double) for name in ("F", "kt", "dFdN", "W", "E", "slip")]
-
-
-def _load_library() -> ct.CDLL:
-    here = Path(__file__).resolve().parent
-    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-        path = here / f"_iwan{suffix}"
-        if path.exists():
-            return ct.CDLL(str(path))
-    raise ImportError(f"fmu_src/_iwan*.so not found in {here}: run `pip install -e .`")
-
-
-_lib = _load_library()
-_P = ct.c_void_p          # raw double* / int* (numpy .ctypes.data): the fastest call path
-_S = ct.c_size_t
-_D = ct.c_double
-_I = ct.c_int
-
-
-def _declare(name, *argtypes):
-    fn = getattr(_lib, name)
-    fn.argtypes = list(argtypes)
-    fn.restype = ct.c_int
-    return fn
-
-
-_model_init = _declare("iwan_model_init", ct.POINTER(_Model), _P, _P, _S, _D, _I)
-_model_from_sliders = _declare("iwan_model_from_sliders", ct.POINTER(_Model), _P, _P, _S, _D, _D)
-_state_init = _declare("iwan_state_init", ct.POINTER(_Model), ct.POINTER(_State), _D)
-_step = _declare("iwan_step", ct.POINTER(_Model), ct.POINTER(_State), _D, _D,
-                 ct.POINTER(_Output))
-_series = _declare("iwan_series", _P, _P, _S, _P, _P, _P, _P, _P, _P)
-_periodic = _declare("iwan_periodic", _P, _S, _P, _P, _P, _P, _P, _P, _I, _D, _P)
-_periodic_jac = _declare("iwan_periodic_jac", _P, _S, _P, _P, _P, _P, _S, _P, _P, _P, _P,
-                         _I, _D, _P)
-_eval = _declare("iwan_eval", ct.POINTER(_Model), ct.POINTER(_State), _D, _D, _P,
-                 ct.POINTER(_Output))
-_lib.iwan_status_text.argtypes = [ct.c_int]
-_lib.iwan_status_text.restype = ct.c_char_p
-
-
-def _check(status: int, where: str) -> None:
-    if status == 0:
-        return
-    text = _STATUS.get(status, _lib.iwan_status_text(status).decode())
-    if status == 5:
-        raise IwanNotConvergedError(f"{where}: {text}")
-    raise IwanInputError(f"{where}: {text}")
-
-
-def _vec(x, name: str, n: int | None = None) -> np.ndarray:
-    """Contiguous float64 1-D copy-free view of ``x`` (shape (n,) when n is given)."""
-    a = np.ascontiguousarray(x, dtype=np.float64)
-    if a.ndim != 1 or a.size == 0 or (n is not None and a.size != n):
-        want = f"({n},)" if n is not None else "(n,) with n >= 1"
-        raise IwanInputError(f"{name} must have shape {want}, got {a.shape}")
-    return a
-
-
-#: A curve ends at gross slip when its last force is mu N to this relative tolerance
-#: (a curve file stores mu N rounded; the tail's force is the table's own T[-1]).
-GROSS_SLIP_RTOL = 1e-6
-
-
-def ends_at_gross_slip(T, mu: float | None, N: float | None) -> bool:
-    """Whether a virgin curve ends at gross slip, T[-1] = mu N (to ``GROSS_SLIP_RTOL``).
-
-    The one rule of every tool (``damper loop``, ``damper fmu``): such a curve is
-    continued flat beyond its end (:func:`with_flat_tail`), any other with its last
-    slope.
-
-    Parameters
-    ----------
-    T : array_like, shape (m,)
-        Tangential force of the virgin curve [N].
-    mu : float or None
-        Friction coefficient the curve file declares [-].
-    N : float or None
-        Normal load the curve was computed at [N].
-    """
-    if mu is None or N is None or not (mu > 0.0 and N > 0.0):
-        return False
-    T_end = float(np.asarray(T, dtype=float).ravel()[-1])
-    return abs(T_end - mu * N) <= GROSS_SLIP_RTOL * mu * N
-
-
-def with_flat_tail(u, T) -> tuple[np.ndarray, np.ndarray]:
+def flat_tail(u, T) -> tuple[np.ndarray, np.ndarray]:
     """The table (u, T), shape (m,), with a point (2 u[-1], T[-1]) appended, shape (m + 1,).
 
     Its last segment is flat, so the element built from it has no residual spring
-    (k_res = 0): the force stays at T[-1] past the end of the curve (gross slip).
+    (k_res = 0): the force stays at T[-1] past the end of the curve (``tail="flat"``,
+    gross slip). The FMU packager writes the same table into the FMU.
     """
     u = _vec(u, "u")
     T = _vec(T, "T", u.size)
     return np.append(u, 2.0 * u[-1]), np.append(T, T[-1])
-
-
-def _normal(N, n: int, default: float) -> np.ndarray:
-    """Normal-load samples: None -> ``default`` everywhere, scalar -> constant."""
-    if N is None:
-        return np.full(n, float(default))
-    if np.ndim(N) == 0:
-        return np.full(n, float(N))
-    return _vec(N, "N", n)
 
 
 class IwanState:
@@ -187,12 +63,12 @@ class IwanState:
         Slider positions [m]; slider force k_j (u - z_j).
     """
 
-    def __init__(self, raw: _State, n_sliders: int):
+    def __init__(self, raw: State, n_sliders: int):
         self._raw = raw
         self._n = n_sliders
 
     def copy(self) -> IwanState:
-        raw = _State()
+        raw = State()
         ct.pointer(raw)[0] = self._raw
         return IwanState(raw, self._n)
 
@@ -243,59 +119,73 @@ class IwanElement:
     Build it with :meth:`from_curve`, :meth:`from_sliders` or :meth:`jenkins`.
     """
 
-    def __init__(self, model: _Model):
-        if model.derived_n != model.n:  # _Model must mirror iwan_model field by field
-            raise ImportError("fmu_src._iwan does not match fmu_src.element._Model: "
+    def __init__(self, model: Model):
+        if model.derived_n != model.n:  # _clib.Model must mirror iwan_model field by field
+            raise ImportError("fmu_src._iwan does not match fmu_src._clib.Model: "
                               "rebuild with `pip install -e .`")
         self._model = model
-        self._mp = ct.addressof(model)
+        self._mp = ct.pointer(model)   # resolved once: every call passes the same pointer
+        #: Largest force error of the reduction to MAX_SLIDERS [N] (from_virgin_curve).
+        self.fit_error = 0.0
 
     # ------------------------------------------------------------ construction
     @classmethod
     def from_curve(cls, u, T, N_ref, fit: str = "reject", scale: float = 1.0,
-                   gross_slip: bool = False) -> IwanElement:
+                   tail: str = "slope") -> IwanElement:
         """Element reproducing a concave piecewise-linear virgin curve exactly (Iwan).
 
         Parameters
         ----------
         u, T : array_like, shape (m,)
             Virgin curve: displacement [m] strictly increasing from 0, force [N] from 0.
-            The last segment's slope continues as the residual spring.
         N_ref : float
             Normal load [N] at which the curve was computed.
         fit : {"reject", "concave"}
-            "reject": a non-concave table raises ``IwanInputError``. "concave": use the
-            least concave non-decreasing majorant (upper hull, flat after the maximum).
+            "reject": a non-concave table raises ``IwanInputError`` naming the point.
+            "concave": use the least concave non-decreasing majorant (upper hull, flat
+            after the maximum).
         scale : float
             Friction scale multiplying every slip strength (>= 0).
-        gross_slip : bool
-            The table ends at gross slip (T = mu N, see :func:`ends_at_gross_slip`):
-            continue it flat (:func:`with_flat_tail`, k_res = 0) instead of with its
-            last slope.
+        tail : {"slope", "flat"}
+            Beyond u[-1]: the last slope continues as the residual spring, or the force
+            stays at T[-1] (gross slip: :func:`flat_tail`, k_res = 0).
+
+        A table with more slope changes than ``MAX_SLIDERS`` is refused here; use
+        :meth:`from_virgin_curve` or :func:`fmu_src.curve_fit.prepare_table` to reduce it.
         """
-        if fit not in _FITS:
-            raise IwanInputError(f"fit must be one of {sorted(_FITS)}, got {fit!r}")
-        u = _vec(u, "u")
-        T = _vec(T, "T", u.size)
-        if gross_slip:
-            u, T = with_flat_tail(u, T)
-        model = _Model()
-        _check(_model_init(ct.byref(model), u.ctypes.data, T.ctypes.data, u.size,
-                           float(N_ref), _FITS[fit]), "IwanElement.from_curve")
+        if tail not in TAILS:
+            raise IwanInputError(f"tail must be one of {TAILS}, got {tail!r}")
+        u, T = check_table(u, T, fit)
+        if tail == "flat":
+            u, T = flat_tail(u, T)
+        model = Model()
+        status = _lib.iwan_model_init(ct.byref(model), arr(u), arr(T), u.size, float(N_ref),
+                                      _FIT_CODE[fit])
+        if status == 2:    # every other table rule was checked above: the slider limit
+            raise IwanInputError(f"IwanElement.from_curve: the curve has more than {MAX_SLIDERS} "
+                                 "slope changes (the element's limit); reduce it with "
+                                 "fmu_src.curve_fit.prepare_table or IwanElement.from_virgin_curve")
+        _check(status, "IwanElement.from_curve")
         return cls._scaled(model, scale)
 
     @classmethod
     def from_virgin_curve(cls, curve, fit: str = "reject", scale: float = 1.0) -> IwanElement:
-        """Element of a curve object (``.u``, ``.T``, ``.N``, ``.mu``; e.g. ``contact_core.curve.VirginCurve``).
+        """Element of a curve object (``contact_core.curve.VirginCurve``: ``.u``, ``.T``, ``.N``, ``.tail``).
 
         The one place where every tool (``damper loop``, ``damper fmu``, harmonic
         balance) turns a curve file into an element: N_ref is the curve's N (1 when
-        it records none), and a curve ending at gross slip (:func:`ends_at_gross_slip`)
-        continues flat beyond its end.
+        it records none), the tail is the curve's own (``"flat"``: gross slip), and a
+        curve with more segments than the element holds is reduced by the min-max
+        optimal fit (:func:`fmu_src.curve_fit.prepare_table`); the element's
+        :attr:`fit_error` [N] is that fit's largest force error (0.0 if not reduced).
         """
+        if fit not in FITS:
+            raise IwanInputError(f"fit must be one of {FITS}, got {fit!r}")
+        u, T, error = prepare_table(curve.u, curve.T, fit, curve.tail)
         N_ref = curve.N if curve.N is not None else 1.0
-        return cls.from_curve(curve.u, curve.T, N_ref, fit=fit, scale=scale,
-                              gross_slip=ends_at_gross_slip(curve.T, curve.mu, curve.N))
+        el = cls.from_curve(u, T, N_ref, fit=fit, scale=scale, tail=curve.tail)
+        el.fit_error = error
+        return el
 
     @classmethod
     def from_sliders(cls, k, fs, k_res: float = 0.0, N_ref: float = 1.0) -> IwanElement:
@@ -304,9 +194,9 @@ class IwanElement:
         fs = np.atleast_1d(np.asarray(fs, dtype=np.float64)).copy()
         if k.ndim != 1 or k.shape != fs.shape or k.size > MAX_SLIDERS:
             raise IwanInputError(f"k and fs must have the same shape (n,), n <= {MAX_SLIDERS}")
-        model = _Model()
-        _check(_model_from_sliders(ct.byref(model), k.ctypes.data, fs.ctypes.data, k.size,
-                                   float(k_res), float(N_ref)), "IwanElement.from_sliders")
+        model = Model()
+        _check(_lib.iwan_model_from_sliders(ct.byref(model), arr(k), arr(fs), k.size, float(k_res),
+                                            float(N_ref)), "IwanElement.from_sliders")
         return cls(model)
 
     @classmethod
@@ -315,7 +205,7 @@ class IwanElement:
         return cls.from_sliders([k], [fs], 0.0, 1.0)
 
     @classmethod
-    def _scaled(cls, model: _Model, scale: float) -> IwanElement:
+    def _scaled(cls, model: Model, scale: float) -> IwanElement:
         scale = float(scale)
         if not np.isfinite(scale) or scale < 0.0:
             raise IwanInputError(f"scale must be finite and >= 0, got {scale!r}")
@@ -352,15 +242,15 @@ class IwanElement:
     # ------------------------------------------------------------ evaluation
     def initial_state(self, N: float | None = None) -> IwanState:
         """Virgin state at u = 0 under normal load N [N] (default ``N_ref``)."""
-        raw = _State()
-        _check(_state_init(ct.byref(self._model), ct.byref(raw),
+        raw = State()
+        _check(_lib.iwan_state_init(self._mp, ct.byref(raw),
                            self.N_ref if N is None else float(N)), "IwanElement.initial_state")
         return IwanState(raw, self.n_sliders)
 
     def step(self, state: IwanState, u: float, N: float | None = None) -> StepOutput:
         """Advance ``state`` in place along the straight path to (u, N); N defaults to N_ref."""
-        out = _Output()
-        _check(_step(ct.byref(self._model), ct.byref(state._raw), float(u),
+        out = Output()
+        _check(_lib.iwan_step(self._mp, ct.byref(state._raw), float(u),
                      self.N_ref if N is None else float(N), ct.byref(out)), "IwanElement.step")
         return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
 
@@ -371,8 +261,8 @@ class IwanElement:
         that evaluate forces at points they may reject and commit accepted ones with
         :meth:`step`.
         """
-        out = _Output()
-        _check(_eval(ct.byref(self._model), ct.byref(state._raw), float(u),
+        out = Output()
+        _check(_lib.iwan_eval(self._mp, ct.byref(state._raw), float(u),
                      self.N_ref if N is None else float(N), None, ct.byref(out)),
                "IwanElement.eval")
         return StepOutput(out.F, out.kt, out.dFdN, out.W, out.E, out.slip)
@@ -418,10 +308,8 @@ class IwanElement:
         else:
             st = state.copy()
         out = np.empty((4, n))
-        _check(_series(self._mp, ct.addressof(st._raw), n, u.ctypes.data,
-                       None if Nv is None else Nv.ctypes.data, out[0].ctypes.data,
-                       out[1].ctypes.data, out[2].ctypes.data, out[3].ctypes.data),
-               "IwanElement.series")
+        _check(_lib.iwan_series(self._mp, ct.byref(st._raw), n, arr(u), arr(Nv), arr(out[0]),
+                                arr(out[1]), arr(out[2]), arr(out[3])), "IwanElement.series")
         return SeriesResult(out[0], out[1], out[2], out[3], st)
 
     def periodic(self, u, N=None, max_periods: int = 100, tol: float = 1e-12) -> PeriodicResult:
@@ -437,9 +325,9 @@ class IwanElement:
         out = np.empty((3, n))
         w = ct.c_double()
         p = ct.c_int()
-        _check(_periodic(self._mp, n, u.ctypes.data, None if Nv is None else Nv.ctypes.data,
-                         out[0].ctypes.data, out[1].ctypes.data, out[2].ctypes.data,
-                         ct.addressof(w), int(max_periods), float(tol), ct.addressof(p)),
+        _check(_lib.iwan_periodic(self._mp, n, arr(u), arr(Nv), arr(out[0]), arr(out[1]),
+                                  arr(out[2]), ct.byref(w),
+                                  int(max_periods), float(tol), ct.byref(p)),
                "IwanElement.periodic")
         return PeriodicResult(out[0], out[1], out[2], w.value, p.value)
 
@@ -480,11 +368,9 @@ class IwanElement:
         dFdXN = None if ENa is None else np.empty((n, nb))
         w = ct.c_double()
         p = ct.c_int()
-        _check(_periodic_jac(self._mp, n, u.ctypes.data,
-                             None if Nv is None else Nv.ctypes.data, Eu.ctypes.data,
-                             None if ENa is None else ENa.ctypes.data, nb, F.ctypes.data,
-                             dFdX.ctypes.data, None if dFdXN is None else dFdXN.ctypes.data,
-                             ct.addressof(w), int(max_periods), float(tol), ct.addressof(p)),
+        _check(_lib.iwan_periodic_jac(self._mp, n, arr(u), arr(Nv), arr(Eu), arr(ENa), nb, arr(F),
+                                      arr(dFdX), arr(dFdXN),
+                                      ct.byref(w), int(max_periods), float(tol), ct.byref(p)),
                "IwanElement.periodic_jac")
         return F, dFdX, dFdXN, w.value
 

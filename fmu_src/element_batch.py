@@ -6,7 +6,9 @@ one numpy buffer of :data:`STATE_DTYPE` (the C ``iwan_state``), and
 ``iwan_step_batch`` advances state i to (u[i], N[i]) through the time series' own
 code, so each state gets the bits ``IwanElement.step`` would give it alone. Reached
 through :meth:`IwanElement.initial_states`, :meth:`IwanElement.step_batch` and
-:meth:`IwanElement.batch_stepper`. Symbols as in :mod:`fmu_src.element`.
+:meth:`IwanElement.batch_stepper`. Symbols as in :mod:`fmu_src.element`. Only the ctypes layer (:mod:`fmu_src._clib`) is
+imported here: ``element`` imports this module, never the other way round; ``element``
+arguments are duck-typed (``._mp``, ``.N_ref``).
 """
 from __future__ import annotations
 
@@ -14,18 +16,9 @@ import ctypes as ct
 
 import numpy as np
 
-from .element import _P, _S, MAX_SLIDERS, IwanInputError, _check, _declare, _normal, _State, _state_init, _vec
+from ._clib import STATE_DTYPE, IwanInputError, State, StateArray, arr, check, lib, normal, vec
 
 __all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "step_batch"]
-
-_step_batch = _declare("iwan_step_batch", _P, _P, _S, _P, _P, _P, _P)
-
-#: numpy view of ``iwan_state`` (one record per state; checked against ctypes below).
-STATE_DTYPE = np.dtype([("version", "<i4"), ("in_contact", "<i4"), ("u", "<f8"),
-                        ("N", "<f8"), ("u_contact", "<f8"), ("w_diss", "<f8"),
-                        ("z", "<f8", (MAX_SLIDERS,)), ("dir", "<f8")], align=True)
-assert STATE_DTYPE.itemsize == ct.sizeof(_State) and all(
-    STATE_DTYPE.fields[name][1] == getattr(_State, name).offset for name, _ in _State._fields_)
 
 
 def _check_states(states) -> int:
@@ -42,7 +35,7 @@ class BatchStepper:
     """Repeated :meth:`IwanElement.step_batch` on one states buffer, with fixed buffers.
 
     Fill :attr:`u` (and :attr:`N` when made with a normal load), call :meth:`step`;
-    the pointers are resolved once, so a call costs about 2 us plus ~25 ns per state
+    the pointers are resolved once, so a call costs a few us plus ~25 ns per state
     instead of ~9 us (time integration calls it once per element per time step).
 
     Attributes
@@ -57,11 +50,11 @@ class BatchStepper:
         n = _check_states(states)
         self.element, self.states = element, states
         self.u = np.zeros(n)
-        self.N = None if N is None else _normal(N, n, element.N_ref).copy()
+        self.N = None if N is None else normal(N, n, element.N_ref).copy()
         self.F, self.kt = np.zeros(n), np.zeros(n)
-        self._args = (element._mp, states.ctypes.data, n, self.u.ctypes.data,
-                      None if self.N is None else self.N.ctypes.data, self.F.ctypes.data,
-                      self.kt.ctypes.data)
+        # typed pointers resolved once (the buffers never move): no Python per call
+        self._args = (element._mp, arr(states, StateArray), n, arr(self.u), arr(self.N),
+                      arr(self.F), arr(self.kt))
 
     def step(self, u=None) -> np.ndarray:
         """Advance every state to (u, N); returns :attr:`F` (shape (n,), overwritten next call).
@@ -70,7 +63,7 @@ class BatchStepper:
         """
         if u is not None:
             np.copyto(self.u, u)
-        _check(_step_batch(*self._args), "BatchStepper.step")
+        check(lib.iwan_step_batch(*self._args), "BatchStepper.step")
         return self.F
 
 
@@ -92,20 +85,21 @@ def initial_states(element, n: int, N=None) -> np.ndarray:
     """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
         raise IwanInputError(f"n must be an integer >= 1, got {n!r}")
-    Nv = _normal(N, int(n), element.N_ref)
+    Nv = normal(N, int(n), element.N_ref)
     states = np.zeros(int(n), dtype=STATE_DTYPE)
     first = {}
     for i, Ni in enumerate(Nv):
         key = float(Ni)
         if key not in first:  # one C init per distinct load, copied to the others
-            raw = _State()
-            _check(_state_init(ct.byref(element._model), ct.byref(raw), key),
-                   "IwanElement.initial_states")
+            raw = State()
+            check(lib.iwan_state_init(element._mp, ct.byref(raw), key),
+                  "IwanElement.initial_states")
             states[i] = np.frombuffer(raw, dtype=STATE_DTYPE)[0]
             first[key] = i
         else:
             states[i] = states[first[key]]
     return states
+
 
 def step_batch(element, states: np.ndarray, u, N=None, out=None):
     """Advance many independent states by one sample each, in one C call.
@@ -133,8 +127,8 @@ def step_batch(element, states: np.ndarray, u, N=None, out=None):
         Tangent stiffness dF/du for continued motion [N/m].
     """
     n = _check_states(states)
-    u = _vec(u, "u", n)
-    Nv = None if N is None else _normal(N, n, element.N_ref)
+    u = vec(u, "u", n)
+    Nv = None if N is None else normal(N, n, element.N_ref)
     if out is None:
         F, kt = np.empty(n), np.empty(n)
     else:
@@ -143,7 +137,6 @@ def step_batch(element, states: np.ndarray, u, N=None, out=None):
             if (not isinstance(a, np.ndarray) or a.dtype != np.float64 or a.shape != (n,)
                     or not a.flags.c_contiguous or not a.flags.writeable):
                 raise IwanInputError(f"out must be two writeable float64 arrays of shape ({n},)")
-    _check(_step_batch(element._mp, states.ctypes.data, n, u.ctypes.data,
-                       None if Nv is None else Nv.ctypes.data, F.ctypes.data,
-                       kt.ctypes.data), "IwanElement.step_batch")
+    check(lib.iwan_step_batch(element._mp, arr(states, StateArray), n, arr(u), arr(Nv), arr(F),
+                              arr(kt)), "IwanElement.step_batch")
     return F, kt

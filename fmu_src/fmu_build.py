@@ -46,13 +46,25 @@ _FMI_HEADERS = {
     2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
     3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
 }
-_WRAPPER_HEADERS = ("fmu_instance.h", "model.h", "damper_vr.h")
+_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h", "damper_vr.h")
+#: Input bound of the Iwan model (model_iwan.c U_BOUND_RTOL): the force error of a
+#: slider, about k eps |u|, stays below this fraction of its slip strength.
+U_BOUND_RTOL = 1e-6
 #: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
 CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
 CORE_HEADERS = ("iwan.h", "iwan_internal.h", "iwan_sweep.h")
-#: Flags of the binary inside the FMU (the same as the CMake build's).
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden",
-          "-Wall", "-Wextra", "-Werror", "-Wl,--no-undefined")
+#: The one compile-flag list shared with CMake and the pip extension (one flag a line).
+CFLAGS_FILE = CORE_DIR / "cflags.txt"
+
+
+def shared_cflags() -> tuple[str, ...]:
+    """Flags of ``fmu_src/core/cflags.txt`` (comments and blank lines skipped)."""
+    lines = (line.strip() for line in CFLAGS_FILE.read_text().splitlines())
+    return tuple(line for line in lines if line and not line.startswith("#"))
+
+
+#: Flags of the binary inside the FMU: the shared list plus those of a shared library.
+CFLAGS = (*shared_cflags(), "-fPIC", "-shared", "-fvisibility=hidden", "-Wl,--no-undefined")
 
 
 def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
@@ -60,7 +72,7 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", MODELS[model], *CORE_SOURCES]
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *CORE_SOURCES]
 
 
 def _check_version(fmi_version: int) -> None:
@@ -68,7 +80,7 @@ def _check_version(fmi_version: int) -> None:
         raise ValueError(f"--fmi-version must be 2 or 3, not {fmi_version!r}")
 
 
-def check_curve(u, T, n_ref: float, fit: str = "reject"):
+def check_curve(u, T, n_ref: float, fit: str = "reject", tail: str = "slope"):
     """Validate a virgin curve by building the element from it.
 
     Parameters
@@ -79,6 +91,8 @@ def check_curve(u, T, n_ref: float, fit: str = "reject"):
         Normal load the curve was computed at [N], > 0.
     fit : {"reject", "concave"}
         A non-concave table is an error, or is replaced by its concave majorant.
+    tail : {"slope", "flat"}
+        What follows the last point (see :meth:`IwanElement.from_curve`).
 
     Returns
     -------
@@ -98,11 +112,12 @@ def check_curve(u, T, n_ref: float, fit: str = "reject"):
     T = np.asarray(T, dtype=float).ravel()
     if u.shape != T.shape or u.size < 2:
         raise ValueError(f"curve needs u and T of equal length >= 2, got {u.size}, {T.size}")
-    if u.size > 4096:  # FMU_MAX_CURVE_POINTS in fmu_instance.h
-        raise ValueError(f"curve has {u.size} points; the FMU reads at most 4096")
+    if u.size + (tail == "flat") > 4096:  # FMU_MAX_CURVE_POINTS in fmu_instance.h
+        raise ValueError(f"curve has {u.size} points; the FMU reads at most 4096 "
+                         "(reduce it: fmu_src.curve_fit.prepare_table)")
     if not (np.isfinite(n_ref) and n_ref > 0):
         raise ValueError(f"reference normal load must be finite and > 0, got {n_ref!r}")
-    IwanElement.from_curve(u, T, float(n_ref), fit=fit)
+    IwanElement.from_curve(u, T, float(n_ref), fit=fit, tail=tail)
     return u, T
 
 
@@ -149,15 +164,40 @@ def compile_binary(source_dir: Path, names: list[str], out: Path,
         raise RuntimeError(f"compiling the FMU binary failed:\n{' '.join(cmd)}\n{proc.stderr}")
 
 
-def _documentation() -> str:
+def input_bound(element) -> float:
+    """Largest |u| [m] the FMU of ``element`` accepts (the same number model_iwan.c computes).
+
+    U_BOUND_RTOL * (smallest slip distance at N_ref, scale 1) / eps: beyond it the
+    round-off of a slider force, about k eps |u|, exceeds U_BOUND_RTOL of its slip
+    strength (and at about 1/U_BOUND_RTOL times the bound u - z cannot resolve the
+    slip distance at all). Infinite for an element without sliders.
+    """
+    if element.n_sliders == 0:
+        return float("inf")
+    radii = element.fs / element.k            # rad_j = fs_j / k_j, as iwan.c derives it
+    return U_BOUND_RTOL * float(np.min(radii)) / float(np.finfo(float).eps)
+
+
+def _documentation(u_bound: float) -> str:
     rows = "".join(f"<tr><td>{v.name}</td><td>{v.causality}</td><td>{v.unit}</td>"
                    f"<td>{v.description}</td></tr>" for v in fmu_xml.VARIABLES)
+    bound = ("any finite value" if not u_bound < float("inf")
+             else f"|u| &lt;= {u_bound!r} m")
     return ("<html><body><h1>damper friction element</h1><p>Masing/Iwan friction element "
             "built from a contact's virgin curve (resources/curve.txt). Outputs follow the "
             "current inputs (direct feedthrough); the history is committed in doStep only. "
             "The input is taken as a straight line between communication points (FMI 2: "
             "with the input derivatives), which the element follows exactly at any step "
-            "size.</p><table><tr><th>name</th><th>causality</th><th>unit</th>"
+            "size.</p><h2>Limits</h2><p>Input bound: " + bound + ". Beyond it double "
+            "precision cannot represent the element's smallest slip distance to 1e-6 of its "
+            "strength; such inputs are refused with a logged error (also the min/max of u in "
+            "the model description). For any accepted input |F| stays within the gross-slip "
+            "force (mu N) exactly. A step size must be &gt; 0.</p><h2>Energy</h2><p>The work "
+            "of the input displacement equals W + stored_energy at constant N: the outputs "
+            "close an importer's energy balance.</p><h2>FMU state</h2><p>Get/Set/Serialize/"
+            "Deserialize in every mode; a state carries mode, time and history; a serialized "
+            "state is refused unless its checksum and physical invariants hold.</p>"
+            "<table><tr><th>name</th><th>causality</th><th>unit</th>"
             f"<th>description</th></tr>{rows}</table></body></html>\n")
 
 
@@ -173,7 +213,7 @@ def _zip_dir(root: Path) -> bytes:
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
               fit: str = "reject", model: str = "iwan", description: str = "",
               compiler: str | None = None, curve_json: str | None = None,
-              gross_slip: bool = False) -> Path:
+              tail: str = "slope") -> Path:
     """Write a co-simulation FMU of the friction element for one contact.
 
     Parameters
@@ -196,22 +236,27 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
     curve_json : str, optional
         Text of the source curve file, kept as ``resources/curve.json`` for
         provenance (the binary reads ``resources/curve.txt``).
-    gross_slip : bool
-        The curve ends at gross slip (:func:`fmu_src.element.ends_at_gross_slip`):
-        ``resources/curve.txt`` gets the flat tail of
-        :func:`fmu_src.element.with_flat_tail`, so the FMU stays at T[-1] past the
-        end of the curve, as ``IwanElement.from_curve(..., gross_slip=True)``.
+    tail : {"slope", "flat"}
+        Beyond u[-1] (the curve file's ``tail``): ``"flat"`` writes the flat tail of
+        :func:`fmu_src.element.flat_tail` into ``resources/curve.txt``, so the FMU
+        stays at T[-1] past the end (gross slip), as ``IwanElement.from_curve(...,
+        tail="flat")``; ``"slope"`` continues the last slope.
 
     Returns
     -------
     Path of the written FMU.
     """
     _check_version(fmi_version)
-    if gross_slip:
-        from fmu_src.element import with_flat_tail
+    u, T = check_curve(u, T, n_ref, fit, tail)
+    if tail == "flat":
+        from fmu_src.element import flat_tail
 
-        u, T = with_flat_tail(u, T)
-    u, T = check_curve(u, T, n_ref, fit)
+        u, T = flat_tail(u, T)
+    u_bound = float("inf")
+    if model == "iwan":
+        from fmu_src.element import IwanElement
+
+        u_bound = input_bound(IwanElement.from_curve(u, T, float(n_ref), fit=fit))
     with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
         root = Path(tmp) / "fmu"
         names = _copy_sources(root / "sources", fmi_version, model)
@@ -220,8 +265,9 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         if curve_json is not None:
             (root / "resources" / "curve.json").write_text(curve_json)
         (root / "documentation").mkdir()
-        (root / "documentation" / "index.html").write_text(_documentation())
-        text = fmu_xml.render_model_description(fmi_version, n_ref, names, description)
+        (root / "documentation" / "index.html").write_text(_documentation(u_bound))
+        text = fmu_xml.render_model_description(fmi_version, n_ref, names, description,
+                                                u_bound if model == "iwan" else None)
         (root / "modelDescription.xml").write_text(text)
         if fmi_version == 3:
             (root / "sources" / "buildDescription.xml").write_text(

@@ -62,7 +62,19 @@ VARIABLES: tuple[Variable, ...] = (
              "Friction scale: multiplies every slip strength (1 = as computed)"),
     Variable("N_ref", 8, "parameter", "fixed", "N", "curve_n",
              "Reference normal load: the load the virgin curve was computed at"),
+    Variable("stored_energy", 9, "output", "continuous", "J", "none",
+             "Elastic energy stored in the sliders and the residual spring: the work of the "
+             "input displacement equals W + stored_energy (at constant N)"),
 )
+
+
+def fmi2_variables() -> tuple[Variable, ...]:
+    """The FMI 2 ModelVariables: all but the independent ``time``.
+
+    FMI 2 does not require an independent variable, and FMI Library before 2.0.3
+    (libcosim) logs "Start attribute is required" for one without a start value.
+    """
+    return tuple(v for v in VARIABLES if v.causality != "independent")
 
 #: SI decomposition of every unit used (FMI BaseUnit exponents).
 UNITS = {
@@ -116,6 +128,13 @@ def _log_categories_xml() -> str:
     return f"  <LogCategories>{items}\n  </LogCategories>"
 
 
+def _bound_attrs(var: Variable, u_bound: float | None) -> str:
+    """min/max of the displacement input: the FMU refuses |u| beyond the bound."""
+    if var.name != "u" or u_bound is None or not u_bound < float("inf"):
+        return ""
+    return f' min="{_fmt(-u_bound)}" max="{_fmt(u_bound)}"'
+
+
 def _variable_attrs(var: Variable) -> str:
     attrs = (f"name={quoteattr(var.name)} valueReference=\"{var.vr}\" "
              f"causality=\"{var.causality}\" variability=\"{var.variability}\"")
@@ -124,11 +143,11 @@ def _variable_attrs(var: Variable) -> str:
     return attrs + f" description={quoteattr(var.description)}"
 
 
-def _fmi2_variables(curve_n: float) -> str:
+def _fmi2_variables(curve_n: float, u_bound: float | None) -> str:
     out = ["  <ModelVariables>"]
-    for i, var in enumerate(VARIABLES, start=1):
+    for i, var in enumerate(fmi2_variables(), start=1):
         start = start_value(var, curve_n)
-        real = f"<Real unit={quoteattr(var.unit)}"
+        real = f"<Real unit={quoteattr(var.unit)}" + _bound_attrs(var, u_bound)
         real += f' start="{_fmt(start)}"/>' if start is not None else "/>"
         out.append(f"    <!-- index {i} -->")
         out.append(f"    <ScalarVariable {_variable_attrs(var)}>\n      {real}\n"
@@ -137,11 +156,11 @@ def _fmi2_variables(curve_n: float) -> str:
     return "\n".join(out)
 
 
-def _fmi3_variables(curve_n: float) -> str:
+def _fmi3_variables(curve_n: float, u_bound: float | None) -> str:
     out = ["  <ModelVariables>"]
     for var in VARIABLES:
         start = start_value(var, curve_n)
-        attrs = _variable_attrs(var) + f" unit={quoteattr(var.unit)}"
+        attrs = _variable_attrs(var) + f" unit={quoteattr(var.unit)}" + _bound_attrs(var, u_bound)
         if start is not None:
             attrs += f' start="{_fmt(start)}"'
         out.append(f"    <Float64 {attrs}/>")
@@ -153,18 +172,19 @@ def _structure(fmi_version: int) -> str:
     """ModelStructure: every output depends directly on both inputs (feedthrough).
 
     During initialization the outputs also depend on the parameters (knowns with
-    initial="exact"). FMI 2 dependencies are 1-based indices into ModelVariables;
+    initial="exact"). FMI 2 dependencies are 1-based indices into the FMI 2 ModelVariables;
     FMI 3 dependencies are value references.
     """
     inputs = by_causality("input")
     knowns = inputs + by_causality("parameter")
     outputs = by_causality("output")
     if fmi_version == 2:
-        deps = " ".join(str(v.vr + 1) for v in inputs)
-        init_deps = " ".join(str(v.vr + 1) for v in knowns)
-        outs = "\n".join(f'      <Unknown index="{v.vr + 1}" dependencies="{deps}"/>'
+        index = {v.vr: i for i, v in enumerate(fmi2_variables(), start=1)}
+        deps = " ".join(str(index[v.vr]) for v in inputs)
+        init_deps = " ".join(str(index[v.vr]) for v in knowns)
+        outs = "\n".join(f'      <Unknown index="{index[v.vr]}" dependencies="{deps}"/>'
                          for v in outputs)
-        inits = "\n".join(f'      <Unknown index="{v.vr + 1}" dependencies="{init_deps}"/>'
+        inits = "\n".join(f'      <Unknown index="{index[v.vr]}" dependencies="{init_deps}"/>'
                           for v in outputs)
         return (f"  <ModelStructure>\n    <Outputs>\n{outs}\n    </Outputs>\n"
                 f"    <InitialUnknowns>\n{inits}\n    </InitialUnknowns>\n  </ModelStructure>")
@@ -177,7 +197,7 @@ def _structure(fmi_version: int) -> str:
 
 
 def render_model_description(fmi_version: int, curve_n: float, source_files: list[str],
-                             description: str) -> str:
+                             description: str, u_bound: float | None = None) -> str:
     """Text of ``modelDescription.xml`` for FMI 2.0 or 3.0 (co-simulation).
 
     Parameters
@@ -190,6 +210,8 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
         :func:`render_build_description` instead).
     description : str
         Free text (curve provenance).
+    u_bound : float, optional
+        Largest |u| the FMU accepts [m] (``min``/``max`` of the input ``u``).
     """
     token = instantiation_token()
     common = (f'modelName="damper friction element" description={quoteattr(description)} '
@@ -205,7 +227,7 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
                 'canNotUseMemoryManagementFunctions="true" '
                 'canBeInstantiatedOnlyOncePerProcess="false">\n'
                 f'    <SourceFiles>{files}\n    </SourceFiles>\n  </CoSimulation>')
-        variables = _fmi2_variables(curve_n)
+        variables = _fmi2_variables(curve_n, u_bound)
     elif fmi_version == 3:
         head = (f'<fmiModelDescription fmiVersion="3.0" {common} '
                 f'instantiationToken="{token}">\n'
@@ -214,7 +236,7 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
                 'canSerializeFMUState="true" providesDirectionalDerivatives="true" '
                 'providesAdjointDerivatives="false" hasEventMode="false" '
                 'canBeInstantiatedOnlyOncePerProcess="false"/>')
-        variables = _fmi3_variables(curve_n)
+        variables = _fmi3_variables(curve_n, u_bound)
     else:
         raise ValueError(f"fmi_version must be 2 or 3, not {fmi_version!r}")
     parts = ['<?xml version="1.0" encoding="UTF-8"?>', head, _units_xml(),
@@ -257,7 +279,13 @@ def render_vr_header() -> str:
     lines += [f"    START_{v.start.upper()},  /* {v.name} */" for v in VARIABLES]
     lines += ["};", "static const char *const damper_name_of[DAMPER_N_VARIABLES] = {"]
     lines += [f'    "{escape(v.name)}",' for v in VARIABLES]
-    lines += ["};", "", "/* log categories */",
+    lines += ["};", "", "/* value references of the inputs and of the outputs */"]
+    for caus in ("input", "output"):
+        vrs = [str(v.vr) for v in by_causality(caus)]
+        lines += [f"#define DAMPER_N_{caus.upper()}S {len(vrs)}",
+                  f"static const unsigned int damper_{caus}s[DAMPER_N_{caus.upper()}S] = "
+                  "{" + ", ".join(vrs) + "};"]
+    lines += ["", "/* log categories */",
               f"#define DAMPER_N_LOG_CATEGORIES {len(LOG_CATEGORIES)}",
               "static const char *const damper_log_categories[DAMPER_N_LOG_CATEGORIES] = {"]
     lines += [f'    "{n}",' for n, _ in LOG_CATEGORIES]

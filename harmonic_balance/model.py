@@ -269,7 +269,8 @@ def _element_link(t: dict, i: int, base: Path) -> ForceElement:
 
         c = read_curve(base / t["path"])
         # Same rule as damper loop / damper fmu: N_ref = the curve's N (1 if none),
-        # flat beyond the end when the curve ends at gross slip (T = mu N).
+        # the curve file's own tail (flat at gross slip or last slope), reduced to
+        # the element's limit when longer (el.fit_error).
         el = IwanElement.from_virgin_curve(c, fit=t.get("fit", "reject"), scale=float(t.get("scale", 1.0)))
     else:
         raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")

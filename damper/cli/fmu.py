@@ -7,9 +7,10 @@ Example::
 The virgin curve (``contact_core.curve`` JSON) travels inside the FMU with the C
 sources and a compiled Linux binary. Inputs ``u`` [m], ``N`` [N]; outputs ``F``
 [N], ``kt`` [N/m], ``W`` [J], ``slip`` [-]; parameters ``scale`` [-], ``N_ref`` [N].
-A curve that declares ``mu`` and ``N`` and ends at T = mu N is continued flat
-beyond its end (gross slip), the same rule as ``damper loop``; otherwise its last
-slope continues.
+Beyond its last point the curve follows its file's ``tail`` (``flat``: gross slip,
+``slope``: the last slope continues), as in ``damper loop``. A curve with more
+segments than the element holds is reduced by the min-max optimal fit
+(``fmu_src.curve_fit``) and the largest force error printed.
 """
 from __future__ import annotations
 
@@ -34,23 +35,29 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Read the curve, build and write the FMU; print the output path."""
+    import sys
     from pathlib import Path
 
     from contact_core.curve import read_curve
-    from fmu_src.element import ends_at_gross_slip
+    from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_build import build_fmu
 
-    curve = read_curve(args.curve)
-    n_ref = args.n_ref if args.n_ref is not None else curve.N
+    source = read_curve(args.curve)
+    n_ref = args.n_ref if args.n_ref is not None else source.N
     if n_ref is None:
         raise ValueError(f"{args.curve}: the curve has no normal load N; pass --n-ref")
-    gross_slip = ends_at_gross_slip(curve.T, curve.mu, curve.N)   # the rule of damper loop
+    curve, error = reduce_virgin_curve(source, fit=args.fit)
+    reduced = (f", reduced from {source.u.size} points, largest force error {error:.3g} N"
+               if curve is not source else "")
     description = (f"Masing/Iwan friction element from the virgin curve {args.curve} "
-                   f"({curve.u.size} points, N_ref = {n_ref:g} N"
+                   f"({curve.u.size} points{reduced}, N_ref = {n_ref:g} N"
                    + (f", mu = {curve.mu:g}" if curve.mu is not None else "")
-                   + (", flat beyond its end: gross slip" if gross_slip else "") + ")")
+                   + (", flat beyond its end: gross slip" if curve.tail == "flat" else "") + ")")
     path = build_fmu(curve.u, curve.T, n_ref, args.output, fmi_version=args.fmi_version,
-                     fit=args.fit, description=description, gross_slip=gross_slip,
+                     fit=args.fit, description=description, tail=curve.tail,
                      curve_json=Path(args.curve).read_text())
+    if reduced:
+        print(f"note: the curve's {source.u.size} points were reduced to {curve.u.size}; "
+              f"largest force error of the fit {error:.3g} N", file=sys.stderr)
     print(path)
     return 0

@@ -8,8 +8,11 @@ Examples::
 The contact's virgin curve (``contact_core.curve`` JSON; ``u``, ``T`` and
 optionally ``N``, ``mu``) becomes a Masing/Iwan element (the C core through
 ``fmu_src.element``), driven by u = a cos(2 pi i / n), i = 0..n-1, at constant
-normal load N. A curve that declares ``mu`` and ``N`` and ends at T = mu N is
-continued flat beyond its end (gross slip); otherwise its last slope continues.
+normal load N. Beyond its last point the curve follows its file's ``tail``
+(``flat``: gross slip; ``slope``: the last slope continues; version 1 files: see
+``contact_core.curve``). A curve with more segments than the element holds is
+reduced by the min-max optimal fit; the resulting largest force error is printed
+(``fit_error`` in the JSON).
 
 Output (JSON with ``--json``): ``energy_per_cycle`` [J], ``force_amplitude`` [N]
 (half the force range), ``displacement_amplitude`` [m], ``u`` [m] and ``F`` [N]
@@ -19,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 
 
 def register(subparsers) -> None:
@@ -59,11 +63,11 @@ def _check_args(args) -> None:
 
 
 def build_element(curve, fit: str, scale: float):
-    """Element of a virgin curve; flat beyond the end when the curve ends at mu N."""
-    from fmu_src.element import IwanElement, ends_at_gross_slip
+    """Element of a virgin curve, and whether it is flat beyond the end (gross slip)."""
+    from fmu_src.element import IwanElement
 
     el = IwanElement.from_virgin_curve(curve, fit=fit, scale=scale)
-    return el, ends_at_gross_slip(curve.T, curve.mu, curve.N)
+    return el, curve.tail == "flat"
 
 
 def amplitude_for_force(el, T_amp: float, N: float) -> float:
@@ -108,11 +112,15 @@ def run(args) -> int:
         "n_sliders": el.n_sliders, "k_res": el.k_res, "initial_stiffness": float(loop.kt.max()),
         "gross_slip_force": el.gross_slip_force(N), "gross_slip_tail": tail,
         "samples": args.samples, "u": u, "F": loop.F,
+        "curve_points": int(curve.u.size), "fit_error": el.fit_error,
     }
     if not math.isfinite(result["gross_slip_force"]):
         result["gross_slip_force"] = None          # no gross slip: k_res > 0
     if args.plot:
         result["plot"] = str(plot_loop(args.plot, el, u, loop.F, N))
+    if el.fit_error > 0.0:
+        print(f"note: the curve's {curve.u.size} points were reduced to the element's limit; "
+              f"largest force error of the fit {el.fit_error:.3g} N", file=sys.stderr)
     if args.json:
         print_json(result)
     else:

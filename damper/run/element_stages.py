@@ -88,23 +88,25 @@ class FMU(Kind):
                       products=("fmu",)) for v in el["fmi_versions"]]
 
     def compute(self, stage, inputs, ctx):
-        from fmu_src.element import ends_at_gross_slip
+        from fmu_src.curve_fit import reduce_virgin_curve
         from fmu_src.fmu_build import build_fmu
 
-        curve = curve_of(inputs[stage.deps[0]])
+        source = curve_of(inputs[stage.deps[0]])
+        curve, error = reduce_virgin_curve(source)     # at most the C element's sliders
         v = stage.params["fmi_version"]
-        curve_json = json.dumps(curve.to_dict(), indent=1, allow_nan=False) + "\n"
-        gross_slip = ends_at_gross_slip(curve.T, curve.mu, curve.N)
+        curve_json = json.dumps(source.to_dict(), indent=1, allow_nan=False) + "\n"
+        reduced = (f", reduced from {source.u.size} points, largest force error {error:.3g} N"
+                   if curve is not source else "")
         description = (f"Masing/Iwan friction element from the virgin curve of {stage.deps[0]} "
-                       f"({curve.u.size} points, N_ref = {curve.N:g} N, mu = {curve.mu:g}"
-                       + (", flat beyond its end: gross slip)" if gross_slip else ")"))
+                       f"({curve.u.size} points{reduced}, N_ref = {curve.N:g} N, mu = {curve.mu:g}"
+                       + (", flat beyond its end: gross slip)" if curve.tail == "flat" else ")"))
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / f"damper_fmi{v}.fmu"
             build_fmu(curve.u, curve.T, curve.N, path, fmi_version=v, description=description,
-                      gross_slip=gross_slip, curve_json=curve_json)
-            check = fmu_check(path, curve)
+                      tail=curve.tail, curve_json=curve_json)
+            check = fmu_check(path, source)
             blob = path.read_bytes()
-        return Result(check, files={path.name: blob})
+        return Result(check | {"curve_points": int(curve.u.size), "fit_error_N": error}, files={path.name: blob})
 
     def outputs(self, stage, result):
         return {"fmu": f"damper_fmi{stage.params['fmi_version']}.fmu"}

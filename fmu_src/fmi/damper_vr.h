@@ -5,8 +5,8 @@
 #define DAMPER_VR_H
 
 #define DAMPER_MODEL_IDENTIFIER "damper"
-#define DAMPER_TOKEN "{7203e11c-8a71-5246-500d-de9980fe38a8}"
-#define DAMPER_N_VARIABLES 9
+#define DAMPER_TOKEN "{49b29d45-df0f-e744-1400-81cd7648a4e5}"
+#define DAMPER_N_VARIABLES 10
 
 /* value references */
 #define VR_TIME 0
@@ -18,6 +18,7 @@
 #define VR_SLIP 6
 #define VR_SCALE 7
 #define VR_N_REF 8
+#define VR_STORED_ENERGY 9
 
 typedef enum { CAUS_INDEPENDENT, CAUS_INPUT, CAUS_OUTPUT, CAUS_PARAMETER } damper_causality;
 typedef enum { START_NONE, START_ZERO, START_ONE, START_CURVE_N } damper_start_rule;
@@ -33,6 +34,7 @@ static const damper_causality damper_causality_of[DAMPER_N_VARIABLES] = {
     CAUS_OUTPUT,  /* slip */
     CAUS_PARAMETER,  /* scale */
     CAUS_PARAMETER,  /* N_ref */
+    CAUS_OUTPUT,  /* stored_energy */
 };
 static const damper_start_rule damper_start_of[DAMPER_N_VARIABLES] = {
     START_NONE,  /* time */
@@ -44,6 +46,7 @@ static const damper_start_rule damper_start_of[DAMPER_N_VARIABLES] = {
     START_NONE,  /* slip */
     START_ONE,  /* scale */
     START_CURVE_N,  /* N_ref */
+    START_NONE,  /* stored_energy */
 };
 static const char *const damper_name_of[DAMPER_N_VARIABLES] = {
     "time",
@@ -55,7 +58,14 @@ static const char *const damper_name_of[DAMPER_N_VARIABLES] = {
     "slip",
     "scale",
     "N_ref",
+    "stored_energy",
 };
+
+/* value references of the inputs and of the outputs */
+#define DAMPER_N_INPUTS 2
+static const unsigned int damper_inputs[DAMPER_N_INPUTS] = {1, 2};
+#define DAMPER_N_OUTPUTS 5
+static const unsigned int damper_outputs[DAMPER_N_OUTPUTS] = {3, 4, 5, 6, 9};
 
 /* log categories */
 #define DAMPER_N_LOG_CATEGORIES 2

@@ -152,9 +152,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 fmi2Status fmi2Terminate(fmi2Component c)
 {
     WRAPPER(c);
-    if (fmu_check_mode(w->inst, MODE_INIT | MODE_STEP, "fmi2Terminate")) return fmi2Error;
-    w->inst->mode = MODE_TERMINATED;
-    return fmi2OK;
+    RET(fmu_terminate(w->inst));
 }
 
 fmi2Status fmi2Reset(fmi2Component c)
@@ -291,7 +289,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
 {
     WRAPPER(c);
     if (s == fmi2LastSuccessfulTime && value) {
-        *value = w->inst->s.time;
+        *value = fmu_time(w->inst);
         return fmi2OK;
     }
     RET(fmu_log(w->inst, FMU_ERROR, "fmi2GetRealStatus: only fmi2LastSuccessfulTime"));

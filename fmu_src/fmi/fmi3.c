@@ -127,9 +127,7 @@ fmi3Status fmi3EnterEventMode(fmi3Instance instance) { UNSUPPORTED("fmi3EnterEve
 fmi3Status fmi3Terminate(fmi3Instance instance)
 {
     WRAPPER(instance);
-    if (fmu_check_mode(w->inst, MODE_INIT | MODE_STEP, "fmi3Terminate")) return fmi3Error;
-    w->inst->mode = MODE_TERMINATED;
-    return fmi3OK;
+    RET(fmu_terminate(w->inst));
 }
 
 fmi3Status fmi3Reset(fmi3Instance instance)
@@ -490,7 +488,7 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     if (eventHandlingNeeded) *eventHandlingNeeded = fmi3False;
     if (terminateSimulation) *terminateSimulation = fmi3False;
     if (earlyReturn) *earlyReturn = fmi3False;
-    if (lastSuccessfulTime) *lastSuccessfulTime = w->inst->s.time;
+    if (lastSuccessfulTime) *lastSuccessfulTime = fmu_time(w->inst);
     RET(st);
 }
 

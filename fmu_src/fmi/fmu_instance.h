@@ -1,23 +1,38 @@
 /*
- * fmu_instance.h -- the FMI-version-independent part of the friction-element FMU.
+ * fmu_instance.h -- the FMI-version-independent, model-independent part of the FMUs.
  *
  * Written once and shared by fmi2.c and fmi3.c (Reference-FMUs shape): the
- * instance, its mode (state machine), inputs/parameters stored by value reference,
- * the curve read from the resources, logging, doStep, FMU state and directional
- * derivatives. The physics is behind three small hooks (model.h), implemented by
- * model_iwan.c (the Masing/Iwan core) or model_passthrough.c (benchmark baseline).
+ * instance, its mode (state machine), variable values by value reference
+ * (damper_vr.h), the resource table, logging, doStep, FMU states and directional
+ * derivatives. It knows nothing of the physics: that is behind the hooks of
+ * model.h (model_iwan.c: the Masing/Iwan element; model_passthrough.c: F = u).
  *
  * Co-simulation semantics (rate-independent element, see issue 5):
  * - the committed history changes only in doStep; getters evaluate a trial update
- *   from the committed state to the current inputs (direct feedthrough), so a master
+ *   from the committed history to the current inputs (direct feedthrough), so a master
  *   may set/get any number of times without corrupting the history;
  * - an input is a straight line in time, x(t) = x + dx (t - time): SetReal sets x,
- *   FMI 2 SetRealInputDerivatives sets dx for the next step (any order; dx is reset
- *   to 0 after each doStep). doStep(h) commits the path to the current inputs, then
- *   along the straight line to time + h, where the inputs then stand; the core
- *   advances every slider exactly along a straight (u, N) path, so no step-size
- *   dependence and no sub-stepping by the master are needed;
- * - everything a saved FMU state holds is the flat struct fmu_flat (no pointers).
+ *   FMI 2 SetRealInputDerivatives sets dx for the next step (dx is reset to 0 after
+ *   each doStep). doStep(h), h > 0, commits the path to the current inputs, then along
+ *   the straight line to time + h;
+ * - inputs beyond the model's bound (model_input_bound; stated in the FMU's
+ *   documentation) are refused with a logged message.
+ *
+ * FMU state (issue 14): one flat block, fmu_header followed by the model's history
+ * (model_history_size() bytes), no pointers; the serialized state is these bytes.
+ * It carries the mode, time, values, input derivatives, whether a history has been
+ * committed (after Exit Initialization Mode), and a 64-bit FNV-1a checksum of
+ * everything after the checksum field. Get/Set/Serialize/Deserialize are allowed
+ * in every mode. SetFMUState restores the saved mode (as Reference-FMUs do), so a
+ * state restored into a fresh instance straight after instantiation continues
+ * stepping; an instance in Initialization Mode stays there, and Exit
+ * Initialization Mode keeps a restored history instead of starting a virgin one.
+ * A deserialized state is accepted only if its size, magic, version, checksum,
+ * header (mode, finite values, parameter ranges) and the model's physical
+ * invariants (model_check_history, with the model rebuilt for the state's
+ * parameters) all hold.
+ * Numbers read from the resources or written to logs do not depend on the
+ * process locale (a C locale object is used around every scanf/printf).
  */
 #ifndef FMU_INSTANCE_H
 #define FMU_INSTANCE_H
@@ -26,10 +41,10 @@
 #include <stdint.h>
 
 #include "damper_vr.h"
-#include "iwan.h"
+#include "model.h"
 
-#define FMU_STATE_MAGIC 0x46504d44   /* "DMPF": marks a serialized state of this FMU */
-#define FMU_STATE_VERSION 1          /* bump when fmu_flat changes layout */
+#define FMU_STATE_MAGIC 0x46504d44u  /* "DMPF": marks a state of this FMU */
+#define FMU_STATE_VERSION 2          /* bump when fmu_header or a history changes layout */
 #define FMU_MAX_CURVE_POINTS 4096    /* largest curve table read from the resources */
 #define FMU_CURVE_FILE "curve.txt"
 
@@ -42,49 +57,35 @@ typedef enum {
     MODE_STEP = 4,
     MODE_TERMINATED = 8
 } fmu_mode;
+#define MODE_ANY (MODE_INSTANTIATED | MODE_INIT | MODE_STEP | MODE_TERMINATED)
 
 /* Logger supplied by the FMI-specific wrapper: (context, status, category, message). */
 typedef void (*fmu_logger)(void *ctx, fmu_status status, const char *category,
                            const char *message);
 
-/* Everything an FMU state saves: flat, fixed size, no pointers, versioned. */
+/* The saved part of an instance, followed in a state by the model's history. */
 typedef struct {
-    int32_t magic;                      /* FMU_STATE_MAGIC */
-    int32_t version;                    /* FMU_STATE_VERSION */
+    uint32_t magic;                     /* FMU_STATE_MAGIC */
+    uint32_t version;                   /* FMU_STATE_VERSION */
+    uint64_t checksum;                  /* FNV-1a 64 of the bytes after this field */
+    uint64_t size;                      /* bytes of the whole state */
+    int32_t mode;                       /* fmu_mode when saved */
+    int32_t has_history;                /* 1 once Exit Initialization Mode committed one */
     double time;                        /* current communication point [s] */
     double value[DAMPER_N_VARIABLES];   /* inputs and parameters, by value reference */
     double deriv[DAMPER_N_VARIABLES];   /* first time derivative of each input [unit/s] */
-    iwan_state committed;               /* history committed by the last doStep */
-} fmu_flat;
+} fmu_header;
 
-typedef struct {
-    fmu_flat s;
-    fmu_mode mode;
-    iwan_model model;       /* built from the curve and the parameters */
-    int model_ready;        /* model and committed state match the parameters */
-    int out_valid;          /* `out` holds the outputs at the current inputs */
-    iwan_output out;
-    iwan_state backup;      /* committed state before the doStep in progress */
-    /* virgin curve read from <resources>/curve.txt */
-    size_t n_points;
-    double *curve_u, *curve_T;
-    double curve_n;
-    int curve_fit;
-    void **states;          /* FMU states this instance handed out (others are refused) */
-    size_t n_states, cap_states;
-    char name[128];
-    fmu_logger log;
-    void *log_ctx;
-} fmu_instance;
+typedef struct fmu_instance fmu_instance;
 
-/* Create an instance: check the token, read the curve from `resource_dir` (a native
- * directory path). Returns NULL (after logging why) on failure. */
+/* Create an instance: check the token, read the resource table from `resource_dir`
+ * (a native directory path). Returns NULL (after logging why) on failure. */
 fmu_instance *fmu_new(const char *name, const char *token, const char *resource_dir,
                       fmu_logger log, void *log_ctx);
 void fmu_free(fmu_instance *inst);
 void fmu_reset(fmu_instance *inst);            /* back to MODE_INSTANTIATED, start values */
 
-/* printf-style log through the wrapper's callback; returns `status` for chaining. */
+/* printf-style log through the wrapper's callback (C locale); returns `status`. */
 fmu_status fmu_log(const fmu_instance *inst, fmu_status status, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -96,19 +97,22 @@ fmu_status fmu_check_mode(fmu_instance *inst, int allowed, const char *function)
 
 fmu_status fmu_enter_init(fmu_instance *inst, double start_time);
 fmu_status fmu_exit_init(fmu_instance *inst);
+fmu_status fmu_terminate(fmu_instance *inst);
+double fmu_time(const fmu_instance *inst);   /* current communication point [s] */
 fmu_status fmu_set(fmu_instance *inst, const unsigned int *vr, size_t n, const double *v);
 fmu_status fmu_set_derivative(fmu_instance *inst, const unsigned int *vr, size_t n,
                               const int *order, const double *v);
+/* Values in any mode: in Instantiated (and after Reset) the start values, and the
+ * outputs of the virgin history at the start inputs. */
 fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double *v);
 fmu_status fmu_do_step(fmu_instance *inst, double t, double h);
 fmu_status fmu_directional_derivative(fmu_instance *inst, const unsigned int *unknowns,
                                       size_t n_unknowns, const unsigned int *knowns,
                                       size_t n_knowns, const double *seed, double *sensitivity);
 
-/* FMU state: a heap copy of fmu_flat, serialized as its bytes. The instance keeps
- * a list of the states it handed out: a pointer not in it (an importer passing an
- * uninitialized FMUstate, a state of another instance, one already freed) is never
- * dereferenced or freed; GetFMUState then allocates a new state. */
+/* FMU states. The instance keeps a list of the states it handed out: a pointer not
+ * in it (an importer passing an uninitialized FMUstate, a state of another instance,
+ * one already freed) is never dereferenced or freed; GetFMUState then allocates. */
 fmu_status fmu_state_get(fmu_instance *inst, void **state);
 fmu_status fmu_state_set(fmu_instance *inst, const void *state);
 fmu_status fmu_state_free(fmu_instance *inst, void **state);

@@ -1,37 +1,70 @@
-/* model_passthrough.c -- a trivial model for the same wrapper: F = u (kt = 1, no
- * dissipation). Built exactly like the friction FMU, it measures the cost of the
- * wrapper and the FMI calls alone (examples/bench_fmu.py). */
+/* model_passthrough.c -- a trivial model behind the same FMI layer: F = u (kt = 1, no
+ * dissipation, no stored energy). Built exactly like the friction FMU, it measures
+ * the cost of the FMI layer and the FMI calls alone (examples/bench_fmu.py). Its
+ * history is the last committed input, nothing else. */
+#include <math.h>
 #include <string.h>
 
+#include "damper_vr.h"
 #include "model.h"
 
-iwan_status model_build(fmu_instance *inst)
+typedef struct {
+    double u;   /* last committed displacement [m] */
+} passthrough_history;
+
+size_t model_size(void) { return 1; }
+size_t model_history_size(void) { return sizeof(passthrough_history); }
+
+void model_copy_history(const void *model, void *dst, const void *src)
 {
-    (void)inst;
-    return IWAN_OK;
+    (void)model;
+    memcpy(dst, src, sizeof(passthrough_history));
 }
 
-iwan_status model_reset_state(fmu_instance *inst, double N)
+const char *model_build(void *model, const model_table *table, const double *value)
 {
-    memset(&inst->s.committed, 0, sizeof inst->s.committed);
-    inst->s.committed.version = IWAN_STATE_VERSION;
-    inst->s.committed.N = N;
-    return IWAN_OK;
+    (void)model; (void)table; (void)value;
+    return NULL;
 }
 
-iwan_status model_eval(const fmu_instance *inst, double u, double N, iwan_output *out)
+const char *model_reset(const void *model, void *history, const double *value)
 {
-    (void)inst;
-    (void)N;
-    memset(out, 0, sizeof *out);
-    out->F = u;
-    out->kt = 1.0;
-    return IWAN_OK;
+    (void)model; (void)value;
+    ((passthrough_history *)history)->u = 0.0;
+    return NULL;
 }
 
-iwan_status model_commit(fmu_instance *inst, double u, double N, iwan_output *out)
+const char *model_eval(const void *model, const void *history, const double *value, double *out)
 {
-    inst->s.committed.u = u;
-    inst->s.committed.N = N;
-    return model_eval(inst, u, N, out);
+    (void)model; (void)history;
+    out[VR_F] = value[VR_U];
+    out[VR_KT] = 1.0;
+    out[VR_W] = out[VR_SLIP] = out[VR_STORED_ENERGY] = 0.0;
+    return NULL;
+}
+
+const char *model_commit(const void *model, void *history, const double *value, double *out)
+{
+    ((passthrough_history *)history)->u = value[VR_U];
+    return model_eval(model, history, value, out);
+}
+
+const char *model_partial(const void *model, const void *history, const double *value,
+                          unsigned int unknown, unsigned int known, double *d)
+{
+    (void)model; (void)history; (void)value;
+    *d = (unknown == VR_F && known == VR_U) ? 1.0 : 0.0;
+    return NULL;
+}
+
+const char *model_check_history(const void *model, const void *history)
+{
+    (void)model;
+    return isfinite(((const passthrough_history *)history)->u) ? NULL : "u not finite";
+}
+
+double model_input_bound(const void *model, unsigned int vr)
+{
+    (void)model; (void)vr;
+    return HUGE_VAL;
 }

@@ -1,4 +1,5 @@
 """The virgin-curve file: round trip, validation and clear errors."""
+import dataclasses
 import json
 
 import numpy as np
@@ -69,3 +70,51 @@ def test_nonfinite_values_are_refused(tmp_path):
     path.write_text('{"u": [0, 1e-6, NaN], "T": [0, 1, 2]}')
     with pytest.raises(ValueError, match="finite"):
         read_curve(path)
+
+
+def test_version_2_writes_and_reads_the_producers_tail(tmp_path):
+    for tail in ("flat", "slope"):
+        path = write_curve(dataclasses.replace(_curve(), tail=tail), tmp_path / f"{tail}.json")
+        assert json.loads(path.read_text())["tail"] == tail
+        assert read_curve(path).tail == tail     # stated, not guessed (T[-1] = mu N in both)
+
+
+def test_version_2_without_a_tail_is_refused(tmp_path):
+    data = _curve().to_dict()
+    del data["tail"]
+    path = tmp_path / "c.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="needs \"tail\""):
+        read_curve(path)
+    with pytest.raises(ValueError, match="tail must be one of"):
+        VirginCurve(u=[0.0, 1.0], T=[0.0, 1.0], tail="up")
+
+
+@pytest.mark.parametrize("schema", ["damper-virgin-curve/1", None])
+def test_version_1_files_get_the_old_gross_slip_rule(tmp_path, schema):
+    """Version 1 (or schema-less): flat iff mu and N are declared and T[-1] = mu N to 1e-6."""
+    from contact_core.curve import V1_GROSS_SLIP_RTOL
+
+    def tail_of(T_end, **meta):
+        data = {"u": [0.0, 1e-6, 2e-6], "T": [0.0, 0.6 * T_end, T_end], **meta}
+        if schema:
+            data["schema"] = schema
+        path = tmp_path / "v1.json"
+        path.write_text(json.dumps(data))
+        return read_curve(path).tail
+
+    assert tail_of(50.0, mu=0.5, N=100.0) == "flat"
+    assert tail_of(50.0 * (1 + 0.5 * V1_GROSS_SLIP_RTOL), mu=0.5, N=100.0) == "flat"
+    assert tail_of(50.0 * (1 + 2 * V1_GROSS_SLIP_RTOL), mu=0.5, N=100.0) == "slope"
+    assert tail_of(50.0, N=100.0) == "slope" and tail_of(50.0, mu=0.5) == "slope"
+    assert tail_of(50.0, mu=0.0, N=100.0) == "slope"
+
+
+def test_table_errors_name_the_point(tmp_path):
+    for data, message in [({"u": [0, 1e-6, 1e-6], "T": [0, 1, 2]}, r"u\[2\] = 1e-06 <= u\[1\]"),
+                          ({"u": [0, 1e-6, 2e-6], "T": [0, 1, -2]}, r"T\[2\] = -2.0"),
+                          ({"u": [], "T": []}, "empty")]:
+        path = tmp_path / "bad.json"
+        path.write_text(json.dumps(data))
+        with pytest.raises(ValueError, match=message):
+            read_curve(path)

@@ -78,16 +78,10 @@ def test_force_above_gross_slip_and_bad_numbers_exit_with_code_2(sphere_curve, c
     assert main(["loop", "--curve", sphere_curve, "--amplitude", "nan"]) == 2
 
 
-def test_gross_slip_rule_shared_by_the_clis():
-    """ends_at_gross_slip: T[-1] = mu N within GROSS_SLIP_RTOL, mu and N declared."""
-    from fmu_src.element import GROSS_SLIP_RTOL, ends_at_gross_slip, with_flat_tail
+def test_flat_tail_appends_one_flat_segment():
+    """flat_tail: the table the element (and the FMU's curve.txt) uses for tail="flat"."""
+    from fmu_src.element import flat_tail
 
-    T = np.array([0.0, 30.0, 50.0])
-    assert ends_at_gross_slip(T, 0.5, 100.0)
-    assert ends_at_gross_slip(T * (1 + 0.5 * GROSS_SLIP_RTOL), 0.5, 100.0)
-    assert not ends_at_gross_slip(T * (1 + 2 * GROSS_SLIP_RTOL), 0.5, 100.0)
-    assert not ends_at_gross_slip(T, None, 100.0) and not ends_at_gross_slip(T, 0.5, None)
-    assert not ends_at_gross_slip(T, 0.0, 100.0)
-    u2, T2 = with_flat_tail([0.0, 1e-6, 2e-6], T)
+    u2, T2 = flat_tail([0.0, 1e-6, 2e-6], [0.0, 30.0, 50.0])
     np.testing.assert_array_equal(u2, [0.0, 1e-6, 2e-6, 4e-6])
     np.testing.assert_array_equal(T2, [0.0, 30.0, 50.0, 50.0])

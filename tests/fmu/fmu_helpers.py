@@ -14,7 +14,8 @@ from fmpy.fmi3 import FMU3Slave
 #: Curve parameters: friction coefficient, normal load [N], slip displacement [m].
 MU, N_CURVE, U_SLIP = 0.5, 200.0, 2.0e-6
 #: Value references (fmu_src/fmi/damper_vr.h; the header's own test checks them).
-VR = {"time": 0, "u": 1, "N": 2, "F": 3, "kt": 4, "W": 5, "slip": 6, "scale": 7, "N_ref": 8}
+VR = {"time": 0, "u": 1, "N": 2, "F": 3, "kt": 4, "W": 5, "slip": 6, "scale": 7, "N_ref": 8,
+      "stored_energy": 9}
 #: Seed of the random histories (written out, see GUIDE.md).
 SEED = 20251122
 

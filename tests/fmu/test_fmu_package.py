@@ -126,13 +126,13 @@ def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
 
 @pytest.mark.parametrize("mu", [MU, None])
 def test_cli_fmu_continues_the_curve_past_its_end_like_damper_loop(tmp_path, mu):
-    """A file whose T[-1] = mu N ends at gross slip: the FMU stays at mu N past the
-    end (flat tail), as the loop CLI's element; without mu the last slope goes on.
-    Both CLIs take the rule from fmu_src.element.ends_at_gross_slip."""
+    """A file with tail "flat" (gross slip): the FMU stays at mu N past the end, as the
+    loop CLI's element; with tail "slope" the last slope goes on. Both CLIs read the
+    file's tail (schema 2; contact_core.curve decides it for version 1 files)."""
     from damper.cli.loop import build_element
 
     u, T = curve_table(11)                          # T[-1] = MU N_CURVE exactly
-    curve = VirginCurve(u=u, T=T, N=N_CURVE, mu=mu)
+    curve = VirginCurve(u=u, T=T, N=N_CURVE, mu=mu, tail="flat" if mu is not None else "slope")
     write_curve(curve, tmp_path / "c.json")
     out = tmp_path / "c.fmu"
     assert damper_main(["fmu", "--curve", str(tmp_path / "c.json"), "-o", str(out)]) == 0

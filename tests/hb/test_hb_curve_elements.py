@@ -11,7 +11,9 @@ MU, N = 0.5, 120.0
 def _write(tmp_path, T_end):
     u = np.linspace(0.0, 1.6e-6, 9)
     T = T_end * (1.0 - (1.0 - u / u[-1]) ** 1.5)   # Cattaneo-Mindlin shape (concave)
-    write_curve(VirginCurve(u=u, T=T, N=N, mu=MU), tmp_path / "c.json")
+    # the producer states the tail (schema 2): flat when the curve ends at gross slip
+    write_curve(VirginCurve(u=u, T=T, N=N, mu=MU, tail="flat" if T_end == MU * N else "slope"),
+                tmp_path / "c.json")
     (tmp_path / "el.toml").write_text('[[element]]\ndofs = [0]\ntype = "curve"\npath = "c.json"\n')
     return load_elements(tmp_path / "el.toml")[0].element
 

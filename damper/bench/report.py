@@ -1,0 +1,127 @@
+"""The benchmark report: one JSON object and one HTML page with a plot per stage.
+
+Each plot puts the error against its reference on the x axis and the time on
+the y axis (both logarithmic), one point per row labelled with its size; cold
+runs are circles, cached runs squares, the tool's default setting a star.
+"""
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+from pathlib import Path
+
+#: What each stage's size and error mean (axis labels and the report's captions).
+LEGEND = {
+    "contact": ("grid (nodes per side)", "max(|a/a_H - 1|, |p0/p0_H - 1|) against Hertz"),
+    "tangential": ("grid (nodes per side)", "max |T - T_Mindlin| / mu N"),
+    "element": ("sliders", "|loop energy / Masing energy of the exact Mindlin curve - 1|"),
+    "fmu": ("communication steps per cycle", "|energy per cycle / exact Masing energy - 1|"),
+    "hb": ("H or AFT samples", "|amplitude / time-integration amplitude - 1| at 1.1 rad/s"),
+    "solvers": ("contact nodes (grid^2)", "largest relative difference of k_n, k_t against the first solver"),
+}
+
+
+def _plot(stage: str, rows: list[dict]) -> str:
+    """PNG (base64) of error against time for one stage."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    floor = 1e-16  # an exact result (error 0) is drawn at round-off
+    for case in dict.fromkeys(r["case"] for r in rows):
+        for cached in (False, True):
+            pts = [r for r in rows if r["case"] == case and r["cached"] == cached and r["error"] is not None]
+            if not pts:
+                continue
+            x = [max(r["error"], floor) for r in pts]
+            y = [r["time_s"] for r in pts]
+            ax.plot(x, y, "s--" if cached else "o-", label=f"{case}{' (cached)' if cached else ''}")
+            for r, xi, yi in zip(pts, x, y):
+                ax.annotate(f"{r['size']:g}", (xi, yi), fontsize=7, xytext=(3, 3), textcoords="offset points")
+                if r.get("default"):
+                    ax.plot(xi, yi, "*", ms=16, mfc="none", mec="k")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    size_label, err_label = LEGEND.get(stage, ("size", "error"))
+    ax.set_xlabel(f"error: {err_label}", fontsize=8)
+    ax.set_ylabel("time [s]")
+    ax.set_title(f"{stage} (labels: {size_label}; star: default)", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=100)
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode()
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.3g}"
+    return html.escape(str(v))
+
+
+def table_text(stage: str, rows: list[dict]) -> str:
+    """Plain-text table of one stage (case, size, error, time, memory, cached)."""
+    lines = [f"== {stage}", f"{'case':26s} {'size':>8s} {'error':>10s} {'time_s':>8s} {'memory_mb':>9s} cached"]
+    for r in rows:
+        err = "-" if r["error"] is None else f"{r['error']:.2e}"
+        lines.append(f"{r['case']:26s} {r['size']:8g} {err:>10s} {r['time_s']:8.2f} {r['memory_mb']:9.0f} "
+                     f"{'yes' if r['cached'] else 'no'}{'  (default)' if r.get('default') else ''}")
+    return "\n".join(lines)
+
+
+def write(out: Path, result: dict) -> tuple[Path, Path]:
+    """Write bench.json and bench.html into ``out``; return their paths."""
+    from contact_core.fileio import atomic_write
+
+    parts = ["<!doctype html><html><head><meta charset='utf-8'><title>damper bench</title>"
+             "<style>body{font-family:sans-serif;max-width:60em;margin:auto}table{border-collapse:collapse;"
+             "font-size:85%}td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}</style></head><body>",
+             "<h1>damper bench</h1>", "<h2>Run</h2><table>"]
+    for k, v in result["stamp"].items():
+        parts.append(f"<tr><th>{html.escape(k)}</th><td style='text-align:left'>{_fmt(json.dumps(v))}</td></tr>")
+    parts.append("</table>")
+    for stage, rows in result["stages"].items():
+        size_label, err_label = LEGEND.get(stage, ("size", "error"))
+        parts.append(f"<h2>{html.escape(stage)}</h2><p>size: {html.escape(size_label)}; error: "
+                     f"{html.escape(err_label)}.</p>")
+        if rows:
+            parts.append(f"<img alt='{html.escape(stage)}' src='data:image/png;base64,{_plot(stage, rows)}'>")
+        parts.append("<table><tr><th>case</th><th>size</th><th>error</th><th>time [s]</th><th>memory [MB]</th>"
+                     "<th>cached</th><th>default</th></tr>")
+        for r in rows:
+            parts.append(f"<tr><td style='text-align:left'>{_fmt(r['case'])}</td><td>{_fmt(r['size'])}</td>"
+                         f"<td>{_fmt(r['error'])}</td><td>{_fmt(r['time_s'])}</td><td>{_fmt(r['memory_mb'])}</td>"
+                         f"<td>{'yes' if r['cached'] else 'no'}</td><td>{'*' if r.get('default') else ''}</td></tr>")
+        parts.append("</table>")
+    parts.append("</body></html>")
+    j = atomic_write(out / "bench.json", json.dumps(result, indent=1) + "\n")
+    h = atomic_write(out / "bench.html", "\n".join(parts))
+    atomic_write(out / "bench.md", markdown(result))
+    return j, h
+
+
+def markdown(result: dict) -> str:
+    """Markdown tables of every stage (what the README quotes), with the run's stamp."""
+    s = result["stamp"]
+    out = [f"Run {s['date_utc']}, revision {s['revision']}, {s['cores']} cores, {s['machine']}, "
+           f"load average {s['load_average'][0]:.1f}, sparse back ends {', '.join(s['sparse_solvers'])}.", ""]
+    for stage, rows in result["stages"].items():
+        size_label, err_label = LEGEND.get(stage, ("size", "error"))
+        out += [f"**{stage}** (size: {size_label}; error: {err_label})", "",
+                "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
+        for r in rows:
+            err = "-" if r["error"] is None else f"{r['error']:.2e}"
+            star = " (default)" if r.get("default") else ""
+            out.append(f"| {r['case']}{star} | {r['size']:g} | {err} | {r['time_s']:.2f} | {r['memory_mb']:.0f} | "
+                       f"{'yes' if r['cached'] else 'no'} |")
+        out.append("")
+    return "\n".join(out)
