@@ -8,19 +8,15 @@ import time
 
 import numpy as np
 
-from . import hertz, normal, report
+from . import normal, report
 from .condense import condense
 from .condensed import CondensedContact
 from .spec import ContactSpec
 
 
 def hertz_reference(spec: ContactSpec, force: float) -> dict | None:
-    """Analytic Hertz values for the pair at ``force`` (None for a flat face)."""
-    if spec.body == "sphere":
-        return hertz.sphere(force, spec.radius, spec.Estar)
-    if spec.body == "cylinder":
-        return hertz.cylinder(force, spec.length, spec.radius, spec.Estar)
-    return None
+    """Analytic reference values of the pair at ``force`` (None without a closed form)."""
+    return spec.kind.reference(spec, force)
 
 
 def solve(cc: CondensedContact, force=None, approach=None, eccentricity=None):
@@ -63,29 +59,21 @@ def run_normal(spec: ContactSpec, force=None, approach=None, eccentricity=None,
         ``curve_points`` > 0: forces from 5 % to 100 % of the solved force),
         ``timings`` [s] and ``meta``.
     """
-    if spec.body != "flat" and eccentricity:
-        raise ValueError("eccentricity applies to the flat face only")
-    if spec.body == "flat" and eccentricity is not None and abs(eccentricity) >= spec.width / 2:
-        raise ValueError(f"eccentricity {eccentricity:g} m lies outside the face (|e| < W/2 = {spec.width / 2:g} m)")
+    kind = spec.kind
+    kind.check_eccentricity(spec, eccentricity)
     t0 = time.perf_counter()
     cc = condense(spec, cache=cache)
     t1 = time.perf_counter()
     sol = solve(cc, force, approach, eccentricity)
     t2 = time.perf_counter()
-    out = report.summarize(cc, sol, spec.body)
+    out = report.summarize(cc, sol, kind)
     if out["zone_edge_in_contact"]:
         raise ValueError("the contact reaches the edge of the potential contact zone: raise the "
                          "design pressure (--p-design) so the zone holds this load, or the grid "
                          "if it is very coarse")
     ref = hertz_reference(spec, out["force"])
     if ref is not None:
-        key = "contact_radius" if spec.body == "sphere" else "contact_halfwidth"
-        size = ref["a"] if spec.body == "sphere" else ref["b"]
-        out["hertz"] = dict(ref, error_size=out[key] / size - 1.0,
-                            error_p0=(out["p_max"] if spec.body == "sphere" else out["p_mid_max"]) / ref["p0"] - 1.0)
-        if spec.body == "sphere":
-            out["hertz"]["error_approach"] = out["approach"] / ref["approach"] - 1.0
-            out["hertz"]["error_k_n"] = out["k_n"] / ref["k_n"] - 1.0
+        out["hertz"] = dict(ref, **kind.reference_errors(out, ref))
     out["maps"] = report.maps(cc, sol)
     if curve_points > 0:
         out["curve"] = curve(cc, np.linspace(0.05, 1.0, curve_points) * out["force"], eccentricity)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import hashlib
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,7 @@ import scipy.io
 import scipy.sparse as sp
 
 from . import linsolve
-from .cache import DiskCache, make_key
+from .cache import make_key, resolve
 from .condense import tributary
 from .condensed import CondensedContact, ContactGrid
 
@@ -144,7 +145,7 @@ def condense_bodies(K1, nodes1, K2, nodes2, directions=("z",), cache=None) -> Co
         for arr in (K.indptr, K.indices, K.data, *[np.asarray(nodes[k]) for k in sorted(nodes)]):
             digest.update(np.ascontiguousarray(arr).tobytes())
     key = make_key("byo", digest.hexdigest(), sorted(directions))
-    store = None if cache is False else cache if isinstance(cache, DiskCache) else DiskCache(cache)
+    store = resolve(cache)
     hit = store.get(key) if store is not None else None
     t0 = time.perf_counter()
     if hit is None:
@@ -188,17 +189,57 @@ def export_body(body, K: sp.spmatrix, stiffness_path, nodes_path, symmetry: str,
     atomic_write(nodes_path, buf.getvalue())
 
 
-def run_from_files(args, cache) -> dict:
-    """``damper normal --stiffness K1 K2 --nodes N1 N2``: condense, solve, summarise."""
+@dataclass(frozen=True)
+class ImportedBodies:
+    """The body kind "imported matrices": a pair of bodies whose geometry lives in files.
+
+    Unlike the built-in kinds (``contact_core.bodies``) it is not meshed here;
+    the contact-size estimators of its report come from the named ``summary``
+    kind (the geometry the matrices describe, e.g. "sphere").
+
+    Attributes
+    ----------
+    K1, K2 : scipy.sparse matrix, shape (3 N_i, 3 N_i)   stiffness of body 1 / 2
+    nodes1, nodes2 : dict                                 node files (module docstring)
+    """
+
+    K1: sp.csr_matrix
+    nodes1: dict
+    K2: sp.csr_matrix
+    nodes2: dict
+
+    @classmethod
+    def from_files(cls, stiffness, nodes) -> ImportedBodies:
+        """Read two stiffness files and two node files (each a pair of paths)."""
+        if not (stiffness and nodes) or len(stiffness) != 2 or len(nodes) != 2:
+            raise ValueError("--stiffness and --nodes go together (two files each)")
+        K1, K2 = (load_matrix(p) for p in stiffness)
+        n1, n2 = (load_nodes(p) for p in nodes)
+        return cls(K1, n1, K2, n2)
+
+    def condense(self, directions=("z",), cache=None) -> CondensedContact:
+        """The condensed contact (see ``condense_bodies``)."""
+        return condense_bodies(self.K1, self.nodes1, self.K2, self.nodes2, directions, cache)
+
+
+def run_from_files(stiffness, nodes, body: str, force=None, approach=None, cache=None) -> dict:
+    """Condense imported bodies, solve one normal load case and summarise it.
+
+    Parameters
+    ----------
+    stiffness, nodes : pair of paths
+        Stiffness matrices and node files of body 1 and body 2.
+    body : str
+        Body kind whose contact-size estimators the summary uses.
+    force, approach : float
+        Exactly one: normal force [N] or approach [m].
+    cache : see ``contact_core.condense.condense``
+    """
     from . import api, report
 
-    if not (args.stiffness and args.nodes):
-        raise ValueError("--stiffness and --nodes go together (two files each)")
-    K1, K2 = (load_matrix(p) for p in args.stiffness)
-    n1, n2 = (load_nodes(p) for p in args.nodes)
-    cc = condense_bodies(K1, n1, K2, n2, cache=cache)
-    sol = api.solve(cc, args.force, args.approach)
-    out = report.summarize(cc, sol, args.body)
+    cc = ImportedBodies.from_files(stiffness, nodes).condense(cache=cache)
+    sol = api.solve(cc, force, approach)
+    out = report.summarize(cc, sol, body)
     out["maps"] = report.maps(cc, sol)
     out["timings"] = cc.meta["timings"]
     out["meta"] = {k: cc.meta[k] for k in ("symmetry", "byo", "cache", "solver")}

@@ -1,9 +1,17 @@
-"""On-disk cache of condensed matrices (.npz), keyed by a content hash.
+"""The condensation cache: its protocol and the on-disk default (.npz per key).
 
-Location: the ``cache_dir`` argument, else the environment variable
-``DAMPER_CACHE_DIR``, else ``.damper_cache`` in the working directory.
-Files are written atomically, so an interrupted run never leaves a torn entry;
-an unreadable entry is treated as a miss and rebuilt.
+Any object with the ``get`` / ``put`` methods of ``CondensationCache`` can be
+passed as ``cache=`` to ``condense.condense``, ``byo.condense_bodies`` and what
+calls them (``api.run_normal``, ``tangential_run.run``): the application layer
+passes its content-addressed store. Keys are built by the library
+(``make_key``: a hash of everything that shapes the result, the code version
+included), so a store only maps opaque keys to arrays and meta.
+
+``DiskCache`` is the default implementation. Location: the ``cache_dir``
+argument, else the environment variable ``DAMPER_CACHE_DIR``, else
+``.damper_cache`` in the working directory. Files are written atomically, so an
+interrupted run never leaves a torn entry; an unreadable entry is treated as a
+miss and rebuilt.
 """
 from __future__ import annotations
 
@@ -13,6 +21,7 @@ import json
 import os
 import zipfile
 from pathlib import Path
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -20,6 +29,43 @@ from .fileio import atomic_write
 
 ENV_VAR = "DAMPER_CACHE_DIR"
 DEFAULT_DIR = ".damper_cache"
+
+
+@runtime_checkable
+class CondensationCache(Protocol):
+    """What the condensation needs from a cache (keys are opaque strings).
+
+    ``get(key)`` returns ``(arrays, meta)`` stored under ``key`` (arrays: name ->
+    ndarray, meta: a JSON-able dict), or None on a miss (an unreadable entry is
+    a miss); ``put(key, arrays, meta)`` stores them atomically (a reader never
+    sees a torn entry). An optional ``path(key)`` says where the entry lives,
+    for the run's provenance.
+    """
+
+    def get(self, key: str) -> tuple[dict, dict] | None: ...
+
+    def put(self, key: str, arrays: dict, meta: dict) -> object: ...
+
+
+def resolve(cache) -> CondensationCache | None:
+    """The store meant by a ``cache=`` argument.
+
+    None: a DiskCache in the default folder; False: no cache; a str or path:
+    a DiskCache there; any object with ``get`` and ``put``: that object.
+    """
+    if cache is False:
+        return None
+    if cache is None or isinstance(cache, (str, os.PathLike)):
+        return DiskCache(cache)
+    if isinstance(cache, CondensationCache):
+        return cache
+    raise TypeError(f"cache must be None, False, a folder or an object with get/put, got {cache!r}")
+
+
+def entry_path(store, key: str) -> str | None:
+    """Where ``store`` keeps ``key`` (None if it does not say)."""
+    path = getattr(store, "path", None)
+    return str(path(key)) if callable(path) else None
 
 
 def default_dir() -> Path:

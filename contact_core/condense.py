@@ -27,11 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from . import assembly, linsolve, mesh
-from .cache import DiskCache, make_key
+from .cache import entry_path, make_key, resolve
 from .condensed import CondensedContact, ContactGrid
 from .spec import ContactSpec
 
-_SOURCES = ("mesh.py", "assembly.py", "condense.py", "spec.py", "linsolve.py")
+_SOURCES = ("mesh.py", "bodies.py", "assembly.py", "condense.py", "spec.py", "linsolve.py")
 DIRECTIONS = ("z", "x")
 
 
@@ -93,14 +93,7 @@ def make_grid(spec: ContactSpec, b1: mesh.BodyMesh, b2: mesh.BodyMesh, symmetry:
     x, y = b2.p[0, b2.contact], b2.p[1, b2.contact]
     ux, uy = np.unique(x), np.unique(y)
     area = np.outer(tributary(ux), tributary(uy)).ravel()
-    if spec.model == "real" and spec.body != "flat":
-        h = b1.p[2, b1.contact] - b2.p[2, b2.contact]   # the true surface z_s(x, y)
-    elif spec.body == "sphere":
-        h = (x**2 + y**2) / (2.0 * spec.radius)           # h = r^2 / (2R)
-    elif spec.body == "cylinder":
-        h = x**2 / (2.0 * spec.radius)
-    else:
-        h = np.zeros_like(x)
+    h = spec.kind.gap(spec, b1, b2, x, y)
     tol = 1e-9 * (ux[1] - ux[0])
     copies = 1 + (np.abs(y) > tol).astype(int)
     if symmetry == "quarter":
@@ -135,8 +128,7 @@ def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
                 arrays[f"C{d}{d}_{ib}"] = body_compliance(K, body, d, sym)
             timings["condensation"] += time.perf_counter() - t0
         del K
-    rigid = [np.ones_like(grid.x)] + ([grid.x] if spec.body == "flat" else [])
-    arrays["rigid"] = np.stack(rigid, axis=1)
+    arrays["rigid"] = spec.kind.rigid(grid.x)
     meta.update({"spec": spec.key_dict(), "directions": list(directions), "dofs": dofs,
                  "solver": linsolve.backend(), "timings": timings})
     return arrays, meta
@@ -160,9 +152,10 @@ def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedConta
     spec : ContactSpec
     directions : sequence of {"z", "x"}
         Compliance blocks to compute; "z" is always included (the normal solve).
-    cache : None, False, str, Path or DiskCache
+    cache : None, False, str, Path or a ``cache.CondensationCache``
         None: the default cache folder (``DAMPER_CACHE_DIR`` or ``.damper_cache``);
-        False: no cache; a folder or a DiskCache: that cache.
+        False: no cache; a folder: a DiskCache there; an object with
+        ``get``/``put`` (e.g. the application's content-addressed store): that.
 
     Returns
     -------
@@ -174,7 +167,7 @@ def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedConta
     if bad:
         raise ValueError(f"unknown direction(s) {sorted(bad)}; use 'z' and/or 'x'")
     directions = tuple(d for d in DIRECTIONS if d in set(directions) | {"z"})
-    store = None if cache is False else cache if isinstance(cache, DiskCache) else DiskCache(cache)
+    store = resolve(cache)
     key = make_key(spec.key_dict(), directions, code_version())
     t0 = time.perf_counter()
     hit = store.get(key) if store is not None else None
@@ -187,5 +180,5 @@ def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedConta
         if store is not None:
             store.put(key, arrays, meta)
     meta["cache"] = {"key": key, "hit": hit is not None,
-                     "path": None if store is None else str(store.path(key))}
+                     "path": None if store is None else entry_path(store, key)}
     return _assemble_result(arrays, meta)

@@ -262,16 +262,8 @@ def condense(spec, directions=("z", "x")):
     """
     import time
 
-    if spec.body not in ("sphere", "cylinder"):
-        raise ValueError(f"the half-space BEM model handles sphere and cylinder, not {spec.body!r}")
     t0 = time.perf_counter()
-    zx, zy = spec.zone()
-    materials = ((spec.E1, spec.nu1), (spec.E2, spec.nu2))
-    n = spec.n_side
-    if spec.body == "sphere":
-        cc = sphere(spec.radius, zx, n, materials, directions)
-    else:
-        cc = cylinder(spec.radius, spec.length, zx, n, n, materials, directions)
+    cc = spec.kind.bem(spec, directions)   # the body kind knows its grid (sphere, cylinder)
     cc.meta.update({"spec": spec.key_dict() | {"model": "bem"},
                     "timings": {"influence": time.perf_counter() - t0}})
     return cc

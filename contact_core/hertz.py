@@ -34,11 +34,6 @@ def sphere_radius_for_peak(p0: float, R: float, Estar: float) -> float:
     return math.pi * R * p0 / (2.0 * Estar)
 
 
-def sphere_force_for_approach(d: float, R: float, Estar: float) -> float:
-    """Hertz force for approach d: F = (4/3) E* R^(1/2) d^(3/2)."""
-    return 4.0 / 3.0 * Estar * math.sqrt(R) * d**1.5
-
-
 def cylinder(F: float, L: float, R: float, Estar: float) -> dict:
     """2D (plane-strain) Hertz line contact, load per length P' = F/L (seed eq. 2.1-2.2)."""
     P = F / L

@@ -15,10 +15,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .spec import ContactSpec
+if TYPE_CHECKING:  # the spec names its body kind, which builds through this module
+    from .spec import ContactSpec
+
 
 #: scikit-fem MeshHex local vertex offsets (i, j, k) of the 8 nodes.
 HEX_OFFSETS = np.array([[0, 0, 0], [0, 0, 1], [0, 1, 0], [1, 0, 0],
@@ -254,52 +257,19 @@ def half_cylinder(R: float, xz: np.ndarray, ys: np.ndarray, q: float) -> BodyMes
 
 
 def build(spec: ContactSpec) -> tuple[BodyMesh, BodyMesh, dict]:
-    """Meshes of body 1 and body 2 for ``spec`` and a description (``meta``)."""
-    q, R = spec.grading, spec.radius
-    zx, zy = spec.zone()
-    n = spec.n_side
-    near = NEAR_DEPTH * zx
-    if spec.body == "sphere":
-        xz = zone_points(zx, n, True)
-        s = xz[1] - xz[0]
-        size = R if spec.model == "real" else max(R, 60.0 * zx)
-        xs = np.concatenate([xz, graded(zx, size, s, q)])
-        b2 = plane_block(xs, xs, size, s, q, xz.size, xz.size, near)
-        b1 = (half_sphere(R, xz, q) if spec.model == "real"
-              else upper_block(xs, xs, size, s, q, xz.size, xz.size, near))
-        sym = "quarter"
-    elif spec.body == "cylinder":
-        xz = zone_points(zx, n, True)
-        s = xz[1] - xz[0]
-        yz = _cylinder_y(zy, s, n)
-        size = R
-        xs = np.concatenate([xz, graded(zx, size, s, q)])
-        ys = np.concatenate([yz, graded(zy, zy + size, yz[-1] - yz[-2], q)])
-        b2 = plane_block(xs, ys, size, s, q, xz.size, yz.size, near)
-        b1 = (half_cylinder(R, xz, yz, q) if spec.model == "real"
-              else upper_block(xs, yz, size, s, q, xz.size, yz.size, near))
-        sym = "quarter"
-    else:
-        xz = zone_points(zx, n, False)
-        s = xz[1] - xz[0]
-        ny = max(3, int(round(zy / s)) + 1)
-        yz = np.linspace(0.0, zy, ny)
-        size = max(2.0 * zx, zy)
-        xr = graded(zx, zx + size, s, q)
-        xs = np.concatenate([-xr[::-1], xz, xr])
-        ys = np.concatenate([yz, graded(zy, zy + size, yz[1] - yz[0], q)])
-        b2 = plane_block(xs, ys, size, s, q, xz.size, yz.size, near)
-        b1 = upper_block(xz, yz, size, s, q, xz.size, yz.size, near)
-        sym = "half"
+    """Meshes of body 1 and body 2 for ``spec`` (built by its body kind) and a description."""
+    b1, b2, s = spec.kind.meshes(spec)
     if b1.contact.size > MAX_CONTACT_NODES:
         raise ValueError(f"{b1.contact.size} contact nodes exceed {MAX_CONTACT_NODES}: "
                          f"lower --grid (dense compliances grow as n^2)")
-    meta = {"symmetry": sym, "zone": [zx, zy], "spacing": float(s), "n_side": n,
-            "nodes": [b1.p.shape[1], b2.p.shape[1]], "elements": [b1.t.shape[1], b2.t.shape[1]]}
+    zx, zy = spec.zone()
+    meta = {"symmetry": spec.kind.symmetry, "zone": [zx, zy], "spacing": float(s),
+            "n_side": spec.n_side, "nodes": [b1.p.shape[1], b2.p.shape[1]],
+            "elements": [b1.t.shape[1], b2.t.shape[1]]}
     return b1, b2, meta
 
 
-def _cylinder_y(zy: float, s: float, n_side: int) -> np.ndarray:
+def cylinder_lines(zy: float, s: float, n_side: int) -> np.ndarray:
     """Lines along the cylinder, 0 <= y <= L/2: s/2 at the end y = L/2, where the
     edge pressure peak sits, growing by 1.25 towards the middle up to the larger
     of 2 s and (L/2) / n_side (a long cylinder is nearly plane strain there)."""

@@ -13,17 +13,23 @@ equivalently the strictly convex QP  min 1/2 f'Cf + f'(h - R_q q), f >= 0 (C is
 symmetric positive definite). For a trial contact set P the thesis reduces the
 stiffness onto P (eqs A.12-A.15: nodes outside carry no force); in compliance
 form that reduction is simply the sub-block C_PP, so each trial costs one dense
-Cholesky solve C_PP f_P = (R_q q - h)_P (the gap closes on P, eq. A.17). It is solved by the thesis's active-set idea
-(nodes in tension leave the contact, penetrating nodes re-enter) organised as a
-Lawson-Hanson primal active-set method: every outer iteration ends on the exact
-minimiser over its active set with f > 0 there and strictly lowers the QP
-objective, so no active set can repeat and the iteration cannot cycle. Several
-penetrating nodes enter at once; a node that would enter with a non-positive
-force is held back (the guard), and if none is left the single most penetrating
-node enters, for which Lawson-Hanson guarantees progress.
+Cholesky solve C_PP f_P = (R_q q - h)_P (the gap closes on P, eq. A.17). The
+thesis's active-set idea (nodes in tension leave the contact, penetrating nodes
+re-enter) is organised as the projected Newton method of ``contact_core.qp``
+(shared with the tangential solve): every step is that contact-set solve,
+projected onto f >= 0 and damped so that the QP objective falls, so no set can
+recur and the iteration cannot cycle; many nodes enter or leave per step.
+Measured against the Lawson-Hanson loop it replaces and scipy's ``nnls`` /
+``lsq_linear`` (bvls) on the Cholesky form, one displacement-controlled solve
+at the 200 N / 350 N bench loads (1 BLAS thread): sphere 21x21 real (121
+nodes) 4.0 / 0.8 / 2.7 / 23 ms, sphere 41x41 half-space (441 nodes)
+32 / 30 / 136 / 337 ms, cylinder 21x21 (275 nodes) 11 / 14 / 31 / 93 ms; all
+agree to 1e-14. The library solvers refactor the whole C each call and cannot
+be warm started across force-control Newton steps.
 
-Tolerances: penetration <= ``GAP_RTOL`` * max|h - R_q q| (no tension holds
-exactly: f = 0 off the active set, f > 0 on it); force control meets its
+Tolerances: penetration and the gap on contact nodes <= ``GAP_RTOL`` *
+max|h - R_q q| (no tension holds exactly: f = 0 off the active set, f > 0 on
+it), checked after every solve (``qp.check_kkt``); force control meets its
 targets to ``FORCE_RTOL``.
 """
 from __future__ import annotations
@@ -35,15 +41,16 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from . import qp
 from .condensed import CondensedContact
 
 #: Allowed penetration relative to the largest effective gap magnitude.
 GAP_RTOL = 1e-10
 #: Relative accuracy of force control (force and moment).
 FORCE_RTOL = 1e-9
-#: A node whose entry round-off forbids is accepted as converged if it
-#: penetrates less than this many gap tolerances.
-STALL_FACTOR = 1e3
+#: The KKT check after the solve allows this many gap tolerances (the solver
+#: stops at GAP_RTOL; the BVLS fallback's Cholesky form loses a few digits).
+KKT_FACTOR = 10.0
 #: Newton steps allowed in force control.
 MAX_NEWTON = 60
 
@@ -106,75 +113,38 @@ def _solve_sub(C, rhs, P):
     return s
 
 
-def _enter(C, b, f, P, cand):
-    """Lawson-Hanson inner loop after ``cand`` nodes enter; None if all are held back."""
-    Pn = P | cand
-    while True:
-        s = _solve_sub(C, -b, Pn)
-        held = Pn & ~P & (f <= 0) & (s <= 0)        # entering with a non-positive force
-        if held.any():
-            Pn &= ~held
-            if not (Pn & ~P).any():
-                return None
-            continue
-        bad = Pn & (s <= 0)
-        if not bad.any():
-            return s, Pn
-        alpha = np.min(f[bad] / (f[bad] - s[bad]))  # step to the first node reaching f = 0
-        f = f + alpha * (s - f)
-        Pn &= f > 1e-300
-        P = P & Pn
-
-
 def lcp(C: np.ndarray, b: np.ndarray, P0: np.ndarray | None = None, max_iter: int | None = None):
-    """Solve g = C f + b >= 0, f >= 0, f g = 0 for SPD C.
+    """Solve g = C f + b >= 0, f >= 0, f g = 0 for SPD C (the QP of the module docstring).
 
     Parameters
     ----------
     C : ndarray (n, n) SPD; b : ndarray (n,) the effective gap h - R_q q [m]
-    P0 : ndarray (n,) bool, optional, a guess of the contact set (warm start)
+    P0 : ndarray (n,) bool, optional, a guess of the contact set (warm start;
+        default: the penetrating nodes b < 0)
+    max_iter : int, optional
+        Iteration cap; when given, reaching it raises RuntimeError. By default
+        (3 n + 10 iterations) the bounded-QP module's BVLS fallback takes over.
 
     Returns
     -------
-    f : ndarray (n,); active : ndarray (n,) bool; iterations : int
+    f : ndarray (n,); active : ndarray (n,) bool (f > 0); iterations : int
 
     Raises
     ------
     RuntimeError
-        If the iteration limit (default 3 n + 10) is reached.
+        If the iteration limit is reached, or the result fails the KKT check.
     """
     n = b.size
-    max_iter = 3 * n + 10 if max_iter is None else max_iter
     tol = GAP_RTOL * max(np.max(np.abs(b)), 1e-300)
-    P = (b < 0) if P0 is None else P0.copy()
-    it = 0
-    while True:  # start: drop tensile nodes from the guess (thesis A.1.4-A.1.5)
-        s = _solve_sub(C, -b, P)
-        it += 1
-        if not (P & (s <= 0)).any():
-            break
-        P &= s > 0
-    f = s
-    while True:
-        w = C @ f + b
-        viol = ~P & (w < -tol)
-        if not viol.any():
-            return f, P, it
-        if it >= max_iter:
-            raise RuntimeError(f"normal contact active set did not converge in {max_iter} iterations "
-                               f"(max penetration {-w[viol].min():.3e} m)")
-        it += 1
-        step = _enter(C, b, f, P, viol)
-        if step is None:
-            one = np.zeros(n, bool)
-            one[np.argmin(np.where(viol, w, np.inf))] = True
-            step = _enter(C, b, f, P, one)
-            if step is None:  # Lawson-Hanson guarantees progress in exact arithmetic only
-                if -w[viol].min() <= STALL_FACTOR * tol:
-                    return f, P, it
-                raise RuntimeError("normal contact active set stalled (ill-conditioned compliance, "
-                                   f"penetration {-w[viol].min():.3e} m)")
-        f, P = step
+    P = (b < 0) if P0 is None else np.asarray(P0, bool)
+    # start (thesis A.1.4-A.1.5): close the gap on the guessed set, drop tension
+    f0 = np.maximum(_solve_sub(C, -b, P), 0.0)
+    lo, hi = np.zeros(n), np.full(n, np.inf)
+    res = qp.solve(C, -b, lo, hi, f0, gtol=tol, max_iter=3 * n + 10 if max_iter is None else max_iter,
+                   fallback=max_iter is None, name="normal contact active set")
+    qp.check_kkt(res.x, res.g, lo, hi, res.free, xtol=0.0, gtol=KKT_FACTOR * tol,
+                 name="normal contact", x_unit="N", g_unit="m")
+    return res.x, res.free, res.iterations + 1
 
 
 @_single_threaded

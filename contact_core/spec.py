@@ -13,12 +13,11 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from . import hertz
+from . import bodies, hertz
 
 #: Steel, the default for both bodies.
 STEEL_E = 200e9
 STEEL_NU = 0.3
-BODIES = ("sphere", "cylinder", "flat")
 #: Largest contact grid accepted: 81 nodes per side is ~0.25 M DOF per body
 #: for the sphere (see also mesh.MAX_CONTACT_NODES).
 MAX_GRID = 81
@@ -31,7 +30,9 @@ class ContactSpec:
 
     Parameters
     ----------
-    body : {"sphere", "cylinder", "flat"}
+    body : str
+        Name of a registered body kind (``contact_core.bodies``: "sphere",
+        "cylinder", "flat"); ``spec.kind`` is its class instance.
     radius : float
         Sphere or cylinder radius R [m] (cylinder: D/2).
     length : float
@@ -54,6 +55,8 @@ class ContactSpec:
         Potential zone / Hertz contact size at ``p_design``.
     grading : float
         Growth ratio of element sizes away from the contact zone.
+    height : float
+        Flat face: height of body 1 above the face [m] (0: max(W, L/2)).
     """
 
     body: str = "sphere"
@@ -70,6 +73,7 @@ class ContactSpec:
     load_hint: float = 0.0
     zone_margin: float = 1.15
     grading: float = 1.45
+    height: float = 0.0
 
     def __post_init__(self):
         validate(self)
@@ -84,21 +88,14 @@ class ContactSpec:
         """Contact-zone nodes per side actually used (odd)."""
         return self.grid + 1 - self.grid % 2
 
+    @property
+    def kind(self) -> bodies.Body:
+        """The body kind (``contact_core.bodies``) named by ``body``."""
+        return bodies.get(self.body)
+
     def zone(self) -> tuple[float, float]:
         """Half-extents (zx, zy) [m] of the potential contact zone of the full model."""
-        Es, R = self.Estar, self.radius
-        if self.body == "sphere":
-            a = hertz.sphere_radius_for_peak(self.p_design, R, Es)
-            if self.load_hint > 0:
-                a = max(a, hertz.sphere(self.load_hint, R, Es)["a"])
-            return self.zone_margin * a, self.zone_margin * a
-        if self.body == "cylinder":
-            b = hertz.cylinder_halfwidth_for_peak(self.p_design, R, Es)
-            if self.load_hint > 0:
-                b = max(b, hertz.cylinder(self.load_hint, self.length, R, Es)["b"])
-            # the edge effect widens the contact at the ends (thesis Fig. 5)
-            return min(1.3 * self.zone_margin * b, 0.5 * R), 0.5 * self.length
-        return 0.5 * self.width, 0.5 * self.length
+        return self.kind.zone(self)
 
     def key_dict(self) -> dict:
         """Fields that define the FE model (for the cache key).
@@ -110,9 +107,10 @@ class ContactSpec:
         d = asdict(self)
         for name in ("p_design", "load_hint", "zone_margin"):
             d.pop(name)
+        if not self.height:
+            d.pop("height")  # the default body height: keys of older specs stay valid
         d["zone"] = [float(v) for v in self.zone()]
-        if self.body == "flat":
-            d["model"] = "halfspace"  # a flat face has no curvature to model
+        d["model"] = self.kind.key_model(self)
         return d
 
 
@@ -123,8 +121,7 @@ def _positive(name: str, value: float) -> None:
 
 def validate(spec: ContactSpec) -> None:
     """Raise ValueError with a clear message for an inconsistent specification."""
-    if spec.body not in BODIES:
-        raise ValueError(f"body must be one of {BODIES}, got {spec.body!r}")
+    kind = bodies.get(spec.body)
     if spec.model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {spec.model!r}")
     for name in ("E1", "E2"):
@@ -133,12 +130,7 @@ def validate(spec: ContactSpec) -> None:
         nu = getattr(spec, name)
         if not (-1.0 < nu < 0.5):
             raise ValueError(f"{name} must lie in (-1, 0.5) (0.5 is incompressible), got {nu!r}")
-    if spec.body in ("sphere", "cylinder"):
-        _positive("radius", spec.radius)
-    if spec.body in ("cylinder", "flat"):
-        _positive("length", spec.length)
-    if spec.body == "flat":
-        _positive("width", spec.width)
+    kind.validate(spec)
     if not isinstance(spec.grid, int) or spec.grid < 3:
         raise ValueError(f"grid must be an integer >= 3, got {spec.grid!r}")
     if spec.grid > MAX_GRID:

@@ -37,19 +37,14 @@ one step (the history inside a step is taken as proportional, as in any
 incremental plasticity scheme; ``contact_core.tangential_curve`` chooses the
 steps).
 
-Solver: Bertsekas' projected Newton method (``_active_set``). Its Newton step
-is the thesis's stick-set solve (A.2.5, eq. A.40) with the slip nodes held at
-+-mu f (A.34-A.36). Exchanging stick and slip sets by their violations alone
-(A.2.6, or a primal-dual active-set method that also releases slip nodes)
-was seen to cycle on the dense half-space compliances (whole sets flipping
-between +mu f and -mu f); here the step is projected onto the bounds and
-shortened by an Armijo rule, so the QP objective falls at every iteration
-and no set can recur, while slip nodes may still return to stick (needed on
-unloading). It stops at a KKT point
-within ``SOLVE_TOL``; should it not within ``MAX_ITER`` iterations, scipy's
-bounded-variable least squares (``lsq_linear``, ``bvls``, a finite
-active-set method) takes over. Every result is checked against the KKT
-conditions with ``KKT_TOL`` (RuntimeError otherwise).
+Solver: the bounded-QP module ``contact_core.qp`` (Bertsekas' projected
+Newton method, BVLS fallback). Its Newton step is the thesis's stick-set solve
+(A.2.5, eq. A.40) with the slip nodes held at +-mu f (A.34-A.36); exchanging
+stick and slip sets by their violations alone (A.2.6) was seen to cycle on the
+dense half-space compliances, the projected, Armijo-damped step cannot, and
+slip nodes may still return to stick (needed on unloading). It stops at a KKT
+point within ``SOLVE_TOL``; every result is checked against Coulomb's law (the
+KKT conditions) with ``KKT_TOL`` (RuntimeError otherwise).
 
 Full stick (all |q_i| < mu f_i) is linear: ``q = delta C^-1 1``, so the
 initial tangential stiffness is exactly ``k_t = w^T C^-1 1``. Gross slip
@@ -60,7 +55,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
+
+from . import qp
 
 #: Relative tolerance of the KKT check of every solution: force bounds
 #: relative to mu max(f), stick slip increments relative to the displacement
@@ -205,8 +202,10 @@ class TangentialProblem:
         if self.mu == 0.0:  # frictionless: every node slides freely, q = 0
             q, it, free, cho = np.zeros(self.n_c), 0, np.zeros(self.n_c, bool), None
         else:
-            q, it, free, cho = _active_set(self.K, self.w * r, self.bound, state.q,
-                                            self.u_scale * self.w.max())
+            res = qp.solve(self.K, self.w * r, -self.bound, self.bound, state.q,
+                           gtol=SOLVE_TOL * self.u_scale * self.w.max(), max_iter=MAX_ITER,
+                           name="tangential solve")
+            q, it, free, cho = res.x, res.iterations, res.free, res.factor
         # a node reaching its bound to round-off is at the bound: snap it, so
         # the stick/slip split does not depend on the last bit (gross slip)
         at = np.abs(q) >= self.bound * (1.0 - SNAP_TOL)
@@ -215,7 +214,9 @@ class TangentialProblem:
             cho = None
         free = free & ~at
         ds = r - self.C @ q
-        _check_kkt(q, ds, self.bound, free, self.u_scale, self.mu)
+        # Coulomb's law as the QP's KKT conditions, in slip units: g = -W ds, W > 0
+        qp.check_kkt(q, -ds, -self.bound, self.bound, free, xtol=KKT_TOL * self.bound.max(),
+                     gtol=KKT_TOL * self.u_scale, name="tangential solve", x_unit="N", g_unit="m")
         k_tan = _tangent_stiffness(self.K, self.w, free, cho)
         new = TangentialState(delta, state.s + np.where(free, 0.0, ds), q)
         return self._expand(delta, q, new.s, free, k_tan, it), new
@@ -229,95 +230,6 @@ class TangentialProblem:
         weight = np.asarray(self.contact.grid.mult, float) * np.asarray(self.contact.grid.area, float)
         frac = float(weight[stick].sum() / weight[self.idx].sum())
         return TangentialSolution(delta, float(self.w @ q_c), q, s, stick, slip, frac, k_tan, it)
-
-
-def _active_set(K, b, bound, q0, u_scale):
-    """Projected Newton solve of min 1/2 q^T K q - q^T b subject to |q| <= bound.
-
-    Bertsekas' projected Newton method (SIAM J. Control Optim. 20, 1982): the
-    nodes at a bound whose gradient pushes outwards are held (binding set); on
-    the others a Newton step (an exact Cholesky solve, the thesis's stick-set
-    solve A.40) is taken, projected onto the box and shortened by an Armijo
-    rule on the QP objective. The objective falls at every iteration, so it
-    cannot cycle (the plain stick/slip exchange of the thesis, or a
-    primal-dual active-set method, does cycle on dense half-space compliances);
-    on a QP the full Newton step lands exactly on the solution once the sets
-    are right, typically in 1-3 iterations when warm started.
-
-    Returns q, iterations, the stick mask and the Cholesky factor of K on the
-    stick set (or None).
-    """
-    dinv = 1.0 / np.diag(K)
-    q = np.clip(q0, -bound, bound)
-    g = K @ q - b
-    gtol = SOLVE_TOL * u_scale  # g = W (C q - r): weighted slip increment [m]
-    F, cho = None, None
-    for it in range(1, MAX_ITER + 1):
-        free = _kkt_free(q, g, bound, gtol)
-        if free is not None:  # reuse the last factor if it is the stick set's
-            same = F is not None and np.array_equal(F, free)
-            return q, it - 1, free, cho if same else None
-        pg = np.abs(q - np.clip(q - dinv * g, -bound, bound))
-        eps = min(1e-3 * bound.max(), float(pg.max()))
-        held = ((q <= -bound + eps) & (g > 0)) | ((q >= bound - eps) & (g < 0))
-        step = -dinv * g
-        F, cho = ~held, None
-        if F.any():
-            cho = linalg.cho_factor(K[np.ix_(F, F)])
-            step[F] = -linalg.cho_solve(cho, g[F])
-        q, g = _armijo(K, b, bound, q, g, step, F)
-    return _bvls(K, b, bound) + (None,)
-
-
-def _armijo(K, b, bound, q, g, step, F, sigma=1e-4):
-    """Projected step with Armijo backtracking (Bertsekas' condition)."""
-    f0 = 0.5 * q @ (K @ q) - b @ q
-    alpha = 1.0
-    for _ in range(60):
-        qa = np.clip(q + alpha * step, -bound, bound)
-        Kqa = K @ qa
-        fa = 0.5 * qa @ Kqa - b @ qa
-        predicted = -alpha * (g[F] @ step[F]) + g[~F] @ (q[~F] - qa[~F])
-        if f0 - fa >= sigma * predicted:
-            return qa, Kqa - b
-        alpha *= 0.5
-    return qa, Kqa - b  # the step has become negligible; the caller re-checks KKT
-
-
-def _kkt_free(q, g, bound, gtol):
-    """The stick mask if (q, g) is a KKT point within ``gtol``, else None."""
-    at_up = q >= bound
-    at_lo = q <= -bound
-    free = ~(at_up | at_lo)
-    ok = (np.all(np.abs(g[free]) <= gtol) and np.all(g[at_up] <= gtol)
-          and np.all(g[at_lo] >= -gtol))
-    return free if ok else None
-
-
-def _bvls(K, b, bound):
-    """Bounded-variable least squares fallback (finite active-set method)."""
-    L = linalg.cholesky(K, lower=True)
-    rhs = linalg.solve_triangular(L, b, lower=True)
-    res = optimize.lsq_linear(L.T, rhs, bounds=(-bound, bound), method="bvls", tol=1e-14)
-    if not res.success:
-        raise RuntimeError(f"tangential solve did not converge (BVLS: {res.message})")
-    q = res.x
-    free = np.abs(q) < bound * (1.0 - 1e-12)
-    return q, MAX_ITER + int(res.nit), free
-
-
-def _check_kkt(q, ds, bound, free, u_scale, mu) -> None:
-    """Raise RuntimeError unless (q, ds) meets Coulomb's law within KKT_TOL."""
-    ftol = KKT_TOL * max(float(bound.max()), 1e-300)
-    utol = KKT_TOL * u_scale
-    over = np.abs(q) - bound
-    if over.max() > ftol:
-        raise RuntimeError(f"tangential solve: |q| exceeds mu f by {over.max():.3e} N")
-    if free.any() and np.abs(ds[free]).max() > utol:
-        raise RuntimeError("tangential solve: a stick node slipped (KKT check failed)")
-    wrong = (~free) & (ds * np.sign(q) < -utol)
-    if mu > 0 and wrong.any():
-        raise RuntimeError("tangential solve: friction does not oppose the slip (KKT check failed)")
 
 
 def _tangent_stiffness(K, w, free, cho) -> float:

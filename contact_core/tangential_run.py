@@ -175,7 +175,7 @@ def _check_mu(mu) -> float:
 
 def _geometry(spec: ContactSpec, model: str) -> dict:
     out = {"body": spec.body, "model": model}
-    for name in ("radius", "length", "width"):
+    for name in ("radius", "length", "width", "height"):
         if getattr(spec, name):
             out[name] = getattr(spec, name)
     return out

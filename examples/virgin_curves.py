@@ -38,12 +38,12 @@ CASES = {
 
 def mindlin_error(run) -> float | None:
     """Largest |T - T_Mindlin| / (mu N) over the curve (sphere only)."""
-    if run.spec.body != "sphere":
+    ref = run.spec.kind.tangential_reference(run.spec, run.problem.N, MU).get("mindlin")
+    if ref is None:
         return None
     N = run.problem.N
-    a = hertz.sphere(N, run.spec.radius, run.spec.Estar)["a"]
-    Gs = tr.shear_modulus_star(run.spec.E1, run.spec.nu1, run.spec.E2, run.spec.nu2)
-    T_ref = tr.mindlin_force(run.virgin.u, N, MU, a, Gs)
+    a = ref["contact_radius"]
+    T_ref = tr.mindlin_force(run.virgin.u, N, MU, a, ref["k_t"] / (8 * a))
     return float(np.abs(run.virgin.T - T_ref).max() / (MU * N))
 
 

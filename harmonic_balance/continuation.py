@@ -100,7 +100,8 @@ class _Scaled:
 
 
 def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
-                 ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000) -> Branch:
+                 ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000,
+                 x_scale: float = 0.0, max_turn: float = MAX_TURN) -> Branch:
     """Trace the branch through (x0, lam0) until lam reaches lam_end.
 
     Parameters
@@ -112,6 +113,11 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     ds, ds_min, ds_max : float, initial / smallest / largest step in scaled arclength
         (lam scaled by |lam_end - lam0|, so ds_max = 0.02 means >= 50 points on a flat branch)
     max_points : int
+    x_scale : float, smallest scale of x (default 0: the RMS of the first point); a
+        homotopy from a tiny level passes the final level's size so that the first
+        steps are not 1 % of a tiny x
+    max_turn : float, tangent turn limit [rad] (np.pi disables it: a homotopy only
+        needs to arrive, not to resolve the path)
 
     Returns
     -------
@@ -128,7 +134,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     s_lam = abs(lam_end - lam0)
     if s_lam == 0:
         raise ValueError("empty parameter range")
-    s_x = max(_rms(first.x), 1e-300)
+    s_x = max(_rms(first.x), x_scale, 1e-300)
     t_prev = np.zeros(len(x0) + 1)
     t_prev[-1] = sign
     _, Jx, Jl = fun(first.x, lam0)
@@ -144,7 +150,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
         if t @ t_prev < 0:
             t = -t
-        y_new, it, ds, J_new = _step(sc, y, t, t_prev, ds, ds_min, branch)
+        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn)
         J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
@@ -165,7 +171,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     raise _stop(f"point limit {max_points} reached", branch)
 
 
-def _step(sc, y, t, t_prev, ds, ds_min, branch):
+def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN):
     """One accepted predictor-corrector step; shrinks ds until it succeeds."""
     while True:
         try:
@@ -173,7 +179,7 @@ def _step(sc, y, t, t_prev, ds, ds_min, branch):
             # A kink of the branch (stick-slip onset: the describing function is only
             # C0 in the Jacobian) keeps its turn at any step, so the turn limit only
             # applies to steps above KINK_STEP.
-            if ds <= KINK_STEP or _turn_ok(sc, res, t):
+            if ds <= KINK_STEP or _turn_ok(sc, res, t, max_turn):
                 return res.x, res.iterations, ds, res.J[:-1]
             reason = "tangent turned too much"
         except NewtonError as err:
@@ -183,13 +189,15 @@ def _step(sc, y, t, t_prev, ds, ds_min, branch):
             raise _stop(f"step below minimum ({reason})", branch)
 
 
-def _turn_ok(sc, res, t) -> bool:
-    """The tangent at the new point stays within MAX_TURN of t."""
+def _turn_ok(sc, res, t, max_turn) -> bool:
+    """The tangent at the new point stays within max_turn of t."""
+    if max_turn >= np.pi:
+        return True
     try:
         t_new = sc.tangent(res.J[:-1], t)
     except (np.linalg.LinAlgError, ValueError):
         return False
-    return abs(t_new @ t) >= np.cos(MAX_TURN)
+    return abs(t_new @ t) >= np.cos(max_turn)
 
 
 def _solve_fixed(fun, x, lam, tol, branch):

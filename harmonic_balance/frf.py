@@ -24,10 +24,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import find_peaks
 
-from .continuation import ContinuationError, continuation, refine_max
+from .continuation import Branch, ContinuationError, continuation, refine_max
 from .fourier import FourierBasis, parse_harmonics
+from .homotopy import HomotopyError
 from .model import Model
+from .parameter import ParameterProblem
 from .residual import FullResidual, energy_per_cycle, make_residual
+from .start import homotopy_start
 
 #: Newton tolerance relative to the residual's reference size (|F_ext| for the
 #: full residual, |X| of the stuck linear response for the condensed one).
@@ -76,6 +79,7 @@ class FRFResult:
     alias_ratio: float = float("nan")
     peaks: list = field(default_factory=list)
     status: str = "complete"
+    stable: list | None = None    # per point: Hill stability (None: not computed)
     extra: dict = field(default_factory=dict)
     problem: FRFProblem | None = field(default=None, repr=False)
 
@@ -93,7 +97,7 @@ class FRFResult:
             "points": self.points, "newton_iterations": self.newton_iterations,
             "residual_evaluations": self.evaluations, "time_s": self.time_s,
             "harmonics": list(self.harmonics), "n_t": self.n_t, "alias_ratio": self.alias_ratio,
-            "status": self.status,
+            "status": self.status, "stable": self.stable,
         }
         return {k: _finite(v) for k, v in out.items()}
 
@@ -155,9 +159,21 @@ class FRFProblem:
         return out
 
 
+#: Largest number of full-residual unknowns for which ``stability="auto"`` runs
+#: Hill's method at every point (a (2N)^2 eigenproblem: ~5 ms at N = 200).
+STABILITY_AUTO_MAX = 200
+
+
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
-                ds_max: float = 0.1, max_points: int = 2000, refine: bool = True) -> FRFResult:
+                ds_max: float = 0.1, max_points: int = 2000, refine: bool = True,
+                stability="auto") -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
+
+    The first point is Newton's from the stuck linear guess or, when that fails, the
+    end of a homotopy in the excitation level (:mod:`homotopy`), so the curve does
+    not depend on where the sweep starts. ``stability`` (True, False or "auto": when
+    the model has matrices and at most STABILITY_AUTO_MAX full unknowns) adds Hill's
+    stability of every point (``result.stable``).
 
     Raises
     ------
@@ -170,14 +186,25 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     t0 = time.perf_counter()
     prob = FRFProblem(model, harmonics, n_t, condensed)
     tol = TOL_REL * max(prob.reference(w0), 1e-300)
-    x0 = prob.residual.linear_guess(w0)
     try:
-        branch = continuation(prob, x0, w0, w1, tol, ds_max=ds_max, max_points=max_points)
-    except ContinuationError as err:
-        result = _collect(prob, err.branch, t0)
-        result.status = str(err)
-        raise FRFError(str(err), result) from None
+        x0, start = homotopy_start(prob, w0, tol)
+    except HomotopyError as err:
+        result = _collect(prob, Branch(status=str(err)), t0)
+        raise FRFError(f"continuation stopped before the first point: {err}", result) from None
+    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points)
+    if error is not None:
+        result = _collect(prob, branch, t0)
+        result.status = branch.status = error
+        result.extra["gaps"] = gaps
+        result.stable = _stability(prob, branch, stability)
+        raise FRFError(error, result)
     result = _collect(prob, branch, t0)
+    result.extra["start"] = start
+    result.extra["gaps"] = gaps
+    if gaps:
+        result.status = (f"complete; {len(gaps)} restart(s) by homotopy after a stalled corrector, "
+                         "no points in omega " + ", ".join(f"{a:.6g}-{b:.6g}" for a, b in gaps))
+    result.stable = _stability(prob, branch, stability)
     if refine:
         _refine_peak(prob, branch, result, tol)
     result.alias_ratio = prob.alias_ratio(result.peak_solution)
@@ -188,6 +215,64 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.evaluations = prob.evaluations
     result.time_s = time.perf_counter() - t0
     return result
+
+
+#: Restarts allowed per curve after a stalled corrector (:func:`_sweep`).
+MAX_RESTARTS = 100
+#: Frequency jumps tried for a restart, as fractions of the range: the smallest
+#: that gives a first point by :func:`start.homotopy_start` is taken.
+RESTART_JUMPS = (1e-3, 4e-3, 1.6e-2)
+
+
+def _sweep(prob, x0, w0, w1, tol, ds_max, max_points):
+    """Continuation from (x0, w0) to w1 with restarts: (Branch, gaps, error or None).
+
+    When the corrector stalls ("step below minimum": on a stiff contact the residual
+    is a staircase of AFT-sample kinks with local minima of |R|), the curve is
+    restarted a small jump further by the start strategies (Newton, excitation and
+    contact-stiffness homotopies), which do not depend on the previous point. The
+    skipped interval is reported (``gaps``); a friction FRF is single-valued there,
+    so no branch is lost, but a fold inside a gap would be (the status names it).
+    """
+    merged, gaps = Branch(), []
+    sign = 1.0 if w1 > w0 else -1.0
+    for _ in range(MAX_RESTARTS + 1):
+        try:
+            br = continuation(prob, x0, w0, w1, tol, ds_max=ds_max,
+                              max_points=max_points - len(merged.lam))
+            error = None
+        except ContinuationError as err:
+            br, error = err.branch, str(err)
+        _extend(merged, br)
+        if error is None:
+            merged.status = "complete"
+            return merged, gaps, None
+        if "step below minimum" not in error:
+            return merged, gaps, error
+        w_last = merged.lam[-1] if merged.lam else w0
+        for jump in RESTART_JUMPS:
+            w_try = w_last + sign * jump * abs(w1 - w0)
+            if sign * (w_try - w1) > 0:
+                w_try = w1
+            try:
+                x0, _ = homotopy_start(prob, w_try, tol)
+            except HomotopyError:
+                continue
+            gaps.append((w_last, w_try))
+            w0 = w_try
+            break
+        else:
+            return merged, gaps, error + "; no restart within " + f"{RESTART_JUMPS[-1]:g} of the range"
+        if w0 == w1:
+            _extend(merged, Branch(x=[x0], lam=[w1], iterations=[0]))
+            merged.status = "complete"
+            return merged, gaps, None
+    return merged, gaps, f"more than {MAX_RESTARTS} restarts"
+
+
+def _extend(merged, br):
+    for x, w, it in zip(br.x, br.lam, br.iterations):
+        merged.append(x, w, it)
 
 
 def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
@@ -212,6 +297,9 @@ def _refine_peak(prob, branch, result, tol):
     the highest refined one becomes the result's peak. Updates ``result`` in place."""
     amp = result.amplitude
     idx, _ = find_peaks(amp, prominence=PEAK_PROMINENCE * amp.max())
+    # a peak next to a restart gap has no continuous neighbours to refine between
+    edges = {w for gap in result.extra.get("gaps", ()) for w in gap}
+    idx = [i for i in idx if not edges & {result.omega[i - 1], result.omega[i], result.omega[i + 1]}]
     peaks, nfev = [], 0
     for i in idx:
         try:
@@ -232,3 +320,94 @@ def _refine_peak(prob, branch, result, tol):
     result.peak_amplitude_h1 = (float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics
                                 else float("nan"))
     result.peak_interior = True
+
+
+def _stability(prob: FRFProblem, branch, mode):
+    """Hill stability per branch point (list of bool), or None when not computed."""
+    from .residual import FullResidual
+    from .stability import is_stable
+
+    lin = prob.model.linear
+    if mode is False or lin.M is None or lin.K is None:
+        return None
+    full = prob.residual if isinstance(prob.residual, FullResidual) else None
+    size = prob.basis.nb * prob.model.n
+    if mode == "auto" and size > STABILITY_AUTO_MAX:
+        return None
+    if full is None:
+        full = FullResidual(prob.model, prob.basis)
+    V = full.viscous_operator()
+    V = V if np.any(V) else None
+    out = []
+    for x, w in zip(branch.x, branch.lam):
+        X = prob.residual.displacements(x, w).ravel() if full is not prob.residual else x
+        _, J, _ = full(X, w)
+        out.append(is_stable(J, lin, prob.basis, w, V)[0])
+    return out
+
+
+@dataclass
+class ParameterCurve:
+    """Solutions along lam at fixed omega: lam, amplitude (peak |x| of the response DOF)."""
+
+    lam: np.ndarray
+    amplitude: np.ndarray
+    solutions: list
+    newton_iterations: int
+    time_s: float
+    stable: list | None = None
+    status: str = "complete"
+
+
+def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
+                    condensed=None, affine: bool = False, ds_max: float = 0.1,
+                    max_points: int = 2000, stability: bool = True) -> ParameterCurve:
+    """Continuation in lam over ``lam_range = (start, end)`` at fixed ``omega`` [rad/s].
+
+    Parameters
+    ----------
+    model_at : callable float -> Model (e.g. :mod:`parameter`'s forcing_level, slip_scale,
+        contact_stiffness_scale)
+    affine : bool, True when R is affine in lam (the excitation level): exact dR/dlam
+
+    Raises
+    ------
+    HomotopyError (a RuntimeError) when no first point is found; a curve that stops
+    early is returned with its points and ``status`` saying why.
+    """
+    l0, l1 = (float(v) for v in lam_range)
+    if not (np.isfinite(l0) and np.isfinite(l1)) or l0 == l1:
+        raise ValueError(f"parameter range must be two different finite numbers, got {lam_range}")
+    t0 = time.perf_counter()
+    pp = ParameterProblem(model_at, harmonics, omega, n_t, condensed, affine)
+    start = FRFProblem(model_at(l0), harmonics, n_t, condensed)
+    tol = TOL_REL * max(float(np.linalg.norm(start.residual.linear_guess(omega))), 1e-300)
+    x0, _ = homotopy_start(start, omega, tol)
+    status = "complete"
+    try:
+        br = continuation(pp, x0, l0, l1, tol, ds_max=ds_max, max_points=max_points)
+    except ContinuationError as err:
+        br, status = err.branch, str(err)
+    amp = np.array([FRFProblem(model_at(l), harmonics, n_t, condensed).amplitude(x, omega)
+                    for x, l in zip(br.x, br.lam)])
+    stable = _parameter_stability(pp, br) if stability else None
+    return ParameterCurve(np.asarray(br.lam), amp, list(br.x), int(sum(br.iterations)),
+                          time.perf_counter() - t0, stable, status)
+
+
+def _parameter_stability(pp, br):
+    from .residual import FullResidual
+    from .stability import is_stable
+
+    out = []
+    for x, lam in zip(br.x, br.lam):
+        res = pp.residual(lam)
+        model = res.model
+        if model.linear.M is None or model.linear.K is None:
+            return None
+        full = res if isinstance(res, FullResidual) else FullResidual(model, pp.basis)
+        X = x if full is res else res.displacements(x, pp.omega).ravel()
+        _, J, _ = full(X, pp.omega)
+        out.append(is_stable(J, model.linear, pp.basis, pp.omega)[0])
+    return out
+

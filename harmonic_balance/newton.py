@@ -1,9 +1,22 @@
-"""Damped Newton solver for square systems R(x) = 0 with a known Jacobian.
+"""Globalised Newton solver for square systems R(x) = 0 with a known Jacobian.
 
 Knows nothing about mechanics: ``fun(x) -> (R (N,), J (N, N))``.
-Backtracking line search on ``phi = |R|^2 / 2`` (Armijo condition, Dennis & Schnabel
-sec. 6.3): a full Newton step is tried first, so convergence stays quadratic near a
-solution, and halved while it does not decrease ``phi`` enough.
+
+Each iteration first tries Newton's step with a backtracking line search on
+``phi = |R|^2 / 2`` (Armijo condition, Dennis & Schnabel sec. 6.3): the full step is
+tried first, so convergence stays quadratic near a solution. When the line search
+stalls (the harmonic-balance residual of a stiff friction contact is only piecewise
+smooth: a kink whenever a slip onset moves to another AFT sample, and Newton's
+direction is then a descent direction only over a tiny fraction of its length),
+the iteration falls back to Levenberg-Marquardt steps with a trust-region update
+(More 1978, Nielsen's damping update; Madsen, Nielsen & Tingleff, "Methods for
+non-linear least squares problems", 2004, sec. 3.2):
+``(J^T J + mu D^T D) p = -J^T R`` with D the running maximum of J's column norms
+(invariant to the units of each unknown), ``mu`` shrunk after a good step and grown
+after a rejected one. Each accepted LM step decreases phi, so the iteration
+converges to a zero of R or a stationary point of phi from anywhere (global
+convergence on piecewise-smooth residuals in the sense of Clarke-stationary points);
+where it stalls at a non-zero local minimum of phi it says so.
 """
 from __future__ import annotations
 
@@ -13,8 +26,15 @@ import numpy as np
 
 #: Armijo constant: accept a step that gives at least this fraction of the predicted decrease.
 ARMIJO = 1e-4
-#: Smallest line-search factor before the step is declared a failure.
+#: Smallest line-search factor before the iteration switches to Levenberg-Marquardt.
 MIN_ALPHA = 1.0 / 256
+#: Gain ratio (actual / predicted decrease of phi) above which an LM step is accepted.
+LM_ACCEPT = 1e-4
+#: Damping mu relative to the largest D^T D entry at which LM gives up (the step is
+#: then ~1e-12 of the steepest-descent step: phi is stationary).
+LM_MU_MAX = 1e12
+#: LM trial steps allowed per iteration before it gives up.
+LM_TRIALS = 60
 
 
 class NewtonError(RuntimeError):
@@ -56,6 +76,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30) -> NewtonResult:
     x = np.array(x0, dtype=float)
     R, J = fun(x)
     nr = _norm(R, x, 0)
+    lm = _LMState()
     for it in range(max_iter + 1):
         if nr <= tol:
             return NewtonResult(x, R, J, it)
@@ -67,19 +88,67 @@ def newton(fun, x0, tol: float, max_iter: int = 30) -> NewtonResult:
             raise NewtonError("singular Jacobian", x, it, nr) from None
         if not np.all(np.isfinite(dx)):
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
-        alpha = 1.0
-        while True:
-            xt = x + alpha * dx
+        step = _line_search(fun, x, dx, nr)
+        if step is None:
+            step, lm = _lm_step(fun, x, R, J, nr, lm)
+            if step is None:
+                raise NewtonError("no decrease, neither along Newton's direction nor by "
+                                  "Levenberg-Marquardt steps (a local minimum of |R| that "
+                                  "is no solution, or no nearby solution)", x, it, nr)
+        x, R, J, nr = step
+    raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
+
+
+def _line_search(fun, x, dx, nr):
+    """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < MIN_ALPHA."""
+    alpha = 1.0
+    while alpha >= MIN_ALPHA:
+        xt = x + alpha * dx
+        Rt, Jt = fun(xt)
+        nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
+        if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
+            return xt, Rt, Jt, nt
+        alpha *= 0.5
+    return None
+
+
+class _LMState:
+    """Damping mu, its growth factor nu and the column scaling D kept between iterations."""
+
+    def __init__(self):
+        self.mu, self.nu, self.d2 = None, 2.0, None
+
+
+def _lm_step(fun, x, R, J, nr, st):
+    """One accepted Levenberg-Marquardt step from x, or (None, st) when none decreases phi."""
+    g = J.T @ R
+    A = J.T @ J
+    d2 = np.diag(A).copy()
+    st.d2 = d2 if st.d2 is None else np.maximum(st.d2, d2)
+    d2 = np.maximum(st.d2, 1e-300 * max(st.d2.max(), 1e-300))
+    if st.mu is None:
+        st.mu = 1e-3  # relative to D^T D: a nearly Gauss-Newton first trial
+    for _ in range(LM_TRIALS):
+        try:
+            p = np.linalg.solve(A + st.mu * np.diag(d2), -g)
+        except np.linalg.LinAlgError:
+            p = None
+        if p is not None and np.all(np.isfinite(p)):
+            xt = x + p
             Rt, Jt = fun(xt)
             nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
-            if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
-                break
-            alpha *= 0.5
-            if alpha < MIN_ALPHA:
-                raise NewtonError("line search found no decrease (non-smooth or no nearby solution)",
-                                  x, it, nr)
-        x, R, J, nr = xt, Rt, Jt, nt
-    raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
+            pred = -(p @ g) - 0.5 * (p @ (A @ p))  # decrease of phi predicted by the model
+            rho = (0.5 * nr**2 - 0.5 * nt**2) / pred if pred > 0 else -1.0
+            if rho > LM_ACCEPT:
+                st.mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+                st.nu = 2.0
+                return (xt, Rt, Jt, nt), st
+        st.mu *= st.nu
+        st.nu *= 2.0
+        if st.mu > LM_MU_MAX:
+            break
+    st.mu, st.nu = None, 2.0
+    return None, st
 
 
 def _norm(R, x, it):

@@ -30,7 +30,7 @@ def plot_frf(result, out_dir) -> list[Path]:
     prob, b = result.problem, result.problem.basis
     paths = []
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(result.omega, result.amplitude, "-", label="peak |x| over the period")
+    _plot_stability(ax, result)
     if np.all(np.isfinite(result.amplitude_h1)):
         ax.plot(result.omega, result.amplitude_h1, "--", label="first harmonic |X_1|")
     if np.isfinite(result.peak_amplitude):
@@ -63,3 +63,20 @@ def plot_frf(result, out_dir) -> list[Path]:
     paths.append(_save(fig, out / "harmonics.png"))
     plt.close(fig)
     return paths
+
+
+def _plot_stability(ax, result):
+    """The curve, solid where stable (or stability unknown), dashed where Hill finds it unstable."""
+    om, amp = np.asarray(result.omega), np.asarray(result.amplitude)
+    if result.stable is None or all(result.stable):
+        ax.plot(om, amp, "-", color="C0", label="peak |x| over the period")
+        return
+    st = np.asarray(result.stable, dtype=bool)
+    labels = {True: "stable", False: "unstable (Hill)"}
+    start = 0
+    for i in range(1, len(om) + 1):
+        if i == len(om) or st[i] != st[start]:
+            j = min(i + 1, len(om))  # overlap one point so the segments join
+            ax.plot(om[start:j], amp[start:j], "-" if st[start] else "--", color="C0",
+                    label=labels.pop(bool(st[start]), None))
+            start = i

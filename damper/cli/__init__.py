@@ -22,7 +22,8 @@ import sys
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 #: Subcommand modules, in the order ``damper --help`` lists them.
-SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "frf", "bench", "stress")
+SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "frf", "backbone", "study",
+               "bench", "stress")
 
 
 def build_parser() -> argparse.ArgumentParser:

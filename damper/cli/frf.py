@@ -17,9 +17,14 @@ JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of 
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
 ``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``points``,
-``newton_iterations`` (corrector iterations), ``time_s`` and ``status``. A run that
-fails part-way prints the points computed so far (``status`` says where and why)
-and exits with code 3.
+``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
+(per point, Hill's method; null for models above 200 full unknowns or modal-only
+ones; unstable stretches are dashed in frf.png). The first point does not depend
+on where the sweep starts: Newton from the stuck linear guess, else a homotopy in
+the excitation level or in the contact stiffness (harmonic_balance.start). A run
+that fails part-way prints the points computed so far (``status`` says where and
+why) and exits with code 3, with or without --json. Nonlinear modes (backbones):
+``damper backbone``.
 """
 from __future__ import annotations
 
@@ -31,6 +36,22 @@ def register(subparsers) -> None:
     p = subparsers.add_parser(
         "frf", help="forced-response curve of a friction-damped model (harmonic balance)",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_model_arguments(p)
+    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
+    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
+                   help="frequency range [rad/s]")
+    p.add_argument("--max-step", type=float, default=0.1,
+                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
+    p.add_argument("--max-points", type=int, default=2000)
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", help="also write the JSON to this file")
+    p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
+    p.set_defaults(func=run)
+
+
+def add_model_arguments(p) -> None:
+    """Model options shared by ``damper frf`` and ``damper backbone``."""
     p.add_argument("--model", required=True, help="'sdof' or a matrices .npz file")
     p.add_argument("--elements", help="friction elements .toml (with a .npz model)")
     g = p.add_argument_group("sdof model (SI units)")
@@ -43,17 +64,6 @@ def register(subparsers) -> None:
     p.add_argument("--force-scale", type=float, default=1.0,
                    help="multiply the .npz excitation by this factor")
     p.add_argument("--response-dof", type=int, help="DOF reported (default: the file's, or 0)")
-    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
-    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
-    p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
-                   help="frequency range [rad/s]")
-    p.add_argument("--max-step", type=float, default=0.1,
-                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
-    p.add_argument("--max-points", type=int, default=2000)
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--out", help="also write the JSON to this file")
-    p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
-    p.set_defaults(func=run)
 
 
 def build_model(args):
@@ -90,6 +100,7 @@ def run(args) -> int:
     if args.max_step <= 0 or args.max_points < 2 or args.samples < 0:
         raise ValueError("--max-step must be > 0, --max-points >= 2, --samples >= 0")
     model = build_model(args)
+    _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
                              ds_max=args.max_step, max_points=args.max_points)
@@ -105,6 +116,17 @@ def run(args) -> int:
     return 0
 
 
+def _report_curve_fits(model) -> None:
+    """Say on stderr which element curves were reduced to the C element's slider limit."""
+    import sys
+
+    for link in model.links:
+        err = getattr(getattr(link, "element", None), "fit_error", 0.0)
+        if err > 0.0:
+            print(f"note: element {link.name!r}: its curve was reduced to the element's slider "
+                  f"limit; largest force error of the fit {err:.3g} N", file=sys.stderr)
+
+
 def _emit(args, summary, print_json, atomic_write, dumps):
     if args.out:
         atomic_write(args.out, dumps(summary, indent=1) + "\n")
@@ -112,7 +134,17 @@ def _emit(args, summary, print_json, atomic_write, dumps):
         print_json(summary)
         return
     print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
-          f"{summary['time_s']:.3f} s, harmonics {summary['harmonics']}, n_t {summary['n_t']}")
-    print(f"peak: omega = {summary['peak_omega']:.9g} rad/s, amplitude = "
-          f"{summary['peak_amplitude']:.9g} m (first harmonic {summary['peak_amplitude_h1']:.9g} m)")
+          f"{_num(summary['time_s'], '.3f')} s, harmonics {summary['harmonics']}, "
+          f"n_t {summary['n_t']}")
+    print(f"peak: omega = {_num(summary['peak_omega'])} rad/s, amplitude = "
+          f"{_num(summary['peak_amplitude'])} m (first harmonic "
+          f"{_num(summary['peak_amplitude_h1'])} m)")
+    if summary.get("stable") is not None:
+        n_unst = sum(1 for s in summary["stable"] if s is False)
+        print(f"stability (Hill): {n_unst} of {summary['points']} points unstable")
     print(f"status: {summary['status']}")
+
+
+def _num(v, fmt=".9g") -> str:
+    """A number for the text summary; 'none' when undefined (no converged point)."""
+    return "none" if v is None else format(v, fmt)

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import argparse
 
+from contact_core.bodies import MIN_NODES_ACROSS
+
 from .common import atomic_write, dumps, print_json
 
 
@@ -49,19 +51,29 @@ def register(subparsers) -> None:
 
 def add_body_options(p) -> None:
     """Body, material and contact-zone options (shared by ``damper normal`` and ``damper tangential``)."""
-    p.add_argument("--body", choices=("sphere", "cylinder", "flat"), required=True)
+    from contact_core import bodies
+
+    p.add_argument("--body", choices=bodies.names(), required=True)
     p.add_argument("--radius", type=float, help="sphere or cylinder radius [m]")
     p.add_argument("--diameter", type=float, help="sphere or cylinder diameter [m] (instead of --radius)")
     p.add_argument("--length", type=float, help="cylinder length / flat-face length along y [m]")
     p.add_argument("--width", type=float, help="flat-face width along x [m]")
+    p.add_argument("--height", type=float, default=None,
+                   help="flat face: height of the damper body above the face [m] (default max(W, L/2))")
     p.add_argument("--E", type=float, default=200e9,
                    help="Young's modulus of body 1 [Pa] (and of the plane unless --E2)")
     p.add_argument("--nu", type=float, default=0.3, help="Poisson's ratio of body 1 (and of the plane unless --nu2)")
     p.add_argument("--E2", type=float, default=None, help="Young's modulus of the plane [Pa]")
     p.add_argument("--nu2", type=float, default=None, help="Poisson's ratio of the plane")
     p.add_argument("--grid", type=int, default=21, help="contact-zone nodes per side (>= 3)")
-    p.add_argument("--p-design", type=float, default=2000e6,
-                   help="peak pressure [Pa] sizing the potential contact zone (thesis: 2000 MPa)")
+    p.add_argument("--p-design", type=float, default=None,
+                   help="peak pressure [Pa] sizing the potential contact zone (default: the thesis's "
+                   "2000 MPa, or, when the Hertz contact of --force would fit inside one grid cell "
+                   "of that zone, the Hertz peak pressure of --force)")
+
+
+#: Geometry fields of a ContactSpec and the options that give them.
+_GEOMETRY_FLAGS = {"radius": "--radius or --diameter", "length": "--length", "width": "--width"}
 
 
 def _radius(args) -> float | None:
@@ -74,26 +86,61 @@ def _radius(args) -> float | None:
 
 def spec_from_args(args):
     """A ``ContactSpec`` from the options; ValueError for missing or bad values."""
+    from contact_core import bodies
     from contact_core.spec import ContactSpec
 
     radius = _radius(args)
-    if args.body in ("sphere", "cylinder") and radius is None:
-        raise ValueError(f"--body {args.body} needs --radius or --diameter")
-    if args.body in ("cylinder", "flat") and args.length is None:
-        raise ValueError(f"--body {args.body} needs --length")
-    if args.body == "flat" and args.width is None:
-        raise ValueError("--body flat needs --width")
+    given = {"radius": radius, "length": args.length, "width": args.width}
+    for name, flag in _GEOMETRY_FLAGS.items():  # the body kind says what it needs
+        if name in bodies.get(args.body).required and given[name] is None:
+            raise ValueError(f"--body {args.body} needs {flag}")
     if args.force is not None and not args.force > 0:
         raise ValueError(f"--force must be positive, got {args.force}")
     if args.approach is not None and not args.approach > 0:
         raise ValueError(f"--approach must be positive, got {args.approach}")
     if args.curve < 0:
         raise ValueError("--curve must be >= 0")
-    return ContactSpec(body=args.body, radius=radius or 0.0, length=args.length or 0.0,
+    spec = ContactSpec(body=args.body, radius=radius or 0.0, length=args.length or 0.0,
                        width=args.width or 0.0, E1=args.E, nu1=args.nu,
                        E2=args.E if args.E2 is None else args.E2,
                        nu2=args.nu if args.nu2 is None else args.nu2, model=args.model,
-                       grid=args.grid, p_design=args.p_design, load_hint=args.force or 0.0)
+                       grid=args.grid, p_design=args.p_design or DEFAULT_P_DESIGN,
+                       load_hint=args.force or 0.0, height=getattr(args, "height", None) or 0.0)
+    if args.p_design is None and args.force:
+        spec = zone_for_load(spec, args.force)
+    return spec
+
+
+#: The thesis's design peak pressure sizing the potential contact zone [Pa].
+DEFAULT_P_DESIGN = 2000e6
+#: A zone sized from a load holds the Hertz contact of this many times the load:
+#: coarse grids spread the discrete contact a cell beyond Hertz's edge (sized
+#: for the load itself, 3-5 nodes per side put contact on the zone's edge).
+LOAD_ZONE_FACTOR = 3.0
+
+
+def zone_for_load(spec, force: float):
+    """``spec`` with its zone sized from the Hertz contact of ``force`` if that contact
+    would fit inside one grid cell of the design pressure's zone.
+
+    Loads that the default zone resolves, even roughly (flagged
+    ``under_resolved`` below MIN_NODES_ACROSS spacings), keep it, so their
+    results and cached models are unchanged; a load whose contact would fall
+    between grid nodes (a 1e-6 N load on a 10 mm sphere came out 45x Hertz's
+    radius) gets a zone of its own, sized by its Hertz peak pressure (the zone
+    is then ``zone_margin`` times the contact of LOAD_ZONE_FACTOR times the load).
+    """
+    from dataclasses import replace
+
+    kind = spec.kind
+    ref = kind.reference(spec, force) if kind.zone_from_load else None
+    if ref is None:
+        return spec
+    zx, _ = spec.zone()
+    spacing = zx / (spec.n_side // 2)
+    if kind.reference_size(ref) >= spacing:
+        return spec
+    return replace(spec, p_design=kind.reference(spec, LOAD_ZONE_FACTOR * force)["p0"])
 
 
 def _brief(result: dict) -> dict:
@@ -108,7 +155,8 @@ def run(args) -> int:
     cache = False if args.no_cache else args.cache_dir
     if args.stiffness or args.nodes:
         from contact_core import byo
-        result = byo.run_from_files(args, cache)
+        result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,
+                                    args.approach, cache)
     else:
         spec = spec_from_args(args)
         result = api.run_normal(spec, force=args.force, approach=args.approach,
@@ -136,3 +184,7 @@ def _print_text(r: dict) -> None:
     if "hertz" in r:
         errs = {k: v for k, v in r["hertz"].items() if k.startswith("error")}
         print("vs Hertz: " + ", ".join(f"{k[6:]} {100 * v:+.2f} %" for k, v in errs.items()))
+    if r.get("under_resolved"):
+        print(f"warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid spacings "
+              "(radius or half-width), so its size and peak pressure are rough; lower --p-design "
+              "(the potential zone is sized for that peak pressure) or refine --grid")

@@ -105,7 +105,7 @@ def _check_finite(args) -> None:
     import math
 
     for name in ("force", "approach", "mu", "tangential_force", "loop_amplitude", "tol",
-                 "radius", "diameter", "length", "width", "E", "nu", "E2", "nu2",
+                 "radius", "diameter", "length", "width", "height", "E", "nu", "E2", "nu2",
                  "eccentricity", "p_design"):
         v = getattr(args, name, None)
         if v is not None and not math.isfinite(v):
@@ -118,8 +118,6 @@ def _check_finite(args) -> None:
 
 def summary(result) -> dict:
     """The JSON object of a run (SI units)."""
-    from contact_core.tangential_reference import shear_modulus_star
-
     path, prob, spec = result.virgin, result.problem, result.spec
     out = {"load_case": result.load_case, "model": result.model, "body": spec.body,
            "u": path.u, "T": path.T, "k_t": prob.k_t, "k_n": result.k_n,
@@ -129,26 +127,14 @@ def summary(result) -> dict:
            "iterations_per_point": path.iterations, "normal_iterations": result.normal.iterations,
            "contact_nodes": prob.n_c, "grid": result.curve.grid, "timings": result.timings,
            "warnings": result.warnings}
-    if spec.body == "sphere":
-        a = (3 * prob.N * spec.radius / (4 * spec.Estar)) ** (1 / 3)
-        Gs = shear_modulus_star(spec.E1, spec.nu1, spec.E2, spec.nu2)
-        out["mindlin"] = {"contact_radius": a, "k_t": 8 * Gs * a,
-                          "u_slip": 3 * prob.mu * prob.N / (16 * Gs * a)}
+    out.update(spec.kind.tangential_reference(spec, prob.N, prob.mu))
     return out
 
 
 def _reference_curve(result):
-    """Cattaneo-Mindlin's curve for a sphere (None otherwise)."""
-    if result.spec.body != "sphere":
-        return None
-    import numpy as np
-
-    from contact_core.tangential_reference import mindlin_force
-
-    m = summary(result)["mindlin"]
-    u = np.linspace(0, m["u_slip"], 100)
-    return u, mindlin_force(u, result.problem.N, result.problem.mu, m["contact_radius"],
-                            m["k_t"] / (8 * m["contact_radius"]))
+    """The body kind's closed-form virgin curve (Cattaneo-Mindlin for a sphere), or None."""
+    spec, prob = result.spec, result.problem
+    return spec.kind.tangential_reference_curve(spec, prob.N, prob.mu)
 
 
 def _extras(result, args) -> dict:

@@ -17,7 +17,8 @@ import numpy as np
 from .graph import Kind, Result, Stage
 
 #: Body fields of a scene contact that define the FE model (the condensation's inputs).
-BODY_KEYS = ("body", "radius", "length", "width", "E", "nu", "E2", "nu2", "model", "grid", "p_design", "zone_load")
+BODY_KEYS = ("body", "radius", "length", "width", "height", "E", "nu", "E2", "nu2", "model", "grid", "p_design",
+             "zone_load")
 #: Points of the normal stage's F-approach curve (5 % to 100 % of the load), as the
 #: normal validation example: enough for the sphere's A F^(2/3) + B F fit.
 CURVE_POINTS = 8
@@ -30,34 +31,7 @@ def contact_spec(p: dict):
     return ContactSpec(body=p["body"], radius=p.get("radius", 0.0), length=p.get("length", 0.0),
                        width=p.get("width", 0.0), E1=p["E"], nu1=p["nu"], E2=p["E2"], nu2=p["nu2"],
                        model=p["model"], grid=p["grid"], p_design=p["p_design"],
-                       load_hint=p["zone_load"])
-
-
-def library_cache(store):
-    """``store`` as the condensation's ``cache=`` argument.
-
-    TEMPORARY until the contact branch (cache protocol) is merged: the old
-    ``condense`` accepts only a ``DiskCache`` instance, so wrap the store in one.
-    """
-    from contact_core import cache as cc_cache
-
-    if hasattr(cc_cache, "resolve"):
-        return store
-
-    class _Adapter(cc_cache.DiskCache):
-        def __init__(self, s):
-            self.folder, self._s = s.folder, s
-
-        def get(self, key):
-            return self._s.get(key)
-
-        def put(self, key, arrays, meta):
-            return self._s.put(key, arrays, meta)
-
-        def path(self, key):
-            return self._s.path(key)
-
-    return _Adapter(store)
+                       load_hint=p["zone_load"], height=p.get("height", 0.0))
 
 
 def _body(c: dict) -> dict:
@@ -96,7 +70,7 @@ class Condense(Kind):
         if entry and stage.name in ctx.forced:
             ctx.store.delete(entry)           # --force: rebuild the FE matrices
         cc = condense(contact_spec(stage.params["body"]), tuple(stage.params["directions"]),
-                      cache=library_cache(ctx.store))
+                      cache=ctx.store)
         meta = cc.meta
         return Result({"entry": meta["cache"]["key"], "hit": meta["cache"]["hit"],
                        "timings": meta.get("timings", {}), "dofs": meta.get("dofs"),
@@ -134,7 +108,7 @@ class Normal(Kind):
         from contact_core.plots import plot_all
 
         p = stage.params
-        result = api.run_normal(contact_spec(p), force=p["force"], cache=library_cache(ctx.store),
+        result = api.run_normal(contact_spec(p), force=p["force"], cache=ctx.store,
                                 curve_points=CURVE_POINTS)
         if p["body"] == "sphere":
             result["approach_fit"] = approach_fit(result["curve"], contact_spec(p))
@@ -205,7 +179,7 @@ class Tangential(Kind):
 
         p = stage.params
         run = tangential_run.run(contact_spec(p), p["mu"], force=p["force"], model=p["model"],
-                                 cache=library_cache(ctx.store),
+                                 cache=ctx.store,
                                  command=f"damper run {ctx.scene.source} ({stage.name})")
         with tempfile.TemporaryDirectory() as tmp:
             plot_all(run.virgin, run.problem, tmp)

@@ -192,6 +192,8 @@ def _check_contacts(data: dict, problems: list) -> None:
                                  + " or ".join(repr(o) for o in options)))
             elif len(given) > 1:
                 problems.append((path + (given[1],), f"give {' or '.join(map(repr, given))}, not both"))
+        if "height" in c and c["body"] != "flat":
+            problems.append((path + ("height",), f"applies to the flat face only, not to {c['body']!r}"))
         if "diameter" in c and "radius" not in c:
             c["radius"] = 0.5 * c["diameter"]
         c.setdefault("zone_load", c["force"])

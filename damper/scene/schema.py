@@ -84,6 +84,7 @@ CONTACT = {
     "diameter": Field("float", "sphere/cylinder diameter [m] (instead of radius)", gt=0),
     "length": Field("float", "cylinder length / flat-face length [m]", gt=0),
     "width": Field("float", "flat-face width [m]", gt=0),
+    "height": Field("float", "flat face: height of the damper body above the face [m] (default max(W, L/2))", gt=0),
     "E": Field("float", "Young's modulus of body 1 [Pa] (and of the plane unless E2)", default=200e9, gt=0),
     "nu": Field("float", "Poisson's ratio of body 1 (and of the plane unless nu2)", default=0.3, gt=-1, lt=0.5),
     "E2": Field("float", "Young's modulus of the plane [Pa]", gt=0),

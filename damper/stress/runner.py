@@ -26,13 +26,7 @@ from .cases import MU, N0, Case, all_cases
 
 #: Known failures: (stage, case name) -> the entry of /work/wt/notes/stress-findings.md
 #: (the stage's owner fixes it; the stress table shows it as known, not unexplained).
-KNOWN: dict[tuple[str, str], str] = {
-    ("normal", "load 1e+06 x nominal, real 11"): "finding 1 (contact): degenerate mesh instead of a load limit",
-    ("normal", "load 1000 x nominal, real 11"): "finding 1 (contact): degenerate mesh instead of a load limit",
-    ("normal", "radius 10 um, real"): "finding 1 (contact): degenerate mesh instead of a load limit",
-    ("normal", "load 1e+06 x nominal, halfspace 11"): "finding 4 (contact): contact beyond the body accepted",
-    ("tangential", "load 1e+06 x nominal, bem 11"): "finding 4 (contact): contact beyond the body accepted",
-}
+KNOWN: dict[tuple[str, str], str] = {}
 #: Words of a message that tells the user what to change (a "clear" error).
 ADVICE = re.compile(r"\b(use|refine|lower|raise|increase|reduce|decrease|must|should|give|set|try|at least|"
                     r"at most|between|choose|limit|remove|check|pass)\b", re.I)

@@ -15,30 +15,34 @@ from damper.cli import main as damper
 
 F_SPHERE = 200.0
 F_CYL = 350.0
-#: Contact radius and peak pressure against Hertz (issue 2): 2 %. Measured on
-#: the 21-node grid: -0.65 % and +0.6 %.
-HERTZ_RTOL = 0.02
+#: Contact radius and peak pressure against Hertz (issue 2 asked 2 %). Measured
+#: on the 21-node grid: a -0.40 % (real), -0.43 % (half-space), -0.24 %
+#: (dissimilar, 15 nodes); p0 within 0.05 %.
+HERTZ_RTOL = 0.0065
 #: Approach against Hertz's half-space a^2/R: finite bodies are stiffer
-#: (references.md: 1-3 % for a real half-sphere); measured -1.5 to -2 %.
-APPROACH_RTOL = 0.05
-#: k_n against 2 E* a: the same finite-body stiffening; measured +2 to +3 %.
-KN_RTOL = 0.05
+#: (references.md: 1-3 % for a real half-sphere); measured -1.95 % (real),
+#: -1.57 % (half-space blocks).
+APPROACH_RTOL = 0.03
+#: k_n against 2 E* a: the same finite-body stiffening; measured +2.89 % (real),
+#: +2.15 % (half-space).
+KN_RTOL = 0.045
 #: Cylinder mid-length against 2D (plane-strain) Hertz: a finite cylinder is
 #: not in plane strain and its ends carry more than F/L (edge effect), and the
-#: 15-node grid is coarse; measured -2.0 % (half-width) and -1.4 % (p0).
-CYL_RTOL = 0.05
+#: 15-node grid is coarse; measured -2.97 % (half-width) and -1.83 % (p0).
+CYL_RTOL = 0.045
 #: The edge pressure peak at the cylinder's ends is well above the mid-length
-#: peak (thesis Fig. 9: ~3x on a fine grid; 1.8x measured on 15 nodes).
+#: peak (thesis Fig. 9: ~3x on a fine grid; 1.76x measured on 15 nodes).
 EDGE_PEAK_RATIO = 1.3
 #: k_t / k_n of a stuck rigid patch on like half-spaces: 4 G*/E* = 2(1-nu)/(2-nu)
-#: (Mindlin); the coarse 9-node grid and finite blocks give +0.9 %.
-KT_KN_RTOL = 0.03
+#: (Mindlin); the coarse 9-node grid and finite blocks give +1.38 % (measured).
+KT_KN_RTOL = 0.021
 #: Stiffness matrix against scikit-fem: same quadrature, so round-off only.
 ASSEMBLY_RTOL = 1e-10
 #: Seeds of the random LCP instances, written out.
 LCP_SEEDS = (20261122, 31415926, 27182818)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["sphere_real", "sphere_halfspace"])
 def test_sphere_matches_hertz(condensed, specs, name):
     cc = condensed(name)
@@ -86,6 +90,7 @@ def test_k_n_is_the_derivative_of_force_by_approach(condensed):
     assert (Fp - Fm) / (2 * eps) == pytest.approx(k_n, rel=1e-6)
 
 
+@pytest.mark.slow
 def test_cylinder_mid_length_matches_2d_hertz_with_edge_peak(condensed, specs):
     cc = condensed("cylinder_real")
     out = report.summarize(cc, normal.solve_force(cc, F_CYL), "cylinder")
@@ -300,8 +305,8 @@ def test_tiny_load_is_flagged_under_resolved_not_nan(condensed):
 
 #: FE half-space variant against the Boussinesq influence-coefficient model on
 #: the same zone and grid (an independent computation): a and p0 agree to
-#: 0.2 % and 0.06 % measured; the approach differs by the finite blocks.
-BEM_RTOL = 0.005
+#: 0.21 % and 0.056 % measured; the approach differs by the finite blocks.
+BEM_RTOL = 0.0032
 
 
 def test_fe_halfspace_agrees_with_boussinesq_model(condensed, specs):
@@ -338,10 +343,11 @@ def test_superlu_schur_and_block_solves_agree(monkeypatch):
 
 #: Body 1's share of the approach on two like half-space blocks is its share of
 #: the compliance, lambda_1 / (lambda_1 + lambda_2), lambda = (1 - nu^2) / E
-#: (Johnson eq. 4.22); 0.07 % measured, the blocks being mirror images.
-SHARE_RTOL = 0.01
+#: (Johnson eq. 4.22); 0.076 % measured, the blocks being mirror images.
+SHARE_RTOL = 0.0012
 
 
+@pytest.mark.slow
 def test_dissimilar_materials_follow_hertz_with_e_star(contact_cache):
     E2, nu2, F = 70e9, 0.33, 400.0   # steel sphere on an aluminium block
     spec = ContactSpec(body="sphere", model="halfspace", grid=15, E2=E2, nu2=nu2)

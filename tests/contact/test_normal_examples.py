@@ -26,6 +26,7 @@ def test_kosarev_half_width_is_hertz():
     assert b == pytest.approx(hertz.cylinder(F, L, R, hertz.contact_modulus(E, nu, E, nu))["b"], rel=1e-12)
 
 
+@pytest.mark.slow
 def test_bench_contact_quick_case_runs(tmp_path, monkeypatch, load_example):
     bench = load_example("bench_contact")
     assert bench.main(["--quick", "--out", str(tmp_path)]) == 0
@@ -34,6 +35,7 @@ def test_bench_contact_quick_case_runs(tmp_path, monkeypatch, load_example):
     assert rows[0]["cached"]["end_to_end"] < rows[0]["cold"]["end_to_end"]
 
 
+@pytest.mark.slow
 def test_normal_validation_writes_json_and_plots(tmp_path, contact_cache, load_example):
     val = load_example("normal_validation")
     summary = val.main(tmp_path, cache=contact_cache)

@@ -20,19 +20,22 @@ A = (3 * F * R / (4 * E_STAR)) ** (1 / 3)
 P0 = 3 * F / (2 * np.pi * A**2)
 GRID = 21
 
-#: Virgin curve against Mindlin, over the whole curve (issue 4): 1 % of mu N.
+#: Virgin curve against Mindlin, over the whole curve: the issue's 1 % of mu N
+#: (0.24 % measured; kept at the requirement, as the gross-slip displacement and
+#: the Masing branch below share it and the step control targets 1 %).
 CURVE_TOL = 0.01
 #: k_t against 8 G* a: the discrete contact area of a 21-cell grid differs from
-#: pi a^2 by up to ~2 %, and k_t scales with the contact size.
-KT_RTOL = 0.03
+#: pi a^2, and k_t scales with the contact size; -1.33 % measured.
+KT_RTOL = 0.02
 #: Loop energy against Mindlin-Deresiewicz at T*/(mu N) ~ 0.75: the thin slip
-#: annulus is resolved by a few cells only (1.2 % measured on 21 x 21).
-MD_RTOL = 0.03
+#: annulus is resolved by a few cells only (1.20 % measured on 21 x 21).
+MD_RTOL = 0.018
 #: Direct loop against Masing's loop from the same model's virgin curve
 #: (both discretised by the step control; 0.2 % measured).
-MASING_RTOL = 0.01
-#: Trapezoid loop area against the frictional dissipation of the same steps.
-AREA_RTOL = 0.01
+MASING_RTOL = 0.003
+#: Trapezoid loop area against the frictional dissipation of the same steps
+#: (-0.105 % measured).
+AREA_RTOL = 0.0016
 
 
 @pytest.fixture(scope="module")

@@ -29,6 +29,7 @@ def test_json_has_the_interface_keys(capsys):
     assert out["load_case"] == "CNF" and out["k_t"] > 0 and out["iterations"] >= 0
 
 
+@pytest.mark.slow
 def test_out_writes_a_curve_file_and_plots(tmp_path, capsys):
     curve_path, plots = tmp_path / "curve.json", tmp_path / "plots"
     assert main(CYLINDER + ["--force", "120", "--out", str(curve_path), "--plot", str(plots)]) == 0
@@ -46,6 +47,7 @@ def test_constant_normal_displacement(capsys):
     assert out["T"][-1] == pytest.approx(0.5 * out["normal_force"], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_force_control_and_loop(capsys, tmp_path):
     out = run_json(capsys, SPHERE + ["--force", "200", "--tangential-force", "50",
                                      "--loop-amplitude", "1e-6", "--plot", str(tmp_path)])
@@ -93,7 +95,8 @@ def test_eccentricity_needs_a_flat_face(capsys):
 
 def test_a_contact_on_one_node_is_refused(capsys):
     # 1 mN on a zone sized for 2000 MPa: the contact falls inside one grid cell
-    assert main(SPHERE + ["--force", "1e-3"]) == 2
+    # (explicit --p-design: by default such a load now gets a zone of its own)
+    assert main(SPHERE + ["--force", "1e-3", "--p-design", "2e9"]) == 2
     assert "too few" in capsys.readouterr().err
 
 

@@ -20,11 +20,11 @@ E_STAR = hertz.contact_modulus(200e9, 0.3, 200e9, 0.3)
 G_STAR = tr.shear_modulus_star(200e9, 0.3, 200e9, 0.3)
 
 #: Hertz p0 and k_n = 2 E* a on the 21-node BEM grid (1.1 % measured on k_n).
-HERTZ_RTOL = 0.02
+HERTZ_RTOL = 0.017
 #: Virgin curve against Mindlin, over the whole curve (issue 4).
 CURVE_TOL = 0.01
 #: k_t against 8 G* a (1.1 % measured at 21 nodes per side; k_t ~ contact size).
-KT_RTOL = 0.02
+KT_RTOL = 0.017
 #: 2D Cattaneo traction at mid-length, as a fraction of mu p0: the traction has
 #: a kink at the stick edge x = +-c that a grid of spacing dx ~ 0.07 b smears
 #: (3.4 % measured).
@@ -33,7 +33,7 @@ TRACTION_TOL = 0.05
 #: 1 % of mu N on the curve (0.4 % measured); k_t within 3 %: on grids this
 #: coarse it scatters by +-3 % between 11 and 15 nodes per side as the discrete
 #: contact boundary moves (0.06 % measured at 15).
-FE_CURVE_TOL = 0.01
+FE_CURVE_TOL = 0.006
 FE_KT_RTOL = 0.03
 
 
@@ -134,6 +134,7 @@ def test_cylinder_ends_carry_the_edge_peak(cylinder):
     assert prob.f_n[mid].max() / (grid.dx * grid.dy) == pytest.approx(p0, rel=HERTZ_RTOL)
 
 
+@pytest.mark.slow
 def test_small_fe_model_matches_mindlin():
     spec = ContactSpec(body="sphere", radius=0.01, grid=15, load_hint=200.0)
     fe = tangential_run.run(spec, MU, force=200.0, model="halfspace", cache=False)

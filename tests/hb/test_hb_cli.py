@@ -90,3 +90,17 @@ def test_non_concave_curve_file_exits_2_with_the_reason(tmp_path, capsys):
     assert main(["frf", "--model", str(tmp_path / "m.npz"), "--elements",
                  str(tmp_path / "e.toml"), "--omega", "0.6", "2.0"]) == 2
     assert "concave" in capsys.readouterr().err
+
+
+def test_long_curve_is_reduced_and_the_fit_error_printed(tmp_path, capsys):
+    """A 2000-point concave curve (more slope changes than the C element holds)."""
+    u = np.linspace(0.0, 1e-3, 2000)
+    write_curve(VirginCurve(u=u, T=10 * (1 - np.exp(-u / 2e-4)), N=1.0), tmp_path / "c.json")
+    np.savez(tmp_path / "m.npz", M=np.eye(1), K=1e5 * np.eye(1), C=10 * np.eye(1),
+             force=np.array([5.0]))
+    (tmp_path / "e.toml").write_text('[[element]]\ndofs = [0]\ntype = "curve"\npath = "c.json"\n')
+    code = main(["frf", "--model", str(tmp_path / "m.npz"), "--elements", str(tmp_path / "e.toml"),
+                 "--omega", "200", "500", "--json"])
+    cap = capsys.readouterr()
+    assert code == 0 and json.loads(cap.out)["status"] == "complete"
+    assert "reduced" in cap.err and "fit" in cap.err

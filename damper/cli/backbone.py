@@ -1,0 +1,69 @@
+"""``damper backbone``: nonlinear mode of a friction-damped model by EPMC.
+
+Examples::
+
+    damper backbone --model sdof --contact-stiffness 1 --slip-force 0.05 --harmonics 1 \\
+        --amplitude 1e-3 10 --json
+    damper backbone --model matrices.npz --elements elements.toml --harmonics odd:7 \\
+        --amplitude 1e-4 1 --mode 0 --json
+
+Model options as ``damper frf`` (the excitation of the model is ignored: a nonlinear
+mode is a free motion). ``--amplitude`` is the range of the mass-normalised modal
+amplitude a [m sqrt(kg)] (for the sdof model of unit mass: the first-harmonic
+amplitude [m]); start it small (the start is the stuck linear mode).
+
+JSON output (SI): ``modal_amplitude``, ``omega`` [rad/s], ``xi`` [1/s] (the
+artificial negative damping), ``damping_ratio`` (xi / (2 omega)), ``amplitude``
+(peak |x| of the response DOF) per point, ``points``, ``newton_iterations``,
+``status``. A backbone that stops early prints its points and exits with code 3.
+"""
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers) -> None:
+    from .frf import add_model_arguments
+
+    p = subparsers.add_parser(
+        "backbone", help="nonlinear mode (backbone: frequency, damping vs amplitude) by EPMC",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_model_arguments(p)
+    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
+    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--amplitude", type=float, nargs=2, required=True, metavar=("START", "END"),
+                   help="modal amplitude range [m sqrt(kg)]")
+    p.add_argument("--mode", type=int, default=0, help="mode of the stuck linear system (0-based)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.add_argument("--out", help="also write the JSON to this file")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from harmonic_balance.epmc import EPMCError, compute_backbone
+
+    from .common import atomic_write, dumps, print_json
+    from .frf import build_model
+
+    if args.samples < 0:
+        raise ValueError("--samples must be >= 0")
+    model = build_model(args)
+    try:
+        bb = compute_backbone(model, args.harmonics, args.amplitude, n_t=args.samples,
+                              mode=args.mode)
+    except EPMCError as err:
+        _emit(args, err.result.summary(), print_json, atomic_write, dumps)
+        raise RuntimeError(f"{err} ({err.result.a.size} points kept)") from None
+    _emit(args, bb.summary(), print_json, atomic_write, dumps)
+    return 0
+
+
+def _emit(args, s, print_json, atomic_write, dumps):
+    if args.out:
+        atomic_write(args.out, dumps(s, indent=1) + "\n")
+    if args.json:
+        print_json(s)
+        return
+    print(f"{s['points']} points, {s['newton_iterations']} Newton iterations, status: {s['status']}")
+    for a, w, d in list(zip(s["modal_amplitude"], s["omega"], s["damping_ratio"]))[:: max(1, s["points"] // 10)]:
+        print(f"a = {a:.4g}  omega = {w:.6g} rad/s  damping ratio = {d:.4g}")

@@ -1,0 +1,105 @@
+"""Robustness benchmark of the HB solver (issue 10): convergence map and cost vs contact stiffness.
+
+Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full]
+
+Model: single-DOF Jenkins oscillator m = k = 1, forcing P = 1 cos(omega t), sweep
+0.5 -> 2 rad/s (start below resonance), 1 -> 2 (start at resonance) and 2 -> 0.5
+(start above, sweeping down), no tuning (library defaults).
+
+Table 1 (convergence map): contact stiffness ratio kt/k, slip force fs/P, damping c,
+harmonics H and the three starts; per kt/k the number of curves completed over
+the whole range, and every failure with where it stopped. Default grid: kt/k in
+{1e-3, 1, 30, 1e3, 1e4, 1e6}, fs/P in {1e-3, 0.5, 10}, c in {1e-4, 0.04, 0.5},
+H in {1, 7, 21}; ``--full`` the issue's whole grid (kt/k 1e-3..1e6 by decades,
+fs/P 1e-3..10, c 1e-4..0.5, H = 1, 3, 7, 21, 51: hours).
+
+Table 2 (cost vs stiffness): the issue's case (c = 0.04, fs = 0.5, H = 15,
+0.5 -> 2 rad/s): time per converged point and corrector iterations per point
+against kt/k (goal: no worse than 2x the soft-contact cost at 1e6).
+
+Wall times depend on the machine's load; nothing here gates CI.
+"""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import itertools  # noqa: E402
+import time  # noqa: E402
+
+from harmonic_balance.frf import FRFError, compute_frf  # noqa: E402
+from harmonic_balance.model import sdof_model  # noqa: E402
+
+STARTS = {"below": (0.5, 2.0), "at": (1.0, 2.0), "above": (2.0, 0.5)}
+GRID = dict(kt=(1e-3, 1.0, 30.0, 1e3, 1e4, 1e6), fs=(1e-3, 0.5, 10.0), c=(1e-4, 0.04, 0.5),
+            H=(1, 7, 21))
+FULL = dict(kt=tuple(10.0**e for e in range(-3, 7)), fs=(1e-3, 1e-2, 0.1, 1.0, 10.0),
+            c=(1e-4, 1e-3, 1e-2, 0.1, 0.5), H=(1, 3, 7, 21, 51))
+SMOKE = dict(kt=(1.0, 30.0), fs=(0.5,), c=(0.04,), H=(3,))
+#: Point limit per curve (a curve that needs more counts as failed).
+MAX_POINTS = 3000
+
+
+def one_curve(kt, fs, c, H, start):
+    """(converged, points, iterations, seconds, message) of one curve."""
+    t0 = time.perf_counter()
+    try:
+        r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
+                        stability=False, max_points=MAX_POINTS)
+        return True, r.points, r.newton_iterations, time.perf_counter() - t0, ""
+    except FRFError as err:
+        res = err.result
+        return False, res.points, res.newton_iterations, time.perf_counter() - t0, str(err)[:160]
+
+
+def convergence_map(grid):
+    print("\nTable 1: convergence map (curves completed over the whole range)")
+    print(f"{'kt/k':>8} {'done':>6} {'total':>6} {'s/curve':>8}")
+    rows, fails = [], []
+    for kt in grid["kt"]:
+        n_ok = n = 0
+        t_all = 0.0
+        for fs, c, H, start in itertools.product(grid["fs"], grid["c"], grid["H"], STARTS):
+            ok, pts, it, t, msg = one_curve(kt, fs, c, H, start)
+            rows.append((kt, fs, c, H, start, ok, pts, it, t))
+            n += 1
+            n_ok += ok
+            t_all += t
+            if not ok:
+                fails.append((kt, fs, c, H, start, msg))
+        print(f"{kt:>8.0e} {n_ok:>6} {n:>6} {t_all / n:>8.2f}", flush=True)
+    print(f"failures ({len(fails)}):")
+    for kt, fs, c, H, start, msg in fails:
+        print(f"  kt/k={kt:.0e} fs/P={fs:g} c={c:g} H={H} start={start}: {msg}")
+    return rows, fails
+
+
+def cost_table(kts, H=15):
+    print(f"\nTable 2: issue case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
+    print(f"{'kt/k':>8} {'ok':>3} {'points':>6} {'iter/pt':>7} {'ms/pt':>7} {'time_s':>7}")
+    out = []
+    for kt in kts:
+        ok, pts, it, t, msg = one_curve(kt, 0.5, 0.04, H, "below")
+        out.append((kt, ok, pts, it, t))
+        per = 1e3 * t / max(pts, 1)
+        print(f"{kt:>8.0e} {'yes' if ok else 'no':>3} {pts:>6} {it / max(pts, 1):>7.2f} "
+              f"{per:>7.2f} {t:>7.2f}" + ("" if ok else f"  {msg[:70]}"), flush=True)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--smoke", action="store_true", help="tiny grid (the test)")
+    ap.add_argument("--full", action="store_true", help="the issue's whole grid (hours)")
+    args = ap.parse_args(argv)
+    grid = SMOKE if args.smoke else FULL if args.full else GRID
+    rows, fails = convergence_map(grid)
+    kts = (1.0, 30.0) if args.smoke else (1.0, 10.0, 30.0, 100.0, 1e3, 1e4, 1e5, 1e6)
+    cost = cost_table(kts, H=3 if args.smoke else 15)
+    return {"map": rows, "failures": fails, "cost": cost}
+
+
+if __name__ == "__main__":
+    main()

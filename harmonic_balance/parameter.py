@@ -1,0 +1,112 @@
+"""Continuation over any model parameter at a fixed frequency (forcing level, slip scale, ...).
+
+NLvib style: :func:`continuation.continuation` knows only ``R(x, lam) -> (R, dR/dx,
+dR/dlam)``; this module builds that callable for an HB problem whose model depends
+on a parameter through a factory ``model_at(lam) -> Model``:
+
+* ``dR/dlam`` exactly when the parameter is the excitation level (R is affine in it:
+  ``R(x; lam) = N(x) - lam f``, :func:`homotopy.forcing_vector`), else by a central
+  difference of the residual at fixed x (two residual evaluations without Jacobian,
+  step ``FD_STEP`` relative; the residual is piecewise smooth in the slip strengths,
+  so the difference is exact to O(h^2) between kinks).
+* Ready-made factories: :func:`forcing_level` and :func:`slip_scale` (every friction
+  slider's strength times lam, for Iwan/Jenkins links).
+
+Curves over a parameter: :func:`frf.parameter_curve`; the contact-stiffness factory
+also serves the start of stiff models (:mod:`start`).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from .aft import FrictionLink
+from .fourier import FourierBasis, parse_harmonics
+from .residual import make_residual
+
+#: Relative step of the central difference in lam.
+FD_STEP = 1e-6
+
+
+def forcing_level(model):
+    """Factory lam -> the model with its excitation times lam."""
+    return lambda lam: replace(model, forcing={h: lam * f for h, f in model.forcing.items()})
+
+
+def slip_scale(model):
+    """Factory lam -> the model with every friction slider's strength times lam (Iwan links)."""
+    from fmu_src.element import IwanElement
+
+    def at(lam):
+        links = []
+        for link in model.links:
+            el = link.element
+            if not isinstance(link, FrictionLink) or not isinstance(el, IwanElement):
+                links.append(link)
+                continue
+            new = IwanElement.from_sliders(el.k, el.fs * el.scale * lam, el.k_res, el.N_ref)
+            links.append(FrictionLink(new, link.dof_a, link.dof_b, link.name))
+        return replace(model, links=links)
+    return at
+
+
+def contact_stiffness_scale(model):
+    """Factory lam -> the model with every friction slider's stiffness (and residual
+    stiffness) times 10**lam, slip strengths unchanged (lam = 0: the model itself).
+
+    The logarithmic parameter lets one continuation run over decades of stiffness.
+    """
+    from fmu_src.element import IwanElement
+
+    def at(lam):
+        s = 10.0**lam
+        links = []
+        for link in model.links:
+            el = link.element
+            if not isinstance(link, FrictionLink) or not isinstance(el, IwanElement):
+                links.append(link)
+                continue
+            new = IwanElement.from_sliders(el.k * s, el.fs * el.scale, el.k_res * s, el.N_ref)
+            links.append(FrictionLink(new, link.dof_a, link.dof_b, link.name))
+        return replace(model, links=links)
+    return at
+
+
+class ParameterProblem:
+    """R(x, lam) at fixed omega for a model family (module docstring)."""
+
+    def __init__(self, model_at, harmonics, omega: float, n_t: int = 0, condensed=None,
+                 affine: bool = False):
+        self.model_at, self.omega, self.affine = model_at, float(omega), affine
+        self.basis = FourierBasis(parse_harmonics(harmonics), n_t)
+        self.condensed = condensed
+        self._cache = {}
+
+    def residual(self, lam):
+        key = float(lam)
+        if key not in self._cache:
+            if len(self._cache) > 4:
+                self._cache.clear()
+            self._cache[key] = make_residual(self.model_at(key), self.basis, self.condensed)
+        return self._cache[key]
+
+    def __call__(self, x, lam):
+        """R, dR/dx, dR/dlam; a parameter the factory refuses (a predictor that left the
+        model's range) gives a non-finite residual, which Newton's line search rejects."""
+        try:
+            return self._eval(x, lam)
+        except (ValueError, ArithmeticError):
+            n = np.size(x)
+            return np.full(n, np.nan), np.eye(n), np.zeros(n)
+
+    def _eval(self, x, lam):
+        R, J, _ = self.residual(lam)(x, self.omega)
+        h = FD_STEP * max(abs(lam), 1.0)
+        if self.affine:  # R(x; lam) = N(x) - lam f: the difference is exact at any step
+            dl = self.residual(lam + 1.0)(x, self.omega, jac=False) - R
+        else:
+            dl = (self.residual(lam + h)(x, self.omega, jac=False)
+                  - self.residual(lam - h)(x, self.omega, jac=False)) / (2 * h)
+        return R, J, dl
+

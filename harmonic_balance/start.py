@@ -1,0 +1,105 @@
+"""The first solution of a curve, wherever it starts: Newton, else homotopies.
+
+Order (each step only when the previous one failed):
+
+1. Newton (globalised, :mod:`newton`) from the stuck linear guess.
+2. Homotopy in the excitation level (:func:`homotopy.solve_with_homotopy`): from a
+   level where the links stick up to the requested one.
+3. Homotopy in the contact stiffness (:func:`parameter.contact_stiffness_scale`):
+   every friction slider softened to the structure's stiffness, solved there (by
+   1-2), then continued in log10 of the stiffness factor back to the model.
+
+Why both homotopies: the excitation homotopy crosses the stick-slip onset, where a
+very stiff contact (1e4 k and more) makes the HB residual a staircase of AFT-sample
+kinks with local minima of |R| (measured: Newton and Levenberg-Marquardt stall at
+|R| ~ 0.2-0.3 for contact stiffness 1e6 k at omega = 0.5); the stiffness homotopy
+stays at the requested excitation, in gross slip when the requested point slips,
+and reached 1e6 k at omega = 1 and 2 rad/s in 31 and 65 points (1.5 s, 2 s, H = 7).
+Models whose links are STIFF_RATIO times stiffer than the structure try the
+stiffness homotopy first (the excitation homotopy's failures cost up to ~75 s).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .aft import FrictionLink
+from .continuation import ContinuationError, continuation
+from .homotopy import HomotopyError, forcing_vector, solve_with_homotopy
+from .newton import NewtonError, newton
+from .parameter import ParameterProblem, contact_stiffness_scale
+from .residual import CondensedResidual, make_residual
+
+#: Ratio of the stiffest friction link's stuck stiffness to the structure's largest
+#: diagonal stiffness above which the stiffness homotopy is tried before the
+#: excitation homotopy.
+STIFF_RATIO = 100.0
+
+
+def homotopy_start(prob, omega: float, tol: float):
+    """First solution (N,) of an FRF problem at ``omega`` (module docstring) and an info dict.
+
+    Parameters
+    ----------
+    prob : harmonic_balance.frf.FRFProblem (model, basis, residual; callable (x, omega))
+    omega : float [rad/s]
+    tol : float, absolute tolerance on |R|_2
+
+    Raises
+    ------
+    HomotopyError naming every attempt and why it failed.
+    """
+    x0 = prob.residual.linear_guess(omega)
+    try:
+        res = newton(lambda z: prob(z, omega)[:2], x0, tol)
+        return res.x, {"method": "newton", "iterations": res.iterations}
+    except NewtonError as err:
+        errors = [f"from the stuck linear guess: {err}"]
+    cond = isinstance(prob.residual, CondensedResidual)
+    ratio = _stiffness_ratio(prob.model)
+    tries = [("excitation homotopy", _forcing), ("stiffness homotopy", _stiffness)]
+    if ratio is not None and ratio >= STIFF_RATIO:
+        tries.reverse()
+    for name, attempt in tries:
+        try:
+            x, info = attempt(prob.model, prob.basis, cond, omega, tol, ratio)
+        except HomotopyError as err:
+            errors.append(f"{name}: {err}")
+            continue
+        info["method"] = name
+        return x, info
+    raise HomotopyError(f"no solution at fixed parameter {omega:.6g}: " + "; ".join(errors))
+
+
+def _forcing(model, basis, cond, omega, tol, ratio):
+    res = make_residual(model, basis, cond)
+    x0 = res.linear_guess(omega)
+    f = forcing_vector(lambda m: make_residual(m, basis, cond), model, x0, omega)
+    return solve_with_homotopy(lambda z: res(z, omega)[:2], x0, f, tol)
+
+
+def _stiffness(model, basis, cond, omega, tol, ratio):
+    if ratio is None or ratio <= 1.0:
+        raise HomotopyError("no friction link stiffer than the structure to soften")
+    pp = ParameterProblem(contact_stiffness_scale(model), basis.harmonics, omega, basis.n_t, cond)
+    lam0 = -float(np.log10(ratio))
+    soft = pp.model_at(lam0)
+    try:
+        x_soft = newton(lambda z: pp(z, lam0)[:2], pp.residual(lam0).linear_guess(omega), tol).x
+    except NewtonError:
+        x_soft, _ = _forcing(soft, basis, cond, omega, tol, None)
+    try:
+        br = continuation(pp, x_soft, lam0, 0.0, tol, ds_max=0.5)
+    except ContinuationError as err:
+        raise HomotopyError(f"from 10^{lam0:.3g} of the contact stiffness: {err}") from None
+    return br.x[-1], {"start_level": lam0, "points": len(br.lam),
+                      "iterations": int(sum(br.iterations))}
+
+
+def _stiffness_ratio(model):
+    """Stiffest friction link's k0 over the structure's largest diagonal stiffness, or None."""
+    k0 = [link.k0 for link in model.links if isinstance(link, FrictionLink)]
+    K = model.linear.K
+    if not k0 or K is None:
+        return None
+    ks = float(np.abs(np.diag(K)).max())
+    return max(k0) / ks if ks > 0 else None

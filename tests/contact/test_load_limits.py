@@ -1,0 +1,59 @@
+"""Loads outside what a mesh represents: refused with the limit, or flagged in the text output."""
+import re
+
+import pytest
+
+from contact_core import bodies, hertz
+from contact_core.spec import ContactSpec
+from damper.cli import main as damper
+
+
+@pytest.mark.parametrize("args", [["--radius", "0.01", "--force", "1e6"],
+                                  ["--radius", "1e-5", "--force", "200"]])
+def test_sphere_load_beyond_the_body_is_refused_with_the_limit(args, capsys):
+    assert damper(["normal", "--body", "sphere", "--grid", "5", "--no-cache", *args]) == 2
+    err = capsys.readouterr().err
+    assert "beyond what the contact model represents" in err and "Traceback" not in err
+    f_max = float(re.search(r"use a force of at most ([0-9.e+-]+) N for this sphere", err).group(1))
+    R = float(args[1])
+    a = hertz.sphere(f_max, R, hertz.contact_modulus(200e9, 0.3, 200e9, 0.3))["a"]
+    assert a == pytest.approx(bodies.MAX_CONTACT_SHARE * R, rel=1e-3)  # the limit is the stated share
+
+
+def test_cylinder_load_beyond_the_body_is_refused():
+    with pytest.raises(ValueError, match="at most .* N for this cylinder"):
+        ContactSpec(body="cylinder", radius=2.5e-3, length=1.2e-3, load_hint=1e5)
+
+
+def test_load_at_the_limit_meshes():
+    """The largest accepted load still gives a valid mesh of the real half-sphere."""
+    from contact_core import assembly, mesh
+
+    R = 0.01
+    Es = hertz.contact_modulus(200e9, 0.3, 200e9, 0.3)
+    F = 4 * Es * (bodies.MAX_CONTACT_SHARE * R) ** 3 / (3 * R)
+    b1, _, _ = mesh.build(ContactSpec(body="sphere", radius=R, grid=7, load_hint=F))
+    assert assembly.stiffness(b1.p, b1.t, 200e9, 0.3).shape[0] == 3 * b1.p.shape[1]
+
+
+def test_under_resolved_contact_is_flagged_in_the_text_output(capsys):
+    """An explicit design pressure far too high for the load: the warning is printed."""
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "1e-6", "--grid", "5",
+                   "--model", "halfspace", "--no-cache", "--p-design", "2e9"]) == 0
+    assert "warning: under-resolved" in capsys.readouterr().out
+
+
+#: A 1e-6 N load on the 10 mm sphere, zone sized from the Hertz contact of 3x
+#: the load, 13 nodes per side: contact radius -0.78 % against Hertz (measured;
+#: 45x Hertz with the design-pressure zone).
+TINY_LOAD_RTOL = 0.012
+
+
+def test_default_zone_follows_a_tiny_load(capsys):
+    import json
+
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "1e-6", "--grid", "13",
+                   "--model", "halfspace", "--no-cache", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert not out["under_resolved"]
+    assert abs(out["hertz"]["error_size"]) < TINY_LOAD_RTOL

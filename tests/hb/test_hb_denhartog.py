@@ -1,0 +1,60 @@
+"""Den Hartog's rigid-Coulomb + viscous oracle, and the stiff-contact limit of the HB."""
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from harmonic_balance.denhartog import den_hartog
+from harmonic_balance.frf import compute_frf
+from harmonic_balance.model import sdof_model
+
+#: The issue's single-DOF case: m = k = 1, c = 0.04, slip force 0.5, forcing 1.
+M, C, K, FS, P = 1.0, 0.04, 1.0, 0.5, 1.0
+
+
+@pytest.mark.parametrize("omega, kind", [(0.5, "stops"), (1.0, "continuous"), (2.0, "continuous")])
+def test_half_period_is_an_antisymmetric_solution_of_the_ode(omega, kind):
+    """The oracle's half period, integrated by solve_ivp from (-A, 0) (sliding forward),
+    ends at (A, 0) (antisymmetry x(t + T/2) = -x(t)), and the kind is the expected one."""
+    d = den_hartog(M, C, K, FS, P, omega)
+    assert d.kind == kind
+
+    def slip(t, z):
+        return [z[1], P * np.cos(omega * t + d.phi) - FS - C * z[1] - K * z[0]]
+
+    s = solve_ivp(slip, (0.0, d.t_slip), [-d.amplitude, 0.0], rtol=1e-12, atol=1e-14)
+    # 2e-12 measured: solve_ivp's own tolerance
+    np.testing.assert_allclose(s.y[:, -1], [d.amplitude, 0.0], atol=1e-9 * d.amplitude)
+
+
+@pytest.mark.slow
+def test_regularised_time_integration_agrees_with_the_oracle():
+    """An independent steady state: sgn(v) ~ tanh(v / 1e-4) integrated 300 periods
+    from rest (measured 1.6e-4 relative at omega = 2, the regularisation's error)."""
+    w, eps = 2.0, 1e-4
+
+    def rhs(t, z):
+        return [z[1], P * np.cos(w * t) - FS * np.tanh(z[1] / eps) - C * z[1] - K * z[0]]
+
+    T = 2 * np.pi / w
+    s = solve_ivp(rhs, (0, 300 * T), [0.0, 0.0], method="LSODA", rtol=1e-9, atol=1e-12,
+                  dense_output=True)
+    x = s.sol(np.linspace(295 * T, 300 * T, 4000))[0]
+    assert abs(np.abs(x).max() / den_hartog(M, C, K, FS, P, w).amplitude - 1) < 5e-4
+
+
+def test_below_the_slip_force_the_mass_never_moves():
+    assert den_hartog(M, C, K, 1.2, P, 1.0).kind == "stuck"
+
+
+@pytest.mark.slow
+def test_stiff_jenkins_at_resonance_agrees_with_den_hartog():
+    """Contact stiffness 1e3 k, H = 21, at resonance: measured 1.1e-4 relative.
+
+    Away from resonance the elastic (Jenkins) steady state approaches the rigid one
+    only like kt^-1/2 (time integration at omega = 2: 9 % at 1e3 k, 3 % at 1e4 k,
+    0.9 % at 1e5 k: the stuck mode sqrt(kt / m) rings after each reversal), so the
+    issue's 1 % at 1e3 k holds at resonance, not over the whole band.
+    """
+    r = compute_frf(sdof_model(M, K, C, 1e3, FS, P), 21, (0.98, 1.02), refine=False)
+    a = np.interp(1.0, r.omega, r.amplitude)
+    assert abs(a / den_hartog(M, C, K, FS, P, 1.0).amplitude - 1) < 2e-4

@@ -1,0 +1,29 @@
+"""Continuation over parameters other than frequency (harmonic_balance.parameter)."""
+import numpy as np
+from hbcases import two_dof
+
+from harmonic_balance.frf import compute_frf, parameter_curve
+from harmonic_balance.model import sdof_model
+from harmonic_balance.parameter import forcing_level, slip_scale
+
+
+def test_forcing_level_curve_ends_on_the_frf_solution():
+    """lam = 0.1 -> 2 at omega = 1 on the stiff (30 k) Jenkins oscillator: the end point is
+    the FRF's solution at forcing 2 (started there by its own homotopy); stuck below the
+    slip onset, the amplitude is linear in the level."""
+    model = sdof_model(1, 1, 0.04, 30, 0.5, 1.0)
+    c = parameter_curve(forcing_level(model), "odd:7", (0.1, 2.0), 1.0, affine=True)
+    assert c.status == "complete" and c.lam[-1] == 2.0 and all(c.stable)
+    r = compute_frf(sdof_model(1, 1, 0.04, 30, 0.5, 2.0), "odd:7", (1.0, 1.01), refine=False)
+    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < 1e-9  # measured 1e-14
+    stuck = c.lam < 0.4  # slip force 0.5 not reached at omega = 1
+    np.testing.assert_allclose(c.amplitude[stuck] / c.lam[stuck], c.amplitude[0] / c.lam[0],
+                               rtol=1e-9)
+
+
+def test_slip_scale_curve_matches_the_model_built_with_that_slip_force():
+    m = two_dof(True)
+    c = parameter_curve(slip_scale(m), "odd:3", (0.1, 3.0), 1.1)
+    assert c.status == "complete" and c.lam[-1] == 3.0
+    r = compute_frf(two_dof(True, fs=0.04 * 3.0), "odd:3", (1.1, 1.11), refine=False)
+    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < 1e-8

@@ -1,0 +1,42 @@
+"""Convergence map (quick) of the single-DOF Jenkins FRF: issue 10's cases that converge.
+
+The full map is examples/bench_hb_robust.py. Here: contact stiffness 1e-3 ... 1e6 k,
+slip force 0.5 of the forcing, sweeps that start below, at and above resonance,
+H = 3: each curve completes over the whole requested range with no tuning (at 1e4 k
+and above through restarts in the stick-slip band, reported as gaps).
+"""
+import json
+
+import pytest
+
+from damper.cli import main
+from harmonic_balance.frf import compute_frf
+from harmonic_balance.model import sdof_model
+
+
+@pytest.mark.parametrize("kt", [1e-3, 1.0, 30.0, 1e3, 1e6])
+@pytest.mark.parametrize("start", [0.5, 1.0, 2.0])
+def test_sdof_jenkins_curve_completes_from_any_start(kt, start):
+    end = 2.0 if start < 2.0 else 0.5
+    r = compute_frf(sdof_model(1, 1, 0.04, kt, 0.5, 1.0), "odd:3", (start, end), refine=False)
+    assert r.status.startswith("complete") and r.omega[-1] == end
+    gap = sum(abs(b - a) for a, b in r.extra["gaps"])
+    assert gap < 0.05 * abs(end - start)  # measured 0 here (H = 3); gaps appear at H >= 7 near 0.5 rad/s
+
+
+def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
+    """Issue 10's reproduction: 30 k failed before the first point at H = 15."""
+    code = main(["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.04",
+                 "--contact-stiffness", "30", "--slip-force", "0.5", "--force", "1",
+                 "--harmonics", "15", "--omega", "0.5", "2", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["status"] == "complete" and out["stable"] is not None
+
+
+def test_failure_text_output_is_a_message_not_a_traceback(capsys):
+    """A run that stops before its first point: exit 3, 'none' numbers, no TypeError."""
+    code = main(["frf", "--model", "sdof", "--damping", "0.0", "--stiffness", "0",
+                 "--contact-stiffness", "1", "--slip-force", "0", "--harmonics", "all:1",
+                 "--omega", "0.5", "1.0"])
+    cap = capsys.readouterr()
+    assert code == 3 and "none" in cap.out and "failed" in cap.err
