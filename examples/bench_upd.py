@@ -101,7 +101,8 @@ def _table(rows):
     print(f"{c['case']} | {c['evaluations']} evaluations | - | {c['time_s']:.2f}")
     o = rows["optimize"]
     print(f"optimal-load curve | {len(o['cf'])} loads, {o['workers']} workers | - | "
-          f"{o['time_s']:.1f} (load grid {o['time_grid_s']:.1f})")
+          f"{o['time_s']:.1f} (load grid {o['time_grid_s']:.1f}; CPU per chunk "
+          f"{', '.join(f'{t:.1f}' for t in o['cpu_chunks_s'])}, search {o['cpu_search_s']:.1f})")
     for r in rows["ti"]:
         for k, v in r.items():
             if k.startswith("H"):

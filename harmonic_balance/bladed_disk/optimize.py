@@ -65,21 +65,27 @@ class _Peaks:
         return w, a
 
 
-def _chunk_peaks(sector, H, omegas, f0, cfs) -> list:
-    """Refined peaks (omega, amplitude) of one contiguous chunk of loads, in order."""
+def _chunk_peaks(sector, H, omegas, f0, cfs) -> tuple[list, float]:
+    """Refined peaks (omega, amplitude) of one contiguous chunk of loads, in order, and
+    the CPU time [s] the chunk took in its process."""
+    c0 = time.process_time()
     peak = _Peaks(sector, H, omegas, f0)
-    return [peak(float(cf)) for cf in cfs]
+    return [peak(float(cf)) for cf in cfs], time.process_time() - c0
 
 
-def load_curve(sector: Sector, cfs, H: int, omegas, f0=None, workers: int = 1) -> list:
+def load_curve(sector: Sector, cfs, H: int, omegas, f0=None,
+               workers: int = 1) -> tuple[list, list]:
     """Refined peaks at every load of ``cfs`` (the :data:`CHUNKS` chunks on ``workers``
-    spawned processes; ``workers = 1`` runs them in this process, same results)."""
+    spawned processes; ``workers = 1`` runs them in this process, same results) and the
+    CPU time [s] of each chunk (on 2 free cores the grid's wall time is their maximum)."""
     chunks = [c for c in np.array_split(np.asarray(cfs, float), CHUNKS) if len(c)]
     if workers <= 1 or len(chunks) == 1:
-        return [p for c in chunks for p in _chunk_peaks(sector, H, omegas, f0, c)]
-    with ProcessPoolExecutor(min(workers, len(chunks)), mp_context=SPAWN) as pool:
-        futures = [pool.submit(_chunk_peaks, sector, H, omegas, f0, c) for c in chunks]
-        return [p for f in futures for p in f.result()]
+        done = [_chunk_peaks(sector, H, omegas, f0, c) for c in chunks]
+    else:
+        with ProcessPoolExecutor(min(workers, len(chunks)), mp_context=SPAWN) as pool:
+            futures = [pool.submit(_chunk_peaks, sector, H, omegas, f0, c) for c in chunks]
+            done = [f.result() for f in futures]
+    return [p for d in done for p in d[0]], [d[1] for d in done]
 
 
 def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz=None,
@@ -109,8 +115,9 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     band = sector.cfg["load.band_hz"] if band_hz is None else band_hz
     omegas = 2 * np.pi * np.linspace(band[0], band[1], grid)
     cfs = np.geomspace(lo, hi, points)
-    peaks = load_curve(sector, cfs, H, omegas, f0, workers)
+    peaks, cpu_chunks = load_curve(sector, cfs, H, omegas, f0, workers)
     t_grid = time.perf_counter() - t0
+    c_search = time.process_time()
     peak = _Peaks(sector, H, omegas, f0)
     amp = np.array([p[1] for p in peaks])
     i = int(np.argmin(amp))
@@ -131,4 +138,5 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
                    interior=True, search_evaluations=int(res.nfev))
     out["time_s"] = time.perf_counter() - t0
     out["time_grid_s"], out["workers"] = t_grid, int(workers)
+    out["cpu_chunks_s"], out["cpu_search_s"] = cpu_chunks, time.process_time() - c_search
     return out

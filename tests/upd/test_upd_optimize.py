@@ -14,7 +14,7 @@ def test_parallel_load_grid_equals_serial():
     sector = Sector(load_config())
     omegas = 2 * np.pi * np.linspace(400.0, 500.0, 8)
     cfs = np.geomspace(60.0, 600.0, 4)
-    serial = load_curve(sector, cfs, 1, omegas, workers=1)
-    parallel = load_curve(sector, cfs, 1, omegas, workers=2)
+    serial = load_curve(sector, cfs, 1, omegas, workers=1)[0]
+    parallel = load_curve(sector, cfs, 1, omegas, workers=2)[0]
     assert len(serial) == 4
     assert serial == parallel
