@@ -24,6 +24,16 @@ def test_sdof_jenkins_curve_completes_from_any_start(kt, start):
     assert gap < 0.05 * abs(end - start)  # measured 0 here (H = 3); gaps appear at H >= 7 near 0.5 rad/s
 
 
+@pytest.mark.slow
+def test_issue_case_stiffness_1e4_no_gaps():
+    """Issue case at 1e4 k (H = 15): the stick-slip band near 0.5 rad/s used to be skipped
+    in 41 gaps (the pseudo-arclength corrector cycled on AFT kinks); the fixed-parameter
+    corrector fallback solves it (measured: 292 points, 0 gaps, ~6 s alone)."""
+    r = compute_frf(sdof_model(1, 1, 0.04, 1e4, 0.5, 1.0), 15, (0.5, 2.0), refine=False,
+                    stability=False)
+    assert r.status == "complete" and r.extra["gaps"] == [] and r.omega[-1] == 2.0
+
+
 def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
     """Issue 10's reproduction: 30 k failed before the first point at H = 15."""
     code = main(["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.04",
