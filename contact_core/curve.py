@@ -98,7 +98,7 @@ class VirginCurve:
     def __post_init__(self):
         u = np.array(self.u, dtype=float)
         T = np.array(self.T, dtype=float)
-        _check_table(u, T)
+        check_table(u, T)
         u.setflags(write=False)
         T.setflags(write=False)
         object.__setattr__(self, "u", u)
@@ -176,31 +176,39 @@ def _v1_tail(curve: VirginCurve) -> str:
     return "flat" if abs(float(curve.T[-1]) - mu * N) <= V1_GROSS_SLIP_RTOL * mu * N else "slope"
 
 
-def _check_table(u: np.ndarray, T: np.ndarray) -> None:
+def check_table(u: np.ndarray, T: np.ndarray) -> None:
     """Raise ValueError unless (u, T) is a usable virgin-curve table.
 
+    The one check of a table's basic rules (shape, at least 2 points, finite, starts at
+    (0, 0), u strictly increasing, T non-negative), used by the curve file and by the
+    friction element (``fmu_src.curve_fit.check_table`` adds the element's own rules).
     The message names the rule and the first point (0-based index) that breaks it.
+
+    Parameters
+    ----------
+    u, T : ndarray, shape (m,)
+        Displacement [m] and force [N].
     """
-    if u.ndim != 1 or T.ndim != 1:
-        raise ValueError("u and T must be one-dimensional arrays")
-    if u.size != T.size:
-        raise ValueError(f"u and T differ in length ({u.size} vs {T.size})")
+    if u.ndim != 1 or T.ndim != 1 or u.size != T.size:
+        raise ValueError(f"curve: u and T must be 1-D of equal length, got shapes {u.shape}, {T.shape}"
+                         + (" (they differ in length)" if u.size != T.size else ""))
     if u.size < 2:
-        raise ValueError(f"a virgin curve needs at least 2 points, got {u.size}"
-                         + (" (empty)" if u.size == 0 else ""))
+        raise ValueError(f"curve: {'empty' if u.size == 0 else 'one point'}; "
+                         "a virgin curve needs at least 2 points")
     for name, x in (("u", u), ("T", T)):
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
-            raise ValueError(f"u and T must be finite (no NaN or infinity): {name}[{bad[0]}] = {x[bad[0]]}")
+            raise ValueError(f"curve: point {bad[0]}: {name} = {float(x[bad[0]])} is not finite")
     if u[0] != 0.0 or T[0] != 0.0:
-        raise ValueError(f"a virgin curve starts at (0, 0), got ({u[0]}, {T[0]}) at point 0")
+        raise ValueError(f"curve: point 0 is ({float(u[0])!r}, {float(T[0])!r}); a virgin curve starts at (0, 0)")
     bad = np.flatnonzero(np.diff(u) <= 0.0)
     if bad.size:
         i = int(bad[0]) + 1
-        raise ValueError(f"u must be strictly increasing: u[{i}] = {u[i]} <= u[{i - 1}] = {u[i - 1]}")
+        raise ValueError(f"curve: point {i}: u = {float(u[i])!r} is not above u[{i - 1}] = {float(u[i - 1])!r} "
+                         "(u must be strictly increasing)")
     bad = np.flatnonzero(T < 0.0)
     if bad.size:
-        raise ValueError(f"T must be non-negative: T[{bad[0]}] = {T[bad[0]]}")
+        raise ValueError(f"curve: point {bad[0]}: T = {float(T[bad[0]])!r} is negative (T must be non-negative)")
 
 
 def read_curve(path: str | Path) -> VirginCurve:

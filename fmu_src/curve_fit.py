@@ -27,6 +27,8 @@ import dataclasses
 
 import numpy as np
 
+from contact_core import curve as curve_file
+
 from ._clib import MAX_SLIDERS, IwanInputError
 
 __all__ = ["FITS", "TAILS", "check_table", "concave_majorant", "reduce_table",
@@ -61,22 +63,10 @@ def check_table(u, T, fit: str = "reject") -> tuple[np.ndarray, np.ndarray]:
         raise IwanInputError(f"fit must be one of {FITS}, got {fit!r}")
     u = np.ascontiguousarray(u, dtype=np.float64)
     T = np.ascontiguousarray(T, dtype=np.float64)
-    if u.ndim != 1 or T.ndim != 1 or u.size != T.size:
-        raise IwanInputError(f"curve: u and T must be 1-D of equal length, got shapes {u.shape}, {T.shape}")
-    if u.size < 2:
-        raise IwanInputError(f"curve: {'empty' if u.size == 0 else 'one point'}; "
-                             "a virgin curve needs at least 2 points")
-    for name, x in (("u", u), ("T", T)):
-        bad = np.flatnonzero(~np.isfinite(x))
-        if bad.size:
-            raise IwanInputError(f"curve: point {bad[0]}: {name} = {x[bad[0]]} is not finite")
-    if u[0] != 0.0 or T[0] != 0.0:
-        raise IwanInputError(f"curve: point 0 is ({u[0]!r}, {T[0]!r}); a virgin curve starts at (0, 0)")
-    bad = np.flatnonzero(np.diff(u) <= 0.0)
-    if bad.size:
-        i = int(bad[0]) + 1
-        raise IwanInputError(f"curve: point {i}: u = {u[i]!r} is not above u[{i - 1}] = {u[i - 1]!r} "
-                             "(u must increase strictly)")
+    try:
+        curve_file.check_table(u, T)  # the basic rules, written once with the curve file
+    except ValueError as err:
+        raise IwanInputError(str(err)) from None
     if not np.max(T) > 0.0:
         raise IwanInputError("curve: T is 0 at every point: no stiffness (a virgin curve must rise)")
     if fit == "concave":

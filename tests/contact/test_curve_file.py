@@ -111,8 +111,8 @@ def test_version_1_files_get_the_old_gross_slip_rule(tmp_path, schema):
 
 
 def test_table_errors_name_the_point(tmp_path):
-    for data, message in [({"u": [0, 1e-6, 1e-6], "T": [0, 1, 2]}, r"u\[2\] = 1e-06 <= u\[1\]"),
-                          ({"u": [0, 1e-6, 2e-6], "T": [0, 1, -2]}, r"T\[2\] = -2.0"),
+    for data, message in [({"u": [0, 1e-6, 1e-6], "T": [0, 1, 2]}, r"point 2: u = 1e-06 is not above u\[1\]"),
+                          ({"u": [0, 1e-6, 2e-6], "T": [0, 1, -2]}, r"point 2: T = -2.0 is negative"),
                           ({"u": [], "T": []}, "empty")]:
         path = tmp_path / "bad.json"
         path.write_text(json.dumps(data))

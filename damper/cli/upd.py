@@ -1,0 +1,189 @@
+"""``damper upd``: bladed disk with an underplatform damper (cyclic sector, HB).
+
+Examples::
+
+    damper upd modes --json
+    damper upd frf --cf 120 --f0 30 --harmonics 7 --band 400 500 --json --plot out/upd
+    damper upd frf --damper stuck --json
+    damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def register(sub) -> None:
+    p = sub.add_parser("upd", help="bladed disk with an underplatform damper (UPD-24 default)",
+                       description=__doc__.split("\n\n")[0])
+    s = p.add_subparsers(dest="upd_command", metavar="ACTION")
+    s.required = True
+    m = s.add_parser("modes", help="free and stuck natural frequencies per nodal diameter")
+    _common(m)
+    m.set_defaults(func=run_modes)
+    f = s.add_parser("frf", help="forced response of the EO excitation (nonlinear or linear limits)")
+    _common(f)
+    f.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
+    f.add_argument("--f0", type=float, help="EO force amplitude on the airfoil [N] (default: config)")
+    f.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (0..H kept)")
+    f.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="band [Hz]")
+    f.add_argument("--points", type=int, default=200, help="frequency points")
+    f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
+                   help="free: damper removed; stuck: contacts stuck (linear limits)")
+    f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
+    f.set_defaults(func=run_frf)
+    o = s.add_parser("optimize", help="peak response against CF and the optimal load")
+    _common(o)
+    o.add_argument("--cf-range", type=float, nargs=2, default=(30.0, 3000.0), metavar=("LO", "HI"))
+    o.add_argument("--points", type=int, default=20, help="number of CF values (log-spaced)")
+    o.add_argument("--harmonics", type=int, default=7)
+    o.add_argument("--grid", type=int, default=40, help="frequency points per curve")
+    o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
+    o.set_defaults(func=run_optimize)
+
+
+def _common(p) -> None:
+    p.add_argument("--config", help="UPD model TOML (default: the bundled UPD-24)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def _sector(args):
+    from harmonic_balance.bladed_disk.config import load_config
+    from harmonic_balance.bladed_disk.sector import Sector
+
+    return Sector(load_config(args.config))
+
+
+def run_modes(args) -> int:
+    from harmonic_balance.bladed_disk.sector import modes_table
+
+    from .common import print_json
+
+    tab = modes_table(_sector(args))
+    if args.json:
+        print_json(tab)
+        return 0
+    print("ND  free modes [Hz]                     stuck modes [Hz] (first 3)")
+    for nd, fr, st in zip(tab["nodal_diameter"], tab["free_hz"], tab["stuck_hz"]):
+        print(f"{nd:2d}  {' '.join(f'{v:9.2f}' for v in fr[:3])}   {' '.join(f'{v:9.2f}' for v in st[:3])}")
+    return 0
+
+
+def run_frf(args) -> int:
+    from .common import print_json
+
+    sector = _sector(args)
+    cfg = sector.cfg
+    band = args.band or cfg["load.band_hz"]
+    if not (0 < band[0] < band[1]) or args.points < 3 or args.harmonics < 1:
+        raise ValueError("--band needs 0 < LO < HI, --points >= 3, --harmonics >= 1")
+    for name in ("cf", "f0"):
+        v = getattr(args, name)
+        if v is not None and not (np.isfinite(v) and v > 0):
+            raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v}")
+    omegas = 2 * np.pi * np.linspace(band[0], band[1], args.points)
+    if args.damper == "nonlinear":
+        out = _frf_nonlinear(sector, args, omegas)
+    else:
+        out = _frf_linear(sector, args, omegas)
+    if args.plot:
+        _plot_frf(out, args.plot)
+    if args.json:
+        print_json(out)
+    else:
+        print(f"peak {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
+              f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
+    return 0
+
+
+def _frf_linear(sector, args, omegas) -> dict:
+    import time
+
+    from harmonic_balance.bladed_disk.sector import U_A, linear_response, peak_of
+
+    t0 = time.perf_counter()
+    f0 = args.f0 or sector.cfg.f0
+    U = linear_response(sector, omegas, args.damper, f0)[:, U_A]
+    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, U_A]),
+                   omegas[0], omegas[-1], len(omegas))
+    return {"damper": args.damper, "frequency_hz": (omegas / (2 * np.pi)).tolist(),
+            "amplitude": np.abs(U).tolist(), "amplitude_max": np.abs(U).tolist(),
+            "peak_frequency_hz": w / (2 * np.pi), "peak_amplitude": a,
+            "time_s": time.perf_counter() - t0}
+
+
+def _frf_nonlinear(sector, args, omegas) -> dict:
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.solve import energy_balance, frf
+
+    hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
+    c = frf(hb, omegas)
+    summ = hb.contact_summary(c.peak_x)
+    return {"damper": "nonlinear", "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
+            "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
+            "amplitude_max": c.amplitude_max.tolist(),
+            "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
+            "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
+            "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
+            "static_normal_load": hb.static["N"].tolist(),
+            "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
+            "evaluations": c.evaluations, "time_s": c.time_s}
+
+
+def run_optimize(args) -> int:
+    from harmonic_balance.bladed_disk.optimize import optimal_load
+
+    from .common import print_json
+
+    out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid)
+    if args.plot:
+        _plot_optimize(out, args.plot)
+    if args.json:
+        print_json(out)
+    else:
+        print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
+              f"({out['method']}, {out['time_s']:.1f} s)")
+    return 0
+
+
+def _figure():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _plot_frf(out, out_dir) -> None:
+    from pathlib import Path
+
+    from harmonic_balance.plots import _save
+
+    plt = _figure()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(out["frequency_hz"], np.array(out["amplitude"]) * 1e3, label="first harmonic")
+    ax.plot(out["frequency_hz"], np.array(out["amplitude_max"]) * 1e3, "--", label="max |u_a(t)|")
+    ax.set_xlabel("frequency [Hz]")
+    ax.set_ylabel("airfoil amplitude [mm]")
+    ax.set_title(f"UPD sector, damper {out['damper']}")
+    ax.legend()
+    fig.tight_layout()
+    _save(fig, Path(out_dir) / "upd_frf.png")
+    plt.close(fig)
+
+
+def _plot_optimize(out, out_dir) -> None:
+    from pathlib import Path
+
+    from harmonic_balance.plots import _save
+
+    plt = _figure()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(out["cf"], np.array(out["peak_amplitude"]) * 1e3, "o-")
+    ax.loglog([out["optimum_cf"]], [out["optimum_peak_amplitude"] * 1e3], "r*", ms=12)
+    ax.set_xlabel("centrifugal load CF [N]")
+    ax.set_ylabel("peak amplitude [mm]")
+    ax.set_title("optimal-load curve")
+    fig.tight_layout()
+    _save(fig, Path(out_dir) / "upd_optimize.png")
+    plt.close(fig)

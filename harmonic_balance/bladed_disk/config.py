@@ -1,0 +1,182 @@
+"""Configuration of a bladed disk with underplatform dampers (UPD), read from TOML.
+
+The bundled default ``upd24.toml`` ("UPD-24") documents every key with its unit
+(SI). A user file may give any subset of the keys; the others keep the default.
+
+Symbols (used in the whole subpackage)
+--------------------------------------
+N_b blades, EO engine order, phi = 2 pi EO / N_b interblade phase [rad];
+g face angle [rad]; k_n, k_t normal / tangential contact stiffness of a contact
+point [N/m]; mu friction coefficient; CF centrifugal load on the damper [N];
+F0 amplitude of the EO force on the airfoil DOF u_a [N]; beta, beta_c structural and
+contact stiffness-proportional damping [s].
+"""
+from __future__ import annotations
+
+import copy
+import tomllib
+from dataclasses import dataclass
+from math import gcd
+from pathlib import Path
+
+import numpy as np
+
+#: The bundled default model.
+DEFAULT_CONFIG = Path(__file__).with_name("upd24.toml")
+
+
+@dataclass
+class ContactPoint:
+    """One contact point of the damper (body-fixed, small rotation).
+
+    Attributes
+    ----------
+    name : str
+    r : (2,) array     position from the damper's centre of mass G [m]
+    n : (2,) array     unit normal: force direction on the damper
+    t : (2,) array     unit tangent
+    kn, kt : float     normal and tangential stiffness [N/m]
+    neighbour : bool   True when the point touches blade j+1's platform
+    """
+
+    name: str
+    r: np.ndarray
+    n: np.ndarray
+    t: np.ndarray
+    kn: float
+    kt: float
+    neighbour: bool
+
+
+@dataclass
+class UPDConfig:
+    """Numbers of a UPD bladed-disk model (SI units); see ``upd24.toml``."""
+
+    data: dict
+
+    # ------------------------------------------------------------ access
+    def __getitem__(self, key: str):
+        section, _, name = key.partition(".")
+        return self.data[section][name]
+
+    @property
+    def blades(self) -> int:
+        return int(self["disk.blades"])
+
+    @property
+    def engine_order(self) -> int:
+        return int(self["disk.engine_order"])
+
+    @property
+    def phi(self) -> float:
+        """Interblade phase 2 pi EO / N_b [rad]."""
+        return 2.0 * np.pi * self.engine_order / self.blades
+
+    @property
+    def ring_blades(self) -> int:
+        """N_r = N_b / gcd(N_b, EO): the shortest ring that carries the EO pattern."""
+        return self.blades // gcd(self.blades, self.engine_order)
+
+    @property
+    def cf(self) -> float:
+        return float(self["load.cf"])
+
+    @property
+    def f0(self) -> float:
+        return float(self["load.f0"])
+
+    @property
+    def mu(self) -> float:
+        return float(self["damper.mu"])
+
+    def with_values(self, **changes) -> UPDConfig:
+        """Copy with ``section__key=value`` changes, e.g. ``load__cf=60``."""
+        data = copy.deepcopy(self.data)
+        for k, v in changes.items():
+            sec, _, name = k.partition("__")
+            data[sec][name] = v
+        out = UPDConfig(data)
+        out.validate()
+        return out
+
+    def contact_points(self) -> list[ContactPoint]:
+        """The cylinder line on blade j and the flat's two end points on blade j+1.
+
+        Normals and tangents of the face angle g (x towards blade j+1, y outward):
+        left n = (sin g, -cos g), t = (cos g, sin g); right n = (-sin g, -cos g),
+        t = (cos g, -sin g). The flat's end points sit at its centre -/+ width / 2
+        along t_R, each with half the flat's stiffness.
+        """
+        d = self.data["damper"]
+        g = np.radians(float(d["angle_deg"]))
+        s, c = np.sin(g), np.cos(g)
+        kn = float(d["kn_per_length"]) * float(d["contact_length"])
+        kt = float(d["kt_ratio"]) * kn
+        nL, tL = np.array([s, -c]), np.array([c, s])
+        nR, tR = np.array([-s, -c]), np.array([c, -s])
+        rc = np.asarray(d["right_centre"], dtype=float)
+        half = 0.5 * float(d["right_width"])
+        return [ContactPoint("left", np.asarray(d["left_point"], float), nL, tL, kn, kt, False),
+                ContactPoint("right1", rc - half * tR, nR, tR, kn / 2, kt / 2, True),
+                ContactPoint("right2", rc + half * tR, nR, tR, kn / 2, kt / 2, True)]
+
+    # ------------------------------------------------------------ checks
+    def validate(self) -> None:
+        """Raise ValueError with a message naming the key when a value is unusable."""
+        positive = ["blade.m_r", "blade.m_p", "blade.m_a", "blade.k_g", "blade.k_rp", "blade.k_v",
+                    "blade.k_pa", "damper.m_d", "damper.I_d", "damper.contact_length",
+                    "damper.kn_per_length", "damper.kt_ratio", "load.f0"]
+        nonneg = ["blade.k_c", "blade.beta", "damper.beta_c", "damper.mu", "load.cf",
+                  "damper.right_width", "damper.R_d"]
+        for key in positive + nonneg:
+            try:
+                v = float(self[key])
+            except (KeyError, TypeError, ValueError):
+                raise ValueError(f"config: {key} missing or not a number") from None
+            if not np.isfinite(v) or v < 0 or (key in positive and v == 0):
+                raise ValueError(f"config: {key} = {v} must be finite and "
+                                 f"{'> 0' if key in positive else '>= 0'}")
+        nb, eo = self["disk.blades"], self["disk.engine_order"]
+        if not (isinstance(nb, int) and isinstance(eo, int)) or nb < 2 or not 0 <= eo <= nb // 2:
+            raise ValueError(f"config: disk.blades = {nb} must be an integer >= 2 and "
+                             f"disk.engine_order = {eo} an integer in 0..blades/2")
+        g = float(self["damper.angle_deg"])
+        if not 0.0 < g < 90.0:
+            raise ValueError(f"config: damper.angle_deg = {g} must lie in (0, 90)")
+        for key in ("damper.left_point", "damper.right_centre"):
+            p = np.asarray(self[key], dtype=float)
+            if p.shape != (2,) or not np.all(np.isfinite(p)):
+                raise ValueError(f"config: {key} must be two finite numbers [x, y] in metres")
+
+
+def load_config(path=None) -> UPDConfig:
+    """Read a UPD config; keys missing from ``path`` keep the UPD-24 defaults.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        TOML file; None gives the bundled UPD-24.
+
+    Raises
+    ------
+    ValueError
+        Unreadable file, unknown section or key, or an unusable value.
+    """
+    data = tomllib.loads(DEFAULT_CONFIG.read_text())
+    if path is not None:
+        path = Path(path)
+        try:
+            user = tomllib.loads(path.read_text())
+        except (OSError, tomllib.TOMLDecodeError) as err:
+            raise ValueError(f"cannot read config {path}: {err}") from None
+        for sec, table in user.items():
+            if sec not in data or not isinstance(table, dict):
+                raise ValueError(f"config {path}: unknown section [{sec}] "
+                                 f"(known: {', '.join(data)})")
+            for k, v in table.items():
+                if k not in data[sec]:
+                    raise ValueError(f"config {path}: unknown key {sec}.{k}")
+                data[sec][k] = v
+    cfg = UPDConfig(data)
+    cfg.validate()
+    return cfg

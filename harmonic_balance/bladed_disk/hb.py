@@ -1,0 +1,212 @@
+"""Nonlinear harmonic balance of one UPD sector under cyclic symmetry.
+
+The sector is a standard :class:`~harmonic_balance.model.Model` solved by the package's
+:class:`~harmonic_balance.residual.FullResidual` (harmonics 0..H):
+
+* linear part: M, K_struct(0) (blade with the hub spring k_g), C = beta K_struct(0);
+* the rim coupling: a cyclic :class:`~harmonic_balance.forces.LinearElement`
+  (q = u_r - u_r of blade j+1, stiffness k_c, dashpot beta k_c), which adds
+  k_g + 2 k_c (1 - cos h phi) per harmonic, so the structure is K_struct(h phi)
+  with damping beta K_struct(h phi);
+* one :class:`~harmonic_balance.contact.ContactElement` per contact point (penalty
+  normal spring with lift-off, the C core's Jenkins element with slip force mu N,
+  dashpots beta_c k_n, beta_c k_t), its kinematics from :class:`~.sector.Sector`
+  (the flat's points with ``Q_next`` on blade j+1's platform and phase phi);
+* forcing: F0 on the harmonic-1 cosine of u_a, CF on the mean of y_d.
+
+The sliders start at the frictionless (mu = 0) prestress state
+(:func:`~harmonic_balance.contact.frictionless_statics`, which sets each contact's
+``slip_ref``): a loop that never slips is k_t (s - s_static).
+
+Time samples: n_t is a multiple of N_r = N_b / gcd(N_b, EO), so phi is a whole number
+of samples and the neighbour's sampled history equals blade j's shifted exactly.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..contact import ContactElement, frictionless_statics
+from ..forces import LinearElement
+from ..fourier import FourierBasis, default_samples
+from ..kinematics import Kinematics, phase_operator
+from ..linear import LinearModel
+from ..model import Model
+from ..residual import FullResidual
+from .sector import N_DOF, PLATFORM, U_A, Y_D, Sector
+
+
+def sector_basis(sector: Sector, H: int, n_t: int = 0) -> FourierBasis:
+    """Basis with harmonics 0..H and n_t a multiple of N_r (exact neighbour samples)."""
+    nr = sector.cfg.ring_blades
+    n_t = n_t or default_samples(H)
+    if n_t % nr:
+        n_t = int(np.ceil(n_t / nr)) * nr
+    return FourierBasis(tuple(range(H + 1)), n_t)
+
+
+def neighbour_map(basis: FourierBasis, psi: float) -> np.ndarray:
+    """Coefficients (n_b, n_b) of u(theta + psi) from those of u(theta)."""
+    return phase_operator(basis, psi)
+
+
+def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: int | None = None):
+    """ContactElements of one damper (cylinder line + the flat's two end points).
+
+    Their kinematics are the sector's rows of slip and penetration (``Sector.Q``, the
+    only copy of the contact geometry), local order [s, p].
+
+    Parameters
+    ----------
+    sector : Sector
+    mu : float
+    offset : int
+        First DOF of the sector (blade j) in the model (7 j in a ring).
+    next_offset : int or None
+        First DOF of blade j+1 in a ring model; None: cyclic sector (blade j+1 through
+        ``Q_next`` and the phase phi).
+    """
+    els = []
+    for i, c in enumerate(sector.points):
+        rows = sector.Q[[2 * i + 1, 2 * i]]  # local q = [s, p] (ContactElement order)
+        own, nxt = rows[:, :N_DOF], rows[:, N_DOF:]  # nxt: blade j+1's (u_p, v_p)
+        if not c.neighbour:
+            kin = Kinematics(offset + np.arange(N_DOF), own)
+        elif next_offset is None:
+            Qn = np.zeros_like(own)
+            Qn[:, list(PLATFORM)] = nxt
+            kin = Kinematics(np.arange(N_DOF), own, Q_next=Qn, phase=sector.cfg.phi)
+        else:
+            dofs = np.r_[offset + np.arange(N_DOF), next_offset + np.array(PLATFORM)]
+            kin = Kinematics(dofs, np.hstack([own, nxt]))
+        els.append(ContactElement.jenkins(kin, c.kn, c.kt, mu, beta_c=sector.beta_c, name=c.name))
+    return els
+
+
+def sector_model(sector: Sector, cf: float, f0: float, mu: float) -> Model:
+    """The cyclic sector as a Model (module docstring)."""
+    K0 = sector.K_struct(0.0)
+    lin = LinearModel(M=sector.M, C=sector.beta * K0, K=K0)
+    kc = float(sector.cfg["blade.k_c"])
+    rim = LinearElement(Kinematics([0], [[1.0]], Q_next=[[-1.0]], phase=sector.cfg.phi),
+                        [[kc]], [[sector.beta * kc]], name="rim")
+    f_static, f_eo = np.zeros(N_DOF), np.zeros(N_DOF, dtype=complex)
+    f_static[Y_D], f_eo[U_A] = cf, f0
+    return Model(lin, [rim] + contact_elements(sector, mu), {0: f_static, 1: f_eo}, U_A)
+
+
+class SectorHB:
+    """HB residual of the UPD sector with its exact Jacobian, and its outputs.
+
+    Parameters
+    ----------
+    sector : Sector
+    H : int            highest harmonic (0..H retained)
+    cf, f0 : float     centrifugal load and EO force amplitude [N] (default: config)
+    mu : float         friction coefficient (default: config)
+    n_t : int          AFT samples (rounded up to a multiple of N_r)
+    """
+
+    blades = 1
+
+    def __init__(self, sector: Sector, H: int = 7, cf=None, f0=None, mu=None, n_t: int = 0):
+        cfg = sector.cfg
+        self.sector, self.H = sector, int(H)
+        self.cf = cfg.cf if cf is None else float(cf)
+        self.f0 = cfg.f0 if f0 is None else float(f0)
+        self.mu = cfg.mu if mu is None else float(mu)
+        if not (np.isfinite(self.cf) and self.cf > 0 and np.isfinite(self.f0) and self.f0 > 0):
+            raise ValueError(f"CF and F0 must be finite and > 0, got CF={self.cf}, F0={self.f0}")
+        if not (np.isfinite(self.mu) and self.mu >= 0):
+            raise ValueError(f"mu must be finite and >= 0, got {self.mu}")
+        self.basis = sector_basis(sector, self.H, n_t)
+        self.model = self._build_model()
+        self.x_static, _ = frictionless_statics(self.model, apply=True)
+        self.contacts = [i for i, e in enumerate(self.model.elements) if isinstance(e, ContactElement)]
+        self.residual = FullResidual(self.model, self.basis)
+        self.nb, self.ndof = self.basis.nb, self.model.n
+        self.size = self.residual.size
+        self.evaluations = 0
+
+    def _build_model(self) -> Model:
+        return sector_model(self.sector, self.cf, self.f0, self.mu)
+
+    @property
+    def points(self):
+        return [self.model.elements[i] for i in self.contacts]
+
+    @property
+    def static(self) -> dict:
+        """Frictionless prestress: q (n,) [m], N (n_c,) normal loads [N], s (n_c,) slips [m]."""
+        N, s = [], []
+        for el in self.points:
+            kin = el.kinematics
+            Q = kin.Q + kin.Q_next if kin.cyclic else kin.Q
+            q = Q @ self.x_static[list(kin.dofs)]
+            N.append(el.k_n * max(el.preload + q[-1], 0.0))
+            s.append(q[0])
+        return {"q": self.x_static, "N": np.array(N), "s": np.array(s)}
+
+    def set_f0(self, f0: float) -> None:
+        """Change the EO force amplitude (start homotopies) [N]."""
+        self.f0 = float(f0)
+        self.model.forcing[1] = self._eo_forcing()
+        self.residual = FullResidual(self.model, self.basis)
+
+    def _eo_forcing(self) -> np.ndarray:
+        f = np.zeros(self.ndof, dtype=complex)
+        f[U_A] = self.f0
+        return f
+
+    @property
+    def Fext(self) -> np.ndarray:
+        return self.residual.Fext.ravel()
+
+    def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
+        """R (size,), dR/dx (size, size), dR/domega (size,)."""
+        self.evaluations += 1
+        return self.residual(x, omega, jac)
+
+    # ------------------------------------------------------------ starts
+    def static_guess(self) -> np.ndarray:
+        """The prestress state in the mean, no vibration."""
+        x = np.zeros((self.nb, self.ndof))
+        x[self.basis.index(0)[0]] = self.x_static
+        return x.ravel()
+
+    def stuck_guess(self, omega: float) -> np.ndarray:
+        """Prestress mean + the linear stuck response at harmonic 1 (a Newton start)."""
+        from .sector import linear_response
+
+        x = self.static_guess().reshape(self.nb, self.ndof)
+        U = linear_response(self.sector, [omega], "stuck", self.f0)[0]
+        ic, isn = self.basis.index(1)
+        for j in range(self.blades):
+            Uj = U * np.exp(1j * j * self.sector.cfg.phi)
+            x[ic, N_DOF * j:N_DOF * (j + 1)], x[isn, N_DOF * j:N_DOF * (j + 1)] = Uj.real, -Uj.imag
+        return x.ravel()
+
+    # ------------------------------------------------------------ outputs
+    def response(self, x: np.ndarray, dof: int = U_A) -> np.ndarray:
+        return x.reshape(self.nb, self.ndof)[:, dof]
+
+    def amplitude_h1(self, x, omega=None) -> float:
+        """First-harmonic magnitude of u_a [m]."""
+        return float(self.basis.magnitude(self.response(x), 1))
+
+    def amplitude_max(self, x, omega=None) -> float:
+        """max |u_a(t) - mean| over the period [m]."""
+        c = self.response(x).copy()
+        c[self.basis.index(0)[0]] = 0.0
+        return self.basis.peak_abs(c)
+
+    def contact_summary(self, x: np.ndarray, omega: float = 0.0) -> dict:
+        """Per contact point: mean and range of N [N], lift-off fraction of the period,
+        friction energy per cycle of the sampled loop [J]."""
+        res = self.residual.evaluate(x, omega, jac=False)
+        lf = [res[i] for i in self.contacts]
+        N = np.column_stack([r.f[:, -1] for r in lf])
+        return {"names": [e.name for e in self.points],
+                "normal_load_mean": N.mean(axis=0).tolist(),
+                "normal_load_range": np.ptp(N, axis=0).tolist(),
+                "lift_off": (N <= 0.0).mean(axis=0).tolist(),
+                "friction_energy": [r.W - r.W_viscous for r in lf]}

@@ -1,0 +1,197 @@
+"""Cyclic sector of a tuned bladed disk with one underplatform damper per sector.
+
+Sector DOFs ``q`` (index: name): 0 u_r rim tangential, 1 u_p platform tangential,
+2 v_p platform radial, 3 u_a airfoil first-bending modal DOF (tangential), 4 x_d,
+5 y_d, 6 theta_d (damper j, between blade j and blade j+1). The contact kinematics
+also use blade j+1's platform (u_p', v_p'), so the *extended* vector is
+``q_ext = [q, u_p', v_p']`` (9 entries).
+
+Cyclic symmetry (symbols in :mod:`config`): blade j+1's harmonic-h complex amplitude
+is exp(i h phi) times blade j's, so per harmonic ``q_ext = S(h phi) q`` with
+``S(psi)`` (9, 7) the identity on q and exp(i psi) on the neighbour's platform rows.
+The rim springs k_c to both neighbours give k_g + 2 k_c (1 - cos h phi) on u_r.
+
+Contact kinematics (small rotation, rigid damper): the damper point at r from G
+moves by (x_d - theta_d r_y, y_d + theta_d r_x); its displacement relative to the
+platform it touches is Delta; penetration p = -n . Delta, slip s = t . Delta.
+``Q`` (2 n_c, 9) stacks the rows of p and s per contact point (rows 2c, 2c + 1), so
+the stuck contact stiffness is ``S^H Q^T diag(k) Q S`` and a contact force pair
+(N, f_t) enters the internal force as ``Q^T [N, f_t]`` (virtual work of
+V = k_n p^2 / 2 + k_t (s - z)^2 / 2).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from .config import UPDConfig
+
+DOF_NAMES = ("u_r", "u_p", "v_p", "u_a", "x_d", "y_d", "theta_d")
+N_DOF = 7
+#: Sector indices of the blade DOFs, the damper DOFs and the platform DOFs.
+BLADE, DAMPER, PLATFORM = (0, 1, 2, 3), (4, 5, 6), (1, 2)
+U_A, Y_D = 3, 5
+
+
+@dataclass
+class Sector:
+    """Linear matrices and contact kinematics of one sector.
+
+    Attributes
+    ----------
+    cfg : UPDConfig
+    M : (7, 7) array          mass [kg, kg m^2]
+    points : list of ContactPoint
+    Q : (2 n_c, 9) array      rows of penetration p and slip s per contact point
+    k : (2 n_c,) array        stiffness of each row (k_n, k_t per point) [N/m]
+    """
+
+    cfg: UPDConfig
+
+    def __post_init__(self):
+        b, d = self.cfg.data["blade"], self.cfg.data["damper"]
+        self.M = np.diag([b["m_r"], b["m_p"], b["m_p"], b["m_a"], d["m_d"], d["m_d"],
+                          d["I_d"]]).astype(float)
+        self.points = self.cfg.contact_points()
+        rows, k = [], []
+        for c in self.points:
+            J = np.zeros((2, 9))  # Delta = J q_ext
+            J[:, 4:6] = np.eye(2)
+            J[:, 6] = (-c.r[1], c.r[0])
+            cols = (7, 8) if c.neighbour else PLATFORM
+            J[0, cols[0]] -= 1.0
+            J[1, cols[1]] -= 1.0
+            rows += [-c.n @ J, c.t @ J]
+            k += [c.kn, c.kt]
+        self.Q = np.array(rows)
+        self.k = np.array(k, dtype=float)
+
+    @property
+    def n_contacts(self) -> int:
+        return len(self.points)
+
+    @property
+    def beta(self) -> float:
+        return float(self.cfg["blade.beta"])
+
+    @property
+    def beta_c(self) -> float:
+        return float(self.cfg["damper.beta_c"])
+
+    def K_struct(self, psi: float) -> np.ndarray:
+        """Structural stiffness (7, 7) [N/m] at phase psi between neighbours (no contacts)."""
+        b = self.cfg.data["blade"]
+        K = np.zeros((N_DOF, N_DOF))
+        K[0, 0] = b["k_g"] + 2.0 * b["k_c"] * (1.0 - np.cos(psi))
+        for i, j, kk in ((0, 1, b["k_rp"]), (1, 3, b["k_pa"])):
+            K[i, i] += kk
+            K[j, j] += kk
+            K[i, j] -= kk
+            K[j, i] -= kk
+        K[2, 2] += b["k_v"]
+        return K
+
+    def S(self, psi: float) -> np.ndarray:
+        """Extension (9, 7) complex: q_ext = S q for phase psi of blade j+1."""
+        S = np.zeros((9, N_DOF), dtype=complex)
+        S[:N_DOF, :N_DOF] = np.eye(N_DOF)
+        S[7, 1] = S[8, 2] = np.exp(1j * psi)
+        return S
+
+    def K_contact(self, psi: float, normal_only: bool = False) -> np.ndarray:
+        """Stuck contact stiffness (7, 7) complex Hermitian at phase psi [N/m]
+        (only the normal springs with ``normal_only``)."""
+        QS = self.Q @ self.S(psi)
+        k = self.k.copy()
+        if normal_only:
+            k[1::2] = 0.0
+        return QS.conj().T @ (k[:, None] * QS)
+
+    def matrices(self, psi: float, damper: str):
+        """(M, K, C) at phase psi for ``damper`` = 'free' (removed, blade DOFs only),
+        'stuck' (contacts stuck) or 'sliding' (mu = 0: normal springs only).
+
+        C = beta K_struct + beta_c K_contact (the contact dashpots act on both
+        directions in every state, so 'sliding' keeps the tangential ones).
+        """
+        Ks = self.K_struct(psi)
+        if damper == "free":
+            ix = np.ix_(BLADE, BLADE)
+            return self.M[ix], Ks[ix], self.beta * Ks[ix]
+        if damper not in ("stuck", "sliding"):
+            raise ValueError(f"damper must be 'free', 'stuck' or 'sliding', got {damper!r}")
+        Kc = self.K_contact(psi)
+        Kk = Kc if damper == "stuck" else self.K_contact(psi, normal_only=True)
+        return self.M, Ks + Kk, self.beta * Ks + self.beta_c * Kc
+
+    def forcing(self, f0: float, damper: str = "stuck") -> np.ndarray:
+        """Complex amplitude of the EO force on blade j (F0 on u_a), shape (7,) or (4,)."""
+        f = np.zeros(4 if damper == "free" else N_DOF, dtype=complex)
+        f[U_A] = f0
+        return f
+
+
+def natural_frequencies(sector: Sector, nd: int, damper: str) -> np.ndarray:
+    """Undamped natural frequencies [Hz] at nodal diameter nd, ascending.
+
+    The complex Hermitian eigenproblem K(phi) v = w^2 M v with phi = 2 pi nd / N_b.
+    """
+    M, K, _ = sector.matrices(2.0 * np.pi * nd / sector.cfg.blades, damper)
+    w2 = sla.eigh(K, M, eigvals_only=True)
+    return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * np.pi)
+
+
+def modes_table(sector: Sector) -> dict:
+    """Free and stuck natural frequencies [Hz] for every nodal diameter 0..N_b/2."""
+    nds = list(range(sector.cfg.blades // 2 + 1))
+    return {"nodal_diameter": nds,
+            "free_hz": [natural_frequencies(sector, nd, "free").tolist() for nd in nds],
+            "stuck_hz": [natural_frequencies(sector, nd, "stuck").tolist() for nd in nds]}
+
+
+def linear_response(sector: Sector, omegas, damper: str, f0: float | None = None) -> np.ndarray:
+    """Complex first-harmonic amplitudes (n_omega, n_dof) of the linear limit, direct solve.
+
+    (K(phi) + i omega C(phi) - omega^2 M) U = F, phi the EO interblade phase.
+    """
+    f0 = sector.cfg.f0 if f0 is None else f0
+    M, K, C = sector.matrices(sector.cfg.phi, damper)
+    F = sector.forcing(f0, damper)
+    return np.array([np.linalg.solve(K + 1j * w * C - w * w * M, F) for w in np.atleast_1d(omegas)])
+
+
+def modal_response(sector: Sector, omegas, damper: str, f0: float | None = None) -> np.ndarray:
+    """The same amplitudes by complex modal superposition of the first-order system.
+
+    State z = [u, u']: A z' = B z + [F, 0] with A = [[C, M], [M, 0]], B = [[-K, 0], [0, M]];
+    A^-1 B = V diag(lambda) V^-1 and z = V (i omega - lambda)^-1 V^-1 A^-1 [F, 0].
+    Independent of :func:`linear_response` (one eigendecomposition, no frequency solve).
+    """
+    f0 = sector.cfg.f0 if f0 is None else f0
+    M, K, C = sector.matrices(sector.cfg.phi, damper)
+    n = M.shape[0]
+    Z = np.zeros_like(M, dtype=complex)
+    A = np.block([[C, M], [M, Z]])
+    B = np.block([[-K, Z], [Z, M]])
+    lam, V = sla.eig(np.linalg.solve(A, B))
+    F = np.concatenate([sector.forcing(f0, damper), np.zeros(n)])
+    g = np.linalg.solve(V, np.linalg.solve(A, F))
+    return np.array([(V @ (g / (1j * w - lam)))[:n] for w in np.atleast_1d(omegas)])
+
+
+def peak_of(f_fun, lo: float, hi: float, n: int = 400) -> tuple[float, float]:
+    """Frequency [rad/s] and value of the maximum of a scalar f_fun(omega) on [lo, hi].
+
+    Grid, then Brent's bounded search in the best grid cell.
+    """
+    from scipy.optimize import minimize_scalar
+
+    grid = np.linspace(lo, hi, n)
+    vals = np.array([f_fun(w) for w in grid])
+    i = int(np.argmax(vals))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, n - 1)]
+    res = minimize_scalar(lambda w: -f_fun(w), bounds=(a, b), method="bounded",
+                          options={"xatol": 1e-10 * hi})
+    return float(res.x), float(-res.fun)

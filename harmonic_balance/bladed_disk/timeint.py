@@ -1,0 +1,129 @@
+"""Time-integration reference: the ring of N_r blades marched to its periodic steady state.
+
+Explicit central differences (as :mod:`harmonic_balance.timeint`), vectorised over the
+frequencies of a curve (state (n_f, n))::
+
+    (M / dt^2 + C / (2 dt)) x_(n+1) = f(t_n) - K x_n - f_c(x_n)
+                                      + M (2 x_n - x_(n-1)) / dt^2 + C x_(n-1) / (2 dt)
+
+Contact forces from the ring's ContactElements (:class:`.ring.RingHB`, the same
+elements as the HB): N = k_n max(p, 0) (C1 of :mod:`harmonic_balance.contact`) and the
+friction of each element's C-core Jenkins element stepped with its own history at
+that N (``IwanElement.step_batch``: one call per element type per step, all
+frequencies and contact points at once; ContactElement.stepper is one state per call),
+dashpots in C. Start: the frictionless prestress state at rest, the
+sliders virgin there (tangential input s - s_static), the same convention as the HB.
+No Fourier series and no periodicity assumption. Steady state: the first harmonic of
+u_a of every blade, period by period; stops when its change, extrapolated
+geometrically (transient ~ rho^p), is below ``tol`` of the amplitude.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .ring import RingHB
+from .sector import N_DOF, U_A, Y_D, Sector
+
+#: Fraction of the stability limit 2 / omega_max of the stuck ring.
+CFL = 0.5
+
+
+def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int = 0,
+               max_periods: int = 3000, tol: float = 1e-6) -> dict:
+    """Steady first-harmonic amplitude of u_a (blade 0) at each frequency [rad/s].
+
+    Returns
+    -------
+    dict: amplitude (n_f,) [m], amplitude_blades (n_f, N_r), phase_steps (n_f, N_r) [rad]
+    (blade j+1 minus blade j, should all be phi), periods, settle_error (n_f,)
+    (extrapolated remaining change, relative), steps_per_period, converged (n_f,).
+    """
+    cfg = sector.cfg
+    cf = cfg.cf if cf is None else float(cf)
+    f0 = cfg.f0 if f0 is None else float(f0)
+    ring = RingHB(sector, 1, cf=cf, f0=f0)  # the ring's model, its contacts and prestress
+    lin, n, nr = ring.model.linear, ring.ndof, ring.blades
+    c = _contact_arrays(ring)
+    M, K = lin.M, lin.K
+    C = lin.C + c["C"]
+    omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
+    nf = omegas.size
+    Kst = K + c["K_stuck"]
+    w_max = np.sqrt(np.max(np.linalg.eigvals(np.linalg.solve(M, Kst)).real))
+    ns = steps_per_period or int(np.ceil(2 * np.pi / omegas.min() / (CFL * 2 / w_max)))
+    dt = 2 * np.pi / omegas / ns  # (nf,)
+    Ainv = np.array([np.linalg.inv(M / h**2 + C / (2 * h)) for h in dt])
+    x = np.tile(ring.x_static, (nf, 1))
+    xm = x.copy()
+    Qp, Qs, kn, s0 = c["Qp"], c["Qs"], c["kn"], c["s0"]
+    N_static = kn * np.maximum(x[0] @ Qp.T, 0.0)
+    groups = c["groups"]
+    states = [el.initial_states(nf * len(idx), np.tile(N_static[idx], nf)) for el, idx in groups]
+    fext = np.zeros((nf, n))
+    fext[:, Y_D::N_DOF] = cf
+    phase = cfg.phi * np.arange(nr)
+    ua = np.arange(nr) * N_DOF + U_A
+    theta = 2 * np.pi * np.arange(ns) / ns
+    hist = np.empty((ns, nf, nr))
+    prev, deltas, periods = None, [], 0
+    est = np.full(nf, np.inf)
+    out = {"steps_per_period": ns, "dt": dt}
+    while periods < max_periods:
+        periods += 1
+        for i in range(ns):
+            P = x @ Qp.T
+            N = kn * np.maximum(P, 0.0)
+            S = x @ Qs.T - s0
+            ft = np.empty_like(S)
+            for (el, idx), sts in zip(groups, states):
+                # unclamped k_n p: the C core treats N <= 0 as lift-off (as ContactElement)
+                ft[:, idx] = el.step_batch(sts, S[:, idx].ravel(),
+                                           (kn[idx] * P[:, idx]).ravel())[0].reshape(nf, -1)
+            fc = N @ Qp + ft @ Qs
+            fext[:, ua] = f0 * np.cos(theta[i] + phase)
+            rhs = (fext - x @ K.T - fc + (2 * x - xm) @ M.T / dt[:, None] ** 2
+                   + xm @ C.T / (2 * dt[:, None]))
+            xm, x = x, np.einsum("fij,fj->fi", Ainv, rhs)
+            hist[i] = x[:, ua]
+        H1 = 2.0 / ns * (np.exp(-1j * theta) @ hist.reshape(ns, -1)).reshape(nf, nr)
+        if prev is not None:
+            deltas.append(np.abs(H1 - prev).max(axis=1) / np.abs(H1).max(axis=1))
+            if len(deltas) >= 3:
+                d = np.array(deltas[-3:])
+                rho = np.clip(d[-1] / np.maximum(d[-2], 1e-300), 0.0, 0.999)
+                est = d[-1] * rho / (1 - rho)
+                if np.all((est < tol) & (d[-1] < tol)):
+                    out.update(converged=np.ones(nf, bool), settle_error=est)
+                    break
+        prev = H1
+    else:
+        out.update(converged=np.zeros(nf, bool), settle_error=est)
+    amp = np.abs(H1)
+    out.update(amplitude=amp[:, 0], amplitude_blades=amp, periods=periods,
+               phase_steps=np.angle(H1[:, (np.arange(nr) + 1) % nr] / H1))
+    return out
+
+
+def _contact_arrays(ring: RingHB) -> dict:
+    """The ring's ContactElements as arrays: rows of s and p (n_c, n), k_n, slip_ref,
+    stuck stiffness and dashpots on the structure, and the C elements grouped by k_t
+    (one batched call per group per step)."""
+    n = ring.ndof
+    Qs, Qp, kn, s0 = [], [], [], []
+    Kst, Cd = np.zeros((n, n)), np.zeros((n, n))
+    by_kt = {}
+    for i, el in enumerate(ring.points):
+        kin = el.kinematics
+        rows = np.zeros((2, n))
+        rows[:, list(kin.dofs)] = kin.Q
+        Qs.append(rows[0])
+        Qp.append(rows[1])
+        kn.append(el.k_n)
+        s0.append(el.slip_ref)
+        Kst += rows.T @ el.stuck_stiffness() @ rows
+        if el.local_damping() is not None:
+            Cd += rows.T @ el.local_damping() @ rows
+        by_kt.setdefault(el.k_t, (el.friction, []))[1].append(i)
+    groups = [(f, np.array(idx)) for f, idx in by_kt.values()]
+    return {"Qs": np.array(Qs), "Qp": np.array(Qp), "kn": np.array(kn), "s0": np.array(s0),
+            "K_stuck": Kst, "C": Cd, "groups": groups}

@@ -1,0 +1,45 @@
+"""damper upd: JSON keys of the issue's interface, linear limits, optimal-load curve."""
+import json
+
+import numpy as np
+import pytest
+
+from damper.cli import main
+
+
+def _run(argv, capsys):
+    assert main(["upd", *argv]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_frf_json_keys(capsys, tmp_path):
+    out = _run(["frf", "--harmonics", "3", "--points", "30", "--band", "420", "470", "--json",
+                "--plot", str(tmp_path)], capsys)
+    for k in ("frequency_hz", "amplitude", "amplitude_max", "peak_frequency_hz", "peak_amplitude",
+              "normal_load_mean", "normal_load_range", "lift_off", "time_s"):
+        assert k in out
+    assert len(out["frequency_hz"]) == len(out["amplitude"]) == 30
+    assert len(out["normal_load_mean"]) == len(out["lift_off"]) == 3
+    # the refined peak is not below the grid's largest value
+    assert out["peak_amplitude"] >= max(out["amplitude"])
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert (tmp_path / "upd_frf.png").exists()
+
+
+def test_frf_linear_limits_and_modes(capsys):
+    modes = _run(["modes", "--json"], capsys)
+    for damper in ("free", "stuck"):
+        out = _run(["frf", "--damper", damper, "--json"], capsys)
+        f_n = modes[f"{damper}_hz"][6][0]  # ND = EO = 6
+        assert out["peak_frequency_hz"] == pytest.approx(f_n, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_optimize_interior_minimum(capsys):
+    """H = 3 on a coarse grid (fast); the default run is H = 7 (README, benchmark)."""
+    out = _run(["optimize", "--cf-range", "30", "3000", "--points", "5", "--harmonics", "3",
+                "--grid", "12", "--json"], capsys)
+    amp = np.array(out["peak_amplitude"])
+    assert out["interior"] and amp.argmin() not in (0, len(amp) - 1)
+    assert out["optimum_peak_amplitude"] <= amp.min() * (1 + 1e-6)
+    assert out["cf"][0] < out["optimum_cf"] < out["cf"][-1]
