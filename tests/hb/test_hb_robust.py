@@ -2,7 +2,7 @@
 
 The full map is examples/bench_hb_robust.py. Here: contact stiffness 1e-3 ... 1e6 k,
 slip force 0.5 of the forcing, sweeps that start below, at and above resonance,
-H = 3: each curve completes over the whole requested range with no tuning (at 1e4 k
+H = 3: each curve completes over the whole requested range with no tuning (at 1e6 k
 and above through restarts in the stick-slip band, reported as gaps).
 """
 import json
