@@ -43,7 +43,8 @@ a stick episode covers only ~4 samples, so fixed-omega Newton from a converged p
 0.001 rad/s away cycles between |R| = 2.1 and 0.46; at n_t = 4096 the same steps
 converge in 7-14 iterations (42 samples in stick). A sweep at n_t = 2048 however turns
 back out of the range at 0.4994 rad/s after 162 points (a fold of the branch or a
-spurious turn, not analysed yet), so the default n_t is unchanged. The full grid (``--full``) was not run (hours on this machine).
+spurious turn, not analysed yet), so the default n_t is unchanged. The full grid
+(``--full``) was not run (hours on this machine).
 """
 from __future__ import annotations
 
