@@ -30,7 +30,11 @@ kt/k        corrector              points  ms/point    gaps (stretches skipped)
 1e4         + fixed-lam fallback   292     19.6        0
 1e6         before                 401     211         26 (0.500-0.550)
 1e6         + fixed-lam fallback   312     414 (*)     gaps remain (0.502-0.55, one 0.516-0.539)
+1e6         + n_t 4096 (8x)        763     316 (*)     0
 ==========  =====================  ======  ==========  ====================================
+
+1e6 k at H = 3 and 7 from 0.5, 1 and 2 rad/s with the 8x grid: 0 gaps (92/45/111 and
+190/57/233 points, 0.8-8.9 s per curve).
 
 (*) under load (the full test suite ran alongside). Cause of the 1e4 gaps: the branch
 crosses kinks of the sampled residual (a slip onset moving to the next AFT sample) and
@@ -41,9 +45,11 @@ parameter (continuation.FIXED_MIN_STEP). Cause of the 1e6 gaps (not fixed): the 
 near 0.5 rad/s sticks several times per period (6 velocity reversals), and at n_t = 512
 a stick episode covers only ~4 samples, so fixed-omega Newton from a converged point
 0.001 rad/s away cycles between |R| = 2.1 and 0.46; at n_t = 4096 the same steps
-converge in 7-14 iterations (42 samples in stick). A sweep at n_t = 2048 however turns
-back out of the range at 0.4994 rad/s after 162 points (a fold of the branch or a
-spurious turn, not analysed yet), so the default n_t is unchanged. The full grid
+converge in 7-14 iterations (42 samples in stick). So compute_frf now gives links at
+least 1e5 times stiffer than the structure 8x the default samples (frf.stiff_samples,
+only when n_t is not given). A sweep at n_t = 2048 (4x) instead turned back out of
+the range at 0.4994 rad/s after 162 points (not analysed). The cost goal (1e6 k no
+worse than 2x soft per point) is NOT met: ~200-300 ms vs 1.35 ms. The full grid
 (``--full``) was not run (hours on this machine).
 """
 from __future__ import annotations
