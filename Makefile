@@ -13,7 +13,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel clean locale
+.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -41,7 +41,7 @@ cbuild: $(CBUILD)/.built
 ctest: cbuild
 	cd $(CBUILD) && ctest --output-on-failure
 
-pytest: $(STAMP) cbuild
+pytest: $(STAMP) cbuild browser
 	OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
 
 lint: $(STAMP)
@@ -62,8 +62,18 @@ locale:
 	  localedef -i de_DE -f UTF-8 $(TEST_LOCALE) && echo "generated locale $(TEST_LOCALE)"; \
 	else echo "note: locale $(TEST_LOCALE) not available (needs root and the locales package): its tests skip"; fi
 
+# The bundled default scene through `damper run`; a second run loads every stage from
+# the cache (.damper_cache) and says so.
 demo: $(STAMP)
-	$(PY) examples/demo.py --out out
+	$(VENV)/bin/damper run examples/scenes/default.toml --out out
+
+# Headless Chromium for the HTML-report test, best effort: installed with apt-get when
+# we are root on Debian; otherwise the test skips and says why.
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	  { [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
+	    (apt-get update -qq && apt-get install -y -qq chromium) >/dev/null 2>&1; } || \
+	  echo "note: no chromium (needs root and apt-get): the HTML report browser test will skip"
 
 # Benchmarks print tables (case, size, error, time, memory); long, never in CI.
 # One report of every stage (out/bench/bench.html, bench.json), sparse back ends included.

@@ -22,8 +22,8 @@ import sys
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 #: Subcommand modules, in the order ``damper --help`` lists them.
-SUBCOMMANDS = ("normal", "tangential", "loop", "fmu", "frf", "upd", "backbone", "study", "bench",
-               "stress")
+SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "frf", "backbone", "upd", "study",
+               "bench", "stress")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,105 @@
+"""``damper sweep``: run a scene for several values of its parameters, on Dask.
+
+Examples::
+
+    damper sweep scene.toml --param contact.damper.mu --values 0.3 0.5 0.7
+    damper sweep scene.toml --param contact.damper.force --range 60 180 5 --out out/sweep
+    damper sweep scene.toml --param contact.damper.mu --values 0.3 0.5 \\
+        --param excitation.forces --values '[10]' '[20]'            # a grid of two parameters
+    damper sweep scene.toml --param ... --values ... --scheduler tcp://host:8786
+
+A parameter is a dotted scene key (``contact.NAME.KEY``, ``structure.zeta``, ...).
+``--values`` takes the values (JSON: numbers, lists), ``--range START STOP NUM`` evenly
+spaced numbers; several parameters form a grid (``--zip``: taken in step). Stages
+shared by the variants run once; every variant then runs as one task on a Dask local
+cluster (one worker per core, ``--workers``), an existing cluster (``--scheduler``),
+or in this process (``--serial``). Writes ``sweep.csv``, ``sweep.json`` and
+``sweep.png`` into ``--out``; ``--json`` prints the table as one object.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .cache import add_cache_options, store_from_args
+
+
+class _Ordered(argparse.Action):
+    """Keep --param / --values / --range in the order given (they pair up)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        items = getattr(namespace, "specs", None) or []
+        items.append((self.dest, values))
+        namespace.specs = items
+
+
+def register(subparsers) -> None:
+    """Add the ``sweep`` subcommand."""
+    p = subparsers.add_parser("sweep", help="run a scene over parameter values (Dask)", description=__doc__,
+                              formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("scene")
+    p.add_argument("--param", action=_Ordered, dest="param", metavar="KEY", help="dotted scene key")
+    p.add_argument("--values", action=_Ordered, dest="values", nargs="+", metavar="V")
+    p.add_argument("--range", action=_Ordered, dest="range", nargs=3, metavar=("START", "STOP", "NUM"))
+    p.add_argument("--zip", action="store_true", help="take the parameters' values in step, not as a grid")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default out/sweep_<scene name>)")
+    p.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler")
+    p.add_argument("--workers", type=int, default=None, help="local cluster workers (default: cores)")
+    p.add_argument("--serial", action="store_true", help="no Dask: run the tasks in this process")
+    p.add_argument("--json", action="store_true", help="print the table as one JSON object")
+    add_cache_options(p)
+    p.set_defaults(func=run, specs=None)
+
+
+def specs_from(items) -> list[tuple[str, list]]:
+    """[(param, values)] from the ordered --param/--values/--range items."""
+    import numpy as np
+
+    from damper.sweep import parse_value
+
+    out, name = [], None
+    for kind, v in items or []:
+        if kind == "param":
+            if name is not None:
+                raise ValueError(f"--param {name} has no --values or --range")
+            name = v
+            continue
+        if name is None:
+            raise ValueError(f"--{kind} must follow a --param")
+        if kind == "values":
+            out.append((name, [parse_value(t) for t in v]))
+        else:
+            try:
+                a, b, n = float(v[0]), float(v[1]), int(v[2])
+            except ValueError:
+                raise ValueError(f"--range needs START STOP NUM (numbers, NUM an integer), got {v}") from None
+            if n < 1:
+                raise ValueError(f"--range NUM must be >= 1, got {n}")
+            out.append((name, [float(x) for x in np.linspace(a, b, n)]))
+        name = None
+    if name is not None:
+        raise ValueError(f"--param {name} has no --values or --range")
+    return out
+
+
+def run(args) -> int:
+    from damper.sweep import run_sweep
+
+    from .common import print_json
+
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    specs = specs_from(args.specs)
+    store = store_from_args(args)
+    out = args.out if args.out is not None else Path("out") / f"sweep_{Path(args.scene).stem}"
+    echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
+    rec = run_sweep(args.scene, specs, store, out, grid=not args.zip, scheduler=args.scheduler,
+                    workers=args.workers, serial=args.serial, echo=echo)
+    if args.json:
+        print_json(rec.to_json())
+    else:
+        for row in rec.rows:
+            print("  ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
+        print(f"results in {out}/ (sweep.csv, sweep.json, sweep.png); shared stages: {', '.join(rec.shared) or 'none'}")
+    return 0

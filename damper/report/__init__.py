@@ -1,0 +1,1 @@
+"""Reports of runs: the one-page HTML report (:mod:`.html`)."""

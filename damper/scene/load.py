@@ -1,0 +1,247 @@
+"""Read and validate a scene once, before anything is computed.
+
+Every error names the key (dotted path), the file and its line, and what to change;
+all problems of a file are reported together (:class:`SceneError`, a ValueError: the
+CLI exits with code 2).
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import schema
+from .lines import key_lines, line_of
+
+
+class SceneError(ValueError):
+    """A scene that cannot run; ``problems`` lists (key path, message) pairs."""
+
+    def __init__(self, source: str, problems: list[tuple[str, int | None, str]]):
+        self.source = source
+        self.problems = problems
+        text = "; ".join(f"{source}:{line or '?'}: {key}: {msg}" if key else f"{source}: {msg}"
+                         for key, line, msg in problems)
+        super().__init__(text)
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene.
+
+    Attributes
+    ----------
+    source : str
+        The file (or a label) it came from.
+    raw : dict
+        The TOML as written (after overrides), for sweeps and provenance.
+    data : dict
+        Validated, with defaults filled in and derived values (a contact's ``radius``
+        from ``diameter``, ``E2``/``nu2`` from ``E``/``nu``, each contact's ``want``).
+    """
+
+    source: str
+    raw: dict
+    data: dict
+
+    @property
+    def want(self) -> list[str]:
+        return list(self.data["want"])
+
+    def hash(self) -> str:
+        """SHA-256 (16 hex digits) of the validated content (comments and layout do not count)."""
+        text = json.dumps(self.data, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def load_scene(path: str | Path, overrides: dict | None = None) -> Scene:
+    """Read, override (``{"contact.damper.mu": 0.3}``) and validate the scene file ``path``."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror}")]) from None
+    return parse_scene(text, str(path), overrides, base=path.parent)
+
+
+def parse_scene(text: str, source: str = "<scene>", overrides: dict | None = None,
+                base: str | Path | None = None) -> Scene:
+    """Validate the scene TOML ``text`` (``source`` names it in messages; files it names are
+    relative to ``base``, default the working directory)."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise SceneError(source, [("", None, f"not valid TOML: {err}")]) from None
+    lines = key_lines(text)
+    raw = copy.deepcopy(raw)
+    for key, value in (overrides or {}).items():
+        set_path(raw, key, value, source)
+    problems: list[tuple[tuple, str]] = []
+    data = _validate(raw, problems, Path(base) if base is not None else Path.cwd())
+    if problems:
+        raise SceneError(source, [(".".join(map(str, p)), line_of(lines, p), m) for p, m in problems])
+    return Scene(source, raw, data)
+
+
+def set_path(raw: dict, dotted: str, value, source: str = "<scene>") -> None:
+    """Set ``raw[a][b][c] = value`` for ``dotted = "a.b.c"``; the key must be a schema key."""
+    parts = dotted.split(".")
+    fields = _fields_of(parts)
+    if fields is None:
+        raise SceneError(source, [(dotted, None, "not a scene parameter (see damper.scene.schema)")])
+    node = raw
+    for p in parts[:-1]:
+        node = node.setdefault(p, {})
+        if not isinstance(node, dict):
+            raise SceneError(source, [(dotted, None, f"{p!r} is not a table")])
+    node[parts[-1]] = value
+
+
+def _fields_of(parts: list[str]):
+    if len(parts) == 1:
+        return schema.TOP.get(parts[0])
+    table = schema.TABLES.get(parts[0])
+    if table is None:
+        return None
+    fields, named = table
+    if named:
+        return fields.get(parts[2]) if len(parts) == 3 else None
+    return fields.get(parts[1]) if len(parts) == 2 else None
+
+
+def _validate(raw: dict, problems: list, base: Path) -> dict:
+    data = _check_fields(raw, schema.TOP, (), problems, skip=set(schema.TABLES))
+    for name, (fields, named) in schema.TABLES.items():
+        if name not in raw:
+            continue
+        table = raw[name]
+        if not isinstance(table, dict):
+            problems.append(((name,), "must be a table"))
+            continue
+        if named:
+            data[name] = {}
+            for item, sub in table.items():
+                if not isinstance(sub, dict):
+                    problems.append(((name, item), f"must be a table [{name}.{item}] of contact options"))
+                    continue
+                data[name][item] = _check_fields(sub, fields, (name, item), problems)
+        else:
+            data[name] = _check_fields(table, fields, (name,), problems)
+    if not problems:
+        _check_contacts(data, problems)
+        _check_structure(data, problems, base)
+        _check_wants(data, problems)
+    return data
+
+
+def _check_structure(data: dict, problems: list, base: Path) -> None:
+    s = data.get("structure")
+    if s is None:
+        return
+    for key in schema.STRUCTURE_NEEDS[s["model"]]:
+        if key not in s:
+            problems.append((("structure", key), f"missing: structure model {s['model']!r} needs it"))
+    unused = [k for k in s if k != "model" and k not in schema.STRUCTURE_NEEDS[s["model"]]]
+    for key in unused:
+        problems.append((("structure", key), f"not used by structure model {s['model']!r}"))
+    if s["model"] == "matrices" and "matrices" in s:
+        path = (base / s["matrices"]).resolve()
+        try:
+            s["matrices_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError as err:
+            problems.append((("structure", "matrices"), f"cannot read {path}: {err.strerror}"))
+        s["matrices"] = str(path)
+        if "element_dofs" in s and len(s["element_dofs"]) not in (1, 2):
+            problems.append((("structure", "element_dofs"), "must be [a] (to the ground) or [a, b]"))
+
+
+def _check_fields(table: dict, fields: dict, path: tuple, problems: list, skip=()) -> dict:
+    out = {}
+    for key, value in table.items():
+        if key in skip:
+            continue
+        f = fields.get(key)
+        if f is None:
+            known = ", ".join(sorted(fields) + sorted(skip))
+            problems.append((path + (key,), f"unknown key (known here: {known})"))
+            continue
+        msg = schema.check_value(f, value)
+        if msg:
+            problems.append((path + (key,), msg))
+        out[key] = value
+    for key, f in fields.items():
+        if key in out:
+            continue
+        if f.required:
+            problems.append((path + (key,), f"missing (required: {f.doc})"))
+        elif f.default is not None:
+            out[key] = copy.deepcopy(f.default)
+    return out
+
+
+def _check_contacts(data: dict, problems: list) -> None:
+    for name, c in data.get("contact", {}).items():
+        path = ("contact", name)
+        for options in schema.BODY_SIZES[c["body"]]:
+            given = [o for o in options if o in c]
+            if not given:
+                problems.append((path + (options[0],), f"missing: body {c['body']!r} needs "
+                                 + " or ".join(repr(o) for o in options)))
+            elif len(given) > 1:
+                problems.append((path + (given[1],), f"give {' or '.join(map(repr, given))}, not both"))
+        if "height" in c and c["body"] != "flat":
+            problems.append((path + ("height",), f"applies to the flat face only, not to {c['body']!r}"))
+        if "diameter" in c and "radius" not in c:
+            c["radius"] = 0.5 * c["diameter"]
+        c.setdefault("zone_load", c["force"])
+        c.setdefault("E2", c["E"])
+        c.setdefault("nu2", c["nu"])
+
+
+def _check_wants(data: dict, problems: list) -> None:
+    wants = data["want"]
+    contacts = data.get("contact", {})
+    for i, w in enumerate(wants):
+        if w in schema.PLANNED:
+            problems.append((("want",), f"item {i}: {w!r}: {schema.PLANNED[w]}"))
+        elif w not in schema.RESULTS:
+            problems.append((("want",), f"item {i}: unknown result {w!r} (known: {', '.join(schema.RESULTS)})"))
+    if problems:
+        return
+    contact_wants = [w for w in wants if schema.RESULTS[w][1]]
+    for name, c in contacts.items():
+        own = c.get("want")
+        if own is not None:
+            bad = [w for w in own if w not in schema.RESULTS or not schema.RESULTS[w][1]]
+            if bad:
+                problems.append((("contact", name, "want"), f"not a contact result: {bad[0]!r} (contact "
+                                 f"results: {', '.join(k for k, v in schema.RESULTS.items() if v[1])})"))
+        c["want"] = list(own) if own is not None else list(contact_wants)
+        if any(schema.RESULTS[w][0] == "tangential" for w in c["want"]) and "mu" not in c:
+            problems.append((("contact", name, "mu"), "missing: needed for "
+                             + ", ".join(w for w in c["want"] if schema.RESULTS[w][0] == "tangential")))
+    if any(schema.RESULTS[w][1] for w in wants) and not contacts:
+        problems.append((("contact",), f"missing: {', '.join(contact_wants)} need at least one [contact.NAME]"))
+    element_wants = [w for w in wants if w in ("loop", "fmu", "frf")]
+    if element_wants:
+        el = data.get("element")
+        if el is None:
+            problems.append((("element",), f"missing: {', '.join(element_wants)} need an [element] table"))
+        elif el["contact"] not in contacts:
+            problems.append((("element", "contact"), f"no contact named {el['contact']!r} (contacts: "
+                             f"{', '.join(contacts) or 'none'})"))
+        elif "mu" not in contacts[el["contact"]] and not any(p == ("contact", el["contact"], "mu")
+                                                              for p, _ in problems):
+            problems.append((("contact", el["contact"], "mu"), f"missing: needed for {', '.join(element_wants)}"))
+        if el is not None and "loop" in wants and "loop_force_amplitude" not in el:
+            problems.append((("element", "loop_force_amplitude"), "missing: needed for loop"))
+    if "frf" in wants:
+        for table in ("structure", "excitation", "sweep"):
+            if table not in data:
+                problems.append(((table,), "missing: needed for frf"))
+        sweep = data.get("sweep")
+        if sweep and not sweep["f_max"] > sweep["f_min"]:
+            problems.append((("sweep", "f_max"), f"must be > f_min = {sweep['f_min']:g} Hz"))

@@ -1,0 +1,196 @@
+"""The scene file's schema: every table, key, type, default and rule, in one place.
+
+A scene (TOML, SI units) is one analysis a user asks for::
+
+    want = ["virgin_curve", "k_t", "loop", "fmu", "frf", "report"]
+
+    [contact.damper]           # one table per contact pair, any name
+    body = "cylinder"          # sphere | cylinder | flat
+    diameter = 5.0e-3          # sphere/cylinder: radius or diameter [m]
+    length = 1.2e-3            # cylinder, flat [m]
+    force = 120.0              # normal load [N] (constant normal force)
+    mu = 0.5                   # needed for virgin_curve, k_t and what follows
+    grid = 21
+    # want = ["k_n"]           # optional: this contact's results (default: the scene's)
+
+    [element]                  # the friction element (loop, fmu, frf)
+    contact = "damper"         # whose virgin curve it is built from
+    loop_force_amplitude = 40.0
+    fmi_versions = [2, 3]
+
+    [structure]                # the forced response (frf)
+    model = "two_dof"          # the bundled 2-DOF blade-damper model (m_tip, m_platform,
+    ...                        # k_blade, k_disk, zeta), or "matrices" (matrices = "file.npz",
+                               # element_dofs = [a] or [a, b])
+    [excitation]
+    forces = [10.0, 20.0]      # tip force amplitudes [N], one curve each
+    [sweep]
+    f_min = 880.0              # [Hz]
+    f_max = 1300.0
+    harmonics = 5
+
+Each field is a :class:`Field`; :data:`RESULTS` names the results ``want`` may
+hold, with the stage kind that produces each and whether it belongs to a contact.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key: its type ("float", "int", "str", "bool", "list[str]", "list[float]",
+    "list[int]"), whether it is required, its default, allowed values, a lower bound
+    (``gt``: strictly greater) and its documentation."""
+
+    type: str
+    doc: str
+    required: bool = False
+    default: object = None
+    choices: tuple = ()
+    gt: float | None = None
+    ge: float | None = None
+    lt: float | None = None
+
+
+#: Results a scene may want: name -> (producing stage kind, per contact?, doc).
+#: The blade-damper results (issue 15) join here with their stage kinds.
+RESULTS = {
+    "k_n": ("normal", True, "normal contact stiffness dN/d(approach), Hertz comparison"),
+    "pressure_map": ("normal", True, "contact pressure map and area plots"),
+    "virgin_curve": ("tangential", True, "virgin curve T(u) to gross slip (curve file)"),
+    "k_t": ("tangential", True, "initial tangential stiffness and stick/slip maps"),
+    "loop": ("loop", False, "steady hysteresis loop and energy per cycle of the element"),
+    "fmu": ("fmu", False, "the friction element as FMI 2.0/3.0 FMUs, validated and run"),
+    "frf": ("frf", False, "forced response of the structure by harmonic balance"),
+    "report": ("report", False, "one-page HTML report of the run"),
+}
+#: Results named by the issues but not built yet: a scene that wants one is refused
+#: with this reason instead of an "unknown result".
+PLANNED = {
+    "backbone": "nonlinear modes (EPMC) are not available in this version",
+    "optimal_load": "the blade-damper optimal-load curve (damper upd optimize) is not available "
+                    "in this version",
+}
+
+BODY_SIZES = {"sphere": (("radius", "diameter"),), "cylinder": (("radius", "diameter"), ("length",)),
+              "flat": (("width",), ("length",))}
+
+CONTACT = {
+    "body": Field("str", "sphere, cylinder or flat face on a plane", required=True,
+                  choices=tuple(BODY_SIZES)),
+    "radius": Field("float", "sphere/cylinder radius [m]", gt=0),
+    "diameter": Field("float", "sphere/cylinder diameter [m] (instead of radius)", gt=0),
+    "length": Field("float", "cylinder length / flat-face length [m]", gt=0),
+    "width": Field("float", "flat-face width [m]", gt=0),
+    "height": Field("float", "flat face: height of the damper body above the face [m] (default max(W, L/2))", gt=0),
+    "E": Field("float", "Young's modulus of body 1 [Pa] (and of the plane unless E2)", default=200e9, gt=0),
+    "nu": Field("float", "Poisson's ratio of body 1 (and of the plane unless nu2)", default=0.3, gt=-1, lt=0.5),
+    "E2": Field("float", "Young's modulus of the plane [Pa]", gt=0),
+    "nu2": Field("float", "Poisson's ratio of the plane", gt=-1, lt=0.5),
+    "model": Field("str", "FE model variant", default="real", choices=("real", "halfspace")),
+    "grid": Field("int", "contact-zone nodes per side", default=21, ge=3),
+    "p_design": Field("float", "design peak pressure sizing the contact zone [Pa]", default=2000e6, gt=0),
+    "force": Field("float", "normal load [N] (constant normal force)", required=True, gt=0),
+    "zone_load": Field("float", "load [N] the potential contact zone is sized to hold besides the design "
+                       "pressure (default: force; 0: design pressure only, as the thesis, App. A.1.2)", ge=0),
+    "mu": Field("float", "friction coefficient", gt=0),
+    "want": Field("list[str]", "this contact's results (default: the scene's contact results)"),
+}
+
+ELEMENT = {
+    "contact": Field("str", "name of the contact whose virgin curve becomes the element", required=True),
+    "loop_force_amplitude": Field("float", "force amplitude of the loop [N]", gt=0),
+    "loop_samples": Field("int", "samples per loop cycle", default=256, ge=4),
+    "fmi_versions": Field("list[int]", "FMI versions of the FMUs", default=[2, 3], choices=(2, 3)),
+}
+
+STRUCTURE = {
+    "model": Field("str", "two_dof: the bundled blade-damper model; matrices: a matrices file",
+                   default="two_dof", choices=("two_dof", "matrices")),
+    "m_tip": Field("float", "two_dof: blade tip mass [kg]", gt=0),
+    "m_platform": Field("float", "two_dof: platform mass [kg]", gt=0),
+    "k_blade": Field("float", "two_dof: blade stiffness tip-platform [N/m]", gt=0),
+    "k_disk": Field("float", "two_dof: disk stiffness platform-ground [N/m]", gt=0),
+    "zeta": Field("float", "two_dof: damping ratio at the first free mode (Rayleigh beta K)", ge=0),
+    "matrices": Field("str", "matrices: the .npz file (harmonic_balance.model's format; relative to the scene)"),
+    "element_dofs": Field("list[int]", "matrices: DOF [a] (to the ground) or [a, b] the element links", ge=0),
+}
+#: Keys each structure model needs.
+STRUCTURE_NEEDS = {"two_dof": ("m_tip", "m_platform", "k_blade", "k_disk", "zeta"),
+                   "matrices": ("matrices", "element_dofs")}
+
+EXCITATION = {
+    "forces": Field("list[float]", "two_dof: tip force amplitudes [N]; matrices: factors on the file's "
+                    "force; one forced response each", required=True, gt=0),
+}
+
+SWEEP = {
+    "f_min": Field("float", "start frequency [Hz]", required=True, gt=0),
+    "f_max": Field("float", "end frequency [Hz]", required=True, gt=0),
+    "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1),
+    "max_step": Field("float", "largest continuation step (scaled arclength)", default=0.1, gt=0),
+}
+
+TOP = {
+    "title": Field("str", "a name for the report", default=""),
+    "want": Field("list[str]", "results wanted", required=True),
+}
+
+#: Tables: name -> (fields, one table per named item?)
+TABLES = {"contact": (CONTACT, True), "element": (ELEMENT, False), "structure": (STRUCTURE, False),
+          "excitation": (EXCITATION, False), "sweep": (SWEEP, False)}
+
+
+@dataclass
+class Problem:
+    """One schema violation: the key path and what is wrong."""
+
+    path: tuple
+    message: str
+    extra: dict = field(default_factory=dict)
+
+
+def check_value(f: Field, value) -> str | None:
+    """What is wrong with ``value`` for ``f`` (None if fine)."""
+    scalar = f.type.removeprefix("list[").removesuffix("]")
+    if f.type.startswith("list["):
+        if not isinstance(value, list):
+            return f"must be a list of {scalar}, got {_kind(value)}"
+        for i, v in enumerate(value):
+            msg = _check_scalar(f, scalar, v)
+            if msg:
+                return f"item {i}: {msg}"
+        return None
+    return _check_scalar(f, scalar, value)
+
+
+def _check_scalar(f: Field, scalar: str, v) -> str | None:
+    if scalar == "float":
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            return f"must be a number, got {_kind(v)} {v!r}"
+        if not math.isfinite(v):
+            return f"must be finite, got {v!r}"
+    elif scalar == "int":
+        if isinstance(v, bool) or not isinstance(v, int):
+            return f"must be an integer, got {_kind(v)} {v!r}"
+    elif scalar == "str":
+        if not isinstance(v, str):
+            return f"must be a string, got {_kind(v)} {v!r}"
+    elif scalar == "bool" and not isinstance(v, bool):
+        return f"must be true or false, got {_kind(v)} {v!r}"
+    if f.choices and v not in f.choices:
+        return f"must be one of {', '.join(map(repr, f.choices))}, got {v!r}"
+    if f.gt is not None and not v > f.gt:
+        return f"must be > {f.gt:g}, got {v!r}"
+    if f.ge is not None and not v >= f.ge:
+        return f"must be >= {f.ge:g}, got {v!r}"
+    if f.lt is not None and not v < f.lt:
+        return f"must be < {f.lt:g}, got {v!r}"
+    return None
+
+
+def _kind(v) -> str:
+    return {dict: "a table", list: "a list", str: "a string", bool: "a boolean",
+            int: "an integer", float: "a number"}.get(type(v), type(v).__name__)

@@ -1,0 +1,26 @@
+"""Progress display: plain lines without a terminal, a redrawn bar with one."""
+import io
+
+from damper.run.progress import Progress
+
+
+def test_plain_lines_when_not_a_terminal():
+    err, out = io.StringIO(), io.StringIO()
+    p = Progress(2, stream=err, out=out)              # StringIO is not a terminal
+    p.start("a", "compute")
+    p.echo("result line")
+    p.finish("a", 1.5)
+    p.close()
+    assert err.getvalue() == "[1/2] a: compute ...\n[1/2] a: done in 1.50 s\n"
+    assert out.getvalue() == "result line\n"
+
+
+def test_live_bar_redraws_in_place():
+    err, out = io.StringIO(), io.StringIO()
+    p = Progress(4, stream=err, out=out, live=True)
+    p.start("tangential:x", "compute")
+    p.finish("tangential:x", 0.1)
+    p.close()
+    text = err.getvalue()
+    assert "\n" not in text and "\r\033[K" in text
+    assert "tangential:x (compute)" in text and "[######..................] 1/4" in text
