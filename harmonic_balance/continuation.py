@@ -30,6 +30,10 @@ TARGET_ITER = 4
 MAX_TURN = 0.35
 #: Scaled step below which a large tangent turn is accepted as a kink of the branch.
 KINK_STEP = 2e-4
+#: Smallest scaled step at which a failed pseudo-arclength corrector is retried at
+#: fixed parameter (below it the fallback only creeps: measured at 1e6 k, 1e-8 rad/s
+#: per point, so the caller's restart is the better way past).
+FIXED_MIN_STEP = 1e-4
 #: Corrector iteration limit inside the continuation (a step is retried smaller).
 CORRECTOR_ITER = 12
 
@@ -98,6 +102,33 @@ class _Scaled:
         res.x = y_pred + res.x
         return res
 
+    def correct_fixed(self, y_pred, max_iter=CORRECTOR_ITER):
+        """Newton on R = 0 at the predicted parameter (natural-parameter corrector), or None.
+
+        Fallback of :meth:`correct`: where the branch crosses a kink of the piecewise-
+        smooth residual (a stiff slider's slip onset moving to the next AFT sample),
+        Newton on the pseudo-arclength system can cycle between the two linear pieces
+        (measured on the Jenkins FRF at 1e4 k near 0.545 rad/s: |R| stuck at 1e-7-1e-3
+        for every step size down to 1e-6) while Newton at fixed parameter from the
+        same predictor converges in 2 iterations. The augmented Jacobian returned
+        carries the plane row ``e_lam`` (only J[:-1] is used by the caller).
+        """
+        lam = y_pred[-1]
+
+        def fixed(d):
+            R, J = self.jac(np.append(y_pred[:-1] + d, lam))
+            return R, J[:, :-1]
+        try:
+            res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter)
+        except NewtonError:
+            return None
+        R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))
+        e = np.zeros(len(y_pred))
+        e[-1] = 1.0
+        res.x = np.append(y_pred[:-1] + res.x, lam)
+        res.J = np.vstack([J, e])
+        return res
+
 
 def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
                  ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000,
@@ -150,7 +181,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
         if t @ t_prev < 0:
             t = -t
-        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn)
+        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn, sign)
         J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
@@ -171,7 +202,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     raise _stop(f"point limit {max_points} reached", branch)
 
 
-def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN):
+def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN, sign=0.0):
     """One accepted predictor-corrector step; shrinks ds until it succeeds."""
     while True:
         try:
@@ -184,6 +215,13 @@ def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN):
             reason = "tangent turned too much"
         except NewtonError as err:
             reason = err.reason
+            # natural-parameter step of the same scaled length from the last point,
+            # towards the end of the range
+            step = np.zeros(len(t))
+            step[-1] = sign or np.sign(t[-1])
+            res = sc.correct_fixed(y + ds * step) if ds >= FIXED_MIN_STEP else None
+            if res is not None and (ds <= KINK_STEP or _turn_ok(sc, res, t, max_turn)):
+                return res.x, res.iterations, ds, res.J[:-1]
         ds *= 0.5
         if ds < ds_min:
             raise _stop(f"step below minimum ({reason})", branch)
