@@ -97,3 +97,62 @@ def plot_backbone(s: dict, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+class OptimalLoad(Kind):
+    """UPD bladed-disk sector: peak response against CF and the optimal load
+    (``harmonic_balance.bladed_disk.optimize.optimal_load``); no contact or FE stage."""
+
+    name = "optimal_load"
+    modules = ("harmonic_balance", "fmu_src")
+
+    def instances(self, data):
+        u = data.get("upd")
+        if u is None:
+            return []
+        params = {k: v for k, v in u.items() if k != "config"}        # the file enters by its hash
+        return [Stage("optimal_load", self, params, products=("optimal_load",),
+                      extra={"config": u.get("config")})]
+
+    def compute(self, stage, inputs, ctx):
+        from harmonic_balance.bladed_disk.config import load_config
+        from harmonic_balance.bladed_disk.optimize import optimal_load
+        from harmonic_balance.bladed_disk.sector import Sector
+
+        p = stage.params
+        out = optimal_load(Sector(load_config(stage.extra["config"])), p["cf_range"], p["points"],
+                           p["harmonics"], grid=p["grid"])
+        with tempfile.TemporaryDirectory() as tmp:
+            plot_optimal_load(out, Path(tmp) / "optimal_load.png")
+            files = collect_files(Path(tmp))
+        return Result(out, files=files)
+
+    def outputs(self, stage, result):
+        return {"optimal_load": "result.json"}
+
+    def lines(self, stage, result):
+        o = result.data
+        return [f"optimum CF {o['optimum_cf']:.4g} N, peak {o['optimum_peak_amplitude']:.5e} m "
+                f"({o['method']}, {o['time_s']:.1f} s)"]
+
+    def scalars(self, stage, result):
+        o = result.data
+        return {"optimum_cf_N": o["optimum_cf"], "optimum_peak_amplitude_m": o["optimum_peak_amplitude"]}
+
+
+def plot_optimal_load(o: dict, path: Path) -> None:
+    """Peak amplitude against CF (log-log) with the optimum marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(o["cf"], np.array(o["peak_amplitude"]) * 1e3, "o-")
+    ax.loglog([o["optimum_cf"]], [o["optimum_peak_amplitude"] * 1e3], "r*", ms=12)
+    ax.set_xlabel("centrifugal load CF [N]")
+    ax.set_ylabel("peak amplitude [mm]")
+    ax.set_title("optimal-load curve (UPD sector)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

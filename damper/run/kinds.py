@@ -5,9 +5,9 @@ results it provides in ``damper.scene.schema.RESULTS``.
 """
 from __future__ import annotations
 
-from .backbone_stages import Backbone
+from .backbone_stages import Backbone, OptimalLoad
 from .contact_stages import Condense, Normal, Tangential
 from .element_stages import FMU, Loop
 from .response_stages import FRF
 
-KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone())
+KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone(), OptimalLoad())

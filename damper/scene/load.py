@@ -133,6 +133,7 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
     if not problems:
         _check_contacts(data, problems)
         _check_structure(data, problems, base)
+        _check_upd(data, problems, base)
         _check_wants(data, problems)
     return data
 
@@ -242,6 +243,9 @@ def _check_wants(data: dict, problems: list) -> None:
             problems.append((("element", "loop_force_amplitude"), "missing: needed for loop"))
     if "backbone" in wants:
         _check_backbone(data, problems)
+    if "optimal_load" in wants and "upd" not in data:
+        problems.append((("upd",), "missing: needed for optimal_load (an empty [upd] table takes the "
+                         "bundled UPD-24 model and the default CF range)"))
     if "frf" in wants:
         for table in ("structure", "excitation", "sweep"):
             if table not in data:
@@ -268,3 +272,20 @@ def _check_backbone(data: dict, problems: list) -> None:
     a = bb["amplitude"]
     if len(a) != 2 or not a[1] > a[0]:
         problems.append((("backbone", "amplitude"), "must be [start, end] with end > start"))
+
+
+def _check_upd(data: dict, problems: list, base: Path) -> None:
+    """The [upd] table: its model file read and hashed (the stage key holds the content)."""
+    u = data.get("upd")
+    if u is None:
+        return
+    lo_hi = u["cf_range"]
+    if len(lo_hi) != 2 or not lo_hi[1] > lo_hi[0]:
+        problems.append((("upd", "cf_range"), "must be [low, high] with high > low"))
+    if "config" in u:
+        path = (base / u["config"]).resolve()
+        try:
+            u["config_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError as err:
+            problems.append((("upd", "config"), f"cannot read {path}: {err.strerror}"))
+        u["config"] = str(path)

@@ -66,14 +66,13 @@ RESULTS = {
     "frf": ("frf", False, "forced response of the structure by harmonic balance"),
     "backbone": ("backbone", False, "nonlinear mode of the structure with the element (EPMC): "
                  "frequency and damping ratio vs modal amplitude"),
+    "optimal_load": ("optimal_load", False, "UPD bladed-disk sector: peak response against the "
+                     "damper's centrifugal load CF and the optimal CF"),
     "report": ("report", False, "one-page HTML report of the run"),
 }
 #: Results named by the issues but not built yet: a scene that wants one is refused
 #: with this reason instead of an "unknown result".
-PLANNED = {
-    "optimal_load": "the blade-damper optimal-load curve (damper upd optimize) is not available "
-                    "in this version",
-}
+PLANNED: dict = {}
 
 BODY_SIZES = {"sphere": (("radius", "diameter"),), "cylinder": (("radius", "diameter"), ("length",)),
               "flat": (("width",), ("length",))}
@@ -149,6 +148,16 @@ BACKBONE = {
 #: Keys each backbone element needs.
 BACKBONE_NEEDS = {"contact": (), "jenkins": ("contact_stiffness", "slip_force")}
 
+UPD = {
+    "config": Field("str", "UPD model TOML (harmonic_balance.bladed_disk's format; relative to the "
+                    "scene; default: the bundled UPD-24)"),
+    "cf_range": Field("list[float]", "[low, high] centrifugal load CF of the damper [N], log-spaced",
+                      default=[30.0, 3000.0], gt=0),
+    "points": Field("int", "number of CF values", default=20, ge=3),
+    "harmonics": Field("int", "highest harmonic", default=7, ge=1),
+    "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3),
+}
+
 TOP = {
     "title": Field("str", "a name for the report", default=""),
     "want": Field("list[str]", "results wanted", required=True),
@@ -156,7 +165,8 @@ TOP = {
 
 #: Tables: name -> (fields, one table per named item?)
 TABLES = {"contact": (CONTACT, True), "element": (ELEMENT, False), "structure": (STRUCTURE, False),
-          "excitation": (EXCITATION, False), "sweep": (SWEEP, False), "backbone": (BACKBONE, False)}
+          "excitation": (EXCITATION, False), "sweep": (SWEEP, False), "backbone": (BACKBONE, False),
+          "upd": (UPD, False)}
 
 
 @dataclass
