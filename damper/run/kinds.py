@@ -1,6 +1,6 @@
 """The stage kinds a scene can use, in the order the plan lists them.
 
-A new kind (the blade-damper ``upd`` stages, ``backbone``) is added here, with the
+A new kind (as ``backbone`` and ``optimal_load`` in :mod:`.backbone_stages`) is added here, with the
 results it provides in ``damper.scene.schema.RESULTS``.
 """
 from __future__ import annotations
