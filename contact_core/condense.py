@@ -102,12 +102,35 @@ def make_grid(spec: ContactSpec, b1: mesh.BodyMesh, b2: mesh.BodyMesh, symmetry:
     return ContactGrid(x=x, y=y, area=area, mult=np.full(x.size, weight), h=h, copies=copies)
 
 
-def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
-    """Run the FE stages; return the arrays and meta of a CondensedContact."""
+#: Arrays every direction's cache entry carries (the contact grid; cheap to store twice).
+GRID_ARRAYS = ("x", "y", "area", "mult", "h", "copies", "rigid")
+
+
+def _blocks(direction: str) -> tuple:
+    """Names of the arrays that belong to one direction's cache entry (besides the grid)."""
+    return (f"C{direction}{direction}_1", f"C{direction}{direction}_2") + (
+        ("probe_C1", "probe_x") if direction == "z" else ())
+
+
+def _build(spec: ContactSpec, directions: tuple, progress=None) -> tuple[dict, dict]:
+    """Run the FE stages for ``directions`` only; return the arrays and meta.
+
+    ``progress(done, total, label)`` is called after the mesh, each body's
+    assembly and each body's condensation in each direction (None: no calls).
+    """
     timings = {"mesh": 0.0, "assembly": 0.0, "condensation": 0.0}
+    total, done = 1 + 2 * (1 + len(directions)), 0
+
+    def step(label):
+        nonlocal done
+        done += 1
+        if progress is not None:
+            progress(done, total, label)
+
     t0 = time.perf_counter()
     b1, b2, meta = mesh.build(spec)
     timings["mesh"] = time.perf_counter() - t0
+    step("mesh")
     sym = meta["symmetry"]
     grid = make_grid(spec, b1, b2, sym)
     arrays = {"x": grid.x, "y": grid.y, "area": grid.area, "mult": grid.mult, "h": grid.h,
@@ -118,6 +141,7 @@ def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
         t0 = time.perf_counter()
         K = assembly.stiffness(body.p, body.t, E, nu)
         timings["assembly"] += time.perf_counter() - t0
+        step(f"assembly body {ib}")
         dofs.append(K.shape[0])
         for d in directions:
             t0 = time.perf_counter()
@@ -127,6 +151,7 @@ def _build(spec: ContactSpec, directions: tuple) -> tuple[dict, dict]:
             else:
                 arrays[f"C{d}{d}_{ib}"] = body_compliance(K, body, d, sym)
             timings["condensation"] += time.perf_counter() - t0
+            step(f"condensation body {ib} {d}")
         del K
     arrays["rigid"] = spec.kind.rigid(grid.x)
     meta.update({"spec": spec.key_dict(), "directions": list(directions), "dofs": dofs,
@@ -144,7 +169,13 @@ def _assemble_result(arrays: dict, meta: dict) -> CondensedContact:
                             probe_x=arrays.get("probe_x"), probe_C1=arrays.get("probe_C1"))
 
 
-def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedContact:
+def direction_key(spec: ContactSpec, direction: str) -> str:
+    """Cache key of one direction's compliance blocks of ``spec`` (each direction is its own
+    entry, so a tangential run after a normal run on the same bodies builds only x)."""
+    return make_key(spec.key_dict(), direction, code_version())
+
+
+def condense(spec: ContactSpec, directions=("z",), cache=None, progress=None) -> CondensedContact:
     """Condensed contact compliance of the pair ``spec``.
 
     Parameters
@@ -156,29 +187,53 @@ def condense(spec: ContactSpec, directions=("z",), cache=None) -> CondensedConta
         None: the default cache folder (``DAMPER_CACHE_DIR`` or ``.damper_cache``);
         False: no cache; a folder: a DiskCache there; an object with
         ``get``/``put`` (e.g. the application's content-addressed store): that.
+        Each direction is stored under its own key (``direction_key``); only the
+        directions missing from the cache are built (the mesh and assembly are
+        redone for them, the cached blocks are loaded).
+    progress : callable(done, total, label) or None
+        Called after each FE step (mesh, assembly and condensation per body and
+        direction) when something is built; None: no calls.
 
     Returns
     -------
     CondensedContact
         ``meta["timings"]`` holds the seconds per stage (mesh, assembly,
-        condensation) or the cache load time; ``meta["cache"]`` the key and hit.
+        condensation; ``cache_load`` when blocks were loaded); ``meta["cache"]``:
+        ``keys`` and ``hits`` per direction (``keys`` are the store entries),
+        ``hit`` (every direction came from the cache), ``key`` (one hash of the
+        per-direction keys, naming the combination) and ``paths`` per direction.
     """
     bad = set(directions) - set(DIRECTIONS)
     if bad:
         raise ValueError(f"unknown direction(s) {sorted(bad)}; use 'z' and/or 'x'")
     directions = tuple(d for d in DIRECTIONS if d in set(directions) | {"z"})
     store = resolve(cache)
-    key = make_key(spec.key_dict(), directions, code_version())
+    keys = {d: direction_key(spec, d) for d in directions}
     t0 = time.perf_counter()
-    hit = store.get(key) if store is not None else None
-    if hit is not None:
-        arrays, meta = hit
-        meta["build_timings"] = meta.get("timings")
-        meta["timings"] = {"cache_load": time.perf_counter() - t0}
-    else:
-        arrays, meta = _build(spec, directions)
+    found = {d: store.get(keys[d]) if store is not None else None for d in directions}
+    load_time = time.perf_counter() - t0
+    missing = tuple(d for d in directions if found[d] is None)
+    arrays, meta = {}, None
+    for d in directions:                     # cached blocks first (DIRECTIONS order: z, x)
+        if found[d] is not None:
+            arrays.update(found[d][0])
+            meta = meta or found[d][1]
+    if missing:
+        built, meta = _build(spec, missing, progress)
+        arrays.update(built)                 # the grid is rebuilt identically (deterministic)
         if store is not None:
-            store.put(key, arrays, meta)
-    meta["cache"] = {"key": key, "hit": hit is not None,
-                     "path": None if store is None else entry_path(store, key)}
+            for d in missing:
+                names = GRID_ARRAYS + tuple(n for n in _blocks(d) if n in built)
+                store.put(keys[d], {n: built[n] for n in names}, meta | {"directions": [d]})
+        if len(missing) < len(directions):
+            meta["timings"]["cache_load"] = load_time
+    else:
+        meta["build_timings"] = meta.get("timings")
+        meta["timings"] = {"cache_load": load_time}
+    meta["directions"] = list(directions)
+    meta["cache"] = {"key": make_key(keys), "keys": keys,
+                     "hits": {d: found[d] is not None for d in directions},
+                     "hit": not missing,
+                     "paths": {d: None if store is None else entry_path(store, keys[d])
+                               for d in directions}}
     return _assemble_result(arrays, meta)

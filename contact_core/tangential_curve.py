@@ -83,9 +83,19 @@ def start_point(problem: TangentialProblem, state: TangentialState) -> Tangentia
     return problem.solve(state, state.delta)[0]
 
 
+#: Resolution of the march's progress reports: ``done`` of ``PROGRESS_TOTAL`` parts of the travel.
+PROGRESS_TOTAL = 100
+
+
 def march(problem: TangentialProblem, state: TangentialState, u_target: float,
-          tol: float = CURVE_TOL, first: TangentialSolution | None = None) -> TangentialPath:
-    """Load monotonically from ``state.delta`` to ``u_target`` with adaptive steps."""
+          tol: float = CURVE_TOL, first: TangentialSolution | None = None,
+          progress=None) -> TangentialPath:
+    """Load monotonically from ``state.delta`` to ``u_target`` with adaptive steps.
+
+    ``progress(done, total, label)``, if given, is called after each accepted load
+    step with the travelled fraction of the displacement as ``done`` of
+    ``PROGRESS_TOTAL`` (the number of steps is not known in advance).
+    """
     u_target = float(u_target)
     if not np.isfinite(u_target):
         raise ValueError(f"tangential displacement must be finite, got {u_target}")
@@ -95,6 +105,7 @@ def march(problem: TangentialProblem, state: TangentialState, u_target: float,
     points, diss = [prev], [0.0]
     sign = 1.0 if u_target >= state.delta else -1.0
     du = MAX_STEP * u_ref
+    u_start, travel = state.delta, abs(u_target - state.delta)
     while sign * (u_target - state.delta) > 0:
         step = min(du, sign * (u_target - state.delta))
         sol, new = problem.solve(state, state.delta + sign * step)
@@ -108,15 +119,19 @@ def march(problem: TangentialProblem, state: TangentialState, u_target: float,
         state, prev = new, sol
         grow = 2.0 if err == 0 else float(np.clip(0.9 * np.sqrt(tol / err), 0.3, 2.0))
         du = min(MAX_STEP * u_ref, max(step * grow, MIN_STEP * u_ref))
+        if progress is not None:
+            done = int(PROGRESS_TOTAL * min(abs(state.delta - u_start) / travel, 1.0))
+            progress(done, PROGRESS_TOTAL, f"load step {len(points) - 1}")
     return TangentialPath(points, np.array(diss), state)
 
 
-def virgin_curve(problem: TangentialProblem, tol: float = CURVE_TOL) -> TangentialPath:
-    """The virgin curve T(u) from the unloaded state to gross slip (T = mu N)."""
+def virgin_curve(problem: TangentialProblem, tol: float = CURVE_TOL, progress=None) -> TangentialPath:
+    """The virgin curve T(u) from the unloaded state to gross slip (T = mu N); ``progress``
+    as in ``march``."""
     if problem.mu <= 0:
         raise ValueError(f"a virgin curve needs mu > 0, got {problem.mu}")
     state = problem.initial_state()
-    return march(problem, state, problem.gross_slip_displacement(state), tol)
+    return march(problem, state, problem.gross_slip_displacement(state), tol, progress=progress)
 
 
 def solve_force(problem: TangentialProblem, state: TangentialState, T_target: float):

@@ -74,15 +74,17 @@ class TangentialRun:
     warnings: list
 
 
-def build_contact(spec: ContactSpec, model: str = "real", cache=None):
-    """Condensed normal and tangential compliance of ``spec`` with ``model``."""
+def build_contact(spec: ContactSpec, model: str = "real", cache=None, progress=None):
+    """Condensed normal and tangential compliance of ``spec`` with ``model`` (``progress``:
+    see ``contact_core.condense.condense``; the BEM model does not report)."""
     if model not in MODELS:
         raise ValueError(f"model must be one of {MODELS}, got {model!r}")
     if model == "bem":
         return halfspace_bem.condense(replace(spec, model="halfspace"), ("z", "x"))
     from contact_core import condense
 
-    return condense.condense(replace(spec, model=model), directions=("z", "x"), cache=cache)
+    return condense.condense(replace(spec, model=model), directions=("z", "x"), cache=cache,
+                             progress=progress)
 
 
 def solve_normal(contact, force: float | None = None, approach: float | None = None,
@@ -106,7 +108,7 @@ def solve_normal(contact, force: float | None = None, approach: float | None = N
 
 def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: float | None = None,
         eccentricity: float | None = None, model: str = "real", cache=None, tol: float = CURVE_TOL,
-        command: str | None = None) -> TangentialRun:
+        command: str | None = None, progress=None) -> TangentialRun:
     """Condense, solve the normal problem, and compute the virgin curve to gross slip.
 
     Parameters
@@ -125,17 +127,20 @@ def run(spec: ContactSpec, mu: float, *, force: float | None = None, approach: f
         Step control of the curve (``contact_core.tangential_curve.CURVE_TOL``).
     command : str, optional
         Command line for the file's provenance.
+    progress : callable(done, total, label), optional
+        Called per FE step of the condensation and per load step of the march
+        (``tangential_curve.march``); None: no calls.
     """
     mu = _check_mu(mu)
     t0 = time.perf_counter()
-    contact = build_contact(spec, model, cache)
+    contact = build_contact(spec, model, cache, progress)
     t1 = time.perf_counter()
     nsol, load_case = solve_normal(contact, force, approach, eccentricity)
     k_n = float(normal.tangent(contact, nsol.active)[0, 0])
     t2 = time.perf_counter()
     problem = TangentialProblem(contact, nsol.f, mu)
     warnings = check_resolution(contact, nsol.f)
-    path = virgin_curve(problem, tol)
+    path = virgin_curve(problem, tol, progress)
     t3 = time.perf_counter()
     curve = to_virgin_curve(path, problem, load_case=load_case, k_n=k_n,
                             geometry=_geometry(spec, model), materials=_materials(spec),

@@ -29,7 +29,8 @@ def test_default_scene_plan_needs_every_stage(tmp_path, capsys):
               "normal:cylinder", "tangential:damper", "loop", "fmu:fmi2", "fmu:fmi3",
               "frf:10N", "frf:20N", "frf:30N", "frf:60N"]
     assert all(acts[n] == "compute" for n in needed)
-    assert sorted(acts) == sorted(needed)                                        # and nothing else
+    # and nothing else: the kinds the scene does not describe (backbone, optimal_load) are idle
+    assert sorted(n for n, a in acts.items() if a != "skip") == sorted(needed)
     assert not list(tmp_path.iterdir())                                           # a dry run computes nothing
 
 

@@ -151,8 +151,11 @@ def _brief(result: dict) -> dict:
 def run(args) -> int:
     """Solve one load case; print, write and plot as asked."""
     from contact_core import api
+    from damper.cache import Store
 
-    cache = False if args.no_cache else args.cache_dir
+    # the application's store (same folder and format as contact_core's DiskCache) keeps
+    # the cache under its size limit ($DAMPER_CACHE_MAX_MB)
+    cache = False if args.no_cache else Store(args.cache_dir)
     if args.stiffness or args.nodes:
         from contact_core import byo
         result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,

@@ -61,29 +61,40 @@ class Condense(Kind):
 
     def is_cached(self, stage, store):
         hit = store.get(stage.key) if store.contains(stage.key) else None
-        return hit is not None and store.contains(hit[1]["data"]["entry"])
+        return hit is not None and all(store.contains(e) for e in _entries(hit[1]["data"]))
 
     def compute(self, stage, inputs, ctx):
         from contact_core.condense import condense
 
-        entry = self._entry(stage, ctx)
-        if entry and stage.name in ctx.forced:
-            ctx.store.delete(entry)           # --force: rebuild the FE matrices
+        if stage.name in ctx.forced:           # --force: rebuild the FE matrices
+            for entry in self._entries(stage, ctx):
+                ctx.store.delete(entry)
         cc = condense(contact_spec(stage.params["body"]), tuple(stage.params["directions"]),
-                      cache=ctx.store)
+                      cache=ctx.store, progress=ctx.progress)
         meta = cc.meta
-        return Result({"entry": meta["cache"]["key"], "hit": meta["cache"]["hit"],
+        # one store entry per direction: the stage is cached only while all of them are
+        return Result({"entries": meta["cache"]["keys"], "hit": meta["cache"]["hit"],
+                       "hits": meta["cache"]["hits"],
                        "timings": meta.get("timings", {}), "dofs": meta.get("dofs"),
                        "solver": meta.get("solver")})
 
-    def _entry(self, stage, ctx):
+    def _entries(self, stage, ctx):
         hit = ctx.store.get(stage.key)
-        return hit[1]["data"]["entry"] if hit else None
+        return _entries(hit[1]["data"]) if hit else []
 
     def lines(self, stage, result):
         d = result.data
-        how = "loaded from the cache" if d["hit"] else "built"
+        hits = d.get("hits", {})
+        how = ("loaded from the cache" if d["hit"] else
+               "built" if not any(hits.values()) else
+               "built " + ", ".join(k for k, v in hits.items() if not v) + "; loaded "
+               + ", ".join(k for k, v in hits.items() if v) + " from the cache")
         return [f"condensed bodies {how} ({', '.join(f'{k} {v:.2f} s' for k, v in d['timings'].items())})"]
+
+
+def _entries(data: dict) -> list:
+    """Store entries of a condense stage's result (one per direction)."""
+    return list(data["entries"].values())
 
 
 def _needs(result_name: str) -> str:
@@ -179,7 +190,7 @@ class Tangential(Kind):
 
         p = stage.params
         run = tangential_run.run(contact_spec(p), p["mu"], force=p["force"], model=p["model"],
-                                 cache=ctx.store,
+                                 cache=ctx.store, progress=ctx.progress,
                                  command=f"damper run {ctx.scene.source} ({stage.name})")
         with tempfile.TemporaryDirectory() as tmp:
             plot_all(run.virgin, run.problem, tmp)

@@ -1,12 +1,13 @@
 """The stage kinds a scene can use, in the order the plan lists them.
 
-A new kind (the blade-damper ``upd`` stages, ``backbone``) is added here, with the
+A new kind (as ``backbone`` and ``optimal_load`` in :mod:`.backbone_stages`) is added here, with the
 results it provides in ``damper.scene.schema.RESULTS``.
 """
 from __future__ import annotations
 
+from .backbone_stages import Backbone, OptimalLoad
 from .contact_stages import Condense, Normal, Tangential
 from .element_stages import FMU, Loop
 from .response_stages import FRF
 
-KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF())
+KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone(), OptimalLoad())

@@ -3,7 +3,10 @@
 The bar counts the plan's stages and shows the running stage with its elapsed time
 (refreshed by a background thread, so a long FE condensation or continuation still
 shows that it is alive). Without a terminal (CI, a pipe, ``--json``) each stage is one
-line when it starts and one when it ends. Summary lines go through :meth:`echo`, which
+line when it starts and one when it ends. Inside a stage the library may report its own
+steps (:meth:`step`, the ``progress(done, total, label)`` callback of ``contact_core``'s
+condensation and tangential march): on a terminal the bar shows the step count and label,
+otherwise one line per quarter of the steps. Summary lines go through :meth:`echo`, which
 clears the bar first so the two never mix.
 """
 from __future__ import annotations
@@ -14,6 +17,8 @@ import time
 
 BAR = 24
 REFRESH_S = 0.2
+#: Plain (non-terminal) step lines: one each time another 1/PLAIN_PARTS of a stage's steps is done.
+PLAIN_PARTS = 4
 
 
 class Progress:
@@ -27,6 +32,7 @@ class Progress:
         self.emit = emit or (lambda text: print(text, file=self.out, flush=True))
         self.live = self.stream.isatty() if live is None else live
         self.current, self.t0 = None, 0.0
+        self.sub = None                      # (done, total, label) of the running stage's steps
         self._lock = threading.Lock()
         self._stop = threading.Event()
         self._thread = None
@@ -34,6 +40,7 @@ class Progress:
     def start(self, name: str, action: str) -> None:
         with self._lock:
             self.current, self.action, self.t0 = name, action, time.perf_counter()
+            self.sub = None
         if self.live:
             if self._thread is None:
                 self._thread = threading.Thread(target=self._loop, daemon=True)
@@ -45,11 +52,23 @@ class Progress:
     def finish(self, name: str, seconds: float) -> None:
         with self._lock:
             self.done += 1
-            self.current = None
+            self.current, self.sub = None, None
         if self.live:
             self._draw()
         else:
             print(f"[{self.done}/{self.total}] {name}: done in {seconds:.2f} s", file=self.stream, flush=True)
+
+    def step(self, done: int, total: int, label: str = "") -> None:
+        """A step inside the running stage (the libraries' ``progress`` callback)."""
+        with self._lock:
+            before = self.sub[0] if self.sub and self.sub[1] == total else 0
+            self.sub = (done, total, label)
+        if self.live:
+            self._draw()
+        elif PLAIN_PARTS * done // max(total, 1) > PLAIN_PARTS * before // max(total, 1):
+            print(f"    {self.current or ''}: {done}/{total} {label}", file=self.stream, flush=True)
+
+    __call__ = step
 
     def echo(self, text: str) -> None:
         """Print a result line (above the bar on a terminal)."""
@@ -75,6 +94,8 @@ class Progress:
             text = f"[{'#' * filled}{'.' * (BAR - filled)}] {self.done}/{self.total}"
             if self.current:
                 text += f"  {self.current} ({self.action}) {time.perf_counter() - self.t0:5.1f} s"
+                if self.sub:
+                    text += f"  {self.sub[0]}/{self.sub[1]} {self.sub[2]}"
             self.stream.write("\r\033[K" + text)
             self.stream.flush()
 

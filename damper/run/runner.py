@@ -32,6 +32,8 @@ class Context:
     store: Store
     scene: object
     forced: set = field(default_factory=set)
+    #: ``progress(done, total, label)`` for steps inside a stage (the libraries' callback), or None
+    progress: object = None
 
 
 @dataclass
@@ -77,7 +79,7 @@ def print_plan(plan: Plan, echo) -> None:
 def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progress) -> RunRecord:
     """Compute or load every stage of ``plan`` in order; write the output folder if ``out``."""
     rec = RunRecord(scene, plan, out=Path(out) if out is not None else None)
-    ctx = Context(store, scene, {s.name for s in plan.stages if s.forced})
+    ctx = Context(store, scene, {s.name for s in plan.stages if s.forced}, progress.step)
     rec.provenance = record(scene=scene.source, scene_hash=scene.hash(), scene_content=scene.raw,
                             cache=str(store.folder.resolve()))
     try:

@@ -133,6 +133,7 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
     if not problems:
         _check_contacts(data, problems)
         _check_structure(data, problems, base)
+        _check_upd(data, problems, base)
         _check_wants(data, problems)
     return data
 
@@ -225,7 +226,9 @@ def _check_wants(data: dict, problems: list) -> None:
                              + ", ".join(w for w in c["want"] if schema.RESULTS[w][0] == "tangential")))
     if any(schema.RESULTS[w][1] for w in wants) and not contacts:
         problems.append((("contact",), f"missing: {', '.join(contact_wants)} need at least one [contact.NAME]"))
-    element_wants = [w for w in wants if w in ("loop", "fmu", "frf")]
+    bb = data.get("backbone")
+    element_wants = [w for w in wants if w in ("loop", "fmu", "frf")
+                     or (w == "backbone" and bb is not None and bb["element"] == "contact")]
     if element_wants:
         el = data.get("element")
         if el is None:
@@ -238,6 +241,11 @@ def _check_wants(data: dict, problems: list) -> None:
             problems.append((("contact", el["contact"], "mu"), f"missing: needed for {', '.join(element_wants)}"))
         if el is not None and "loop" in wants and "loop_force_amplitude" not in el:
             problems.append((("element", "loop_force_amplitude"), "missing: needed for loop"))
+    if "backbone" in wants:
+        _check_backbone(data, problems)
+    if "optimal_load" in wants and "upd" not in data:
+        problems.append((("upd",), "missing: needed for optimal_load (an empty [upd] table takes the "
+                         "bundled UPD-24 model and the default CF range)"))
     if "frf" in wants:
         for table in ("structure", "excitation", "sweep"):
             if table not in data:
@@ -245,3 +253,39 @@ def _check_wants(data: dict, problems: list) -> None:
         sweep = data.get("sweep")
         if sweep and not sweep["f_max"] > sweep["f_min"]:
             problems.append((("sweep", "f_max"), f"must be > f_min = {sweep['f_min']:g} Hz"))
+
+
+def _check_backbone(data: dict, problems: list) -> None:
+    """The [backbone] table and the [structure] it needs; keys of the other element refused."""
+    bb = data.get("backbone")
+    for table in ("structure", "backbone"):
+        if table not in data:
+            problems.append(((table,), "missing: needed for backbone"))
+    if bb is None:
+        return
+    for key in schema.BACKBONE_NEEDS[bb["element"]]:
+        if key not in bb:
+            problems.append((("backbone", key), f"missing: backbone element {bb['element']!r} needs it"))
+    for key in set().union(*schema.BACKBONE_NEEDS.values()) - set(schema.BACKBONE_NEEDS[bb["element"]]):
+        if key in bb:
+            problems.append((("backbone", key), f"not used by backbone element {bb['element']!r}"))
+    a = bb["amplitude"]
+    if len(a) != 2 or not a[1] > a[0]:
+        problems.append((("backbone", "amplitude"), "must be [start, end] with end > start"))
+
+
+def _check_upd(data: dict, problems: list, base: Path) -> None:
+    """The [upd] table: its model file read and hashed (the stage key holds the content)."""
+    u = data.get("upd")
+    if u is None:
+        return
+    lo_hi = u["cf_range"]
+    if len(lo_hi) != 2 or not lo_hi[1] > lo_hi[0]:
+        problems.append((("upd", "cf_range"), "must be [low, high] with high > low"))
+    if "config" in u:
+        path = (base / u["config"]).resolve()
+        try:
+            u["config_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
+        except OSError as err:
+            problems.append((("upd", "config"), f"cannot read {path}: {err.strerror}"))
+        u["config"] = str(path)

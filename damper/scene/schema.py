@@ -64,15 +64,15 @@ RESULTS = {
     "loop": ("loop", False, "steady hysteresis loop and energy per cycle of the element"),
     "fmu": ("fmu", False, "the friction element as FMI 2.0/3.0 FMUs, validated and run"),
     "frf": ("frf", False, "forced response of the structure by harmonic balance"),
+    "backbone": ("backbone", False, "nonlinear mode of the structure with the element (EPMC): "
+                 "frequency and damping ratio vs modal amplitude"),
+    "optimal_load": ("optimal_load", False, "UPD bladed-disk sector: peak response against the "
+                     "damper's centrifugal load CF and the optimal CF"),
     "report": ("report", False, "one-page HTML report of the run"),
 }
 #: Results named by the issues but not built yet: a scene that wants one is refused
 #: with this reason instead of an "unknown result".
-PLANNED = {
-    "backbone": "nonlinear modes (EPMC) are not available in this version",
-    "optimal_load": "the blade-damper optimal-load curve (damper upd optimize) is not available "
-                    "in this version",
-}
+PLANNED: dict = {}
 
 BODY_SIZES = {"sphere": (("radius", "diameter"),), "cylinder": (("radius", "diameter"), ("length",)),
               "flat": (("width",), ("length",))}
@@ -133,6 +133,31 @@ SWEEP = {
     "max_step": Field("float", "largest continuation step (scaled arclength)", default=0.1, gt=0),
 }
 
+BACKBONE = {
+    "element": Field("str", "contact: the [element] built from its contact's virgin curve (runs the "
+                     "contact stages); jenkins: a Jenkins element (contact_stiffness, slip_force), no "
+                     "contact stage", default="contact", choices=("contact", "jenkins")),
+    "contact_stiffness": Field("float", "jenkins: stick stiffness of the element [N/m]", gt=0),
+    "slip_force": Field("float", "jenkins: slip force of the element [N]", gt=0),
+    "amplitude": Field("list[float]", "[start, end] mass-normalised modal amplitude [m sqrt(kg)]; "
+                       "start small (the start is the stuck linear mode)", required=True, gt=0),
+    "harmonics": Field("int", "harmonics 0..H retained", default=3, ge=1),
+    "mode": Field("int", "mode of the stuck linear system (0-based)", default=0, ge=0),
+    "samples": Field("int", "AFT samples per period (0: automatic)", default=0, ge=0),
+}
+#: Keys each backbone element needs.
+BACKBONE_NEEDS = {"contact": (), "jenkins": ("contact_stiffness", "slip_force")}
+
+UPD = {
+    "config": Field("str", "UPD model TOML (harmonic_balance.bladed_disk's format; relative to the "
+                    "scene; default: the bundled UPD-24)"),
+    "cf_range": Field("list[float]", "[low, high] centrifugal load CF of the damper [N], log-spaced",
+                      default=[30.0, 3000.0], gt=0),
+    "points": Field("int", "number of CF values", default=20, ge=3),
+    "harmonics": Field("int", "highest harmonic", default=7, ge=1),
+    "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3),
+}
+
 TOP = {
     "title": Field("str", "a name for the report", default=""),
     "want": Field("list[str]", "results wanted", required=True),
@@ -140,7 +165,8 @@ TOP = {
 
 #: Tables: name -> (fields, one table per named item?)
 TABLES = {"contact": (CONTACT, True), "element": (ELEMENT, False), "structure": (STRUCTURE, False),
-          "excitation": (EXCITATION, False), "sweep": (SWEEP, False)}
+          "excitation": (EXCITATION, False), "sweep": (SWEEP, False), "backbone": (BACKBONE, False),
+          "upd": (UPD, False)}
 
 
 @dataclass

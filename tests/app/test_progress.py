@@ -24,3 +24,12 @@ def test_live_bar_redraws_in_place():
     text = err.getvalue()
     assert "\n" not in text and "\r\033[K" in text
     assert "tangential:x (compute)" in text and "[######..................] 1/4" in text
+
+
+def test_live_bar_shows_the_steps_inside_a_stage():
+    err = io.StringIO()
+    p = Progress(1, stream=err, out=io.StringIO(), live=True)
+    p.start("condense:c:zx", "compute")
+    p.step(3, 7, "assembly body 2")
+    p.close()
+    assert "condense:c:zx (compute)" in err.getvalue() and "3/7 assembly body 2" in err.getvalue()

@@ -43,7 +43,6 @@ def _line(text: str, needle: str) -> int:
     (("[structure]", "[structure_x]"), "structure_x", "[structure_x]", "unknown key"),
     (("zeta = 0.002", "zeta = -0.1"), "structure.zeta", "zeta = -0.1", "must be >= 0"),
     (('"report"]', '"report", "k_x"]'), "want", "want =", "unknown result 'k_x'"),
-    (('"report"]', '"report", "backbone"]'), "want", "want =", "not available"),
     (('contact = "damper"', 'contact = "other"'), "element.contact", 'contact = "other"', "no contact named"),
     (("f_max = 1300.0", "f_max = 800.0"), "sweep.f_max", "f_max = 800.0", "must be > f_min"),
     (("forces = [30.0]", "forces = [30.0, -1]"), "excitation.forces", "forces =", "item 1: must be > 0"),

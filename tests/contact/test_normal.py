@@ -166,6 +166,7 @@ def test_cache_returns_identical_results(contact_cache):
     first = condense(spec, cache=contact_cache)
     again = condense(spec, cache=contact_cache)
     assert again.meta["cache"]["hit"] and again.meta["cache"]["key"] == first.meta["cache"]["key"]
+    assert again.meta["cache"]["hits"] == {"z": True} and first.meta["cache"]["hits"] == {"z": False}
     assert np.array_equal(first.Czz, again.Czz) and np.array_equal(first.grid.h, again.grid.h)
     fresh = condense(spec, cache=False)
     assert not fresh.meta["cache"]["hit"]

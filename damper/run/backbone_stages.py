@@ -1,0 +1,158 @@
+"""The backbone stage: nonlinear mode of the structure with the friction element (EPMC).
+
+The structure is the scene's ``[structure]`` (the 2-DOF blade-damper model or a matrices
+file; its excitation is ignored, a nonlinear mode is a free motion); the element is either
+the scene's ``[element]`` (built from its contact's virgin curve, so the plan runs the
+contact stages) or a Jenkins element given in ``[backbone]`` (no contact or FE stage).
+"""
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .contact_stages import collect_files
+from .element_stages import curve_of
+from .graph import Kind, Result, Stage
+from .response_stages import matrices_model, two_dof_model
+
+#: Continuation points at most per backbone (``compute_backbone``'s default).
+MAX_POINTS = 2000
+
+
+class Backbone(Kind):
+    """Backbone (frequency and damping ratio vs modal amplitude) by ``harmonic_balance.epmc``."""
+
+    name = "backbone"
+    modules = ("harmonic_balance", "fmu_src", "contact_core.curve")
+
+    def instances(self, data):
+        bb, s = data.get("backbone"), data.get("structure")
+        if not (bb and s) or (bb["element"] == "contact" and "element" not in data):
+            return []
+        deps = (f"tangential:{data['element']['contact']}",) if bb["element"] == "contact" else ()
+        structure = {k: v for k, v in s.items() if k != "matrices"}     # the file enters by its hash
+        return [Stage("backbone", self, {"structure": structure, "backbone": bb}, deps=deps,
+                      products=("backbone",), extra={"matrices": s.get("matrices")})]
+
+    def compute(self, stage, inputs, ctx):
+        from fmu_src.element import IwanElement
+        from harmonic_balance.epmc import EPMCError, compute_backbone
+
+        p, bb = stage.params, stage.params["backbone"]
+        if bb["element"] == "contact":
+            element = IwanElement.from_virgin_curve(curve_of(inputs[stage.deps[0]]))
+        else:
+            element = IwanElement.jenkins(bb["contact_stiffness"], bb["slip_force"])
+        # a Model needs an excitation; EPMC ignores it (a nonlinear mode is a free motion)
+        if p["structure"]["model"] == "two_dof":
+            model = two_dof_model(p["structure"], 1.0, element)
+        else:
+            model = matrices_model(stage.extra["matrices"], p["structure"]["element_dofs"], 1.0, element)
+        try:
+            result = compute_backbone(model, str(bb["harmonics"]), bb["amplitude"], n_t=bb["samples"],
+                                      mode=bb["mode"], max_points=MAX_POINTS)
+        except EPMCError as err:
+            raise RuntimeError(f"{err} ({err.result.a.size} points kept)") from None
+        summary = result.summary()
+        with tempfile.TemporaryDirectory() as tmp:
+            plot_backbone(summary, Path(tmp) / "backbone.png")
+            files = collect_files(Path(tmp))
+        return Result(summary, files=files)
+
+    def outputs(self, stage, result):
+        return {"backbone": "result.json"}
+
+    def lines(self, stage, result):
+        s = result.data
+        w, d = np.asarray(s["omega"]), np.asarray(s["damping_ratio"])
+        i = int(np.nanargmax(d)) if d.size else 0
+        return [f"{s['points']} points, {s['newton_iterations']} Newton iterations, status: {s['status']}",
+                f"   frequency {w[0] / (2 * np.pi):.1f} Hz (stuck) -> {w[-1] / (2 * np.pi):.1f} Hz; "
+                f"largest damping ratio {d[i]:.4g} at modal amplitude {s['modal_amplitude'][i]:.4g}"]
+
+    def scalars(self, stage, result):
+        s = result.data
+        d = np.asarray(s["damping_ratio"], dtype=float)
+        return {"stuck_frequency_Hz": s["omega"][0] / (2 * np.pi), "end_frequency_Hz": s["omega"][-1] / (2 * np.pi),
+                "max_damping_ratio": float(np.nanmax(d)), "points": s["points"]}
+
+
+def plot_backbone(s: dict, path: Path) -> None:
+    """Frequency and damping ratio against the modal amplitude (log scale), one figure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    a = np.asarray(s["modal_amplitude"])
+    fig, (ax1, ax2) = plt.subplots(2, 1, sharex=True, figsize=(6, 5))
+    ax1.semilogx(a, np.asarray(s["omega"]) / (2 * np.pi))
+    ax1.set_ylabel("frequency [Hz]")
+    ax2.semilogx(a, s["damping_ratio"])
+    ax2.set_ylabel("damping ratio [-]")
+    ax2.set_xlabel("modal amplitude [m sqrt(kg)]")
+    ax1.set_title("backbone (EPMC)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+class OptimalLoad(Kind):
+    """UPD bladed-disk sector: peak response against CF and the optimal load
+    (``harmonic_balance.bladed_disk.optimize.optimal_load``); no contact or FE stage."""
+
+    name = "optimal_load"
+    modules = ("harmonic_balance", "fmu_src")
+
+    def instances(self, data):
+        u = data.get("upd")
+        if u is None:
+            return []
+        params = {k: v for k, v in u.items() if k != "config"}        # the file enters by its hash
+        return [Stage("optimal_load", self, params, products=("optimal_load",),
+                      extra={"config": u.get("config")})]
+
+    def compute(self, stage, inputs, ctx):
+        from harmonic_balance.bladed_disk.config import load_config
+        from harmonic_balance.bladed_disk.optimize import optimal_load
+        from harmonic_balance.bladed_disk.sector import Sector
+
+        p = stage.params
+        out = optimal_load(Sector(load_config(stage.extra["config"])), p["cf_range"], p["points"],
+                           p["harmonics"], grid=p["grid"])
+        with tempfile.TemporaryDirectory() as tmp:
+            plot_optimal_load(out, Path(tmp) / "optimal_load.png")
+            files = collect_files(Path(tmp))
+        return Result(out, files=files)
+
+    def outputs(self, stage, result):
+        return {"optimal_load": "result.json"}
+
+    def lines(self, stage, result):
+        o = result.data
+        return [f"optimum CF {o['optimum_cf']:.4g} N, peak {o['optimum_peak_amplitude']:.5e} m "
+                f"({o['method']}, {o['time_s']:.1f} s)"]
+
+    def scalars(self, stage, result):
+        o = result.data
+        return {"optimum_cf_N": o["optimum_cf"], "optimum_peak_amplitude_m": o["optimum_peak_amplitude"]}
+
+
+def plot_optimal_load(o: dict, path: Path) -> None:
+    """Peak amplitude against CF (log-log) with the optimum marked."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.loglog(o["cf"], np.array(o["peak_amplitude"]) * 1e3, "o-")
+    ax.loglog([o["optimum_cf"]], [o["optimum_peak_amplitude"] * 1e3], "r*", ms=12)
+    ax.set_xlabel("centrifugal load CF [N]")
+    ax.set_ylabel("peak amplitude [mm]")
+    ax.set_title("optimal-load curve (UPD sector)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
