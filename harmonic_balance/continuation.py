@@ -132,7 +132,7 @@ class _Scaled:
 
 def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
                  ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000,
-                 x_scale: float = 0.0, max_turn: float = MAX_TURN) -> Branch:
+                 x_scale: float = 0.0, max_turn: float = MAX_TURN, on_point=None) -> Branch:
     """Trace the branch through (x0, lam0) until lam reaches lam_end.
 
     Parameters
@@ -149,6 +149,8 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         steps are not 1 % of a tiny x
     max_turn : float, tangent turn limit [rad] (np.pi disables it: a homotopy only
         needs to arrive, not to resolve the path)
+    on_point : callable (lam) -> None, optional
+        Called after every accepted point (progress display); None: no call.
 
     Returns
     -------
@@ -188,12 +190,16 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
             x_end = _interpolate(branch, y_new[:-1] * s_x, lam_new, lam_end)
             res = _solve_fixed(fun, x_end, lam_end, tol, branch)
             branch.append(res.x, lam_end, res.iterations)
+            if on_point is not None:
+                on_point(lam_end)
             branch.status = "complete"
             return branch
         if sign * (lam_new - lam0) < 0:
             branch.append(y_new[:-1] * s_x, lam_new, it)
             raise _stop("the branch turned back out of the parameter range", branch)
         branch.append(y_new[:-1] * s_x, lam_new, it)
+        if on_point is not None:
+            on_point(lam_new)
         s_x = max(s_x, _rms(branch.x[-1]))
         # Tangent expressed in the (possibly updated) scaling, for the next orientation.
         t_prev = t * np.append(np.full(len(x0), sc.s_x / s_x), 1.0)

@@ -166,14 +166,16 @@ STABILITY_AUTO_MAX = 200
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
                 ds_max: float = 0.1, max_points: int = 2000, refine: bool = True,
-                stability="auto") -> FRFResult:
+                stability="auto", progress=None) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
     end of a homotopy in the excitation level (:mod:`homotopy`), so the curve does
     not depend on where the sweep starts. ``stability`` (True, False or "auto": when
     the model has matrices and at most STABILITY_AUTO_MAX full unknowns) adds Hill's
-    stability of every point (``result.stable``).
+    stability of every point (``result.stable``). ``progress(done, total, label)``, if
+    given, is called after every continuation point with the share of the frequency
+    range covered, in percent (``total`` = 100), as ``contact_core``'s long stages do.
 
     Raises
     ------
@@ -191,7 +193,11 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     except HomotopyError as err:
         result = _collect(prob, Branch(status=str(err)), t0)
         raise FRFError(f"continuation stopped before the first point: {err}", result) from None
-    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points)
+    on_point = None
+    if progress is not None:
+        def on_point(w):
+            progress(min(100, round(100 * abs(w - w0) / abs(w1 - w0))), 100, "continuation")
+    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point)
     if error is not None:
         result = _collect(prob, branch, t0)
         result.status = branch.status = error
@@ -243,7 +249,7 @@ MAX_RESTARTS = 100
 RESTART_JUMPS = (1e-3, 4e-3, 1.6e-2)
 
 
-def _sweep(prob, x0, w0, w1, tol, ds_max, max_points):
+def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
     """Continuation from (x0, w0) to w1 with restarts: (Branch, gaps, error or None).
 
     When the corrector stalls ("step below minimum": on a stiff contact the residual
@@ -258,7 +264,7 @@ def _sweep(prob, x0, w0, w1, tol, ds_max, max_points):
     for _ in range(MAX_RESTARTS + 1):
         try:
             br = continuation(prob, x0, w0, w1, tol, ds_max=ds_max,
-                              max_points=max_points - len(merged.lam))
+                              max_points=max_points - len(merged.lam), on_point=on_point)
             error = None
         except ContinuationError as err:
             br, error = err.branch, str(err)

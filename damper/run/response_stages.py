@@ -85,7 +85,8 @@ class FRF(Kind):
         sw = p["sweep"]
         omega = (2 * math.pi * sw["f_min"], 2 * math.pi * sw["f_max"])
         try:
-            result = compute_frf(model, str(sw["harmonics"]), omega, ds_max=sw["max_step"], max_points=MAX_POINTS)
+            result = compute_frf(model, str(sw["harmonics"]), omega, ds_max=sw["max_step"], max_points=MAX_POINTS,
+                                 progress=ctx.progress)
         except FRFError as err:
             raise RuntimeError(f"{err} ({err.result.points} points kept)") from None
         with tempfile.TemporaryDirectory() as tmp:
