@@ -4,6 +4,7 @@ import io
 import json
 
 import numpy as np
+import pytest
 
 from contact_core.condense import condense, direction_key
 from contact_core.spec import ContactSpec
@@ -14,6 +15,7 @@ from damper.run.progress import Progress
 SPEC = ContactSpec(body="sphere", model="halfspace", grid=5)
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_tangential_after_normal_builds_only_x_and_equals_uncached_run(tmp_path):
     store = Store(tmp_path)
     normal = condense(SPEC, ("z",), cache=store)

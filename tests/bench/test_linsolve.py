@@ -33,6 +33,7 @@ def test_superlu_always_available():
     assert "superlu" in linsolve.available_backends()
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 @pytest.mark.parametrize("name", linsolve.BACKENDS)
 def test_backends_agree_with_dense_inverse(name, small_body, monkeypatch):
     if name not in linsolve.available_backends():

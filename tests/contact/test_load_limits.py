@@ -49,6 +49,7 @@ def test_under_resolved_contact_is_flagged_in_the_text_output(capsys):
 TINY_LOAD_RTOL = 0.012
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_default_zone_follows_a_tiny_load(capsys):
     import json
 

@@ -58,6 +58,7 @@ def test_sphere_matches_hertz(condensed, specs, name):
         assert 0 < out["body1_share_far"] < 0.08
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_solution_is_in_equilibrium_without_tension_or_penetration(condensed):
     cc = condensed("sphere_real")
     sol = normal.solve_force(cc, F_SPHERE)
@@ -71,6 +72,7 @@ def test_solution_is_in_equilibrium_without_tension_or_penetration(condensed):
     assert np.allclose(sol.g, cc.grid.h - cc.rigid @ sol.q + cc.Czz @ sol.f, atol=tol)
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_force_and_displacement_control_agree(condensed):
     cc = condensed("sphere_halfspace")
     sol_f = normal.solve_force(cc, 123.0)
@@ -80,6 +82,7 @@ def test_force_and_displacement_control_agree(condensed):
     assert np.array_equal(sol_d.active, sol_f.active)
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_k_n_is_the_derivative_of_force_by_approach(condensed):
     cc = condensed("sphere_real")
     sol = normal.solve_force(cc, F_SPHERE)
@@ -296,6 +299,7 @@ def test_inconsistent_imported_matrices_exit_2(tmp_path, capsys):
     assert "x-y" in capsys.readouterr().err
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_tiny_load_is_flagged_under_resolved_not_nan(condensed):
     cc = condensed("sphere_halfspace")
     out = report.summarize(cc, normal.solve_force(cc, 1e-3), "sphere")

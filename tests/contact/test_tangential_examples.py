@@ -1,6 +1,8 @@
 """Smoke runs of the tangential examples (tiny grids): they run, print and save."""
+import pytest
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_virgin_curves_example_smoke(tmp_path, capsys, load_example):
     assert load_example("virgin_curves").main(["--smoke", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out

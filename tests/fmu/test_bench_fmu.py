@@ -2,11 +2,14 @@
 import runpy
 from pathlib import Path
 
+import pytest
+
 BENCH = Path(__file__).resolve().parents[2] / "examples" / "bench_fmu.py"
 #: The C master and the array API run the same core on the same history.
 EXACT_TOL = 1e-12
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_bench_fmu_smoke(capsys):
     bench = runpy.run_path(str(BENCH), run_name="bench_fmu")
     rows = bench["measure"]([3, 50], steps=500, py_steps=50, repeats=1)

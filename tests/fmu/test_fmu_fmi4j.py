@@ -40,6 +40,7 @@ def fmi4j_classpath(tmp_path_factory):
     return f"{classes}:{cp_file.read_text().strip()}"
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_fmi4j_equals_array_api(fmus, fmi4j_classpath, tmp_path):
     k = np.arange(150)
     u = 1.3 * U_SLIP * np.sin(0.21 * k) * (1.0 + 0.4 * np.sin(0.9 * k))

@@ -109,6 +109,7 @@ def test_cli_refuses_a_bad_curve_and_writes_nothing(tmp_path, capsys, change):
     assert list(tmp_path.glob("*.fmu*")) == [] and not any(tmp_path.glob(".x.fmu*"))
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
     """--fit concave: the FMU runs the same majorant as the array API with fit="concave"."""
     u, T = curve_table(11)
@@ -124,6 +125,7 @@ def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
     assert np.max(np.abs(F - ref.F)) <= 1e-12 * np.max(np.abs(ref.F))
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 @pytest.mark.parametrize("mu", [MU, None])
 def test_cli_fmu_continues_the_curve_past_its_end_like_damper_loop(tmp_path, mu):
     """A file with tail "flat" (gross slip): the FMU stays at mu N past the end, as the

@@ -38,6 +38,7 @@ def test_energy_per_cycle_independent_of_step_size_and_masing(fmus, version, amp
     assert abs(fine - masing_energy(uc, Tc, amplitude)) <= MASING_TOL * fine
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 @pytest.mark.parametrize("version", [2, 3])
 def test_fmpy_compile_rebuilds_the_source_fmu(fmus, version, tmp_path):
     """Delete the binary, rebuild it from sources/ with fmpy's builder, same numbers."""

@@ -1,9 +1,12 @@
 """Smoke run of examples/bench_hb.py with tiny settings (the full run is by hand)."""
+import pytest
+
 #: The smoke reference uses 64/128 steps per period and a loose steady-state
 #: tolerance (its own step error ~0.2 %): H = 3 must still land within 1 %.
 SMOKE_RTOL = 1e-2
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_benchmark_smoke_runs_and_h3_is_close_to_the_reference(capsys, load_example):
     bench = load_example("bench_hb")
     out = bench.main(["--smoke"])

@@ -1,5 +1,6 @@
 """Continuation over parameters other than frequency (harmonic_balance.parameter)."""
 import numpy as np
+import pytest
 from hbcases import two_dof
 
 from harmonic_balance.frf import compute_frf, parameter_curve
@@ -7,6 +8,7 @@ from harmonic_balance.model import sdof_model
 from harmonic_balance.parameter import forcing_level, slip_scale
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_forcing_level_curve_ends_on_the_frf_solution():
     """lam = 0.1 -> 2 at omega = 1 on the stiff (30 k) Jenkins oscillator: the end point is
     the FRF's solution at forcing 2 (started there by its own homotopy); stuck below the

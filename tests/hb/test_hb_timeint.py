@@ -25,6 +25,7 @@ def test_peak_converges_with_the_number_of_harmonics(peaks):
     assert d57 < d35 and d57 < 1e-3 * r[7].peak_amplitude
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_converged_hb_peak_agrees_with_time_integration(peaks):
     model, r = peaks
     amp, _, step_err, ss = steady_amplitude(model, r[7].peak_omega, 256, tol=SS_TOL)
@@ -32,6 +33,7 @@ def test_converged_hb_peak_agrees_with_time_integration(peaks):
     assert abs(r[7].peak_amplitude / amp - 1) < TI_RTOL
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_two_dof_hb_agrees_with_time_integration_at_the_peak():
     # at the peak the friction damping is largest, so the march settles fastest
     model = two_dof()

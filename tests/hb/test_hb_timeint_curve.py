@@ -20,6 +20,7 @@ SAME_SCHEME_RTOL = 1e-9
 SS_TOL = 1e-7
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_curve_march_equals_march_frequency_by_frequency_two_dof():
     model = two_dof()                       # one element between DOFs, one to ground
     ws = np.array([0.85, 1.25])             # settle at different periods
@@ -32,6 +33,7 @@ def test_curve_march_equals_march_frequency_by_frequency_two_dof():
                                    atol=SAME_SCHEME_RTOL * np.abs(s.x_last).max())
 
 
+@pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_curve_march_agrees_with_converged_harmonic_balance_at_the_peak():
     model = sdof()
     r = compute_frf(model, "odd:7", (0.9, 1.3))

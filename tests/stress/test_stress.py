@@ -48,6 +48,7 @@ def test_fmu_check_uses_trapezoid_slack():
     assert np.isfinite(checks.fmu(dict(base, stored=0.0, slack=0.0), {})[0])
 
 
+@pytest.mark.slow  # > 2 s: outside the `-m "not slow"` inner loop
 def test_a_hang_is_detected_and_killed():
     from damper.bench.common import run_child
 
