@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 
 def contact_modulus(E1: float, nu1: float, E2: float, nu2: float) -> float:
     """E* [Pa] from 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2 (Johnson eq. 4.22)."""
@@ -45,3 +47,26 @@ def cylinder(F: float, L: float, R: float, Estar: float) -> dict:
 def cylinder_halfwidth_for_peak(p0: float, R: float, Estar: float) -> float:
     """Half-width at which the 2D Hertz peak pressure is ``p0``: b = 2 R p0 / E*."""
     return 2.0 * R * p0 / Estar
+
+
+def sphere_approach_fit(force, approach, Estar: float, R: float) -> dict:
+    """Fit d = A F^(2/3) + B F to a sphere's force-approach curve; A against Hertz.
+
+    The finite bodies add a nearly linear compliance B (references.md), so the
+    Hertzian coefficient A_H = (3 / (4 E*))^(2/3) R^(-1/3) is compared on its own.
+
+    Parameters
+    ----------
+    force, approach : array_like, shape (n,)
+        Normal forces [N] and approaches [m].
+    Estar, R : float
+        Contact modulus [Pa] and sphere radius [m].
+
+    Returns
+    -------
+    dict: A [m N^-2/3], B [m/N], A_hertz, error_A (A / A_hertz - 1)
+    """
+    F, d = np.asarray(force, dtype=float), np.asarray(approach, dtype=float)
+    (A, B), *_ = np.linalg.lstsq(np.stack([F ** (2 / 3), F], axis=1), d, rcond=None)
+    A_h = (3 / (4 * Estar)) ** (2 / 3) / R ** (1 / 3)
+    return {"A": float(A), "B": float(B), "A_hertz": A_h, "error_A": float(A / A_h - 1)}

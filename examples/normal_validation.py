@@ -14,8 +14,6 @@ import argparse
 import sys
 from pathlib import Path
 
-import numpy as np
-
 from contact_core import api
 from contact_core.fileio import atomic_write
 from contact_core.plots import plot_all
@@ -28,16 +26,11 @@ CASES = (
 )
 
 
-def approach_fit(curve: dict, spec: ContactSpec) -> dict:
-    """Fit d = A F^(2/3) + B F to a sphere's F-approach curve; A against Hertz.
+def approach_fit(curve: dict, spec) -> dict:
+    """d = A F^(2/3) + B F fit of a sphere's F-approach curve (:func:`contact_core.hertz.sphere_approach_fit`)."""
+    from contact_core.hertz import sphere_approach_fit
 
-    The finite bodies add a nearly linear compliance B (references.md), so the
-    Hertzian coefficient A_H = (3 / (4 E*))^(2/3) R^(-1/3) is tested on its own.
-    """
-    F, d = np.asarray(curve["force"]), np.asarray(curve["approach"])
-    (A, B), *_ = np.linalg.lstsq(np.stack([F ** (2 / 3), F], axis=1), d, rcond=None)
-    A_h = (3 / (4 * spec.Estar)) ** (2 / 3) / spec.radius ** (1 / 3)
-    return {"A": float(A), "B": float(B), "A_hertz": A_h, "error_A": float(A / A_h - 1)}
+    return sphere_approach_fit(curve["force"], curve["approach"], spec.Estar, spec.radius)
 
 
 def run_case(name: str, spec: ContactSpec, force: float, out_dir: Path, cache=None) -> dict:

@@ -162,15 +162,10 @@ class Normal(Kind):
 
 
 def approach_fit(curve: dict, spec) -> dict:
-    """Fit d = A F^(2/3) + B F to a sphere's F-approach curve; A against Hertz.
+    """d = A F^(2/3) + B F fit of a sphere's F-approach curve (:func:`contact_core.hertz.sphere_approach_fit`)."""
+    from contact_core.hertz import sphere_approach_fit
 
-    The finite bodies add a nearly linear compliance B (references.md), so the
-    Hertzian coefficient A_H = (3 / (4 E*))^(2/3) R^(-1/3) is compared on its own.
-    """
-    F, d = np.asarray(curve["force"]), np.asarray(curve["approach"])
-    (A, B), *_ = np.linalg.lstsq(np.stack([F ** (2 / 3), F], axis=1), d, rcond=None)
-    A_h = (3 / (4 * spec.Estar)) ** (2 / 3) / spec.radius ** (1 / 3)
-    return {"A": float(A), "B": float(B), "A_hertz": A_h, "error_A": float(A / A_h - 1)}
+    return sphere_approach_fit(curve["force"], curve["approach"], spec.Estar, spec.radius)
 
 
 class Tangential(Kind):
