@@ -39,15 +39,8 @@ def slip_scale(model):
     from fmu_src.element import IwanElement
 
     def at(lam):
-        links = []
-        for link in model.links:
-            el = link.element
-            if not isinstance(link, FrictionLink) or not isinstance(el, IwanElement):
-                links.append(link)
-                continue
-            new = IwanElement.from_sliders(el.k, el.fs * el.scale * lam, el.k_res, el.N_ref)
-            links.append(FrictionLink(new, link.dof_a, link.dof_b, link.name))
-        return replace(model, links=links)
+        return _with_iwan_links(model, lambda el: IwanElement.from_sliders(
+            el.k, el.fs * el.scale * lam, el.k_res, el.N_ref))
     return at
 
 
@@ -61,15 +54,8 @@ def contact_stiffness_scale(model):
 
     def at(lam):
         s = 10.0**lam
-        links = []
-        for link in model.links:
-            el = link.element
-            if not isinstance(link, FrictionLink) or not isinstance(el, IwanElement):
-                links.append(link)
-                continue
-            new = IwanElement.from_sliders(el.k * s, el.fs * el.scale, el.k_res * s, el.N_ref)
-            links.append(FrictionLink(new, link.dof_a, link.dof_b, link.name))
-        return replace(model, links=links)
+        return _with_iwan_links(model, lambda el: IwanElement.from_sliders(
+            el.k * s, el.fs * el.scale, el.k_res * s, el.N_ref))
     return at
 
 
@@ -110,3 +96,12 @@ class ParameterProblem:
                   - self.residual(lam - h)(x, self.omega, jac=False)) / (2 * h)
         return R, J, dl
 
+
+def _with_iwan_links(model, remake):
+    """The model with every Iwan friction link's element replaced by ``remake(element)``."""
+    from fmu_src.element import IwanElement
+
+    links = [FrictionLink(remake(link.element), link.dof_a, link.dof_b, link.name)
+             if isinstance(link, FrictionLink) and isinstance(link.element, IwanElement) else link
+             for link in model.links]
+    return replace(model, links=links)
