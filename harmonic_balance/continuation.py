@@ -20,16 +20,27 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg import lu_factor, lu_solve
 from scipy.optimize import minimize_scalar
 
 from .newton import NewtonError, newton
 
+#: Floor of the x scale relative to the largest RMS met on the branch (the scale
+#: is the current point's RMS above it).
+S_X_FLOOR = 1e-4
 #: Corrector iterations the step control aims at.
 TARGET_ITER = 4
 #: Largest angle between successive tangents in scaled variables [rad].
 MAX_TURN = 0.35
 #: Scaled step below which a large tangent turn is accepted as a kink of the branch.
 KINK_STEP = 2e-4
+#: Scaled step below which a reversed orientation (det([J; t]) changing sign) is
+#: accepted as a kink turning the branch by more than 90 deg; above it, the corrector
+#: jumped to the other flank of a peak: measured on the Jenkins FRF with c = 1e-4
+#: (resonance 3e-5 of the range wide), which without this test circled the peak
+#: (left flank up, jump to the right flank, up it backwards, over the top, down the
+#: left flank ...) until the point limit.
+FLIP_STEP = 1e-5
 #: Smallest scaled step at which a failed pseudo-arclength corrector is retried at
 #: fixed parameter (below it the fallback only creeps: measured at 1e6 k, 1e-8 rad/s
 #: per point, so the caller's restart is the better way past).
@@ -80,13 +91,26 @@ class _Scaled:
         return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
 
     def tangent(self, J, t_prev):
+        """Unit tangent t (N+1,) with t . t_prev > 0, and the sign of det([J; t^T]).
+
+        The sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays the
+        same along a regular branch, through turning points and peaks, whatever the
+        scaling (positive column scales change det([J; t]) by a positive factor).
+        """
         A = np.vstack([J, t_prev])
         rhs = np.zeros(A.shape[0])
         rhs[-1] = 1.0
-        t = np.linalg.solve(A, rhs)
+        lu, piv = lu_factor(A, check_finite=False)
+        t = lu_solve((lu, piv), rhs, check_finite=False)
         if not np.all(np.isfinite(t)):
             raise np.linalg.LinAlgError("non-finite tangent")
-        return t / np.linalg.norm(t)
+        n = np.linalg.norm(t)
+        # det is linear in the last row, det([J; w]) = w . c with c parallel to t (the
+        # cofactors), so det([J; t]) has the sign of det([J; t_prev]) (t . t_prev > 0),
+        # which the LU gives.
+        perm = np.count_nonzero(piv != np.arange(len(piv))) % 2
+        sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
+        return t / n, float(sign)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
         """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
@@ -98,7 +122,7 @@ class _Scaled:
         def aug(d):
             R, J = self.jac(y_pred + d)
             return np.append(R, normal @ d), np.vstack([J, normal])
-        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter)
+        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred))
         res.x = y_pred + res.x
         return res
 
@@ -119,7 +143,8 @@ class _Scaled:
             R, J = self.jac(np.append(y_pred[:-1] + d, lam))
             return R, J[:, :-1]
         try:
-            res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter)
+            res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter,
+                         np.linalg.norm(y_pred[:-1]))
         except NewtonError:
             return None
         R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))
@@ -167,23 +192,27 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     s_lam = abs(lam_end - lam0)
     if s_lam == 0:
         raise ValueError("empty parameter range")
-    s_x = max(_rms(first.x), x_scale, 1e-300)
+    s_max = _rms(first.x)
+    s_x = max(s_max, x_scale, 1e-300)
     t_prev = np.zeros(len(x0) + 1)
     t_prev[-1] = sign
     _, Jx, Jl = fun(first.x, lam0)
     J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
+    orient = 0.0  # sign of det([J; t]): the branch's orientation (set at the first point)
     while len(branch.lam) < max_points:
         sc = _Scaled(fun, s_x, s_lam, tol)
         y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
         col = np.append(np.full(len(x0), s_x), s_lam)
         J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
         try:
-            t = sc.tangent(J, t_prev)
+            t, d = sc.tangent(J, t_prev)
         except (np.linalg.LinAlgError, ValueError):
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
-        if t @ t_prev < 0:
-            t = -t
-        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn, sign)
+        if not orient:
+            orient = d  # t points towards lam_end here
+        elif d != orient:
+            t = -t  # a kink accepted at a tiny step turned the branch by more than 90 deg
+        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn, sign, orient)
         J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
@@ -200,7 +229,9 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         branch.append(y_new[:-1] * s_x, lam_new, it)
         if on_point is not None:
             on_point(lam_new)
-        s_x = max(s_x, _rms(branch.x[-1]))
+        s_now = _rms(branch.x[-1])
+        s_max = max(s_max, s_now)
+        s_x = max(s_now, S_X_FLOOR * s_max, x_scale, 1e-300)
         # Tangent expressed in the (possibly updated) scaling, for the next orientation.
         t_prev = t * np.append(np.full(len(x0), sc.s_x / s_x), 1.0)
         t_prev /= np.linalg.norm(t_prev)
@@ -208,17 +239,20 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     raise _stop(f"point limit {max_points} reached", branch)
 
 
-def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN, sign=0.0):
-    """One accepted predictor-corrector step; shrinks ds until it succeeds."""
+def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN, sign=0.0, orient=0.0):
+    """One accepted predictor-corrector step; shrinks ds until it succeeds.
+
+    A corrected point is rejected (step halved) when the tangent there turned by more
+    than max_turn (above KINK_STEP) or when it has the opposite orientation
+    (:meth:`_Scaled.tangent`, above FLIP_STEP): the corrector then landed on the
+    other flank of a peak narrower than the step, or on another branch.
+    """
     while True:
         try:
             res = sc.correct(y + ds * t, t)
-            # A kink of the branch (stick-slip onset: the describing function is only
-            # C0 in the Jacobian) keeps its turn at any step, so the turn limit only
-            # applies to steps above KINK_STEP.
-            if ds <= KINK_STEP or _turn_ok(sc, res, t, max_turn):
+            reason = _rejected(sc, res, t, ds, max_turn, orient)
+            if reason is None:
                 return res.x, res.iterations, ds, res.J[:-1]
-            reason = "tangent turned too much"
         except NewtonError as err:
             reason = err.reason
             # natural-parameter step of the same scaled length from the last point,
@@ -226,22 +260,31 @@ def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN, sign=0.0):
             step = np.zeros(len(t))
             step[-1] = sign or np.sign(t[-1])
             res = sc.correct_fixed(y + ds * step) if ds >= FIXED_MIN_STEP else None
-            if res is not None and (ds <= KINK_STEP or _turn_ok(sc, res, t, max_turn)):
+            if res is not None and _rejected(sc, res, t, ds, max_turn, orient) is None:
                 return res.x, res.iterations, ds, res.J[:-1]
         ds *= 0.5
         if ds < ds_min:
             raise _stop(f"step below minimum ({reason})", branch)
 
 
-def _turn_ok(sc, res, t, max_turn) -> bool:
-    """The tangent at the new point stays within max_turn of t."""
-    if max_turn >= np.pi:
-        return True
+def _rejected(sc, res, t, ds, max_turn, orient):
+    """Why the corrected point ``res`` is not accepted after a step ds along t, or None.
+
+    A kink of the branch (stick-slip onset: the describing function is only C0 in the
+    Jacobian) keeps its turn at any step, so the turn limit only applies to steps
+    above KINK_STEP and the orientation test to steps above FLIP_STEP.
+    """
+    if max_turn >= np.pi and not orient:
+        return None
     try:
-        t_new = sc.tangent(res.J[:-1], t)
+        t_new, d_new = sc.tangent(res.J[:-1], t)
     except (np.linalg.LinAlgError, ValueError):
-        return False
-    return abs(t_new @ t) >= np.cos(max_turn)
+        return "singular extended Jacobian at the corrected point"
+    if ds > KINK_STEP and max_turn < np.pi and abs(t_new @ t) < np.cos(max_turn):
+        return "tangent turned too much"
+    if ds > FLIP_STEP and orient and d_new != orient:
+        return "orientation of the branch reversed (a peak or fold jumped over)"
+    return None
 
 
 def _solve_fixed(fun, x, lam, tol, branch):
