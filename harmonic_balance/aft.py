@@ -135,7 +135,23 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis):
         # Fully stuck: apply the virgin-state convention of the module docstring.
         F = link.k0 * u
         dF = link.k0 * basis.E
-    return basis.D @ F, basis.D @ dF, float(W), F
+    return basis.D @ F, _project_rows(basis.D, dF), float(W), F
+
+
+def _project_rows(D, dF):
+    """``D @ dF`` over the samples where dF has a non-zero row only.
+
+    A sample depends on U only while a slider sticks (slipping sliders carry the
+    constant force +-f_s): on a stiff contact in gross slip a few per cent of the
+    samples, so the (n_b, n_t) x (n_t, n_b) product, the AFT's largest cost at
+    n_t = 4096, shrinks by the stuck fraction. Zero rows add nothing; the row test
+    by squares (twice as fast as ``any``) drops only rows below ~1e-154, whose terms
+    are below double precision anyway.
+    """
+    rows = np.flatnonzero(np.einsum("ij,ij->i", dF, dF))
+    if rows.size > 0.5 * dF.shape[0]:
+        return D @ dF
+    return D[:, rows] @ dF[rows]
 
 
 #: Relative round-off allowance when deciding that a loop is a straight stuck line.

@@ -45,6 +45,12 @@ FLIP_STEP = 1e-5
 #: fixed parameter (below it the fallback only creeps: measured at 1e6 k, 1e-8 rad/s
 #: per point, so the caller's restart is the better way past).
 FIXED_MIN_STEP = 1e-4
+#: Newton options of the correctors: no Levenberg-Marquardt fallback and a short line
+#: search (a failing corrector is retried with half the step, which is cheaper).
+#: Measured on the Jenkins FRF at 1e6 k, H = 15, 0.5 -> 0.8 rad/s: 16807 residual
+#: evaluations for 577 points with the full globalisation (66 % in failed correctors),
+#: 9894 for 579 points with these options.
+CORRECTOR_NEWTON = {"lm": False, "min_alpha": 0.1}
 #: Corrector iteration limit inside the continuation (a step is retried smaller).
 CORRECTOR_ITER = 12
 
@@ -122,7 +128,8 @@ class _Scaled:
         def aug(d):
             R, J = self.jac(y_pred + d)
             return np.append(R, normal @ d), np.vstack([J, normal])
-        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred))
+        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred),
+                     **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
 

@@ -59,7 +59,8 @@ class NewtonResult:
     iterations: int
 
 
-def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0) -> NewtonResult:
+def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
+           min_alpha: float = None, lm: bool = True) -> NewtonResult:
     """Solve R(x) = 0 to |R|_2 <= tol, or until Newton's step is below round-off.
 
     The second test (|dx|_2 <= STEP_RTOL max(|x|_2, x_norm)) ends the iteration when
@@ -74,6 +75,9 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0) -> Newt
     tol : float, absolute tolerance on the 2-norm of R (callers scale it)
     max_iter : int
     x_norm : float, size of x for the step test when x is an offset (0: |x|)
+    min_alpha : float, smallest line-search factor (default MIN_ALPHA)
+    lm : bool, fall back to Levenberg-Marquardt when the line search fails (False:
+        fail at once, e.g. in a continuation corrector, which then takes a smaller step)
 
     Returns
     -------
@@ -87,7 +91,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0) -> Newt
     x = np.array(x0, dtype=float)
     R, J = fun(x)
     nr = _norm(R, x, 0)
-    lm = _LMState()
+    state = _LMState()
     for it in range(max_iter + 1):
         if nr <= tol:
             return NewtonResult(x, R, J, it)
@@ -101,9 +105,11 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0) -> Newt
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         if np.linalg.norm(dx) <= STEP_RTOL * max(np.linalg.norm(x), x_norm):
             return NewtonResult(x, R, J, it)
-        step = _line_search(fun, x, dx, nr)
+        step = _line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha)
         if step is None:
-            step, lm = _lm_step(fun, x, R, J, nr, lm)
+            if not lm:
+                raise NewtonError("no decrease along Newton's direction", x, it, nr)
+            step, state = _lm_step(fun, x, R, J, nr, state)
             if step is None:
                 raise NewtonError("no decrease, neither along Newton's direction nor by "
                                   "Levenberg-Marquardt steps (a local minimum of |R| that "
@@ -112,10 +118,10 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0) -> Newt
     raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
 
 
-def _line_search(fun, x, dx, nr):
-    """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < MIN_ALPHA."""
+def _line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA):
+    """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < min_alpha."""
     alpha = 1.0
-    while alpha >= MIN_ALPHA:
+    while alpha >= min_alpha:
         xt = x + alpha * dx
         Rt, Jt = fun(xt)
         nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
