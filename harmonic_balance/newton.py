@@ -104,7 +104,9 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
         if not np.all(np.isfinite(dx)):
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         if np.linalg.norm(dx) <= STEP_RTOL * max(np.linalg.norm(x), x_norm):
-            return NewtonResult(x, R, J, it)
+            x = x + dx  # the last (tiny) step, so a smooth residual keeps quadratic accuracy
+            R, J = fun(x)
+            return NewtonResult(x, R, J, it + 1)
         step = _line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha)
         if step is None:
             if not lm:
