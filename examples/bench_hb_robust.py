@@ -75,34 +75,45 @@ SMOKE = dict(kt=(1.0, 30.0), fs=(0.5,), c=(0.04,), H=(3,))
 MAX_POINTS = 3000
 
 
-def one_curve(kt, fs, c, H, start):
-    """(converged, points, iterations, seconds, message) of one curve."""
+def one_curve(kt, fs, c, H, start, details=False):
+    """(converged, points, iterations, seconds, message) of one curve; with ``details``
+    also (residual evaluations, AFT samples, gaps)."""
     t0 = time.perf_counter()
     try:
         r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
                         stability=False, max_points=MAX_POINTS)
-        return True, r.points, r.newton_iterations, time.perf_counter() - t0, ""
+        ok, msg = True, ""
     except FRFError as err:
-        res = err.result
-        return False, res.points, res.newton_iterations, time.perf_counter() - t0, str(err)[:160]
+        r, ok, msg = err.result, False, str(err)[:160]
+    out = (ok, r.points, r.newton_iterations, time.perf_counter() - t0, msg)
+    return out + (r.evaluations, r.n_t, len(r.extra.get("gaps", ()))) if details else out
 
 
-def convergence_map(grid):
+def convergence_map(grid, log=None):
+    """Every curve of ``grid``, H by H (cheapest first), one row per (H, kt/k).
+
+    ``log``: open text file that gets one CSV line per curve as it finishes (a long
+    run stopped early keeps its rows).
+    """
     print("\nTable 1: convergence map (curves completed over the whole range)")
-    print(f"{'kt/k':>8} {'done':>6} {'total':>6} {'s/curve':>8}")
+    print(f"{'H':>3} {'kt/k':>8} {'done':>6} {'total':>6} {'s/curve':>8}")
     rows, fails = [], []
-    for kt in grid["kt"]:
+    for H, kt in itertools.product(grid["H"], grid["kt"]):
         n_ok = n = 0
         t_all = 0.0
-        for fs, c, H, start in itertools.product(grid["fs"], grid["c"], grid["H"], STARTS):
+        for fs, c, start in itertools.product(grid["fs"], grid["c"], STARTS):
             ok, pts, it, t, msg = one_curve(kt, fs, c, H, start)
             rows.append((kt, fs, c, H, start, ok, pts, it, t))
+            if log is not None:
+                log.write(f"{H},{kt:g},{fs:g},{c:g},{start},{int(ok)},{pts},{it},{t:.3f},"
+                          f"\"{msg}\"\n")
+                log.flush()
             n += 1
             n_ok += ok
             t_all += t
             if not ok:
                 fails.append((kt, fs, c, H, start, msg))
-        print(f"{kt:>8.0e} {n_ok:>6} {n:>6} {t_all / n:>8.2f}", flush=True)
+        print(f"{H:>3} {kt:>8.0e} {n_ok:>6} {n:>6} {t_all / n:>8.2f}", flush=True)
     print(f"failures ({len(fails)}):")
     for kt, fs, c, H, start, msg in fails:
         print(f"  kt/k={kt:.0e} fs/P={fs:g} c={c:g} H={H} start={start}: {msg}")
@@ -111,14 +122,16 @@ def convergence_map(grid):
 
 def cost_table(kts, H=15):
     print(f"\nTable 2: issue case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
-    print(f"{'kt/k':>8} {'ok':>3} {'points':>6} {'iter/pt':>7} {'ms/pt':>7} {'time_s':>7}")
+    print(f"{'kt/k':>8} {'ok':>3} {'n_t':>5} {'points':>6} {'gaps':>4} {'iter/pt':>7} "
+          f"{'eval/pt':>7} {'ms/pt':>7} {'time_s':>7}")
     out = []
     for kt in kts:
-        ok, pts, it, t, msg = one_curve(kt, 0.5, 0.04, H, "below")
-        out.append((kt, ok, pts, it, t))
-        per = 1e3 * t / max(pts, 1)
-        print(f"{kt:>8.0e} {'yes' if ok else 'no':>3} {pts:>6} {it / max(pts, 1):>7.2f} "
-              f"{per:>7.2f} {t:>7.2f}" + ("" if ok else f"  {msg[:70]}"), flush=True)
+        ok, pts, it, t, msg, nev, n_t, gaps = one_curve(kt, 0.5, 0.04, H, "below", details=True)
+        out.append((kt, ok, pts, it, t, nev))
+        n = max(pts, 1)
+        print(f"{kt:>8.0e} {'yes' if ok else 'no':>3} {n_t:>5} {pts:>6} {gaps:>4} {it / n:>7.2f} "
+              f"{nev / n:>7.2f} {1e3 * t / n:>7.2f} {t:>7.2f}" + ("" if ok else f"  {msg[:70]}"),
+              flush=True)
     return out
 
 
@@ -126,9 +139,20 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="tiny grid (the test)")
     ap.add_argument("--full", action="store_true", help="the issue's whole grid (hours)")
+    ap.add_argument("--harmonics", help="comma-separated subset of the grid's H (e.g. 1,3)")
+    ap.add_argument("--log", help="CSV file: one line per curve as it finishes")
+    ap.add_argument("--no-cost", action="store_true", help="skip table 2")
+    ap.add_argument("--cost-only", action="store_true", help="skip table 1")
     args = ap.parse_args(argv)
-    grid = SMOKE if args.smoke else FULL if args.full else GRID
-    rows, fails = convergence_map(grid)
+    grid = dict(SMOKE if args.smoke else FULL if args.full else GRID)
+    if args.harmonics:
+        grid["H"] = tuple(int(h) for h in args.harmonics.split(","))
+    log = open(args.log, "w") if args.log else None
+    if log is not None:
+        log.write("H,kt,fs,c,start,ok,points,iterations,seconds,message\n")
+    rows, fails = ([], []) if args.cost_only else convergence_map(grid, log)
+    if args.no_cost:
+        return {"map": rows, "failures": fails, "cost": []}
     kts = (1.0, 30.0) if args.smoke else (1.0, 10.0, 30.0, 100.0, 1e3, 1e4, 1e5, 1e6)
     cost = cost_table(kts, H=3 if args.smoke else 15)
     return {"map": rows, "failures": fails, "cost": cost}

@@ -51,6 +51,7 @@ FIXED_MIN_STEP = 1e-4
 #: evaluations for 577 points with the full globalisation (66 % in failed correctors),
 #: 9894 for 579 points with these options.
 CORRECTOR_NEWTON = {"lm": False, "min_alpha": 0.1}
+FIXED_NEWTON = {}
 #: Corrector iteration limit inside the continuation (a step is retried smaller).
 CORRECTOR_ITER = 12
 
@@ -151,7 +152,7 @@ class _Scaled:
             return R, J[:, :-1]
         try:
             res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter,
-                         np.linalg.norm(y_pred[:-1]))
+                         np.linalg.norm(y_pred[:-1]), **FIXED_NEWTON)
         except NewtonError:
             return None
         R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))

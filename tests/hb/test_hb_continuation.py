@@ -60,3 +60,43 @@ def test_newton_converges_quadratically():
     res = newton(lambda x: (np.array([np.exp(x[0]) - 2.0]), np.array([[np.exp(x[0])]])),
                  np.array([0.0]), 1e-14)
     assert abs(res.x[0] - np.log(2)) < 1e-14 and res.iterations <= 6
+
+
+def _oscillator(c):
+    """x'' + c x' + x = cos(lam t) at H = 1, x = a cos + b sin: the response traces a
+    circle of diameter 1 / c through the origin within ~c of lam = 1 (its Nyquist plot)."""
+    def fun(x, lam):
+        a, b = x
+        d = 1.0 - lam**2
+        R = np.array([d * a + c * lam * b - 1.0, d * b - c * lam * a])
+        J = np.array([[d, c * lam], [-c * lam, d]])
+        return R, J, np.array([-2 * lam * a + c * b, -2 * lam * b - c * a])
+    return fun
+
+
+@pytest.mark.parametrize("lam0, lam1", [(0.5, 2.0), (1.0, 2.0), (2.0, 0.5)])
+def test_continuation_crosses_a_resonance_of_q_10000(lam0, lam1):
+    """c = 1e-4: the peak is 1e-4 of the range wide and 1e4 high. With the x scale
+    fixed at the largest RMS met, the two flanks near the origin lay ~1e-3 apart in
+    scaled units and the corrector jumped between them (the branch circled the peak
+    until the point limit, or, started at 1, left the range after 31 points); the x
+    scale following the current point and the orientation test keep lam monotone
+    (measured 20-30 points per decade of amplitude)."""
+    fun = _oscillator(1e-4)
+    br = continuation(fun, np.array([1.0, 0.0]), lam0, lam1, TOL, ds_max=0.1, max_points=3000)
+    lam = np.array(br.lam)
+    assert br.status == "complete" and lam[-1] == lam1
+    assert np.all(np.sign(lam1 - lam0) * np.diff(lam) > 0)  # no turning back
+    assert len(lam) < 600  # measured 180-360 (the 'at' start has one flank)
+    amp = np.hypot(*np.array(br.x).T)
+    assert amp.max() > 0.9e4  # the top of the peak (1 / c = 1e4) is on the curve
+
+
+def test_newton_stops_at_the_round_off_floor():
+    """A stiff residual with an absolute noise floor above tol (as a 1e6 k link's
+    F = k0 (u - z)): converged once the step is below STEP_RTOL of |x|, not an error."""
+    def fun(x):
+        R = 1e6 * (x - 3.0) + 1e-9 * np.sin(1e12 * x)  # noise 1e-9 > tol
+        return R, np.array([[1e6]])
+    res = newton(fun, np.array([1.0]), 1e-12)
+    assert abs(res.x[0] - 3.0) < 1e-14 * 3 + 2e-15 and res.iterations <= 4
