@@ -82,12 +82,15 @@ MAX_POINTS = 3000
 
 def one_curve(kt, fs, c, H, start, details=False):
     """(converged, points, iterations, seconds, message) of one curve; with ``details``
-    also (residual evaluations, AFT samples, gaps)."""
+    also (residual evaluations, AFT samples, gaps). Converged: complete with no gap."""
     t0 = time.perf_counter()
     try:
         r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
                         stability=False, max_points=MAX_POINTS)
-        ok, msg = True, ""
+        # a curve with restart gaps has stretches without points: not converged over the
+        # whole range
+        ok = not r.extra.get("gaps")
+        msg = "" if ok else r.status[:160]
     except FRFError as err:
         r, ok, msg = err.result, False, str(err)[:160]
     out = (ok, r.points, r.newton_iterations, time.perf_counter() - t0, msg)
@@ -107,11 +110,11 @@ def convergence_map(grid, log=None):
         n_ok = n = 0
         t_all = 0.0
         for fs, c, start in itertools.product(grid["fs"], grid["c"], STARTS):
-            ok, pts, it, t, msg = one_curve(kt, fs, c, H, start)
+            ok, pts, it, t, msg, nev, n_t, gaps = one_curve(kt, fs, c, H, start, details=True)
             rows.append((kt, fs, c, H, start, ok, pts, it, t))
             if log is not None:
                 log.write(f"{H},{kt:g},{fs:g},{c:g},{start},{int(ok)},{pts},{it},{t:.3f},"
-                          f"\"{msg}\"\n")
+                          f"{nev},{n_t},{gaps},\"{msg}\"\n")
                 log.flush()
             n += 1
             n_ok += ok
@@ -178,7 +181,7 @@ def main(argv=None):
         grid["H"] = tuple(int(h) for h in args.harmonics.split(","))
     log = open(args.log, "w") if args.log else None
     if log is not None:
-        log.write("H,kt,fs,c,start,ok,points,iterations,seconds,message\n")
+        log.write("H,kt,fs,c,start,ok,points,iterations,seconds,evaluations,n_t,gaps,message\n")
     rows, fails = ([], []) if args.cost_only else convergence_map(grid, log)
     if args.no_cost:
         return {"map": rows, "failures": fails, "cost": []}
