@@ -224,9 +224,10 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
 
 
 #: Stiffness ratio (stiffest friction link over the structure) up to which the
-#: default AFT samples resolve the stick episodes (measured: 1e4 k, H = 15, 512
-#: samples, 0.5 -> 2 rad/s: no gaps).
+#: default AFT samples resolve the stick episodes, and the samples per period that
+#: do so there (measured: 1e4 k, H = 15, 512 samples, 0.5 -> 2 rad/s: no gaps).
 STIFF_SAMPLES_RATIO = 1e4
+STIFF_SAMPLES_BASE = 512
 
 
 def stiff_samples(model: Model, harmonics) -> int:
@@ -236,18 +237,20 @@ def stiff_samples(model: Model, harmonics) -> int:
     A slider sticks at a reversal until the relative displacement has changed by
     2 f_s / k_t; near a reversal u ~ u_r - a t^2 / 2, so a stick episode lasts
     ~ sqrt(4 f_s / (k_t a)): its share of the period, and the samples it spans at a
-    fixed n_t, fall like k_t^-1/2. Above STIFF_SAMPLES_RATIO the default grid is
-    multiplied by sqrt(ratio / STIFF_SAMPLES_RATIO), rounded to a power of two, so
-    the samples per stick episode stay those that work at STIFF_SAMPLES_RATIO.
-    Measured on the Jenkins FRF (H = 15, 0.5 -> 2 rad/s, gaps = stretches the
-    corrector could not cross): 1e5 k: 512 samples 7 gaps, 1024 4, 2048 (this rule)
-    none; 1e6 k: 2048 2 gaps, 4096 (this rule) none.
+    fixed n_t, fall like k_t^-1/2. Above STIFF_SAMPLES_RATIO the grid is
+    STIFF_SAMPLES_BASE sqrt(ratio / STIFF_SAMPLES_RATIO) samples, rounded to a power
+    of two (at least the default), so the samples per stick episode stay those that
+    work at STIFF_SAMPLES_RATIO. Measured on the Jenkins FRF (gaps = stretches the
+    corrector could not cross): H = 15, 0.5 -> 2 rad/s: 1e5 k: 512 samples 7 gaps,
+    1024 4, 2048 (this rule) none; 1e6 k: 2048 2 gaps, 4096 (this rule) none; H = 3
+    from 0.5 rad/s at 1e5 k: 1024 samples 1 gap.
     """
     ratio = _stiffness_ratio(model)
     if ratio is None or ratio <= STIFF_SAMPLES_RATIO:
         return 0
-    factor = 2 ** max(0, round(0.5 * np.log2(ratio / STIFF_SAMPLES_RATIO)))
-    return int(factor * default_samples(max(parse_harmonics(harmonics))))
+    need = STIFF_SAMPLES_BASE * np.sqrt(ratio / STIFF_SAMPLES_RATIO)
+    default = default_samples(max(parse_harmonics(harmonics)))
+    return int(max(default, 2 ** round(np.log2(need))))
 
 
 #: Restarts allowed per curve after a stalled corrector (:func:`_sweep`).

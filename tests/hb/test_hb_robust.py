@@ -10,19 +10,29 @@ import numpy as np
 import pytest
 
 from damper.cli import main
-from harmonic_balance.frf import compute_frf
+from harmonic_balance.frf import compute_frf, stiff_samples
 from harmonic_balance.model import sdof_model
 
 
-@pytest.mark.parametrize("kt", [1e-3, 1.0, 30.0, 1e3, 1e4, 1e6])
+@pytest.mark.parametrize("kt", [1e-3, 1.0, 30.0, 1e3, 1e4, 1e5, 1e6])
 @pytest.mark.parametrize("start", [0.5, 1.0, 2.0])
 def test_sdof_jenkins_curve_completes_from_any_start(kt, start):
     end = 2.0 if start < 2.0 else 0.5
     r = compute_frf(sdof_model(1, 1, 0.04, kt, 0.5, 1.0), "odd:3", (start, end), refine=False)
     assert r.status.startswith("complete") and r.omega[-1] == end
     # no gaps: the fixed-parameter corrector fallback removed them at 1e4 k, the finer AFT
-    # grid for links >= 1e5 k (frf.stiff_samples) at 1e6 k
+    # grid for links > 1e4 k (frf.stiff_samples) at 1e5 and 1e6 k
     assert r.extra["gaps"] == []
+
+
+def test_stiff_samples_grow_like_the_square_root_of_the_stiffness_ratio():
+    """Stick episodes last ~ kt^-1/2 of the period: default grid up to 1e4 k, then
+    512 sqrt(ratio / 1e4) samples rounded to a power of two (the measured 2048 at 1e5,
+    4096 at 1e6 k), whatever H (at least H's default)."""
+    for H in (3, 15):
+        n = {kt: stiff_samples(sdof_model(1, 1, 0.04, kt, 0.5, 1.0), H) for kt in (1e4, 1e5, 1e6)}
+        assert n == {1e4: 0, 1e5: 2048, 1e6: 4096}
+    assert stiff_samples(sdof_model(1, 1, 0.04, 1e5, 0.5, 1.0), 51) == 2048  # default 2048
 
 
 @pytest.mark.parametrize("kt, fs, H", [(1e-3, 1e-3, 1), (1.0, 0.5, 7), (1e3, 0.5, 1)])
@@ -70,7 +80,7 @@ def test_stiffness_1e6_h7_no_gaps():
     (measured after: 190 points, 0 gaps, ~9 s)."""
     r = compute_frf(sdof_model(1, 1, 0.04, 1e6, 0.5, 1.0), 7, (0.5, 2.0), refine=False,
                     stability=False)
-    assert r.status == "complete" and r.extra["gaps"] == [] and r.n_t == 8 * 256
+    assert r.status == "complete" and r.extra["gaps"] == [] and r.n_t == 4096
 
 
 def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
