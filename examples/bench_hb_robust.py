@@ -1,56 +1,30 @@
 """Robustness benchmark of the HB solver (issue 10): convergence map and cost vs contact stiffness.
 
-Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full]
+Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full] [--harmonics 1,3]
+          [--log map.csv] [--no-cost | --cost-only] [--den-hartog]
 
 Model: single-DOF Jenkins oscillator m = k = 1, forcing P = 1 cos(omega t), sweep
 0.5 -> 2 rad/s (start below resonance), 1 -> 2 (start at resonance) and 2 -> 0.5
 (start above, sweeping down), no tuning (library defaults).
 
 Table 1 (convergence map): contact stiffness ratio kt/k, slip force fs/P, damping c,
-harmonics H and the three starts; per kt/k the number of curves completed over
-the whole range, and every failure with where it stopped. Default grid: kt/k in
-{1e-3, 1, 30, 1e3, 1e4, 1e6}, fs/P in {1e-3, 0.5, 10}, c in {1e-4, 0.04, 0.5},
-H in {1, 7, 21}; ``--full`` the issue's whole grid (kt/k 1e-3..1e6 by decades,
-fs/P 1e-3..10, c 1e-4..0.5, H = 1, 3, 7, 21, 51: hours).
+harmonics H and the three starts; per (H, kt/k) the number of curves converged over
+the whole range (complete AND without restart gaps), and every failure with where it
+stopped. Default grid: kt/k in {1e-3, 1, 30, 1e3, 1e4, 1e6}, fs/P in {1e-3, 0.5, 10},
+c in {1e-4, 0.04, 0.5}, H in {1, 7, 21}; ``--full`` the issue's whole grid (kt/k
+1e-3..1e6 by decades, fs/P 1e-3..10, c 1e-4..0.5, H = 1, 3, 7, 21, 51: 3750 curves,
+many hours; ``--harmonics`` picks a subset of H, ``--log`` keeps one CSV line per
+curve).
 
 Table 2 (cost vs stiffness): the issue's case (c = 0.04, fs = 0.5, H = 15,
-0.5 -> 2 rad/s): time per converged point and corrector iterations per point
-against kt/k (goal: no worse than 2x the soft-contact cost at 1e6).
+0.5 -> 2 rad/s): points, Newton iterations and residual evaluations per point, and
+time per point against kt/k (goal: no worse than 2x the soft-contact cost at 1e6).
 
-Wall times depend on the machine's load; nothing here gates CI.
+Table 3 (``--den-hartog``): HB (H = 21) and time integration of the same elastic
+model against Den Hartog's rigid-Coulomb steady state at 1e3 and 1e5 k, 0.5-2 rad/s.
 
-Measured (hbsolver2, 2026-11-23, issue case H = 15, 0.5 -> 2 rad/s, shared 2-core machine;
-/tmp scripts calling compute_frf(..., refine=False, stability=False)):
-
-==========  =====================  ======  ==========  ====================================
-kt/k        corrector              points  ms/point    gaps (stretches skipped)
-==========  =====================  ======  ==========  ====================================
-1           either                 268     1.35        0
-1e4         before (arclength)     617     44.6        41 (0.545-0.671 rad/s)
-1e4         + fixed-lam fallback   292     19.6        0
-1e6         before                 401     211         26 (0.500-0.550)
-1e6         + fixed-lam fallback   312     414 (*)     gaps remain (0.502-0.55, one 0.516-0.539)
-1e6         + n_t 4096 (8x)        763     316 (*)     0
-==========  =====================  ======  ==========  ====================================
-
-1e6 k at H = 3 and 7 from 0.5, 1 and 2 rad/s with the 8x grid: 0 gaps (92/45/111 and
-190/57/233 points, 0.8-8.9 s per curve).
-
-(*) under load (the full test suite ran alongside). Cause of the 1e4 gaps: the branch
-crosses kinks of the sampled residual (a slip onset moving to the next AFT sample) and
-Newton on the pseudo-arclength system cycles between the two linear pieces (|R| stuck
-at 1e-7 ... 1e-3 for every step down to 1e-6), while Newton at fixed omega from the
-same point converges in 2 iterations: continuation now retries a failed step at fixed
-parameter (continuation.FIXED_MIN_STEP). Cause of the 1e6 gaps (not fixed): the motion
-near 0.5 rad/s sticks several times per period (6 velocity reversals), and at n_t = 512
-a stick episode covers only ~4 samples, so fixed-omega Newton from a converged point
-0.001 rad/s away cycles between |R| = 2.1 and 0.46; at n_t = 4096 the same steps
-converge in 7-14 iterations (42 samples in stick). So compute_frf now gives links at
-least 1e5 times stiffer than the structure 8x the default samples (frf.stiff_samples,
-only when n_t is not given). A sweep at n_t = 2048 (4x) instead turned back out of
-the range at 0.4994 rad/s after 162 points (not analysed). The cost goal (1e6 k no
-worse than 2x soft per point) is NOT met: ~200-300 ms vs 1.35 ms. The full grid
-(``--full``) was not run (hours on this machine).
+Wall times depend on the machine's load; nothing here gates CI. Measured numbers and
+their history: README, "Harmonic balance on stiff contacts".
 """
 from __future__ import annotations
 
