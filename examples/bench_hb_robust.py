@@ -54,9 +54,10 @@ SMOKE = dict(kt=(1.0, 30.0), fs=(0.5,), c=(0.04,), H=(3,))
 MAX_POINTS = 3000
 
 
-def one_curve(kt, fs, c, H, start, details=False):
+def one_curve(kt, fs, c, H, start, details=False, eval_cost=False):
     """(converged, points, iterations, seconds, message) of one curve; with ``details``
-    also (residual evaluations, AFT samples, gaps). Converged: complete with no gap."""
+    also (residual evaluations, AFT samples, gaps), with ``eval_cost`` then the ms per
+    evaluation (:func:`_eval_ms`). Converged: complete with no gap."""
     t0 = time.perf_counter()
     try:
         r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
@@ -68,7 +69,26 @@ def one_curve(kt, fs, c, H, start, details=False):
     except FRFError as err:
         r, ok, msg = err.result, False, str(err)[:160]
     out = (ok, r.points, r.newton_iterations, time.perf_counter() - t0, msg)
-    return out + (r.evaluations, r.n_t, len(r.extra.get("gaps", ()))) if details else out
+    if not details:
+        return out
+    out += (r.evaluations, r.n_t, len(r.extra.get("gaps", ())))
+    return out + (_eval_ms(r),) if eval_cost else out
+
+
+def _eval_ms(r, reps=5, n=20):
+    """Cost of one residual evaluation [ms] at the curve's middle point: the minimum over
+    ``reps`` batches of ``n`` (less sensitive to the machine's load than the wall time)."""
+    if not r.points or r.problem is None:
+        return float("nan")
+    i = r.points // 2
+    x, w = r.solutions[i], r.omega[i]
+    best = float("inf")
+    for _ in range(reps):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            r.problem(x, w)
+        best = min(best, (time.perf_counter() - t0) / n)
+    return 1e3 * best
 
 
 def convergence_map(grid, log=None):
@@ -104,16 +124,18 @@ def convergence_map(grid, log=None):
 
 def cost_table(kts, H=15):
     print(f"\nTable 2: issue case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
+    print("(ms/eval: best of 5 x 20 evaluations at the middle point; est = eval/pt x ms/eval,"
+          " less load-dependent than the wall ms/pt)")
     print(f"{'kt/k':>8} {'ok':>3} {'n_t':>5} {'points':>6} {'gaps':>4} {'iter/pt':>7} "
-          f"{'eval/pt':>7} {'ms/pt':>7} {'time_s':>7}")
+          f"{'eval/pt':>7} {'ms/eval':>7} {'est/pt':>7} {'ms/pt':>7} {'time_s':>7}")
     out = []
     for kt in kts:
-        ok, pts, it, t, msg, nev, n_t, gaps = one_curve(kt, 0.5, 0.04, H, "below", details=True)
-        out.append((kt, ok, pts, it, t, nev))
+        ok, pts, it, t, msg, nev, n_t, gaps, ms = one_curve(kt, 0.5, 0.04, H, "below", True, True)
+        out.append((kt, ok, pts, it, t, nev, ms))
         n = max(pts, 1)
         print(f"{kt:>8.0e} {'yes' if ok else 'no':>3} {n_t:>5} {pts:>6} {gaps:>4} {it / n:>7.2f} "
-              f"{nev / n:>7.2f} {1e3 * t / n:>7.2f} {t:>7.2f}" + ("" if ok else f"  {msg[:70]}"),
-              flush=True)
+              f"{nev / n:>7.2f} {ms:>7.3f} {ms * nev / n:>7.2f} {1e3 * t / n:>7.2f} {t:>7.2f}"
+              + ("" if ok else f"  {msg[:70]}"), flush=True)
     return out
 
 
