@@ -3,10 +3,17 @@
 Knows nothing about mechanics: ``fun(x, lam) -> (R (N,), dR/dx (N, N), dR/dlam (N,))``.
 
 Scaling: the arclength is measured in scaled variables ``x / s_x`` and
-``lam / s_lam``, with ``s_lam`` the length of the parameter range and ``s_x`` the
-largest RMS of x met so far on the branch (grows with the response, so a resonance
-peak is resolved by more points and the step never lets lam run away: without it a
-50-DOF case wandered to negative frequency, performance.md).
+``lam / s_lam``, with ``s_lam`` the length of the parameter range and ``s_x`` the RMS
+of x at the current point, floored at :data:`S_X_FLOOR` of the largest met so far
+(a steep flank is climbed and descended in relative steps, so a resonance peak is
+resolved by more points and the step never lets lam run away: with a fixed scale a
+50-DOF case wandered to negative frequency, performance.md; with the largest RMS met
+as the scale the two flanks of a peak 1e4 high came within 1e-3 of each other in
+scaled units and the corrector jumped between them).
+
+Orientation: the branch keeps the sign of det([R_x R_lam; t^T]) (Allgower & Georg,
+sec. 2.1), so a corrected point where it flips (the step jumped over a peak or a fold
+narrower than itself) is rejected, above :data:`FLIP_STEP`.
 
 Step (Allgower & Georg, Numerical Continuation Methods, ch. 6): tangent t from
 ``[R_x R_lam; t_prev^T] t = [0; 1]``; predictor ``y + ds t``; corrector Newton on R = 0
