@@ -54,10 +54,11 @@ SMOKE = dict(kt=(1.0, 30.0), fs=(0.5,), c=(0.04,), H=(3,))
 MAX_POINTS = 3000
 
 
-def one_curve(kt, fs, c, H, start, details=False, eval_cost=False):
+def one_curve(kt, fs, c, H, start, details=False, eval_point=False):
     """(converged, points, iterations, seconds, message) of one curve; with ``details``
-    also (residual evaluations, AFT samples, gaps), with ``eval_cost`` then the ms per
-    evaluation (:func:`_eval_ms`). Converged: complete with no gap."""
+    also (residual evaluations, AFT samples, gaps), with ``eval_point`` then the curve's
+    problem and middle point (problem, x, omega) for :func:`_eval_ms`. Converged:
+    complete with no gap."""
     t0 = time.perf_counter()
     try:
         r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
@@ -72,23 +73,22 @@ def one_curve(kt, fs, c, H, start, details=False, eval_cost=False):
     if not details:
         return out
     out += (r.evaluations, r.n_t, len(r.extra.get("gaps", ())))
-    return out + (_eval_ms(r),) if eval_cost else out
-
-
-def _eval_ms(r, reps=5, n=20):
-    """Cost of one residual evaluation [ms] at the curve's middle point: the minimum over
-    ``reps`` batches of ``n`` (less sensitive to the machine's load than the wall time)."""
-    if not r.points or r.problem is None:
-        return float("nan")
     i = r.points // 2
-    x, w = r.solutions[i], r.omega[i]
-    best = float("inf")
-    for _ in range(reps):
-        t0 = time.perf_counter()
-        for _ in range(n):
-            r.problem(x, w)
-        best = min(best, (time.perf_counter() - t0) / n)
-    return 1e3 * best
+    return out + ((r.problem, r.solutions[i], r.omega[i]),) if eval_point else out
+
+
+def _eval_ms(points, rounds=7, n=30):
+    """Cost of one residual evaluation [ms] at each (problem, x, omega): the minimum over
+    ``rounds`` batches of ``n``, the points interleaved in every round so that the
+    machine's load weighs on all alike."""
+    best = [float("inf")] * len(points)
+    for _ in range(rounds):
+        for k, (prob, x, w) in enumerate(points):
+            t0 = time.perf_counter()
+            for _ in range(n):
+                prob(x, w)
+            best[k] = min(best[k], (time.perf_counter() - t0) / n)
+    return [1e3 * b for b in best]
 
 
 def convergence_map(grid, log=None):
@@ -124,17 +124,18 @@ def convergence_map(grid, log=None):
 
 def cost_table(kts, H=15):
     print(f"\nTable 2: issue case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
-    print("(ms/eval: best of 5 x 20 evaluations at the middle point; est = eval/pt x ms/eval,"
-          " less load-dependent than the wall ms/pt)")
+    curves = [one_curve(kt, 0.5, 0.04, H, "below", True, True) for kt in kts]
+    ms = _eval_ms([cv[-1] for cv in curves])
+    print("(ms/eval: one residual evaluation, best of 7 x 30 interleaved over the rows; "
+          "est/pt = eval/pt x ms/eval, less load-dependent than the wall ms/pt)")
     print(f"{'kt/k':>8} {'ok':>3} {'n_t':>5} {'points':>6} {'gaps':>4} {'iter/pt':>7} "
           f"{'eval/pt':>7} {'ms/eval':>7} {'est/pt':>7} {'ms/pt':>7} {'time_s':>7}")
     out = []
-    for kt in kts:
-        ok, pts, it, t, msg, nev, n_t, gaps, ms = one_curve(kt, 0.5, 0.04, H, "below", True, True)
-        out.append((kt, ok, pts, it, t, nev, ms))
+    for kt, (ok, pts, it, t, msg, nev, n_t, gaps, _), me in zip(kts, curves, ms):
+        out.append((kt, ok, pts, it, t, nev, me))
         n = max(pts, 1)
         print(f"{kt:>8.0e} {'yes' if ok else 'no':>3} {n_t:>5} {pts:>6} {gaps:>4} {it / n:>7.2f} "
-              f"{nev / n:>7.2f} {ms:>7.3f} {ms * nev / n:>7.2f} {1e3 * t / n:>7.2f} {t:>7.2f}"
+              f"{nev / n:>7.2f} {me:>7.3f} {me * nev / n:>7.2f} {1e3 * t / n:>7.2f} {t:>7.2f}"
               + ("" if ok else f"  {msg[:70]}"), flush=True)
     return out
 
