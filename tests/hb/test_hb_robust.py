@@ -50,6 +50,22 @@ def test_nearly_undamped_peak_completes_from_any_start(kt, fs, H, start):
     assert np.all(np.sign(end - start) * np.diff(r.omega) > 0)
 
 
+def test_grazing_slip_is_crossed_on_a_finer_grid():
+    """Slip force = forcing, 10 k, c = 1e-4, H = 3: above 1 rad/s the link's force only
+    just exceeds f_s at the turning points, so the slip episodes span a handful of
+    samples and the corrector stalled at 1.1066 rad/s (a gap) on 256-1024 samples
+    (found by the full map); compute_frf traces the curve again on doubled grids:
+    measured complete at 2048 samples (3 doublings), ~2 s."""
+    r = compute_frf(sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0), 3, (0.5, 2.0), refine=False,
+                    stability=False)
+    assert r.status.startswith("complete") and r.extra["gaps"] == [] and r.omega[-1] == 2.0
+    assert r.extra["grid_doublings"] >= 1 and r.n_t == 256 * 2 ** r.extra["grid_doublings"]
+    # with the grid fixed by the caller there is no doubling: the stall shows as a gap
+    r0 = compute_frf(sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0), 3, (0.5, 2.0), n_t=256,
+                     refine=False, stability=False)
+    assert r0.extra["gaps"] and r0.extra["grid_doublings"] == 0
+
+
 @pytest.mark.slow
 def test_first_point_at_1e6_k_inside_the_slipping_resonance():
     """1e6 k, slip force 0.5 P, c = 1e-4, H = 7, at omega = 1 (amplitude 3634): every
