@@ -140,6 +140,29 @@ def cost_table(kts, H=15):
     return out
 
 
+def rerun_failed(files, log=None):
+    """Re-run the failed curves (ok = 0) of ``--log`` CSV files; one CSV line each."""
+    import csv
+
+    rows = [r for f in files for r in csv.DictReader(open(f)) if r["ok"] == "0"]
+    out = open(log, "w") if log else None
+    head = "H,kt,fs,c,start,ok,points,iterations,seconds,evaluations,n_t,gaps,message"
+    print(head)
+    if out is not None:
+        out.write(head + "\n")
+    res = []
+    for r in rows:
+        H, kt, fs, c, st = int(r["H"]), float(r["kt"]), float(r["fs"]), float(r["c"]), r["start"]
+        ok, pts, it, t, msg, nev, n_t, gaps = one_curve(kt, fs, c, H, st, details=True)
+        line = f"{H},{kt:g},{fs:g},{c:g},{st},{int(ok)},{pts},{it},{t:.3f},{nev},{n_t},{gaps},\"{msg}\""
+        print(line, flush=True)
+        if out is not None:
+            out.write(line + "\n")
+            out.flush()
+        res.append((kt, fs, c, H, st, ok))
+    return res
+
+
 def den_hartog_table(kts=(1e3, 1e5), omegas=(0.5, 0.75, 1.0, 1.5, 2.0), H=21):
     """Table 3: HB (H) and time integration of the same elastic Jenkins model against
     Den Hartog's rigid-Coulomb steady state (c = 0.04, fs = 0.5, P = 1)."""
@@ -168,11 +191,15 @@ def main(argv=None):
     ap.add_argument("--log", help="CSV file: one line per curve as it finishes")
     ap.add_argument("--no-cost", action="store_true", help="skip table 2")
     ap.add_argument("--cost-only", action="store_true", help="skip table 1")
+    ap.add_argument("--rerun-failed", nargs="+", metavar="CSV",
+                    help="re-run the failed curves of --log files (e.g. after a solver change)")
     ap.add_argument("--den-hartog", action="store_true",
                     help="only table 3 (HB and time integration vs Den Hartog, minutes)")
     args = ap.parse_args(argv)
     if args.den_hartog:
         return {"den_hartog": den_hartog_table()}
+    if args.rerun_failed:
+        return {"rerun": rerun_failed(args.rerun_failed, args.log)}
     grid = dict(SMOKE if args.smoke else FULL if args.full else GRID)
     if args.harmonics:
         grid["H"] = tuple(int(h) for h in args.harmonics.split(","))
