@@ -30,6 +30,7 @@ def register(sub) -> None:
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
+    _contacts(f)
     f.set_defaults(func=run_frf)
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     _common(o)
@@ -40,6 +41,7 @@ def register(sub) -> None:
     o.add_argument("--workers", type=int, default=2,
                    help="processes for the load grid (results do not depend on it)")
     o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
+    _contacts(o)
     o.set_defaults(func=run_optimize)
 
 
@@ -48,11 +50,18 @@ def _common(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
+def _contacts(p) -> None:
+    p.add_argument("--contacts", choices=("toml", "geometry"), default="toml",
+                   help="contact laws: the TOML's Jenkins points, or computed by contact_core "
+                   "from the [geometry] section (damper.upd_geometry; cached)")
+
+
 def _sector(args):
+    from damper.upd_geometry import apply_to_args
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.sector import Sector
 
-    return Sector(load_config(args.config))
+    return Sector(apply_to_args(args, load_config(args.config)))
 
 
 def run_modes(args) -> int:
@@ -87,6 +96,7 @@ def run_frf(args) -> int:
         out = _frf_nonlinear(sector, args, omegas)
     else:
         out = _frf_linear(sector, args, omegas)
+    out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -138,6 +148,7 @@ def run_optimize(args) -> int:
 
     out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
                        workers=args.workers)
+    out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_optimize(out, args.plot)
     if args.json:
