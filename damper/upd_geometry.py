@@ -45,7 +45,7 @@ from dataclasses import replace
 import numpy as np
 
 #: Version of the cached contact entry's content (bump when it changes).
-ENTRY_VERSION = 1
+ENTRY_VERSION = 2
 #: The cylinder's potential contact zone holds the 2D Hertz contact of this many times its
 #: nominal load (plus contact_core's margins: zone_margin 1.15, end widening 1.3). Sized
 #: from the load, not from the thesis's 2000 MPa design pressure: at the default 85 N the
@@ -178,7 +178,7 @@ def solve_contact(name: str, spec, model: str, N: float, mu: float, store=None) 
     hit = store.get(key) if store is not None else None
     if hit is not None:
         arrays, meta = hit
-        curve = VirginCurve(u=arrays["u"], T=arrays["T"], N=N, mu=mu, k_t=meta["k_t"],
+        curve = VirginCurve(u=arrays["u"], T=arrays["T"], N=meta["N"], mu=mu, k_t=meta["k_t"],
                             k_n=meta["k_n"], load_case="CNF", tail="flat")
         return {"curve": curve, "k_n": meta["k_n"], "k_t": meta["k_t"],
                 "contact_nodes": meta["contact_nodes"], "warnings": meta["warnings"],
@@ -189,7 +189,8 @@ def solve_contact(name: str, spec, model: str, N: float, mu: float, store=None) 
                                  command=f"damper upd --contacts geometry ({name})")
     except ValueError as err:
         raise ValueError(f"{name} contact ({spec.body}) at N = {N:.4g} N: {err}") from None
-    meta = {"k_n": run.k_n, "k_t": run.problem.k_t, "contact_nodes": int(run.problem.n_c),
+    # N: the solved nodal forces' sum (N to round-off), the curve's own N_ref
+    meta = {"N": run.curve.N, "k_n": run.k_n, "k_t": run.problem.k_t, "contact_nodes": int(run.problem.n_c),
             "warnings": list(run.warnings)}
     if store is not None:
         store.put(key, {"u": np.asarray(run.curve.u), "T": np.asarray(run.curve.T)}, meta)
