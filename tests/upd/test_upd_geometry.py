@@ -164,3 +164,14 @@ def test_bad_geometry_is_a_clear_message_exit_2(tmp_path, capsys, monkeypatch, g
     captured = capsys.readouterr()
     assert code == 2 and captured.out == ""
     assert words in captured.err and "Traceback" not in captured.err
+
+
+@pytest.mark.slow
+def test_comparison_example_smoke(load_example, tmp_path, capsys):
+    """examples/upd_geometry_compare.py --quick: both contact choices through HB and TI."""
+    out = load_example("upd_geometry_compare").main(["--quick", "--cache-dir", str(tmp_path)])
+    assert set(out) == {"toml", "geometry"} and "contacts" in out["geometry"]
+    for res in out.values():
+        assert res["peak_amplitude"] > 0 and len(res["ti_vs_hb"]["ti"]) == 5
+        assert all(p > 0 for p in res["ti_scan"]["ti_peak"])
+    assert "TI peak vs CF" in capsys.readouterr().out
