@@ -22,6 +22,9 @@ from .solve import frf
 
 #: Relative tolerance of the optimum CF (log-space Brent bracket).
 CF_XTOL = 1e-3
+#: Rise of the peak over the optimum that bounds the reported flat band (1 %): the
+#: optimum CF itself is ill-conditioned (the minimum is flat; README).
+FLAT_BAND = 0.01
 #: Relative half-width of the frequency grid around the previous peak.
 NARROW = 0.03
 #: Points of that grid (3 % / 8 = 0.4 % of the peak frequency apart).
@@ -44,6 +47,25 @@ def peak_at(sector: Sector, cf: float, H: int, omegas, f0=None, mu=None) -> tupl
     """Refined peak (omega [rad/s], first-harmonic amplitude [m]) at centrifugal load cf [N]."""
     c = frf(SectorHB(sector, H, cf=cf, f0=f0, mu=mu), omegas)
     return c.peak_omega, c.peak_amplitude
+
+
+def flat_band(samples: dict, rise: float) -> list:
+    """CF interval [N] where the peak stays within ``1 + rise`` of the smallest sampled
+    peak, by linear interpolation in log CF between the samples {CF: peak} (a convex
+    curve: the interval is slightly narrower than the true one). An end that the
+    samples do not bracket is None."""
+    cf = np.array(sorted(samples))
+    a = np.array([samples[c] for c in cf]) / min(samples.values()) - 1 - rise
+    i, z, ends = int(np.argmin(a)), np.log(cf), []
+    for j in (range(i, 0, -1), range(i, cf.size - 1)):
+        end = None
+        for k in j:
+            k2 = k - 1 if j.step < 0 else k + 1
+            if a[k2] > 0:
+                end = float(np.exp(z[k] + (z[k2] - z[k]) * a[k] / (a[k] - a[k2])))
+                break
+        ends.append(end)
+    return ends
 
 
 class _Peaks:
@@ -133,7 +155,8 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     Returns
     -------
     dict with cf, peak_amplitude, peak_frequency_hz (lists), optimum_cf,
-    optimum_peak_amplitude, method, interior (bool), time_s.
+    optimum_peak_amplitude, method, interior (bool), time_s; when interior also
+    optimum_band_cf ([low, high] N: the peak within FLAT_BAND of the optimum).
     """
     lo, hi = (float(v) for v in cf_range)
     if not (0 < lo < hi and np.isfinite(hi)) or points < 3:
@@ -160,12 +183,18 @@ def optimal_load(sector: Sector, cf_range, points: int = 20, H: int = 7, band_hz
     else:
         peak.seed(cfs[i - 1], peaks[i - 1][0])
         peak.seed(cfs[i + 1], peaks[i + 1][0])
-        res = minimize_scalar(lambda z: peak(np.exp(z))[1],
-                              bounds=(np.log(cfs[i - 1]), np.log(cfs[i + 1])), method="bounded",
-                              options={"xatol": CF_XTOL})
+        seen = {float(c): float(a) for c, a in zip(cfs[i - 1:i + 2], amp[i - 1:i + 2])}
+
+        def objective(z):
+            seen[float(np.exp(z))] = a = peak(np.exp(z))[1]
+            return a
+
+        res = minimize_scalar(objective, bounds=(np.log(cfs[i - 1]), np.log(cfs[i + 1])),
+                              method="bounded", options={"xatol": CF_XTOL})
         out.update(optimum_cf=float(np.exp(res.x)), optimum_peak_amplitude=float(res.fun),
                    method="bounded scalar search (Brent, log CF) on the refined peak",
-                   interior=True, search_evaluations=int(res.nfev))
+                   interior=True, search_evaluations=int(res.nfev),
+                   optimum_band_cf=flat_band(seen, FLAT_BAND))
     out["time_s"] = time.perf_counter() - t0
     out["time_grid_s"], out["workers"] = t_grid, int(workers)
     out["cpu_chunks_s"], out["cpu_search_s"] = cpu_chunks, time.process_time() - c_search

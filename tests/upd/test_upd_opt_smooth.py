@@ -11,7 +11,7 @@ import pytest
 
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
-from harmonic_balance.bladed_disk.optimize import _Peaks, peak_at
+from harmonic_balance.bladed_disk.optimize import _Peaks, flat_band, peak_at
 from harmonic_balance.bladed_disk.sector import Sector
 from harmonic_balance.bladed_disk.solve import frf
 
@@ -38,3 +38,17 @@ def test_peak_against_cf_is_path_independent_and_convex():
     assert np.all(np.diff(np.log(warm), 2) > 0)
     fine = frf(SectorHB(sector, 3, cf=cfs[2], n_t=512), omegas).peak_amplitude
     assert abs(fine / cold[2] - 1) < SAMPLES_RTOL
+
+
+def test_flat_band_of_a_parabola_in_log_cf():
+    # A = 1 + c ln(CF / CF*)^2 is within 1 % for |ln(CF / CF*)| <= sqrt(0.01 / c);
+    # linear interpolation on 30 log-spaced samples: measured 5e-4 relative (the chord
+    # of a convex curve lies above it, so the band comes out narrower)
+    c, opt = 0.68, 130.0
+    cf = np.geomspace(50.0, 300.0, 30)
+    band = flat_band({x: 1 + c * np.log(x / opt) ** 2 for x in cf}, 0.01)
+    exact = opt * np.exp(np.array([-1, 1]) * np.sqrt(0.01 / c))
+    np.testing.assert_allclose(band, exact, rtol=1e-3)
+    assert band[0] >= exact[0] and band[1] <= exact[1]
+    # an end the samples do not bracket is None
+    assert flat_band({100.0: 1.05, 130.0: 1.0, 140.0: 1.001}, 0.01)[1] is None
