@@ -8,6 +8,8 @@ TI's step error (2x steps) and settling error, and the TI's cost against its own
 accuracy. Times are CPU (process_time): the machine is shared.
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_upd.py --out out/bench_upd [--quick]
+    ... bench_upd.py --scan 5 7 9 11 13 15            # the objective per H (25 loads 80-250 N)
+    ... bench_upd.py --scan 17 21 --scan-range 105 185 11 --ti   # and the TI's optimum
 """
 from __future__ import annotations
 
@@ -134,6 +136,26 @@ def objective_scan(sector, Hs, cfs, nt_factors=(1,), points=40):
     return rows
 
 
+def ti_optimum(sector, cfs, tol=1e-3, periods=150):
+    """Optimum CF of the ring TI: per load the TI peak (parabola through 3 frequencies
+    at +-0.5 % around the H = 7 peak, settled to ``tol``), then a parabola in log CF
+    through the five loads around the smallest peak."""
+    peaks, cpu = [], 0.0
+    for cf in cfs:
+        c7, _, _ = hb_peak(sector, cf, 7)
+        _, p, t = ti_peak(sector, c7.peak_omega * np.array([0.995, 1.0, 1.005]), cf, periods, tol)
+        peaks.append(p)
+        cpu += t
+    amp = np.array(peaks)
+    i = min(max(int(np.argmin(amp)), 2), len(cfs) - 3)
+    q = np.polyfit(np.log(cfs[i - 2:i + 3]), amp[i - 2:i + 3], 2)
+    row = {"H": "TI", "peak": peaks, "optimum_cf": float(np.exp(-q[1] / (2 * q[0]))),
+           "optimum_peak": float(np.polyval(q, -q[1] / (2 * q[0]))), "ti_cpu_s": cpu,
+           "convex": bool(np.all(np.diff(np.log(amp), 2) > 0))}
+    print({k: row[k] for k in ("optimum_cf", "optimum_peak", "convex", "ti_cpu_s")}, flush=True)
+    return row
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", default="out/bench_upd")
@@ -141,16 +163,22 @@ def main(argv=None):
     ap.add_argument("--periods", type=int, default=150, help="TI periods per load")
     ap.add_argument("--workers", type=int, default=2, help="processes for the load grid")
     ap.add_argument("--scan", nargs="*", type=int, metavar="H",
-                    help="only the objective scan: independent refined peaks at 25 loads "
+                    help="only the objective scan: independent refined peaks at the loads "
                          "80-250 N for these H (default 5 7 9 11 15; n_t x1, and x2, x4 at H=7)")
+    ap.add_argument("--scan-range", nargs=3, type=float, metavar=("LOW", "HIGH", "N"),
+                    default=(80.0, 250.0, 25), help="loads of the scan [N] (log-spaced)")
+    ap.add_argument("--ti", action="store_true", help="with --scan: also the ring TI's optimum")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     sector = Sector(load_config())
     if a.scan is not None:
-        cfs = np.geomspace(80.0, 250.0, 25)
+        lo, hi, n = a.scan_range
+        cfs = np.geomspace(lo, hi, int(n))
         rows = [r for H in (a.scan or (5, 7, 9, 11, 15))
                 for r in objective_scan(sector, [H], cfs, (1, 2, 4) if H == 7 else (1,))]
+        if a.ti:
+            rows.append(ti_optimum(sector, cfs))
         (out / "objective_scan.json").write_text(json.dumps({"cf": cfs.tolist(), "rows": rows}))
         return rows
     q = a.quick
