@@ -37,6 +37,10 @@ class ContactPoint:
     t : (2,) array     unit tangent
     kn, kt : float     normal and tangential stiffness [N/m]
     neighbour : bool   True when the point touches blade j+1's platform
+    friction : IwanElement or None
+        Tangential element of this point (slip strengths scale with N / N_ref), e.g.
+        from a ``contact_core`` virgin curve; None: a Jenkins element k_t, mu N.
+        With it, ``kt`` is its stuck stiffness (used by the linear stuck limit).
     """
 
     name: str
@@ -46,13 +50,21 @@ class ContactPoint:
     kn: float
     kt: float
     neighbour: bool
+    friction: object = None
 
 
 @dataclass
 class UPDConfig:
-    """Numbers of a UPD bladed-disk model (SI units); see ``upd24.toml``."""
+    """Numbers of a UPD bladed-disk model (SI units); see ``upd24.toml``.
+
+    ``contacts`` optionally replaces the TOML's contact laws per point name
+    ("left", "right1", "right2"): ``{"kn": float, "friction": IwanElement}`` (either
+    key may be missing). It carries computed data (e.g. ``contact_core`` virgin
+    curves), not TOML keys, and is kept by :meth:`with_values`.
+    """
 
     data: dict
+    contacts: dict | None = None
 
     # ------------------------------------------------------------ access
     def __getitem__(self, key: str):
@@ -95,7 +107,7 @@ class UPDConfig:
         for k, v in changes.items():
             sec, _, name = k.partition("__")
             data[sec][name] = v
-        out = UPDConfig(data)
+        out = UPDConfig(data, self.contacts)
         out.validate()
         return out
 
@@ -116,13 +128,27 @@ class UPDConfig:
         nR, tR = np.array([-s, -c]), np.array([c, -s])
         rc = np.asarray(d["right_centre"], dtype=float)
         half = 0.5 * float(d["right_width"])
-        return [ContactPoint("left", np.asarray(d["left_point"], float), nL, tL, kn, kt, False),
-                ContactPoint("right1", rc - half * tR, nR, tR, kn / 2, kt / 2, True),
-                ContactPoint("right2", rc + half * tR, nR, tR, kn / 2, kt / 2, True)]
+        pts = [ContactPoint("left", np.asarray(d["left_point"], float), nL, tL, kn, kt, False),
+               ContactPoint("right1", rc - half * tR, nR, tR, kn / 2, kt / 2, True),
+               ContactPoint("right2", rc + half * tR, nR, tR, kn / 2, kt / 2, True)]
+        for c in pts:
+            over = (self.contacts or {}).get(c.name, {})
+            c.kn = float(over.get("kn", c.kn))
+            if over.get("friction") is not None:
+                c.friction = over["friction"]
+                c.kt = float(np.sum(c.friction.k) + c.friction.k_res)
+        return pts
 
     # ------------------------------------------------------------ checks
     def validate(self) -> None:
         """Raise ValueError with a message naming the key when a value is unusable."""
+        for name, over in (self.contacts or {}).items():
+            if name not in ("left", "right1", "right2") or set(over) - {"kn", "friction"}:
+                raise ValueError(f"contact override {name}: {sorted(over)} (points left, right1, "
+                                 "right2; keys kn, friction)")
+            kn = over.get("kn", 1.0)
+            if not (np.isfinite(kn) and kn > 0):
+                raise ValueError(f"contact override {name}: kn = {kn} must be finite and > 0")
         positive = ["blade.m_r", "blade.m_p", "blade.m_a", "blade.k_g", "blade.k_rp", "blade.k_v",
                     "blade.k_pa", "damper.m_d", "damper.I_d", "damper.contact_length",
                     "damper.kn_per_length", "damper.kt_ratio", "load.f0"]

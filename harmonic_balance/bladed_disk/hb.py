@@ -59,6 +59,8 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
     ----------
     sector : Sector
     mu : float
+        Friction coefficient of the Jenkins points (points with their own
+        ``friction`` element keep it).
     offset : int
         First DOF of the sector (blade j) in the model (7 j in a ring).
     next_offset : int or None
@@ -78,7 +80,10 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
         else:
             dofs = np.r_[offset + np.arange(N_DOF), next_offset + np.array(PLATFORM)]
             kin = Kinematics(dofs, np.hstack([own, nxt]))
-        els.append(ContactElement.jenkins(kin, c.kn, c.kt, mu, beta_c=sector.beta_c, name=c.name))
+        if c.friction is None:
+            els.append(ContactElement.jenkins(kin, c.kn, c.kt, mu, beta_c=sector.beta_c, name=c.name))
+        else:  # the point's own element (e.g. a contact_core virgin curve); mu is in it
+            els.append(ContactElement(kin, c.kn, c.friction, beta_c=sector.beta_c, name=c.name))
     return els
 
 

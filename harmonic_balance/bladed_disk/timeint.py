@@ -106,7 +106,7 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
 
 def _contact_arrays(ring: RingHB) -> dict:
     """The ring's ContactElements as arrays: rows of s and p (n_c, n), k_n, slip_ref,
-    stuck stiffness and dashpots on the structure, and the C elements grouped by k_t
+    stuck stiffness and dashpots on the structure, and the C elements grouped by their law
     (one batched call per group per step)."""
     n = ring.ndof
     Qs, Qp, kn, s0 = [], [], [], []
@@ -123,7 +123,9 @@ def _contact_arrays(ring: RingHB) -> dict:
         Kst += rows.T @ el.stuck_stiffness() @ rows
         if el.local_damping() is not None:
             Cd += rows.T @ el.local_damping() @ rows
-        by_kt.setdefault(el.k_t, (el.friction, []))[1].append(i)
+        f = el.friction  # equal laws share one batched call (Jenkins points: by k_t, fs)
+        key = (tuple(f.k), tuple(f.fs), f.k_res, f.N_ref, f.scale)
+        by_kt.setdefault(key, (f, []))[1].append(i)
     groups = [(f, np.array(idx)) for f, idx in by_kt.values()]
     return {"Qs": np.array(Qs), "Qp": np.array(Qp), "kn": np.array(kn), "s0": np.array(s0),
             "K_stuck": Kst, "C": Cd, "groups": groups}
