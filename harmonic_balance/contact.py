@@ -142,12 +142,12 @@ class ContactElement(ForceElement):
         f[:, -1] = self.k_n * np.where(on, p, 0.0)
         dF = np.zeros((nb * m, nb * m)) if jac else None
         if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
-            dF[m - 1::m, m - 1::m] = (D * (self.k_n * on)) @ E
+            dF[m - 1::m, m - 1::m] = self._normal_block(basis, on)
         W, s = 0.0, None
         if m == 2:
             s = E @ U[:, 0]
             Ft, dFs, dFp, W = self.friction.periodic_jac(
-                s - self.slip_ref, E, N=self.k_n * p, EN=self.k_n * E,
+                s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
                 max_periods=self.max_periods, tol=self.tol)
             f[:, 0] = Ft
             if jac:
@@ -162,6 +162,25 @@ class ContactElement(ForceElement):
             if jac:
                 dF += omega * op
         return ContactForce(F, dF, dw, f, float(W), (C, U, basis, omega), (s, pl))
+
+    def _cached(self, basis: FourierBasis, what: str, on=None) -> np.ndarray:
+        """Per-basis constants, rebuilt when k_n or the basis change: ``EN`` = k_n E
+        (n_t, n_b) and ``Knn`` = D diag(k_n) E (n_b, n_b), the normal block in full
+        contact. Computed by the same expressions as the uncached path (bit-identical)."""
+        key = (basis.harmonics, basis.n_t, self.k_n)
+        cache = getattr(self, "_basis_cache", None)
+        if cache is None or cache[0] != key:
+            cache = self._basis_cache = (key, {})
+        if what not in cache[1]:
+            cache[1][what] = (self.k_n * basis.E if what == "EN"
+                              else (basis.D * (self.k_n * on)) @ basis.E)
+        return cache[1][what]
+
+    def _normal_block(self, basis: FourierBasis, on: np.ndarray) -> np.ndarray:
+        """dN/dU_p harmonics D diag(k_n on) E (n_b, n_b); cached when in contact throughout."""
+        if on.all():
+            return self._cached(basis, "Knn", on)
+        return (basis.D * (self.k_n * on)) @ basis.E
 
     def _local_damping_cached(self):
         """local_damping(), rebuilt only when beta_c, k_t or k_n change."""
