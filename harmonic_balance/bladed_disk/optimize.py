@@ -6,6 +6,11 @@ Brent's bounded scalar search in log CF between the neighbours of the smallest g
 value, each evaluation a refined peak. (casadi is not used: the objective is a
 maximum over frequency of a non-smooth branch, which a bounded scalar search on the
 refined peak handles directly; see the README.)
+
+Measured (README, UPD section): the objective is smooth and path-independent (warm
+narrow grids equal independent full-band searches to 3e-5; n_t x4: 1e-4), but its
+minimum is flat, so the optimum CF depends on the harmonic truncation (H 5: 150 N,
+7: 131 N, 11-21: 135-141 N, ring time integration 138 N); hence ``optimum_band_cf``.
 """
 from __future__ import annotations
 
@@ -25,7 +30,7 @@ CF_XTOL = 1e-3
 #: Rise of the peak over the optimum that bounds the reported flat band (1 %): the
 #: optimum CF itself is ill-conditioned (the minimum is flat; README).
 FLAT_BAND = 0.01
-#: Relative half-width of the frequency grid around the previous peak.
+#: Relative half-width of the frequency grid around the predicted peak.
 NARROW = 0.03
 #: Points of that grid (3 % / 8 = 0.4 % of the peak frequency apart).
 NARROW_POINTS = 17
