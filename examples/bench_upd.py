@@ -188,7 +188,7 @@ def main(argv=None):
                        workers=a.workers)
     rows["optimize"] = opt
     print({k: opt[k] for k in ("optimum_cf", "optimum_peak_amplitude", "time_s", "method")}, flush=True)
-    rows["optimum_vs_h"] = optimum_vs_h(sector, (1, 3) if q else (5, 7, 9, 11, 15),
+    rows["optimum_vs_h"] = optimum_vs_h(sector, (1,) if q else (5, 7, 9, 11, 15),
                                         (80.0, 250.0), 4 if q else 7, 15 if q else 40)
     Hs = (1, 3) if q else (1, 3, 5, 7, 9, 15)
     tols = (1e-1,) if q else (3e-2, 1e-2, 3e-3, 1e-3)
