@@ -256,10 +256,8 @@ def geometry_contacts(cfg, cf: float | None = None, store=None) -> tuple[dict, d
 
 def with_geometry_contacts(cfg, cf: float | None = None, store=None):
     """``cfg`` with the geometry's contact laws, and the report of :func:`geometry_contacts`."""
-    from harmonic_balance.bladed_disk.config import UPDConfig
-
     contacts, report = geometry_contacts(cfg, cf, store)
-    out = UPDConfig(cfg.data, contacts)
+    out = replace(cfg, contacts=contacts)  # keeps every other field of the config
     out.validate()
     return out, report
 
