@@ -100,12 +100,13 @@ def run_frf(args) -> int:
 def _frf_linear(sector, args, omegas) -> dict:
     import time
 
-    from harmonic_balance.bladed_disk.sector import U_A, linear_response, peak_of
+    from harmonic_balance.bladed_disk.sector import linear_response, peak_of
 
     t0 = time.perf_counter()
     f0 = args.f0 or sector.cfg.f0
-    U = linear_response(sector, omegas, args.damper, f0)[:, U_A]
-    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, U_A]),
+    r = sector.response  # the blade's response DOF (u_a of UPD-24)
+    U = linear_response(sector, omegas, args.damper, f0)[:, r]
+    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, r]),
                    omegas[0], omegas[-1], len(omegas))
     return {"damper": args.damper, "frequency_hz": (omegas / (2 * np.pi)).tolist(),
             "amplitude": np.abs(U).tolist(), "amplitude_max": np.abs(U).tolist(),
