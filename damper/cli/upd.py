@@ -87,6 +87,7 @@ def run_frf(args) -> int:
         out = _frf_nonlinear(sector, args, omegas)
     else:
         out = _frf_linear(sector, args, omegas)
+    out["response_dof"] = sector.dof_names[sector.response]  # what "amplitude" measures
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:

@@ -147,6 +147,13 @@ def load_blade(section: dict, base: Path | None = None) -> Blade:
     ValueError naming the file, array or DOF that is unusable.
     """
     base = Path(base or ".")
+    for k in ("file",) + MATRICES + ("forced", "response"):
+        if not isinstance(section.get(k, ""), str):
+            raise ValueError(f"blade: {k} = {section[k]!r} must be a string")
+    for k in ("dofs", "left", "right"):
+        v = section.get(k, [])
+        if not (isinstance(v, list) and all(isinstance(e, str) for e in v)):
+            raise ValueError(f"blade: {k} = {v!r} must be a list of DOF names (strings)")
     given = {k: section.get(k) for k in MATRICES if section.get(k)}
     file = section.get("file") or ""
     if file and given:

@@ -219,7 +219,7 @@ def load_config(path=None) -> UPDConfig:
                     raise ValueError(f"config {path}: unknown key {sec}.{k}")
                 data[sec][k] = v
         for k in ("file",) + MATRICES:  # blade files relative to the TOML's directory
-            if data["blade"].get(k) and k in user.get("blade", {}):
+            if isinstance(data["blade"].get(k), str) and data["blade"][k] and k in user.get("blade", {}):
                 data["blade"][k] = str(path.parent / data["blade"][k])
     cfg = UPDConfig(data)
     cfg.validate()

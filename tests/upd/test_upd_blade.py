@@ -70,6 +70,7 @@ def test_cli_runs_a_blade_file(from_file, capsys):
     assert main(["upd", "frf", "--config", from_file, "--damper", "stuck", "--json"]) == 0
     stuck = json.loads(capsys.readouterr().out)
     assert stuck["peak_frequency_hz"] == pytest.approx(modes["stuck_hz"][6][0], rel=1e-3)
+    assert stuck["response_dof"] == "u_a"
 
 
 def _coupled_blade(builtin):
@@ -150,6 +151,8 @@ def test_bad_blade_file_is_refused(case, tmp_path, builtin, capsys):
     ({"file": "b.npz", "K": "K.mtx"}, "either file"),
     ({"forced": "nope"}, "unknown DOF 'nope'"),
     ({"left": ["u_p"]}, "left must name 2"),
+    ({"file": 3}, "file = 3 must be a string"),
+    ({"left": "u_p"}, "must be a list of DOF names"),
 ])
 def test_bad_blade_section_is_refused(keys, match, tmp_path, capsys):
     cfg = _toml(tmp_path, keys)
