@@ -23,8 +23,9 @@ class SceneError(ValueError):
     def __init__(self, source: str, problems: list[tuple[str, int | None, str]]):
         self.source = source
         self.problems = problems
-        text = "; ".join(f"{source}:{line or '?'}: {key}: {msg}" if key else f"{source}: {msg}"
-                         for key, line, msg in problems)
+        # a key without a line (e.g. a --param of a sweep) is named without one
+        text = "; ".join(f"{source}{f':{line}' if line else ''}: {key}: {msg}" if key
+                         else f"{source}: {msg}" for key, line, msg in problems)
         super().__init__(text)
 
 
