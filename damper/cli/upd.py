@@ -87,7 +87,6 @@ def run_frf(args) -> int:
         out = _frf_nonlinear(sector, args, omegas)
     else:
         out = _frf_linear(sector, args, omegas)
-    out["response_dof"] = sector.dof_names[sector.response]  # what "amplitude" measures
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -109,7 +108,8 @@ def _frf_linear(sector, args, omegas) -> dict:
     U = linear_response(sector, omegas, args.damper, f0)[:, r]
     w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, r]),
                    omegas[0], omegas[-1], len(omegas))
-    return {"damper": args.damper, "frequency_hz": (omegas / (2 * np.pi)).tolist(),
+    return {"damper": args.damper, "response_dof": sector.dof_names[r],
+            "frequency_hz": (omegas / (2 * np.pi)).tolist(),
             "amplitude": np.abs(U).tolist(), "amplitude_max": np.abs(U).tolist(),
             "peak_frequency_hz": w / (2 * np.pi), "peak_amplitude": a,
             "time_s": time.perf_counter() - t0}
@@ -122,7 +122,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
     c = frf(hb, omegas)
     summ = hb.contact_summary(c.peak_x)
-    return {"damper": "nonlinear", "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
+    return {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
+            "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
