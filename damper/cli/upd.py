@@ -131,7 +131,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
             "static_normal_load": hb.static["N"].tolist(),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
-            "evaluations": c.evaluations, "time_s": c.time_s}
+            "method": c.extra.get("method", ""), "evaluations": c.evaluations, "time_s": c.time_s}
 
 
 def run_optimize(args) -> int:
