@@ -148,6 +148,9 @@ def run_optimize(args) -> int:
     else:
         print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
               f"({out['method']}, {out['time_s']:.1f} s)")
+        band = out.get("optimum_band_cf")
+        if band:  # the minimum is flat: the CF range a design can use
+            print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
     return 0
 
 
