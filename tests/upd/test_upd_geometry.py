@@ -175,3 +175,18 @@ def test_comparison_example_smoke(load_example, tmp_path, capsys):
         assert res["peak_amplitude"] > 0 and len(res["ti_vs_hb"]["ti"]) == 5
         assert all(p > 0 for p in res["ti_scan"]["ti_peak"])
     assert "TI peak vs CF" in capsys.readouterr().out
+
+
+def test_iwan_element_pickles_bit_identically():
+    """optimize's spawned workers pickle the sector, per-point Iwan elements included."""
+    import pickle
+
+    from fmu_src.element import IwanElement
+
+    el = IwanElement.from_curve([0.0, 1e-7, 2e-7, 4e-7], [0.0, 10.0, 16.0, 20.0], 40.0, tail="flat")
+    el.fit_error = 0.25
+    copy = pickle.loads(pickle.dumps(el))
+    u = 3e-7 * np.sin(np.linspace(0.0, 20.0, 400))
+    N = 40.0 + 10.0 * np.cos(np.linspace(0.0, 20.0, 400))
+    assert np.array_equal(copy.series(u, N).F, el.series(u, N).F)
+    assert (copy.N_ref, copy.k_res, copy.fit_error) == (el.N_ref, el.k_res, el.fit_error)
