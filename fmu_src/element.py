@@ -49,6 +49,13 @@ def flat_tail(u, T) -> tuple[np.ndarray, np.ndarray]:
     return np.append(u, 2.0 * u[-1]), np.append(T, T[-1])
 
 
+def _from_model_bytes(data: bytes, fit_error: float) -> IwanElement:
+    """The element of a pickled C model (:meth:`IwanElement.__reduce__`)."""
+    el = IwanElement(Model.from_buffer_copy(data))
+    el.fit_error = fit_error
+    return el
+
+
 class IwanState:
     """A copy of the element's flat C state (save/restore by copying).
 
@@ -203,6 +210,10 @@ class IwanElement:
     def jenkins(cls, k: float, fs: float) -> IwanElement:
         """One Jenkins element (spring k [N/m] in series with a slider fs [N]), N_ref = 1."""
         return cls.from_sliders([k], [fs], 0.0, 1.0)
+
+    def __reduce__(self):
+        """Pickle (e.g. to a process pool) as the C model's bytes: the copy is bit-identical."""
+        return (_from_model_bytes, (bytes(self._model), self.fit_error))
 
     @classmethod
     def _scaled(cls, model: Model, scale: float) -> IwanElement:

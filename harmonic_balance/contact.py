@@ -126,41 +126,68 @@ class ContactElement(ForceElement):
         return np.array([0.0, self.k_n * max(self.preload, 0.0)][2 - self.m:])
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
-        """AFT of (C1)-(C3) on local harmonics U (n_b, m); exact Jacobian."""
+        """AFT of (C1)-(C3) on local harmonics U (n_b, m); exact Jacobian.
+
+        Only F, dF and dF_domega are computed here (what a Newton step needs); the
+        sampled q, the friction work and the dashpots' work are filled in when first
+        read (:class:`ContactForce`), from the same numbers in the same order as an
+        eager evaluation, so they are bit-identical to it.
+        """
         nb, m, E, D = basis.nb, self.m, basis.E, basis.D
         U = np.asarray(U, dtype=float).reshape(nb, m)
         pl = E @ U[:, -1]
         p = self.preload + pl
         on = p > 0.0
-        q = np.empty((basis.n_t, m))
         f = np.empty((basis.n_t, m))
-        q[:, -1] = pl
         f[:, -1] = self.k_n * np.where(on, p, 0.0)
         dF = np.zeros((nb * m, nb * m)) if jac else None
         if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
-            dF[m - 1::m, m - 1::m] = (D * (self.k_n * on)) @ E
-        W = 0.0
+            dF[m - 1::m, m - 1::m] = self._normal_block(basis, on)
+        W, s = 0.0, None
         if m == 2:
             s = E @ U[:, 0]
-            q[:, 0] = s
             Ft, dFs, dFp, W = self.friction.periodic_jac(
-                s - self.slip_ref, E, N=self.k_n * p, EN=self.k_n * E,
+                s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
                 max_periods=self.max_periods, tol=self.tol)
             f[:, 0] = Ft
             if jac:
                 dF[0::2, 0::2] = D @ dFs
                 dF[0::2, 1::2] = D @ dFp
         F = D @ f
-        dw, Wv = None, 0.0
-        C = self.local_damping()
+        dw, C = None, self._local_damping_cached()
         if C is not None:
             op = self._damping_operator(basis)
             dw = op @ U.ravel()
             F += omega * dw.reshape(nb, m)
             if jac:
                 dF += omega * op
-            Wv = viscous_work(C, U, basis, omega)
-        return LocalForce(F, dF, dw, float(W) + Wv, Wv, q, f)
+        return ContactForce(F, dF, dw, f, float(W), (C, U, basis, omega), (s, pl))
+
+    def _cached(self, basis: FourierBasis, what: str, on=None) -> np.ndarray:
+        """Per-basis constants, rebuilt when k_n or the basis change: ``EN`` = k_n E
+        (n_t, n_b) and ``Knn`` = D diag(k_n) E (n_b, n_b), the normal block in full
+        contact. Computed by the same expressions as the uncached path (bit-identical)."""
+        key = (basis.harmonics, basis.n_t, self.k_n)
+        cache = getattr(self, "_basis_cache", None)
+        if cache is None or cache[0] != key:
+            cache = self._basis_cache = (key, {})
+        if what not in cache[1]:
+            cache[1][what] = (self.k_n * basis.E if what == "EN"
+                              else (basis.D * (self.k_n * on)) @ basis.E)
+        return cache[1][what]
+
+    def _normal_block(self, basis: FourierBasis, on: np.ndarray) -> np.ndarray:
+        """dN/dU_p harmonics D diag(k_n on) E (n_b, n_b); cached when in contact throughout."""
+        if on.all():
+            return self._cached(basis, "Knn", on)
+        return (basis.D * (self.k_n * on)) @ basis.E
+
+    def _local_damping_cached(self):
+        """local_damping(), rebuilt only when beta_c, k_t or k_n change."""
+        key = (self.beta_c, self.k_t, self.k_n, self.m)
+        if getattr(self, "_C", (None,))[0] != key:
+            self._C = (key, self.local_damping())
+        return self._C[1]
 
     def _damping_operator(self, basis: FourierBasis) -> np.ndarray:
         """D_theta (x) C_local (n_b m, n_b m), cached per basis."""
@@ -191,6 +218,41 @@ class ContactElement(ForceElement):
     def batch_stepper(self, n: int) -> ContactBatchStepper:
         """``n`` independent virgin histories advanced together (:class:`ContactBatchStepper`)."""
         return ContactBatchStepper(self, n)
+
+
+class ContactForce(LocalForce):
+    """:class:`~.forces.LocalForce` of a ContactElement with lazy energies and samples.
+
+    ``W_viscous`` (``viscous_work`` of the dashpots), ``W`` (friction loop + dashpots)
+    and ``q`` (the sampled [s, p]) are computed on first access and cached: a Newton
+    iteration reads only F, dF and dF_domega and skips them.
+    """
+
+    def __init__(self, F, dF, dF_domega, f, W_friction, damping, samples):
+        self.F, self.dF, self.dF_domega, self.f = F, dF, dF_domega, f
+        self._W_friction, self._damping, self._samples = W_friction, damping, samples
+        self._Wv = self._q = None
+
+    @property
+    def W_viscous(self) -> float:
+        if self._Wv is None:
+            C, U, basis, omega = self._damping
+            self._Wv = 0.0 if C is None else viscous_work(C, U, basis, omega)
+        return self._Wv
+
+    @property
+    def W(self) -> float:
+        return self._W_friction + self.W_viscous
+
+    @property
+    def q(self) -> np.ndarray:
+        if self._q is None:
+            s, pl = self._samples
+            self._q = np.empty((pl.size, 1 if s is None else 2))
+            self._q[:, -1] = pl
+            if s is not None:
+                self._q[:, 0] = s
+        return self._q
 
 
 class ContactBatchStepper:

@@ -30,6 +30,7 @@ def register(sub) -> None:
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
+    _contacts(f)
     f.set_defaults(func=run_frf)
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     _common(o)
@@ -40,6 +41,7 @@ def register(sub) -> None:
     o.add_argument("--workers", type=int, default=2,
                    help="processes for the load grid (results do not depend on it)")
     o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
+    _contacts(o)
     o.set_defaults(func=run_optimize)
 
 
@@ -48,11 +50,18 @@ def _common(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
+def _contacts(p) -> None:
+    p.add_argument("--contacts", choices=("toml", "geometry"), default="toml",
+                   help="contact laws: the TOML's Jenkins points, or computed by contact_core "
+                   "from the [geometry] section (damper.upd_geometry; cached)")
+
+
 def _sector(args):
+    from damper.upd_geometry import apply_to_args
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.sector import Sector
 
-    return Sector(load_config(args.config))
+    return Sector(apply_to_args(args, load_config(args.config)))
 
 
 def run_modes(args) -> int:
@@ -87,6 +96,7 @@ def run_frf(args) -> int:
         out = _frf_nonlinear(sector, args, omegas)
     else:
         out = _frf_linear(sector, args, omegas)
+    out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -100,14 +110,16 @@ def run_frf(args) -> int:
 def _frf_linear(sector, args, omegas) -> dict:
     import time
 
-    from harmonic_balance.bladed_disk.sector import U_A, linear_response, peak_of
+    from harmonic_balance.bladed_disk.sector import linear_response, peak_of
 
     t0 = time.perf_counter()
     f0 = args.f0 or sector.cfg.f0
-    U = linear_response(sector, omegas, args.damper, f0)[:, U_A]
-    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, U_A]),
+    r = sector.response  # the blade's response DOF (u_a of UPD-24)
+    U = linear_response(sector, omegas, args.damper, f0)[:, r]
+    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, r]),
                    omegas[0], omegas[-1], len(omegas))
-    return {"damper": args.damper, "frequency_hz": (omegas / (2 * np.pi)).tolist(),
+    return {"damper": args.damper, "response_dof": sector.dof_names[r],
+            "frequency_hz": (omegas / (2 * np.pi)).tolist(),
             "amplitude": np.abs(U).tolist(), "amplitude_max": np.abs(U).tolist(),
             "peak_frequency_hz": w / (2 * np.pi), "peak_amplitude": a,
             "time_s": time.perf_counter() - t0}
@@ -120,7 +132,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
     c = frf(hb, omegas)
     summ = hb.contact_summary(c.peak_x)
-    return {"damper": "nonlinear", "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
+    return {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
+            "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
@@ -128,7 +141,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
             "static_normal_load": hb.static["N"].tolist(),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
-            "evaluations": c.evaluations, "time_s": c.time_s}
+            "method": c.extra.get("method", ""), "evaluations": c.evaluations, "time_s": c.time_s}
 
 
 def run_optimize(args) -> int:
@@ -138,6 +151,7 @@ def run_optimize(args) -> int:
 
     out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
                        workers=args.workers)
+    out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_optimize(out, args.plot)
     if args.json:
@@ -145,6 +159,9 @@ def run_optimize(args) -> int:
     else:
         print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
               f"({out['method']}, {out['time_s']:.1f} s)")
+        band = out.get("optimum_band_cf")
+        if band:  # the minimum is flat: the CF range a design can use
+            print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
     return 0
 
 

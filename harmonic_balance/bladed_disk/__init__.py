@@ -1,5 +1,7 @@
 """Tuned bladed disk with underplatform dampers: cyclic-sector harmonic balance.
 
-Modules: :mod:`config` (TOML, bundled UPD-24), :mod:`sector` (linear sector,
-kinematics, linear limits), :mod:`hb` (nonlinear sector harmonic balance).
+Modules: :mod:`config` (TOML, bundled UPD-24), :mod:`blade` (the blade's reduced
+matrices with named platform DOFs: built-in lumped UPD-24, .npz or Matrix Market,
+Craig-Bampton), :mod:`sector` (linear sector, kinematics, linear limits), :mod:`hb`
+(nonlinear sector harmonic balance), :mod:`ring` and :mod:`timeint` (the short ring).
 """

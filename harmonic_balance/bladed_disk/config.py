@@ -8,8 +8,12 @@ Symbols (used in the whole subpackage)
 N_b blades, EO engine order, phi = 2 pi EO / N_b interblade phase [rad];
 g face angle [rad]; k_n, k_t normal / tangential contact stiffness of a contact
 point [N/m]; mu friction coefficient; CF centrifugal load on the damper [N];
-F0 amplitude of the EO force on the airfoil DOF u_a [N]; beta, beta_c structural and
-contact stiffness-proportional damping [s].
+F0 amplitude of the EO force on the blade's forced DOF (u_a of UPD-24) [N]; beta,
+beta_c structural and contact stiffness-proportional damping [s].
+
+The ``[blade]`` section is either UPD-24's lumped keys or a blade of reduced matrices
+(``file`` / Matrix Market keys, :mod:`.blade`); relative paths are taken from the
+TOML file's directory (resolved by :func:`load_config`).
 """
 from __future__ import annotations
 
@@ -20,6 +24,8 @@ from math import gcd
 from pathlib import Path
 
 import numpy as np
+
+from .blade import MATRICES, Blade, load_blade
 
 #: The bundled default model.
 DEFAULT_CONFIG = Path(__file__).with_name("upd24.toml")
@@ -67,6 +73,12 @@ class UPDConfig:
     contacts: dict | None = None
 
     # ------------------------------------------------------------ access
+    def blade(self) -> Blade:
+        """The sector's blade (:mod:`.blade`), read once per config."""
+        if getattr(self, "_blade", None) is None:
+            self._blade = load_blade(self.data["blade"])
+        return self._blade
+
     def __getitem__(self, key: str):
         section, _, name = key.partition(".")
         return self.data[section][name]
@@ -108,6 +120,8 @@ class UPDConfig:
             sec, _, name = k.partition("__")
             data[sec][name] = v
         out = UPDConfig(data, self.contacts)
+        if data["blade"] == self.data["blade"]:
+            out._blade = getattr(self, "_blade", None)
         out.validate()
         return out
 
@@ -166,6 +180,7 @@ class UPDConfig:
         if not (isinstance(nb, int) and isinstance(eo, int)) or nb < 2 or not 0 <= eo <= nb // 2:
             raise ValueError(f"config: disk.blades = {nb} must be an integer >= 2 and "
                              f"disk.engine_order = {eo} an integer in 0..blades/2")
+        self.blade()  # the blade's matrices and DOF names (ValueError naming the problem)
         g = float(self["damper.angle_deg"])
         if not 0.0 < g < 90.0:
             raise ValueError(f"config: damper.angle_deg = {g} must lie in (0, 90)")
@@ -203,6 +218,9 @@ def load_config(path=None) -> UPDConfig:
                 if k not in data[sec]:
                     raise ValueError(f"config {path}: unknown key {sec}.{k}")
                 data[sec][k] = v
+        for k in ("file",) + MATRICES:  # blade files relative to the TOML's directory
+            if isinstance(data["blade"].get(k), str) and data["blade"][k] and k in user.get("blade", {}):
+                data["blade"][k] = str(path.parent / data["blade"][k])
     cfg = UPDConfig(data)
     cfg.validate()
     return cfg

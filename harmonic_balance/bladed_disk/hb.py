@@ -3,16 +3,19 @@
 The sector is a standard :class:`~harmonic_balance.model.Model` solved by the package's
 :class:`~harmonic_balance.residual.FullResidual` (harmonics 0..H):
 
-* linear part: M, K_struct(0) (blade with the hub spring k_g), C = beta K_struct(0);
-* the rim coupling: a cyclic :class:`~harmonic_balance.forces.LinearElement`
-  (q = u_r - u_r of blade j+1, stiffness k_c, dashpot beta k_c), which adds
-  k_g + 2 k_c (1 - cos h phi) per harmonic, so the structure is K_struct(h phi)
-  with damping beta K_struct(h phi);
+* linear part: M, K_struct(0) = K + K_next + K_next^T, C_struct(0) likewise;
+* the blade-to-blade coupling (:mod:`.blade` (B1); UPD-24: the rim springs k_c): a
+  cyclic :class:`~harmonic_balance.forces.LinearElement` on the DOFs that K_next or
+  C_next touch, q = [u_j, u_(j+1)], local stiffness [[-S, K_next], [K_next^T, -S]]
+  with S = (K_next + K_next^T) / 2 (dashpots likewise). Its own part plus the part
+  of blade j-1's element give -2 S + K_next e^(i h phi) + K_next^T e^(-i h phi) per
+  harmonic, so the structure is K_struct(h phi) with damping C_struct(h phi)
+  (UPD-24: q = [u_r, u_r'], k_c [[1, -1], [-1, 1]], the rim spring);
 * one :class:`~harmonic_balance.contact.ContactElement` per contact point (penalty
   normal spring with lift-off, the C core's Jenkins element with slip force mu N,
   dashpots beta_c k_n, beta_c k_t), its kinematics from :class:`~.sector.Sector`
   (the flat's points with ``Q_next`` on blade j+1's platform and phase phi);
-* forcing: F0 on the harmonic-1 cosine of u_a, CF on the mean of y_d.
+* forcing: F0 on the harmonic-1 cosine of the forced DOF (u_a), CF on the mean of y_d.
 
 The sliders start at the frictionless (mu = 0) prestress state
 (:func:`~harmonic_balance.contact.frictionless_statics`, which sets each contact's
@@ -32,7 +35,7 @@ from ..kinematics import Kinematics, phase_operator
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
-from .sector import N_DOF, PLATFORM, U_A, Y_D, Sector
+from .sector import Sector
 
 
 def sector_basis(sector: Sector, H: int, n_t: int = 0) -> FourierBasis:
@@ -53,7 +56,8 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
     """ContactElements of one damper (cylinder line + the flat's two end points).
 
     Their kinematics are the sector's rows of slip and penetration (``Sector.Q``, the
-    only copy of the contact geometry), local order [s, p].
+    only copy of the contact geometry), local order [s, p], restricted to the DOFs
+    they touch (the damper's and one platform point's).
 
     Parameters
     ----------
@@ -62,24 +66,27 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
         Friction coefficient of the Jenkins points (points with their own
         ``friction`` element keep it).
     offset : int
-        First DOF of the sector (blade j) in the model (7 j in a ring).
+        First DOF of the sector (blade j) in the model (n_dof j in a ring).
     next_offset : int or None
         First DOF of blade j+1 in a ring model; None: cyclic sector (blade j+1 through
         ``Q_next`` and the phase phi).
     """
+    n, right = sector.n_dof, list(sector.blade.right)
     els = []
     for i, c in enumerate(sector.points):
         rows = sector.Q[[2 * i + 1, 2 * i]]  # local q = [s, p] (ContactElement order)
-        own, nxt = rows[:, :N_DOF], rows[:, N_DOF:]  # nxt: blade j+1's (u_p, v_p)
+        own, nxt = rows[:, :n], rows[:, n:]  # nxt: blade j+1's right platform point (u, v)
+        used = np.flatnonzero(np.any(own != 0.0, axis=0))
         if not c.neighbour:
-            kin = Kinematics(offset + np.arange(N_DOF), own)
+            kin = Kinematics(offset + used, own[:, used])
         elif next_offset is None:
+            used = np.union1d(used, right)
             Qn = np.zeros_like(own)
-            Qn[:, list(PLATFORM)] = nxt
-            kin = Kinematics(np.arange(N_DOF), own, Q_next=Qn, phase=sector.cfg.phi)
+            Qn[:, right] = nxt
+            kin = Kinematics(used, own[:, used], Q_next=Qn[:, used], phase=sector.cfg.phi)
         else:
-            dofs = np.r_[offset + np.arange(N_DOF), next_offset + np.array(PLATFORM)]
-            kin = Kinematics(dofs, np.hstack([own, nxt]))
+            dofs = np.r_[offset + used, next_offset + np.array(right)]
+            kin = Kinematics(dofs, np.hstack([own[:, used], nxt]))
         if c.friction is None:
             els.append(ContactElement.jenkins(kin, c.kn, c.kt, mu, beta_c=sector.beta_c, name=c.name))
         else:  # the point's own element (e.g. a contact_core virgin curve); mu is in it
@@ -87,16 +94,42 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
     return els
 
 
+def coupling_element(sector: Sector) -> LinearElement | None:
+    """Cyclic LinearElement of the blade-to-blade coupling (module docstring); None
+    for a blade on a rigid disk (no K_next, no C_next)."""
+    b = sector.blade
+    K_next, C_next = b.K_next, b.damping_parts(sector.beta)[1]
+    parts = [A for A in (K_next, C_next) if A is not None]
+    if not parts:
+        return None
+    used = np.flatnonzero(sum(np.any(A != 0.0, axis=0) | np.any(A != 0.0, axis=1) for A in parts))
+    if used.size == 0:
+        return None
+    d = used.size
+    eye, zero = np.eye(d), np.zeros((d, d))
+
+    def local(A):
+        if A is None:
+            return None
+        A = A[np.ix_(used, used)]
+        S = 0.5 * (A + A.T)
+        return np.block([[-S, A], [A.T, -S]])
+
+    kin = Kinematics(used, np.vstack([eye, zero]), Q_next=np.vstack([zero, eye]),
+                     phase=sector.cfg.phi)
+    Kl = local(K_next)
+    return LinearElement(kin, np.zeros((2 * d, 2 * d)) if Kl is None else Kl, local(C_next),
+                         name="coupling")
+
+
 def sector_model(sector: Sector, cf: float, f0: float, mu: float) -> Model:
     """The cyclic sector as a Model (module docstring)."""
-    K0 = sector.K_struct(0.0)
-    lin = LinearModel(M=sector.M, C=sector.beta * K0, K=K0)
-    kc = float(sector.cfg["blade.k_c"])
-    rim = LinearElement(Kinematics([0], [[1.0]], Q_next=[[-1.0]], phase=sector.cfg.phi),
-                        [[kc]], [[sector.beta * kc]], name="rim")
-    f_static, f_eo = np.zeros(N_DOF), np.zeros(N_DOF, dtype=complex)
-    f_static[Y_D], f_eo[U_A] = cf, f0
-    return Model(lin, [rim] + contact_elements(sector, mu), {0: f_static, 1: f_eo}, U_A)
+    lin = LinearModel(M=sector.M, C=sector.C_struct(0.0), K=sector.K_struct(0.0))
+    coupling = coupling_element(sector)
+    f_static, f_eo = np.zeros(sector.n_dof), np.zeros(sector.n_dof, dtype=complex)
+    f_static[sector.y_d], f_eo[sector.forced] = cf, f0
+    return Model(lin, ([coupling] if coupling else []) + contact_elements(sector, mu),
+                 {0: f_static, 1: f_eo}, sector.response)
 
 
 class SectorHB:
@@ -159,7 +192,7 @@ class SectorHB:
 
     def _eo_forcing(self) -> np.ndarray:
         f = np.zeros(self.ndof, dtype=complex)
-        f[U_A] = self.f0
+        f[self.sector.forced] = self.f0
         return f
 
     @property
@@ -185,21 +218,23 @@ class SectorHB:
         x = self.static_guess().reshape(self.nb, self.ndof)
         U = linear_response(self.sector, [omega], "stuck", self.f0)[0]
         ic, isn = self.basis.index(1)
+        n = self.sector.n_dof
         for j in range(self.blades):
             Uj = U * np.exp(1j * j * self.sector.cfg.phi)
-            x[ic, N_DOF * j:N_DOF * (j + 1)], x[isn, N_DOF * j:N_DOF * (j + 1)] = Uj.real, -Uj.imag
+            x[ic, n * j:n * (j + 1)], x[isn, n * j:n * (j + 1)] = Uj.real, -Uj.imag
         return x.ravel()
 
     # ------------------------------------------------------------ outputs
-    def response(self, x: np.ndarray, dof: int = U_A) -> np.ndarray:
-        return x.reshape(self.nb, self.ndof)[:, dof]
+    def response(self, x: np.ndarray, dof: int | None = None) -> np.ndarray:
+        """Harmonic coefficients (n_b,) of ``dof`` (default: the blade's response DOF)."""
+        return x.reshape(self.nb, self.ndof)[:, self.sector.response if dof is None else dof]
 
     def amplitude_h1(self, x, omega=None) -> float:
-        """First-harmonic magnitude of u_a [m]."""
+        """First-harmonic magnitude of the response DOF (u_a) [m]."""
         return float(self.basis.magnitude(self.response(x), 1))
 
     def amplitude_max(self, x, omega=None) -> float:
-        """max |u_a(t) - mean| over the period [m]."""
+        """max |u(t) - mean| of the response DOF (u_a) over the period [m]."""
         c = self.response(x).copy()
         c[self.basis.index(0)[0]] = 0.0
         return self.basis.peak_abs(c)

@@ -1,23 +1,24 @@
 """Cyclic sector of a tuned bladed disk with one underplatform damper per sector.
 
-Sector DOFs ``q`` (index: name): 0 u_r rim tangential, 1 u_p platform tangential,
-2 v_p platform radial, 3 u_a airfoil first-bending modal DOF (tangential), 4 x_d,
-5 y_d, 6 theta_d (damper j, between blade j and blade j+1). The contact kinematics
-also use blade j+1's platform (u_p', v_p'), so the *extended* vector is
-``q_ext = [q, u_p', v_p']`` (9 entries).
+Sector DOFs ``q`` (n_dof = n + 3): the blade's n reduced DOFs (:mod:`.blade`; UPD-24:
+u_r rim tangential, u_p platform tangential, v_p platform radial, u_a airfoil
+first-bending modal DOF), then x_d, y_d, theta_d of damper j (between blade j and
+blade j+1). The contact kinematics also use blade j+1's ``right`` platform point
+(u', v'), so the *extended* vector is ``q_ext = [q, u', v']`` (n + 5 entries).
 
 Cyclic symmetry (symbols in :mod:`config`): blade j+1's harmonic-h complex amplitude
 is exp(i h phi) times blade j's, so per harmonic ``q_ext = S(h phi) q`` with
-``S(psi)`` (9, 7) the identity on q and exp(i psi) on the neighbour's platform rows.
-The rim springs k_c to both neighbours give k_g + 2 k_c (1 - cos h phi) on u_r.
+``S(psi)`` (n + 5, n + 3) the identity on q and exp(i psi) on the neighbour's platform
+rows. The blade's structure is K(psi) = K + K_next e^(i psi) + K_next^T e^(-i psi)
+(:mod:`.blade`, (B1); UPD-24: k_g + 2 k_c (1 - cos psi) on u_r).
 
 Contact kinematics (small rotation, rigid damper): the damper point at r from G
 moves by (x_d - theta_d r_y, y_d + theta_d r_x); its displacement relative to the
-platform it touches is Delta; penetration p = -n . Delta, slip s = t . Delta.
-``Q`` (2 n_c, 9) stacks the rows of p and s per contact point (rows 2c, 2c + 1), so
-the stuck contact stiffness is ``S^H Q^T diag(k) Q S`` and a contact force pair
-(N, f_t) enters the internal force as ``Q^T [N, f_t]`` (virtual work of
-V = k_n p^2 / 2 + k_t (s - z)^2 / 2).
+platform point it touches (blade j's ``left``, blade j+1's ``right``) is Delta;
+penetration p = -n . Delta, slip s = t . Delta. ``Q`` (2 n_c, n + 5) stacks the rows
+of p and s per contact point (rows 2c, 2c + 1), so the stuck contact stiffness is
+``S^H Q^T diag(k) Q S`` and a contact force pair (N, f_t) enters the internal force as
+``Q^T [N, f_t]`` (virtual work of V = k_n p^2 / 2 + k_t (s - z)^2 / 2).
 """
 from __future__ import annotations
 
@@ -28,11 +29,8 @@ import scipy.linalg as sla
 
 from .config import UPDConfig
 
-DOF_NAMES = ("u_r", "u_p", "v_p", "u_a", "x_d", "y_d", "theta_d")
-N_DOF = 7
-#: Sector indices of the blade DOFs, the damper DOFs and the platform DOFs.
-BLADE, DAMPER, PLATFORM = (0, 1, 2, 3), (4, 5, 6), (1, 2)
-U_A, Y_D = 3, 5
+#: Names of the damper's DOFs (after the blade's).
+DAMPER_DOFS = ("x_d", "y_d", "theta_d")
 
 
 @dataclass
@@ -42,25 +40,35 @@ class Sector:
     Attributes
     ----------
     cfg : UPDConfig
-    M : (7, 7) array          mass [kg, kg m^2]
+    blade : Blade              the blade's reduced matrices and named DOFs
+    n_blade, n_dof : int       n and n + 3
+    dof_names : tuple of str (n_dof,)
+    y_d, forced, response : int  indices of y_d, of the EO force and of the output DOF
+    M : (n_dof, n_dof) array   mass [kg, kg m^2]
     points : list of ContactPoint
-    Q : (2 n_c, 9) array      rows of penetration p and slip s per contact point
+    Q : (2 n_c, n_dof + 2) array  rows of penetration p and slip s per contact point
     k : (2 n_c,) array        stiffness of each row (k_n, k_t per point) [N/m]
     """
 
     cfg: UPDConfig
 
     def __post_init__(self):
-        b, d = self.cfg.data["blade"], self.cfg.data["damper"]
-        self.M = np.diag([b["m_r"], b["m_p"], b["m_p"], b["m_a"], d["m_d"], d["m_d"],
-                          d["I_d"]]).astype(float)
+        d = self.cfg.data["damper"]
+        self.blade = b = self.cfg.blade()
+        n = self.n_blade = b.n
+        self.n_dof = n + 3
+        self.dof_names = tuple(b.dofs) + DAMPER_DOFS
+        self.y_d, self.forced, self.response = n + 1, b.forced, b.response
+        self.M = np.zeros((self.n_dof, self.n_dof))
+        self.M[:n, :n] = b.M
+        self.M[n:, n:] = np.diag([d["m_d"], d["m_d"], d["I_d"]])
         self.points = self.cfg.contact_points()
         rows, k = [], []
         for c in self.points:
-            J = np.zeros((2, 9))  # Delta = J q_ext
-            J[:, 4:6] = np.eye(2)
-            J[:, 6] = (-c.r[1], c.r[0])
-            cols = (7, 8) if c.neighbour else PLATFORM
+            J = np.zeros((2, n + 5))  # Delta = J q_ext
+            J[:, n:n + 2] = np.eye(2)
+            J[:, n + 2] = (-c.r[1], c.r[0])
+            cols = (n + 3, n + 4) if c.neighbour else b.left
             J[0, cols[0]] -= 1.0
             J[1, cols[1]] -= 1.0
             rows += [-c.n @ J, c.t @ J]
@@ -80,28 +88,29 @@ class Sector:
     def beta_c(self) -> float:
         return float(self.cfg["damper.beta_c"])
 
+    def _pad(self, A: np.ndarray) -> np.ndarray:
+        out = np.zeros((self.n_dof, self.n_dof), dtype=A.dtype)
+        out[:self.n_blade, :self.n_blade] = A
+        return out
+
     def K_struct(self, psi: float) -> np.ndarray:
-        """Structural stiffness (7, 7) [N/m] at phase psi between neighbours (no contacts)."""
-        b = self.cfg.data["blade"]
-        K = np.zeros((N_DOF, N_DOF))
-        K[0, 0] = b["k_g"] + 2.0 * b["k_c"] * (1.0 - np.cos(psi))
-        for i, j, kk in ((0, 1, b["k_rp"]), (1, 3, b["k_pa"])):
-            K[i, i] += kk
-            K[j, j] += kk
-            K[i, j] -= kk
-            K[j, i] -= kk
-        K[2, 2] += b["k_v"]
-        return K
+        """Structural stiffness (n_dof, n_dof) [N/m] at phase psi between neighbours (no
+        contacts): the blade's K(psi) of (B1); complex Hermitian for a non-symmetric K_next."""
+        return self._pad(self.blade.stiffness(psi))
+
+    def C_struct(self, psi: float) -> np.ndarray:
+        """Structural damping (n_dof, n_dof) [N s/m]: the blade's C(psi) (beta K(psi) by default)."""
+        return self._pad(self.blade.damping(psi, self.beta))
 
     def S(self, psi: float) -> np.ndarray:
-        """Extension (9, 7) complex: q_ext = S q for phase psi of blade j+1."""
-        S = np.zeros((9, N_DOF), dtype=complex)
-        S[:N_DOF, :N_DOF] = np.eye(N_DOF)
-        S[7, 1] = S[8, 2] = np.exp(1j * psi)
+        """Extension (n_dof + 2, n_dof) complex: q_ext = S q for phase psi of blade j+1."""
+        S = np.zeros((self.n_dof + 2, self.n_dof), dtype=complex)
+        S[:self.n_dof, :self.n_dof] = np.eye(self.n_dof)
+        S[self.n_dof, self.blade.right[0]] = S[self.n_dof + 1, self.blade.right[1]] = np.exp(1j * psi)
         return S
 
     def K_contact(self, psi: float, normal_only: bool = False) -> np.ndarray:
-        """Stuck contact stiffness (7, 7) complex Hermitian at phase psi [N/m]
+        """Stuck contact stiffness (n_dof, n_dof) complex Hermitian at phase psi [N/m]
         (only the normal springs with ``normal_only``)."""
         QS = self.Q @ self.S(psi)
         k = self.k.copy()
@@ -113,23 +122,23 @@ class Sector:
         """(M, K, C) at phase psi for ``damper`` = 'free' (removed, blade DOFs only),
         'stuck' (contacts stuck) or 'sliding' (mu = 0: normal springs only).
 
-        C = beta K_struct + beta_c K_contact (the contact dashpots act on both
+        C = C_struct + beta_c K_contact (the contact dashpots act on both
         directions in every state, so 'sliding' keeps the tangential ones).
         """
-        Ks = self.K_struct(psi)
         if damper == "free":
-            ix = np.ix_(BLADE, BLADE)
-            return self.M[ix], Ks[ix], self.beta * Ks[ix]
+            b = self.blade
+            return b.M, b.stiffness(psi), b.damping(psi, self.beta)
         if damper not in ("stuck", "sliding"):
             raise ValueError(f"damper must be 'free', 'stuck' or 'sliding', got {damper!r}")
         Kc = self.K_contact(psi)
         Kk = Kc if damper == "stuck" else self.K_contact(psi, normal_only=True)
-        return self.M, Ks + Kk, self.beta * Ks + self.beta_c * Kc
+        return self.M, self.K_struct(psi) + Kk, self.C_struct(psi) + self.beta_c * Kc
 
     def forcing(self, f0: float, damper: str = "stuck") -> np.ndarray:
-        """Complex amplitude of the EO force on blade j (F0 on u_a), shape (7,) or (4,)."""
-        f = np.zeros(4 if damper == "free" else N_DOF, dtype=complex)
-        f[U_A] = f0
+        """Complex amplitude of the EO force on blade j (F0 on the forced DOF),
+        shape (n_dof,) or (n,) for the free blade."""
+        f = np.zeros(self.n_blade if damper == "free" else self.n_dof, dtype=complex)
+        f[self.forced] = f0
         return f
 
 

@@ -5,7 +5,10 @@ The sweep walks a fixed frequency grid with Newton's method (line search,
 interval is bisected (down to :data:`MAX_BISECT` levels) so stick-slip kinks are
 passed in small steps. The peak is refined by Brent's bounded search on the
 first-harmonic amplitude between the grid neighbours of the largest grid value,
-each evaluation a Newton solve from the nearest converged point.
+each evaluation a Newton solve from the nearest converged point. Where the grid
+sweep fails (a fold of the curve: two amplitudes at one frequency, which a frequency
+grid cannot follow) the band is followed by pseudo-arclength continuation instead
+(:func:`follow`).
 """
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from ..contact import ContactElement
+from ..continuation import ContinuationError, continuation, refine_max
 from ..forces import harmonic_work
 from ..newton import NewtonError, newton
 from ..residual import energy_per_cycle
@@ -123,7 +127,7 @@ def sweep(hb: SectorHB, omegas, x0: np.ndarray | None = None) -> list:
             x = _step(hb, omegas[k - 1], xs[-1], slope, omegas[k])
         except NewtonError as err:
             raise SolverError(f"harmonic balance failed near {omegas[k] / 2 / np.pi:.6g} Hz "
-                              f"({err}); use more frequency points") from None
+                              f"({err})") from None
         slope = (x - xs[-1]) / (omegas[k] - omegas[k - 1])
         xs.append(x)
     return xs
@@ -153,13 +157,65 @@ def refine_peak(hb: SectorHB, omegas, xs) -> tuple[float, float, np.ndarray]:
     return float(res.x), float(-res.fun), cache[res.x]
 
 
+def follow(hb: SectorHB, omegas, reason: str = "") -> Curve:
+    """Response curve by pseudo-arclength continuation in omega over the band of ``omegas``.
+
+    The fallback of :func:`frf` when the fixed-grid sweep fails: where the curve folds
+    (two stable amplitudes at one frequency, e.g. high CF/F0) a frequency grid cannot
+    follow it, the arclength can (:mod:`harmonic_balance.continuation`). The points are
+    the branch's own (omega may go back and forth); the peak is refined on the branch
+    (``continuation.refine_max``).
+    """
+    omegas = np.asarray(omegas, dtype=float)
+    fun = hb.__call__
+    try:
+        x0 = start_point(hb, omegas[0])
+        # ds_max: at least ~2 x the grid's point count on a flat branch
+        branch = continuation(fun, x0, omegas[0], omegas[-1], _tol(hb),
+                              ds_max=min(0.02, 1.0 / max(len(omegas), 2)), max_points=20000)
+    except NewtonError as err:
+        raise SolverError(f"no solution at the start frequency {omegas[0] / 2 / np.pi:.6g} Hz "
+                          f"({err}); start the band further from resonance") from None
+    except ContinuationError as err:
+        w = err.branch.lam[-1] / 2 / np.pi if err.branch.lam else omegas[0] / 2 / np.pi
+        raise SolverError(f"{reason}; the arclength continuation then stopped at {w:.6g} Hz "
+                          f"({err}); try fewer harmonics or a narrower --band") from None
+    xs, lam = branch.x, np.array(branch.lam)
+    c = Curve(lam, xs, np.array([hb.amplitude_h1(x) for x in xs]),
+              np.array([hb.amplitude_max(x) for x in xs]))
+    i = int(np.argmax(c.amplitude))
+    if 0 < i < len(xs) - 1:
+        x, w, a, _ = refine_max(fun, branch, i, lambda x, lam: hb.amplitude_h1(x), _tol(hb),
+                                PEAK_XTOL * lam[i])
+        c.peak_omega, c.peak_amplitude, c.peak_x = w, a, x
+    else:
+        c.peak_omega, c.peak_amplitude, c.peak_x = float(lam[i]), float(c.amplitude[i]), xs[i]
+    c.extra["method"] = f"arclength continuation ({reason})"
+    return c
+
+
 def frf(hb: SectorHB, omegas, refine: bool = True) -> Curve:
-    """Response curve on the frequency grid ``omegas`` [rad/s], peak refined."""
+    """Response curve on the frequency grid ``omegas`` [rad/s], peak refined.
+
+    The fixed-grid sweep first (fast, the points on the user's grid); where it fails
+    (a fold of the curve, a kink Newton cannot pass in 2^-MAX_BISECT of a step) the
+    whole band is followed by arclength continuation instead (:func:`follow`,
+    ``Curve.extra["method"]`` says so).
+    """
     t0 = time.perf_counter()
     e0 = hb.evaluations
-    xs = sweep(hb, omegas)
+    try:
+        xs = sweep(hb, omegas)
+    except SolverError as err:
+        if str(err).startswith("no solution at the start"):
+            raise
+        c = follow(hb, omegas, f"the frequency-grid sweep failed: {err}")
+        c.evaluations = hb.evaluations - e0
+        c.time_s = time.perf_counter() - t0
+        return c
     c = Curve(np.asarray(omegas, float), xs, np.array([hb.amplitude_h1(x) for x in xs]),
               np.array([hb.amplitude_max(x) for x in xs]))
+    c.extra["method"] = "frequency grid"
     if refine:
         try:
             c.peak_omega, c.peak_amplitude, c.peak_x = refine_peak(hb, c.omega, xs)

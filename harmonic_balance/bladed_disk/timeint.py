@@ -14,7 +14,7 @@ frequencies and contact points at once; ContactElement.stepper is one state per 
 dashpots in C. Start: the frictionless prestress state at rest, the
 sliders virgin there (tangential input s - s_static), the same convention as the HB.
 No Fourier series and no periodicity assumption. Steady state: the first harmonic of
-u_a of every blade, period by period; stops when its change, extrapolated
+the response DOF (u_a) of every blade, period by period; stops when its change, extrapolated
 geometrically (transient ~ rho^p), is below ``tol`` of the amplitude.
 """
 from __future__ import annotations
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from .ring import RingHB
-from .sector import N_DOF, U_A, Y_D, Sector
+from .sector import Sector
 
 #: Fraction of the stability limit 2 / omega_max of the stuck ring.
 CFL = 0.5
@@ -30,7 +30,8 @@ CFL = 0.5
 
 def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int = 0,
                max_periods: int = 3000, tol: float = 1e-6) -> dict:
-    """Steady first-harmonic amplitude of u_a (blade 0) at each frequency [rad/s].
+    """Steady first-harmonic amplitude of the response DOF (u_a) of blade 0 at each
+    frequency [rad/s].
 
     Returns
     -------
@@ -60,9 +61,10 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     groups = c["groups"]
     states = [el.initial_states(nf * len(idx), np.tile(N_static[idx], nf)) for el, idx in groups]
     fext = np.zeros((nf, n))
-    fext[:, Y_D::N_DOF] = cf
+    fext[:, sector.y_d::sector.n_dof] = cf
     phase = cfg.phi * np.arange(nr)
-    ua = np.arange(nr) * N_DOF + U_A
+    fd = np.arange(nr) * sector.n_dof + sector.forced  # the EO force's DOFs
+    ua = np.arange(nr) * sector.n_dof + sector.response  # the output DOFs
     theta = 2 * np.pi * np.arange(ns) / ns
     hist = np.empty((ns, nf, nr))
     prev, deltas, periods = None, [], 0
@@ -80,7 +82,7 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
                 ft[:, idx] = el.step_batch(sts, S[:, idx].ravel(),
                                            (kn[idx] * P[:, idx]).ravel())[0].reshape(nf, -1)
             fc = N @ Qp + ft @ Qs
-            fext[:, ua] = f0 * np.cos(theta[i] + phase)
+            fext[:, fd] = f0 * np.cos(theta[i] + phase)
             rhs = (fext - x @ K.T - fc + (2 * x - xm) @ M.T / dt[:, None] ** 2
                    + xm @ C.T / (2 * dt[:, None]))
             xm, x = x, np.einsum("fij,fj->fi", Ainv, rhs)
