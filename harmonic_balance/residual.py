@@ -73,11 +73,15 @@ class _Residual:
         return [el.evaluate(U[sl].reshape(nb, el.m), self.basis, w, jac)
                 for el, sl in zip(self.elements, self._slices)]
 
-    def nonlinear(self, x: np.ndarray, jac: bool = True, omega: float | None = None):
+    def nonlinear(self, x: np.ndarray, jac: bool = True, omega: float | None = None,
+                  energies: bool = True):
         """Element forces (size,) on the active DOFs, Jacobian, energies per element.
 
         ``omega`` is needed by elements with dashpots (None counts as 0); the
         derivative of the forces with respect to omega is left in ``self.dF_domega``.
+        ``energies=False`` returns None for the energies: the residual's own calls,
+        where reading them would make lazy elements (ContactElement) compute their
+        dissipated work on every Newton step.
         """
         res = self.evaluate(x, omega, jac)
         Fh = np.concatenate([r.F.ravel() for r in res]) if res else np.zeros(0)
@@ -94,7 +98,7 @@ class _Residual:
             dw = np.concatenate([np.zeros(sl.stop - sl.start) if d is None else d
                                  for sl, d in zip(self._slices, dw)])
             self.dF_domega = self._T @ dw
-        return Fnl, dF, [r.W for r in res]
+        return Fnl, dF, ([r.W for r in res] if energies else None)
 
     def link_samples(self, x: np.ndarray, omega: float | None = None):
         """Per element: first local displacement, its force over one period (n_t,) each, and W."""
@@ -151,7 +155,7 @@ class FullResidual(_Residual):
 
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         A = self._K - omega**2 * self._M + omega * self._C
-        Fnl, dF, _ = self.nonlinear(x, jac, omega)
+        Fnl, dF, _ = self.nonlinear(x, jac, omega, energies=False)
         R = A @ x + Fnl - self._f
         if not jac:
             return R
@@ -225,7 +229,7 @@ class CondensedResidual(_Residual):
 
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         G, dG, Xl, dXl = self._operators(omega)
-        Fnl, dF, _ = self.nonlinear(x, jac, omega)
+        Fnl, dF, _ = self.nonlinear(x, jac, omega, energies=False)
         R = x - Xl + G @ Fnl
         if not jac:
             return R
@@ -241,7 +245,7 @@ class CondensedResidual(_Residual):
     def displacements(self, x: np.ndarray, omega: float, rows=None) -> np.ndarray:
         """Harmonics (n_b, len(rows)) of any DOFs, recovered through the receptance."""
         rows = np.arange(self.model.n) if rows is None else np.asarray(rows)
-        Fnl, _, _ = self.nonlinear(x, jac=False, omega=omega)
+        Fnl, _, _ = self.nonlinear(x, jac=False, omega=omega, energies=False)
         G, _ = self._real_block(rows, self.dofs, omega, False)
         X, _ = self._linear_response(rows, omega, False)
         return X - (G @ Fnl).reshape(self.basis.nb, len(rows))
