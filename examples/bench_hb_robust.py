@@ -188,6 +188,8 @@ def main(argv=None):
     ap.add_argument("--smoke", action="store_true", help="tiny grid (the test)")
     ap.add_argument("--full", action="store_true", help="the issue's whole grid (hours)")
     ap.add_argument("--harmonics", help="comma-separated subset of the grid's H (e.g. 1,3)")
+    ap.add_argument("--stiffness", help="comma-separated subset of the grid's kt/k (e.g. 1e5,1e6): "
+                    "split a long map over processes or finish a partial one")
     ap.add_argument("--log", help="CSV file: one line per curve as it finishes")
     ap.add_argument("--no-cost", action="store_true", help="skip table 2")
     ap.add_argument("--cost-only", action="store_true", help="skip table 1")
@@ -203,6 +205,8 @@ def main(argv=None):
     grid = dict(SMOKE if args.smoke else FULL if args.full else GRID)
     if args.harmonics:
         grid["H"] = tuple(int(h) for h in args.harmonics.split(","))
+    if args.stiffness:
+        grid["kt"] = tuple(float(v) for v in args.stiffness.split(","))
     log = open(args.log, "w") if args.log else None
     if log is not None:
         log.write("H,kt,fs,c,start,ok,points,iterations,seconds,evaluations,n_t,gaps,message\n")
