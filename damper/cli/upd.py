@@ -195,15 +195,6 @@ def _plot_frf(out, out_dir) -> None:
 def _plot_optimize(out, out_dir) -> None:
     from pathlib import Path
 
-    from harmonic_balance.plots import _save
+    from damper.run.backbone_stages import plot_optimal_load
 
-    plt = _figure()
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.loglog(out["cf"], np.array(out["peak_amplitude"]) * 1e3, "o-")
-    ax.loglog([out["optimum_cf"]], [out["optimum_peak_amplitude"] * 1e3], "r*", ms=12)
-    ax.set_xlabel("centrifugal load CF [N]")
-    ax.set_ylabel("peak amplitude [mm]")
-    ax.set_title("optimal-load curve")
-    fig.tight_layout()
-    _save(fig, Path(out_dir) / "upd_optimize.png")
-    plt.close(fig)
+    plot_optimal_load(out, Path(out_dir) / "upd_optimize.png")

@@ -141,11 +141,14 @@ class OptimalLoad(Kind):
 
 
 def plot_optimal_load(o: dict, path: Path) -> None:
-    """Peak amplitude against CF (log-log) with the optimum marked."""
+    """Peak amplitude against CF (log-log) with the optimum marked, written atomically
+    (the scene stage and ``damper upd optimize --plot`` share it)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
+    from harmonic_balance.plots import _save
 
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.loglog(o["cf"], np.array(o["peak_amplitude"]) * 1e3, "o-")
@@ -154,5 +157,5 @@ def plot_optimal_load(o: dict, path: Path) -> None:
     ax.set_ylabel("peak amplitude [mm]")
     ax.set_title("optimal-load curve (UPD sector)")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    _save(fig, Path(path))
     plt.close(fig)
