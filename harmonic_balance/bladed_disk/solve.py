@@ -40,6 +40,10 @@ class SolverError(RuntimeError):
     """The harmonic balance did not converge; message says where and what to change."""
 
 
+class StartError(SolverError):
+    """No solution at the band's first frequency (no curve to follow from)."""
+
+
 @dataclass
 class Curve:
     """A computed response curve (SI units; omega in rad/s)."""
@@ -113,14 +117,19 @@ def _step(hb, w_a, x_a, dxdw, w_b, depth=0):
     return _step(hb, w_m, x_m, (x_m - x_a) / (w_m - w_a), w_b, depth + 1)
 
 
+def _start(hb: SectorHB, omega: float, x0: np.ndarray | None = None) -> np.ndarray:
+    """Solution at the band's first frequency (from x0, else :func:`start_point`)."""
+    try:
+        return start_point(hb, omega) if x0 is None else solve_point(hb, omega, x0, 80)
+    except NewtonError as err:
+        raise StartError(f"no solution at the start frequency {omega / 2 / np.pi:.6g} Hz "
+                         f"({err}); start the band further from resonance") from None
+
+
 def sweep(hb: SectorHB, omegas, x0: np.ndarray | None = None) -> list:
     """Solutions at every frequency of the grid (increasing or decreasing) [rad/s]."""
     omegas = np.asarray(omegas, dtype=float)
-    try:
-        x = start_point(hb, omegas[0]) if x0 is None else solve_point(hb, omegas[0], x0, 80)
-    except NewtonError as err:
-        raise SolverError(f"no solution at the start frequency {omegas[0] / 2 / np.pi:.6g} Hz "
-                          f"({err}); start the band further from resonance") from None
+    x = _start(hb, omegas[0], x0)
     xs, slope = [x], np.zeros_like(x)
     for k in range(1, len(omegas)):
         try:
@@ -157,7 +166,7 @@ def refine_peak(hb: SectorHB, omegas, xs) -> tuple[float, float, np.ndarray]:
     return float(res.x), float(-res.fun), cache[res.x]
 
 
-def follow(hb: SectorHB, omegas, reason: str = "") -> Curve:
+def follow(hb: SectorHB, omegas, reason: str = "", x0: np.ndarray | None = None) -> Curve:
     """Response curve by pseudo-arclength continuation in omega over the band of ``omegas``.
 
     The fallback of :func:`frf` when the fixed-grid sweep fails: where the curve folds
@@ -168,14 +177,11 @@ def follow(hb: SectorHB, omegas, reason: str = "") -> Curve:
     """
     omegas = np.asarray(omegas, dtype=float)
     fun = hb.__call__
+    x0 = _start(hb, omegas[0], x0)
     try:
-        x0 = start_point(hb, omegas[0])
         # ds_max: at least ~2 x the grid's point count on a flat branch
         branch = continuation(fun, x0, omegas[0], omegas[-1], _tol(hb),
                               ds_max=min(0.02, 1.0 / max(len(omegas), 2)), max_points=20000)
-    except NewtonError as err:
-        raise SolverError(f"no solution at the start frequency {omegas[0] / 2 / np.pi:.6g} Hz "
-                          f"({err}); start the band further from resonance") from None
     except ContinuationError as err:
         w = err.branch.lam[-1] / 2 / np.pi if err.branch.lam else omegas[0] / 2 / np.pi
         raise SolverError(f"{reason}; the arclength continuation then stopped at {w:.6g} Hz "
@@ -204,12 +210,11 @@ def frf(hb: SectorHB, omegas, refine: bool = True) -> Curve:
     """
     t0 = time.perf_counter()
     e0 = hb.evaluations
+    x_start = _start(hb, omegas[0])  # StartError: nothing to follow either
     try:
-        xs = sweep(hb, omegas)
+        xs = sweep(hb, omegas, x_start)
     except SolverError as err:
-        if str(err).startswith("no solution at the start"):
-            raise
-        c = follow(hb, omegas, f"the frequency-grid sweep failed: {err}")
+        c = follow(hb, omegas, f"the frequency-grid sweep failed: {err}", x_start)
         c.evaluations = hb.evaluations - e0
         c.time_s = time.perf_counter() - t0
         return c
