@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MAX_SLIDERS", "STATE_VERSION", "Model", "State", "Output", "STATE_DTYPE",
-           "DoubleArray", "StateArray", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
+           "DoubleArray", "StateArray", "SizeArray", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
            "IwanNotConvergedError", "vec", "normal"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h (the header test checks it)
@@ -65,6 +65,8 @@ STATE_DTYPE = np.dtype(State)
 DoubleArray = ct.POINTER(ct.c_double)
 #: ``iwan_state *``: one state (``ct.byref``) or a batch (``arr(states, StateArray)``).
 StateArray = ct.POINTER(State)
+#: ``size_t *``: index arrays (``arr(rows, SizeArray)``, numpy dtype ``np.uintp``).
+SizeArray = ct.POINTER(ct.c_size_t)
 
 
 def arr(a, kind=DoubleArray):
@@ -79,7 +81,7 @@ def arr(a, kind=DoubleArray):
     """
     if a is None:
         return None
-    want = STATE_DTYPE if kind is StateArray else np.float64
+    want = STATE_DTYPE if kind is StateArray else np.uintp if kind is SizeArray else np.float64
     if a.dtype != want or not a.flags.c_contiguous:
         raise TypeError(f"expected a C-contiguous {np.dtype(want)} array, got {a.dtype} "
                         f"(contiguous: {a.flags.c_contiguous})")
@@ -109,6 +111,9 @@ FUNCTIONS = {
     "iwan_periodic_jac": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, DoubleArray,
                                     DoubleArray, _S, DoubleArray, DoubleArray, DoubleArray,
                                     _PD, _I, _D, _PI]),
+    "iwan_periodic_jac_rows": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, DoubleArray,
+                                         DoubleArray, _S, DoubleArray, SizeArray, ct.POINTER(_S),
+                                         DoubleArray, DoubleArray, _PD, _I, _D, _PI]),
     "iwan_status_text": (ct.c_char_p, [_STATUS]),
 }
 

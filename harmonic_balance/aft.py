@@ -81,10 +81,10 @@ class FrictionLink(ForceElement):
         return 1
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
-        """:func:`aft_link` on U (n_b, 1); the Jacobian is always computed (one C call)."""
+        """:func:`aft_link` on U (n_b, 1) (without ``jac``: the loop alone, no Jacobian)."""
         U = np.asarray(U, dtype=float).reshape(basis.nb)
-        Fh, dFh, W, F = aft_link(self, U, basis)
-        return LocalForce(Fh[:, None], dFh if jac else None, None, W, 0.0,
+        Fh, dFh, W, F = aft_link(self, U, basis, jac)
+        return LocalForce(Fh[:, None], dFh, None, W, 0.0,
                           (basis.E @ U)[:, None], F[:, None])
 
     def stuck_stiffness(self) -> np.ndarray:
@@ -110,7 +110,7 @@ def initial_stiffness(element) -> float:
     return float(np.sum(k) + k_res)
 
 
-def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis):
+def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool = True):
     """Harmonics of one link's force and their exact Jacobian.
 
     Parameters
@@ -119,34 +119,44 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis):
     U : (n_b,) array
         Harmonics of the relative displacement u = x_a - x_b [m].
     basis : FourierBasis
+    jac : bool
+        False: the loop alone (``periodic``, no Jacobian; dFh is None), e.g. the
+        residual differences of a parameter continuation.
 
     Returns
     -------
     Fh : (n_b,) array      harmonics of the force [N]
-    dFh : (n_b, n_b) array dFh / dU [N/m]
+    dFh : (n_b, n_b) array dFh / dU [N/m], or None without ``jac``
     W : float              energy dissipated per cycle by the sampled loop [J]
     F : (n_t,) array       force samples [N]
     """
     u = basis.E @ U
-    F, dF, _, W = link.element.periodic_jac(u, basis.E)
-    F = np.asarray(F, dtype=float)
-    dF = np.asarray(dF, dtype=float)
+    el = link.element
+    if not jac and hasattr(el, "periodic"):
+        loop = el.periodic(u)
+        F, dFh, W = loop.F, None, loop.W_cycle
+    elif not hasattr(el, "periodic_jac_rows"):   # e.g. the cubic spring: dense dF
+        F, dF, _, W = el.periodic_jac(u, basis.E)
+        dFh = _project_rows(basis.D, np.asarray(dF, dtype=float)) if jac else None
+    else:
+        # Only the samples where a slider sticks depend on U (a slipping slider carries
+        # +-f_s): the C core returns those rows alone (on a stiff contact in gross slip a
+        # few per cent of them), so D dF costs O(stuck samples x n_b), not O(n_t x n_b).
+        F, rows, dFr, _, W = el.periodic_jac_rows(u, basis.E)
+        dFh = basis.D[:, rows] @ dFr
     if basis.harmonics[0] == 0 and W <= 0.0 and _stuck(F, u, link.k0):
         # Fully stuck: apply the virgin-state convention of the module docstring.
         F = link.k0 * u
-        dF = link.k0 * basis.E
-    return basis.D @ F, _project_rows(basis.D, dF), float(W), F
+        dFh = link.k0 * (basis.D @ basis.E) if jac else None
+    return basis.D @ F, dFh, float(W), F
 
 
 def _project_rows(D, dF):
-    """``D @ dF`` over the samples where dF has a non-zero row only.
+    """``D @ dF`` over the samples where dF has a non-zero row only (dense dF from an
+    element without :meth:`periodic_jac_rows`, e.g. the cubic spring).
 
-    A sample depends on U only while a slider sticks (slipping sliders carry the
-    constant force +-f_s): on a stiff contact in gross slip a few per cent of the
-    samples, so the (n_b, n_t) x (n_t, n_b) product, the AFT's largest cost at
-    n_t = 4096, shrinks by the stuck fraction. Zero rows add nothing; the row test
-    by squares (twice as fast as ``any``) drops only rows below ~1e-154, whose terms
-    are below double precision anyway.
+    Zero rows add nothing; the row test by squares (twice as fast as ``any``) drops only
+    rows below ~1e-154, whose terms are below double precision anyway.
     """
     rows = np.flatnonzero(np.einsum("ij,ij->i", dF, dF))
     if rows.size > 0.5 * dF.shape[0]:

@@ -27,6 +27,8 @@ from .residual import make_residual
 
 #: Relative step of the central difference in lam.
 FD_STEP = 1e-6
+#: Residuals kept (a point and its two difference neighbours, for two points).
+CACHE_SIZE = 6
 
 
 def forcing_level(model):
@@ -68,13 +70,25 @@ class ParameterProblem:
         self.basis = FourierBasis(parse_harmonics(harmonics), n_t)
         self.condensed = condensed
         self._cache = {}
+        self._base = None
 
     def residual(self, lam):
+        """The residual at ``lam`` (a few kept). A model that differs from the first only
+        in its links' elements (slip strength, contact stiffness) reuses the first
+        residual's operators (``with_elements``): no rebuild per parameter value."""
         key = float(lam)
         if key not in self._cache:
-            if len(self._cache) > 4:
-                self._cache.clear()
-            self._cache[key] = make_residual(self.model_at(key), self.basis, self.condensed)
+            if len(self._cache) >= CACHE_SIZE:
+                self._cache.pop(next(iter(self._cache)))   # the oldest
+            model = self.model_at(key)
+            try:
+                res = self._base.with_elements(model) if self._base is not None else None
+            except ValueError:
+                res = None
+            if res is None:
+                res = make_residual(model, self.basis, self.condensed)
+                self._base = self._base or res
+            self._cache[key] = res
         return self._cache[key]
 
     def __call__(self, x, lam):

@@ -23,6 +23,8 @@ Both return ``R (N,), dR/dx (N, N), dR/domega (N,)``.
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 
 from .fourier import FourierBasis
@@ -64,6 +66,31 @@ class _Residual:
         self._static = np.concatenate(
             [np.tile(el.static_force(), basis.nb) * _mean_mask(basis, el.m)
              for el in self.elements]) if self.elements else np.zeros(0)
+
+    def with_elements(self, model: Model):
+        """This residual for ``model``, which differs from ``self.model`` only in its
+        friction links' elements (same links on the same DOFs, same linear part and
+        forcing), sharing every operator: a parameter continuation over slip strength or
+        contact stiffness (:mod:`parameter`) then costs no rebuild per parameter value.
+
+        Raises
+        ------
+        ValueError when ``model`` has another structure (build a new residual then).
+        """
+        from .aft import FrictionLink
+
+        old, new = self.model, model
+        same = (new.linear is old.linear and new.forcing == old.forcing
+                and len(new.elements) == len(self.elements))
+        for a, b in zip(self.elements, new.elements) if same else ():
+            same = a is b or (type(a) is type(b) is FrictionLink and a.dofs == b.dofs)
+            if not same:
+                break
+        if not same:
+            raise ValueError("with_elements: the model differs in more than its links' elements")
+        out = copy.copy(self)
+        out.model, out.elements = new, list(new.elements)
+        return out
 
     def evaluate(self, x: np.ndarray, omega: float | None = None, jac: bool = True):
         """Every element's :class:`~.forces.LocalForce` at unknowns x (size,)."""

@@ -173,6 +173,21 @@ iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u
                               double *F, double *dFdX, double *dFdXN, double *W_cycle,
                               int max_periods, double tol, int *periods_used);
 
+/* iwan_periodic_jac with the Jacobian's non-zero rows only (same numbers): the
+ * samples whose row may be non-zero go to rows[0 .. *n_rows - 1] (ascending in the
+ * sweep order, each once) and their rows, packed, to dFdX[r*nb + c] (and dFdXN) for
+ * r < *n_rows; every other row is exactly zero (lifted off, or all sliders slipping
+ * without a residual spring and, with EN, without strength). rows and dFdX need room
+ * for n rows. On a stiff contact in gross slip a few per cent of the samples stick,
+ * so this costs O(n + stuck samples x nb) instead of O(n x nb). Eu and EN are checked
+ * through the result: IWAN_ERR_NONFINITE when a non-finite entry reaches a row (a
+ * row of Eu that no Jacobian row uses is not read). */
+iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const double *u,
+                                   const double *N, const double *Eu, const double *EN, size_t nb,
+                                   double *F, size_t *rows, size_t *n_rows, double *dFdX,
+                                   double *dFdXN, double *W_cycle, int max_periods, double tol,
+                                   int *periods_used);
+
 /* Human-readable text of a status code (static string). */
 const char *iwan_status_text(iwan_status status);
 

@@ -165,15 +165,23 @@ static void recontact_grad(size_t n, size_t nb, const double *u, const double *N
 /* Row t of dF/dX (and dF/dXN): a slider that slipped into t carries
  * sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) + sg g(N(aN));
  * one stuck since the virgin state k u(t); one stuck since re-contact
- * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy. */
-static void jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
-                    size_t nb, const double *u, const double *N, const double *Eu,
-                    const double *EN, double *rX, double *rXN)
+ * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy.
+ * Returns 0, without touching rX, rXN, when the row is structurally zero (lifted
+ * off, or every slider slipping with no residual spring and no dF/dXN asked):
+ * on a stiff contact in gross slip that is most samples, so the compact layout
+ * (iwan_periodic_jac_rows) skips them and the work is O(stuck samples x nb). */
+static int jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
+                   size_t nb, const double *u, const double *N, const double *Eu,
+                   const double *EN, double *rX, double *rXN)
 {
+    if (!s->in_contact) return 0;
     const size_t t = (size_t)an->t;
     const double dgdN = m->scale / m->n_ref;
+    int any = m->k_res != 0.0 || ANCHOR_IS_RECONTACT(an->res);
+    for (int32_t j = 0; j < m->n && !any; ++j)
+        any = !an->slip[j] || (rXN && m->fs[j] != 0.0);
+    if (!any) return 0;
     for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
-    if (!s->in_contact) return;
     double kst = m->k_res, krc = ANCHOR_IS_RECONTACT(an->res) ? m->k_res : 0.0, cnow = 0.0;
     double gk = 0.0, gc = 0.0;
     int32_t ga = ANCHOR_ORIGIN, gn = 0;
@@ -200,21 +208,30 @@ static void jac_row(const iwan_model *m, const iwan_state *s, const anchors *an,
         if (rXN) rXN[c] += cnow * EN[t * nb + c];
     }
     if (krc > 0.0) recontact_grad(n, nb, u, N, Eu, EN, ANCHOR_RECONTACT_STEP(an->res), krc, rX, rXN);
+    return 1;
 }
 
-iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
-                              const double *Eu, const double *EN, size_t nb,
-                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
-                              int max_periods, double tol, int *periods_used)
+/* Shared body of iwan_periodic_jac (rows == NULL: dense rows, t * nb) and
+ * iwan_periodic_jac_rows (rows != NULL: only the non-zero rows, packed, their
+ * samples in rows[0 .. *n_rows - 1]). */
+static iwan_status periodic_jac_impl(const iwan_model *model, size_t n, const double *u,
+                                     const double *N, const double *Eu, const double *EN,
+                                     size_t nb, double *F, size_t *rows, size_t *n_rows,
+                                     double *dFdX, double *dFdXN, double *W_cycle,
+                                     int max_periods, double tol, int *periods_used)
 {
     iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
     if (st != IWAN_OK) return st;
     /* anchors hold sample indices as int32; n * nb must not overflow */
     if (!Eu || nb == 0 || n > (size_t)INT32_MAX / 2 || nb > SIZE_MAX / n) return IWAN_ERR_BAD_PARAM;
-    if (iwanp_check_finite(Eu, n * nb) || (EN && iwanp_check_finite(EN, n * nb))) return IWAN_ERR_NONFINITE;
+    /* Dense rows: every entry of Eu, EN is checked. Packed rows: only the rows the
+     * Jacobian is made of, through its (non-finite where they are) rows at the end;
+     * checking all n x nb inputs cost as much as the whole sweep on a stiff contact. */
+    if (!rows && (iwanp_check_finite(Eu, n * nb) || (EN && iwanp_check_finite(EN, n * nb))))
+        return IWAN_ERR_NONFINITE;
     iwan_state s;
     anchors an;
-    size_t tM;
+    size_t tM, k_row = 0;
     double w = 0.0;
     int p = 0;
     periodic_start(model, n, u, N, &s, &an, &tM);
@@ -225,18 +242,46 @@ iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u
             return st;
         }
     }
+    double *dXN = (EN && dFdXN) ? dFdXN : NULL;
     const double w0 = s.w_diss;
     for (size_t k = 1; k <= n; ++k) {       /* final pass from the closed state */
         const size_t t = (tM + k) % n;
         an.t = (int32_t)t;
         iwanp_advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
         if (F) F[t] = iwanp_force(model, &s);
-        if (dFdX) {
-            jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + t * nb,
-                    (EN && dFdXN) ? dFdXN + t * nb : NULL);
+        if (!dFdX) continue;
+        const size_t r = rows ? k_row : t;
+        if (jac_row(model, &s, &an, n, nb, u, N, Eu, EN, dFdX + r * nb, dXN ? dXN + r * nb : NULL)) {
+            if (rows) rows[k_row++] = t;
+        } else if (!rows) {
+            memset(dFdX + t * nb, 0, nb * sizeof *dFdX);
+            if (dXN) memset(dXN + t * nb, 0, nb * sizeof *dXN);
         }
     }
+    if (rows && (iwanp_check_finite(dFdX, k_row * nb) || (dXN && iwanp_check_finite(dXN, k_row * nb))))
+        return IWAN_ERR_NONFINITE;
+    if (n_rows) *n_rows = k_row;
     if (W_cycle) *W_cycle = s.w_diss - w0;
     if (periods_used) *periods_used = p + 1;
     return IWAN_OK;
+}
+
+iwan_status iwan_periodic_jac(const iwan_model *model, size_t n, const double *u, const double *N,
+                              const double *Eu, const double *EN, size_t nb,
+                              double *F, double *dFdX, double *dFdXN, double *W_cycle,
+                              int max_periods, double tol, int *periods_used)
+{
+    return periodic_jac_impl(model, n, u, N, Eu, EN, nb, F, NULL, NULL, dFdX, dFdXN, W_cycle,
+                             max_periods, tol, periods_used);
+}
+
+iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const double *u,
+                                   const double *N, const double *Eu, const double *EN, size_t nb,
+                                   double *F, size_t *rows, size_t *n_rows, double *dFdX,
+                                   double *dFdXN, double *W_cycle, int max_periods, double tol,
+                                   int *periods_used)
+{
+    if (!rows || !n_rows || !dFdX) return IWAN_ERR_BAD_PARAM;
+    return periodic_jac_impl(model, n, u, N, Eu, EN, nb, F, rows, n_rows, dFdX, dFdXN, W_cycle,
+                             max_periods, tol, periods_used);
 }

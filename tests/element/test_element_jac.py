@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from elcases import N_SPHERE, SEED, cattaneo_table
 
-from fmu_src.element import IwanElement
+from fmu_src.element import IwanElement, IwanInputError
 
 #: Central differences with step 1e-7 of the coefficient scale: truncation is zero
 #: for this piecewise-linear map away from kinks, round-off ~1e-16/1e-7 ~ 1e-9.
@@ -85,3 +85,58 @@ def test_jenkins_first_harmonic_matches_the_describing_function():
     assert 2 * np.mean(F * E[:, 1]) == pytest.approx(a1, rel=1e-3)
     assert 2 * np.mean(F * E[:, 2]) == pytest.approx(b1, rel=1e-3)
     assert W == pytest.approx(-np.pi * a * b1, rel=1e-12)
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_packed_rows_are_the_dense_jacobian(el, case):
+    """periodic_jac_rows: the same numbers as periodic_jac, every omitted row exactly zero."""
+    X, XN = CASES[case]
+    E = basis()
+    N, EN = (None, None) if XN is None else (E @ XN, E)
+    F, J, JN, W = el.periodic_jac(E @ X, E, N, EN)
+    F2, rows, Jr, JNr, W2 = el.periodic_jac_rows(E @ X, E, N, EN)
+    assert len(set(rows)) == len(rows) and np.array_equal(F, F2) and W == W2
+    full = np.zeros_like(J)
+    full[rows] = Jr
+    assert np.array_equal(full, J)
+    if JN is not None:
+        full[:] = 0.0
+        full[rows] = JNr
+        assert np.array_equal(full, JN)
+
+
+def test_packed_rows_of_a_stiff_jenkins_link_in_gross_slip_are_its_stuck_samples():
+    """1e4 N/m, f_s = 0.5 N, amplitude 1 m: a slider sticks for 2 f_s / k = 1e-4 m of
+    travel after each reversal (theta < sqrt(2e-4), 9 samples of 4096), so 18 samples
+    carry a row; the rest slip at +-f_s."""
+    E = basis(4096, 15)
+    X = np.zeros(E.shape[1])
+    X[1] = 1.0
+    link = IwanElement.jenkins(1e4, 0.5)
+    F, rows, Jr, _, W = link.periodic_jac_rows(E @ X, E)
+    _, J, _, _ = link.periodic_jac(E @ X, E)
+    stuck = np.flatnonzero(np.any(J != 0.0, axis=1))
+    assert 16 <= len(rows) <= 20 and set(stuck) == set(rows)
+    slipping = np.setdiff1d(np.arange(4096), rows)
+    np.testing.assert_allclose(np.abs(F[slipping]), 0.5, rtol=1e-12)
+
+
+def test_packed_rows_refuse_a_non_finite_basis_row_they_use():
+    """The packed layout checks Eu through its rows: a NaN in a row the Jacobian uses is
+    refused (IwanInputError), one in the row of a sample mid-way between the reversals
+    (slipping, and no slider's anchor) is not read."""
+    E = basis(256, 3)
+    X = np.array([0, 1.0, 0, 0, 0, 0, 0])
+    link = IwanElement.jenkins(1e2, 0.5)
+    _, rows, _, _, _ = link.periodic_jac_rows(E @ X, E)
+    bad = E.copy()
+    bad[rows[0], 2] = np.nan
+    with pytest.raises(IwanInputError, match="NaN"):
+        link.periodic_jac_rows(E @ X, bad)
+    unused = 64   # theta = pi / 2: stick episodes and their anchors are near 0 and pi
+    assert unused not in rows
+    ok = E.copy()
+    ok[unused, 2] = np.nan
+    assert np.array_equal(link.periodic_jac_rows(E @ X, ok)[2], link.periodic_jac_rows(E @ X, E)[2])
+    with pytest.raises(IwanInputError, match="NaN"):   # the dense layout reads every row
+        link.periodic_jac(E @ X, ok)

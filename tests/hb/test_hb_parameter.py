@@ -29,3 +29,24 @@ def test_slip_scale_curve_matches_the_model_built_with_that_slip_force():
     assert c.status == "complete" and c.lam[-1] == 3.0
     r = compute_frf(two_dof(True, fs=0.04 * 3.0), "odd:3", (1.1, 1.11), refine=False)
     assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < 1e-8
+
+
+def test_contact_stiffness_family_shares_the_first_residual_operators():
+    """ParameterProblem builds one residual and swaps the links' elements for the others
+    (Residual.with_elements): the same numbers as a residual built from scratch."""
+    from harmonic_balance.fourier import FourierBasis
+    from harmonic_balance.parameter import ParameterProblem, contact_stiffness_scale
+    from harmonic_balance.residual import make_residual
+
+    model = sdof_model(1, 1, 0.04, 1e3, 0.5, 1.0)
+    at = contact_stiffness_scale(model)
+    pp = ParameterProblem(at, "odd:5", 0.8)
+    x = make_residual(model, pp.basis).linear_guess(0.8) * 30
+    for lam in (-3.0, -1.5, 0.0):
+        fresh = make_residual(at(lam), FourierBasis(pp.basis.harmonics))
+        R, J, _ = pp.residual(lam)(x, 0.8)
+        R0, J0, _ = fresh(x, 0.8)
+        assert np.array_equal(R, R0) and np.array_equal(J, J0)
+    assert pp.residual(-1.5)._K is pp.residual(0.0)._K   # shared, not rebuilt
+    with pytest.raises(ValueError, match="more than its links"):
+        pp.residual(0.0).with_elements(sdof_model(1, 2, 0.04, 1e3, 0.5, 1.0))

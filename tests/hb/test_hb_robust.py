@@ -115,3 +115,23 @@ def test_failure_text_output_is_a_message_not_a_traceback(capsys):
                  "--omega", "0.5", "1.0"])
     cap = capsys.readouterr()
     assert code == 3 and "none" in cap.out and "failed" in cap.err
+
+
+def test_stiff_start_on_a_coarse_grid_is_the_fine_grids_solution(monkeypatch):
+    """1e6 k, H = 15, 4096 samples, from 0.5 rad/s (the stiffness homotopy's case): the
+    homotopy runs on H's default 512 samples and Newton finishes on 4096 from there
+    (measured: 1.0 s -> 0.5 s, 3-4 Newton iterations); the answer is the one the fine
+    grid's own homotopy gives, to the solver tolerance."""
+    import harmonic_balance.start as start
+    from harmonic_balance.frf import TOL_REL, FRFProblem
+
+    m = sdof_model(1, 1, 0.04, 1e6, 0.5, 1.0)
+    fine = FRFProblem(m, 15, 4096)
+    tol = TOL_REL * fine.reference(0.5)
+    x, info = start.homotopy_start(fine, 0.5, tol)
+    assert info["method"] == "stiffness homotopy on 512 samples, then Newton"
+    assert np.linalg.norm(fine(x, 0.5)[0]) <= tol
+    monkeypatch.setattr(start, "COARSE_FACTOR", 1e9)   # the fine grid's homotopy
+    ref, info_ref = start.homotopy_start(fine, 0.5, tol)
+    assert info_ref["method"] == "stiffness homotopy"
+    assert abs(fine.amplitude(x, 0.5) / fine.amplitude(ref, 0.5) - 1) < 1e-8
