@@ -238,19 +238,22 @@ def stiff_samples(model: Model, harmonics) -> int:
     2 f_s / k_t; near a reversal u ~ u_r - a t^2 / 2, so a stick episode lasts
     ~ sqrt(4 f_s / (k_t a)): its share of the period, and the samples it spans at a
     fixed n_t, fall like k_t^-1/2. Above STIFF_SAMPLES_RATIO the grid is
-    STIFF_SAMPLES_BASE sqrt(ratio / STIFF_SAMPLES_RATIO) samples, rounded to a power
-    of two (at least the default), so the samples per stick episode stay those that
-    work at STIFF_SAMPLES_RATIO. Measured on the Jenkins FRF (gaps = stretches the
+    STIFF_SAMPLES_BASE sqrt(ratio / STIFF_SAMPLES_RATIO) samples, rounded up to a
+    power of two (at least the default), so the samples per stick episode stay those
+    that work at STIFF_SAMPLES_RATIO. Measured on the Jenkins FRF (gaps = stretches the
     corrector could not cross): H = 15, 0.5 -> 2 rad/s: 1e5 k: 512 samples 7 gaps,
-    1024 4, 2048 (this rule) none; 1e6 k: 2048 2 gaps, 4096 (this rule) none; H = 3
-    from 0.5 rad/s at 1e5 k: 1024 samples 1 gap.
+    1024 4, 2048 (this rule) none; 1e6 k: 2048 2 gaps, 4096 none, 8192 (this rule)
+    none; H = 3 from 0.5 rad/s at 1e5 k: 1024 samples 1 gap. Since the AFT's Jacobian
+    costs only the stuck samples (``periodic_jac_rows``), a finer grid is cheap and
+    its smaller kinks save corrector work: 1e6 k, H = 15: 4096 samples 737 points,
+    11.1 evaluations per point, 3.4 s; 8192: 474 points, 5.4 per point, 2.2 s.
     """
     ratio = _stiffness_ratio(model)
     if ratio is None or ratio <= STIFF_SAMPLES_RATIO:
         return 0
     need = STIFF_SAMPLES_BASE * np.sqrt(ratio / STIFF_SAMPLES_RATIO)
     default = default_samples(max(parse_harmonics(harmonics)))
-    return int(max(default, 2 ** round(np.log2(need))))
+    return int(max(default, 2 ** int(np.ceil(np.log2(need) - 1e-9))))
 
 
 #: Doublings of the AFT grid tried, when n_t is not given, after a curve that stalled

@@ -27,11 +27,11 @@ def test_sdof_jenkins_curve_completes_from_any_start(kt, start):
 
 def test_stiff_samples_grow_like_the_square_root_of_the_stiffness_ratio():
     """Stick episodes last ~ kt^-1/2 of the period: default grid up to 1e4 k, then
-    512 sqrt(ratio / 1e4) samples rounded to a power of two (the measured 2048 at 1e5,
-    4096 at 1e6 k), whatever H (at least H's default)."""
+    512 sqrt(ratio / 1e4) samples rounded up to a power of two (2048 at 1e5, 8192 at
+    1e6 k), whatever H (at least H's default)."""
     for H in (3, 15):
         n = {kt: stiff_samples(sdof_model(1, 1, 0.04, kt, 0.5, 1.0), H) for kt in (1e4, 1e5, 1e6)}
-        assert n == {1e4: 0, 1e5: 2048, 1e6: 4096}
+        assert n == {1e4: 0, 1e5: 2048, 1e6: 8192}
     assert stiff_samples(sdof_model(1, 1, 0.04, 1e5, 0.5, 1.0), 51) == 2048  # default 2048
 
 
@@ -93,10 +93,10 @@ def test_issue_case_stiffness_1e4_no_gaps():
 @pytest.mark.slow
 def test_stiffness_1e6_h7_no_gaps():
     """1e6 k, H = 7, from 0.5 rad/s: gaps in the stick-slip band before frf.stiff_samples
-    (measured after: 190 points, 0 gaps, ~9 s)."""
+    (measured after: 190 points, 0 gaps, ~9 s; 8192 samples since the packed AFT rows)."""
     r = compute_frf(sdof_model(1, 1, 0.04, 1e6, 0.5, 1.0), 7, (0.5, 2.0), refine=False,
                     stability=False)
-    assert r.status == "complete" and r.extra["gaps"] == [] and r.n_t == 4096
+    assert r.status == "complete" and r.extra["gaps"] == [] and r.n_t == 8192
 
 
 def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
