@@ -89,7 +89,7 @@ class _Residual:
         if not same:
             raise ValueError("with_elements: the model differs in more than its links' elements")
         out = copy.copy(self)
-        out.model, out.elements = new, list(new.elements)
+        out.model, out.elements, out._last = new, list(new.elements), None
         return out
 
     def evaluate(self, x: np.ndarray, omega: float | None = None, jac: bool = True):
@@ -111,6 +111,8 @@ class _Residual:
         dissipated work on every Newton step.
         """
         res = self.evaluate(x, omega, jac)
+        if jac:   # kept for element_action at the same point (no second evaluation)
+            self._last = (x.copy(), omega, res)
         Fh = np.concatenate([r.F.ravel() for r in res]) if res else np.zeros(0)
         Fnl = self._T @ Fh
         dF = None
@@ -126,6 +128,25 @@ class _Residual:
                                  for sl, d in zip(self._slices, dw)])
             self.dF_domega = self._T @ dw
         return Fnl, dF, ([r.W for r in res] if energies else None)
+
+    def element_action(self, x: np.ndarray, omega: float, select) -> np.ndarray:
+        """Residual change (size,) along the selected elements' own displacement:
+        ``dR/dF_nl T_s dF_s/dU_s U_s`` summed over the elements e with ``select(e)``,
+        at x: the Jacobians of the residual's last evaluation when it was at this
+        (x, omega), else one evaluation of those elements. The derivative of R with
+        respect to a parameter that scales the selected elements' input (e.g. a contact
+        stiffness factor, :class:`parameter.StiffnessScale`)."""
+        U = self._Q @ x
+        nb = self.basis.nb
+        last = getattr(self, "_last", None)
+        same = last is not None and last[1] == omega and np.array_equal(last[0], x)
+        v = np.zeros(self.size)
+        for k, (el, sl) in enumerate(zip(self.elements, self._slices)):
+            if select(el):
+                r = last[2][k] if same else el.evaluate(U[sl].reshape(nb, el.m), self.basis,
+                                                          float(omega), True)
+                v += self._T[:, sl] @ (r.dF @ U[sl])
+        return self.force_to_residual(v, omega)
 
     def link_samples(self, x: np.ndarray, omega: float | None = None):
         """Per element: first local displacement, its force over one period (n_t,) each, and W."""
@@ -188,6 +209,10 @@ class FullResidual(_Residual):
             return R
         Rw = (-2.0 * omega * self._M + self._C) @ x
         return R, A + dF, Rw if self.dF_domega is None else Rw + self.dF_domega
+
+    def force_to_residual(self, v: np.ndarray, omega: float) -> np.ndarray:
+        """dR/dF_nl v: the full residual carries the element forces as they are."""
+        return v
 
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
@@ -262,6 +287,10 @@ class CondensedResidual(_Residual):
             return R
         Rw = -dXl + dG @ Fnl
         return R, np.eye(self.size) + G @ dF, Rw if self.dF_domega is None else Rw + G @ self.dF_domega
+
+    def force_to_residual(self, v: np.ndarray, omega: float) -> np.ndarray:
+        """dR/dF_nl v = G(omega) v (R = x - X_lin + G F_nl)."""
+        return self._operators(omega)[0] @ v
 
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""

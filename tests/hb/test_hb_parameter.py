@@ -50,3 +50,23 @@ def test_contact_stiffness_family_shares_the_first_residual_operators():
     assert pp.residual(-1.5)._K is pp.residual(0.0)._K   # shared, not rebuilt
     with pytest.raises(ValueError, match="more than its links"):
         pp.residual(0.0).with_elements(sdof_model(1, 2, 0.04, 1e3, 0.5, 1.0))
+
+
+@pytest.mark.parametrize("condensed", [False, True])
+def test_exact_stiffness_derivative_matches_the_central_difference(condensed):
+    """StiffnessScale.dR_dlam (ln 10 x the links' Jacobian on their own displacement,
+    from F(q; s k) = F(s q; k)) against the central difference of the residual in lam,
+    on a 2-DOF model (one link between the DOFs, one to ground), full and condensed.
+    Away from AFT kinks the difference is exact to O(h^2) + round-off / h ~ 1e-9."""
+    from harmonic_balance.parameter import ParameterProblem, contact_stiffness_scale
+
+    model = two_dof(True)
+    at = contact_stiffness_scale(model)
+    pp = ParameterProblem(at, "odd:5", 1.05, condensed=condensed)
+    x = pp.residual(-0.5).linear_guess(1.05) * 40
+    for lam in (-2.0, -0.5, 0.0):
+        R, J, exact = pp(x, lam)
+        h = 1e-6
+        fd = (pp.residual(lam + h)(x, 1.05, jac=False) - pp.residual(lam - h)(x, 1.05, jac=False)) / (2 * h)
+        assert np.linalg.norm(exact - fd) < 1e-6 * np.linalg.norm(fd)
+        assert np.linalg.norm(fd) > 0
