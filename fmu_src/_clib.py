@@ -114,6 +114,9 @@ FUNCTIONS = {
     "iwan_periodic_jac_rows": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, DoubleArray,
                                          DoubleArray, _S, DoubleArray, SizeArray, ct.POINTER(_S),
                                          DoubleArray, DoubleArray, _PD, _I, _D, _PI]),
+    "iwan_periodic_branches": (_STATUS, [_PM, _S, DoubleArray, _S, SizeArray, SizeArray,
+                                         DoubleArray, DoubleArray, DoubleArray, DoubleArray,
+                                         DoubleArray, _PD]),
     "iwan_status_text": (ct.c_char_p, [_STATUS]),
 }
 

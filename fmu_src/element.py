@@ -425,6 +425,34 @@ class IwanElement:
         return (F, rows[:k].astype(np.intp), dFdX[:k], None if dFdXN is None else dFdXN[:k],
                 w.value)
 
+    def periodic_branches(self, u_ext):
+        """Exact periodic loop of an input monotone between its extrema ``u_ext`` (n >= 2,
+        alternating maxima and minima, periodic), at N_ref: piecewise-linear branches.
+
+        Returns
+        -------
+        dict with ``seg`` (m,) int (segment: from extremum seg to the next), ``u_lo``,
+        ``u_hi`` (m,) [m] (interval ends in travel order), ``slope`` (m,) [N/m],
+        ``icpt`` (m,) [N] (F = icpt + slope u on the interval), ``A`` (m, n) [N/m]
+        (d icpt / d u_ext = -A) and ``W`` [J] (energy dissipated per period).
+        """
+        u = _vec(u_ext, "u_ext")
+        n = u.size
+        if n < 2:
+            raise IwanInputError(f"u_ext needs at least two extrema, got {n}")
+        cap = n * (self._model.n + 1)
+        seg = np.empty(cap, dtype=np.uintp)
+        lo, hi, sl, c = (np.empty(cap) for _ in range(4))
+        A = np.empty((cap, n))
+        m, w = ct.c_size_t(), ct.c_double()
+        _check(_lib.iwan_periodic_branches(self._mp, n, arr(u), cap, ct.byref(m),
+                                           arr(seg, _clib.SizeArray), arr(lo), arr(hi), arr(sl),
+                                           arr(c), arr(A), ct.byref(w)),
+               "IwanElement.periodic_branches")
+        k = m.value
+        return {"seg": seg[:k].astype(np.intp), "u_lo": lo[:k], "u_hi": hi[:k],
+                "slope": sl[:k], "icpt": c[:k], "A": A[:k], "W": w.value}
+
     def virgin(self, u, N: float | None = None) -> np.ndarray:
         """Virgin-curve force [N] at normal load N (default N_ref), odd extension, shape (n,)."""
         u = _vec(u, "u")

@@ -110,6 +110,9 @@ def initial_stiffness(element) -> float:
     return float(np.sum(k) + k_res)
 
 
+EXACT = False
+
+
 def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool = True):
     """Harmonics of one link's force and their exact Jacobian.
 
@@ -132,6 +135,16 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
     """
     u = basis.E @ U
     el = link.element
+    if EXACT and hasattr(el, "periodic_branches"):
+        ex = basis.__dict__.get("_exact")
+        if ex is None:
+            from .aft_exact import ExactAFT
+            ex = basis.__dict__["_exact"] = ExactAFT(basis)
+        Fh, dFh, W, F = ex.link(el, U, link.k0)
+        if basis.harmonics[0] == 0 and W <= 0.0 and _stuck(F, u, link.k0):
+            F = link.k0 * u
+            return basis.D @ F, link.k0 * (basis.D @ basis.E), float(W), F
+        return Fh, dFh if jac else None, W, F
     if not jac and hasattr(el, "periodic"):
         loop = el.periodic(u)
         F, dFh, W = loop.F, None, loop.W_cycle

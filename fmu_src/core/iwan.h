@@ -188,6 +188,21 @@ iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const doub
                                    double *dFdXN, double *W_cycle, int max_periods, double tol,
                                    int *periods_used);
 
+/* Exact periodic loop of an input that is monotone between its n >= 2 extrema u_ext
+ * (alternating maxima and minima; after u_ext[n-1] comes u_ext[0]) at N = n_ref, the
+ * convention of iwan_periodic. Between two extrema the force is piecewise linear in
+ * u: interval i of segment seg[i] (from extremum seg[i] to the next) runs from u_lo[i]
+ * to u_hi[i] in travel order with F = icpt[i] + slope[i] u; at most n * (n_sliders + 1)
+ * intervals (cap, the rows of A). A[i*n + e] = summed stiffness of the sliders stuck on
+ * interval i since extremum e (position u_ext[e] -+ r_j), so d icpt[i] / d u_ext[e] =
+ * -A[i*n + e]; sliders stuck since the virgin state carry no such term. With the
+ * extrema of a smooth input this gives the exact Fourier coefficients of the loop (no
+ * sampling error). W_cycle (may be NULL) = energy dissipated per period [J]. */
+iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const double *u_ext,
+                                   size_t cap, size_t *n_int, size_t *seg, double *u_lo,
+                                   double *u_hi, double *slope, double *icpt, double *A,
+                                   double *W_cycle);
+
 /* Human-readable text of a status code (static string). */
 const char *iwan_status_text(iwan_status status);
 

@@ -285,3 +285,62 @@ iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const doub
     return periodic_jac_impl(model, n, u, N, Eu, EN, nb, F, rows, n_rows, dFdX, dFdXN, W_cycle,
                              max_periods, tol, periods_used);
 }
+
+/* ------------------------------------------- exact loop of a monotone-piecewise input */
+
+iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const double *u_ext,
+                                   size_t cap, size_t *n_int, size_t *seg, double *u_lo,
+                                   double *u_hi, double *slope, double *icpt, double *A,
+                                   double *W_cycle)
+{
+    iwan_status st = check_periodic(model, n, u_ext, NULL, 1, 0.0);
+    if (st != IWAN_OK) return st;
+    const size_t ns = (size_t)model->n;
+    if (n < 2 || !n_int || !seg || !u_lo || !u_hi || !slope || !icpt || !A
+        || n > (size_t)INT32_MAX / 2 || cap < n * (ns + 1) || cap > SIZE_MAX / n)
+        return IWAN_ERR_BAD_PARAM;
+    iwan_state s;
+    anchors an;
+    size_t tM, m = 0;
+    periodic_start(model, n, u_ext, NULL, &s, &an, &tM);
+    const double f = strength_factor(model, model->n_ref), w0 = s.w_diss;
+    memset(A, 0, cap * n * sizeof *A);
+    for (size_t k = 1; k <= n; ++k) {
+        const size_t e0 = (tM + k - 1) % n, e1 = (tM + k) % n;
+        const double ua = s.u, ub = u_ext[e1], sg = ub >= ua ? 1.0 : -1.0, len = sg * (ub - ua);
+        /* travel at which each slider reaches its limit (0: already there) */
+        double d[IWAN_MAX_SLIDERS];
+        for (size_t j = 0; j < ns; ++j) {
+            const double r = model->rad[j] * f, t = sg * (s.z[j] + sg * r - ua);
+            d[j] = t > 0.0 ? t : 0.0;
+        }
+        double at = 0.0;   /* travel at the start of the current interval */
+        while (at < len) {
+            double next = len;
+            for (size_t j = 0; j < ns; ++j)
+                if (d[j] > at && d[j] < next) next = d[j];
+            double sl = model->k_res, c = -model->k_res * s.u_contact;
+            for (size_t j = 0; j < ns; ++j) {
+                if (d[j] > at) {                  /* stuck on this interval */
+                    sl += model->k[j];
+                    c -= model->k[j] * s.z[j];
+                    if (an.au[j] >= 0) A[m * n + (size_t)an.au[j]] += model->k[j];
+                } else {                          /* at its limit: carries +-g_j */
+                    c += sg * model->k[j] * model->rad[j] * f;
+                }
+            }
+            seg[m] = e0;
+            u_lo[m] = ua + sg * at;
+            u_hi[m] = next >= len ? ub : ua + sg * next;   /* the extremum exactly */
+            slope[m] = sl;
+            icpt[m] = c;
+            ++m;
+            at = next;
+        }
+        an.t = (int32_t)e1;
+        iwanp_advance(model, &s, ub, model->n_ref, &an);
+    }
+    *n_int = m;
+    if (W_cycle) *W_cycle = s.w_diss - w0;
+    return IWAN_OK;
+}
