@@ -342,6 +342,22 @@ class IwanElement:
                "IwanElement.periodic")
         return PeriodicResult(out[0], out[1], out[2], w.value, p.value)
 
+    def _jac_inputs(self, u, Eu, N, EN):
+        """Checked inputs of the periodic Jacobians: u (n,), n, Eu (n, nb), nb, the normal
+        load samples (or None) and EN (n, nb) (or None)."""
+        u = _vec(u, "u")
+        n = u.size
+        Eu = np.ascontiguousarray(Eu, dtype=np.float64)
+        if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
+            raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        ENa = None
+        if EN is not None:
+            ENa = np.ascontiguousarray(EN, dtype=np.float64)
+            if ENa.shape != Eu.shape:
+                raise IwanInputError(f"EN must have shape {Eu.shape}, got {ENa.shape}")
+        return u, n, Eu, Eu.shape[1], Nv, ENa
+
     def periodic_jac(self, u, Eu, N=None, EN=None, max_periods: int = 100,
                      tol: float = 1e-12):
         """Periodic loop and its exact derivatives for u = Eu X (and N = EN XN).
@@ -362,18 +378,7 @@ class IwanElement:
         F : ndarray (n,);  dFdX : ndarray (n, nb);  dFdXN : ndarray (n, nb) or None;
         W_cycle : float
         """
-        u = _vec(u, "u")
-        n = u.size
-        Eu = np.ascontiguousarray(Eu, dtype=np.float64)
-        if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
-            raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
-        nb = Eu.shape[1]
-        Nv = None if N is None else _normal(N, n, self.N_ref)
-        ENa = None
-        if EN is not None:
-            ENa = np.ascontiguousarray(EN, dtype=np.float64)
-            if ENa.shape != Eu.shape:
-                raise IwanInputError(f"EN must have shape {Eu.shape}, got {ENa.shape}")
+        u, n, Eu, nb, Nv, ENa = self._jac_inputs(u, Eu, N, EN)
         F = np.empty(n)
         dFdX = np.empty((n, nb))
         dFdXN = None if ENa is None else np.empty((n, nb))
@@ -399,18 +404,7 @@ class IwanElement:
         dFdX : ndarray (r, nb);  dFdXN : ndarray (r, nb) or None;  W_cycle : float.
         Every row not in ``rows`` is exactly zero.
         """
-        u = _vec(u, "u")
-        n = u.size
-        Eu = np.ascontiguousarray(Eu, dtype=np.float64)
-        if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
-            raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
-        nb = Eu.shape[1]
-        Nv = None if N is None else _normal(N, n, self.N_ref)
-        ENa = None
-        if EN is not None:
-            ENa = np.ascontiguousarray(EN, dtype=np.float64)
-            if ENa.shape != Eu.shape:
-                raise IwanInputError(f"EN must have shape {Eu.shape}, got {ENa.shape}")
+        u, n, Eu, nb, Nv, ENa = self._jac_inputs(u, Eu, N, EN)
         F = np.empty(n)
         rows = np.empty(n, dtype=np.uintp)
         dFdX = np.empty((n, nb))

@@ -16,7 +16,12 @@ kinks with local minima of |R| (measured: Newton and Levenberg-Marquardt stall a
 stays at the requested excitation, in gross slip when the requested point slips,
 and reached 1e6 k at omega = 1 and 2 rad/s in 31 and 65 points (1.5 s, 2 s, H = 7).
 Models whose links are STIFF_RATIO times stiffer than the structure try the
-stiffness homotopy first (the excitation homotopy's failures cost up to ~75 s).
+stiffness homotopy first (the excitation homotopy's failures cost up to ~75 s), their
+first Newton fails fast (no Levenberg-Marquardt: the stuck guess of a stiff link is
+rarely near the answer), and when their AFT grid is COARSE_FACTOR times H's default
+(1e5 k and stiffer, :func:`frf.stiff_samples`) the stiffness homotopy runs on the
+default grid and Newton finishes on the requested one (the slow part, the homotopy's
+steps, on the cheap grid).
 """
 from __future__ import annotations
 

@@ -8,3 +8,20 @@ def test_robustness_benchmark_smoke(capsys, load_example):
     text = capsys.readouterr().out
     assert "Table 1" in text and "Table 2" in text
     assert not out["failures"] and all(row[1] for row in out["cost"])
+
+
+def test_soft_baseline_benchmark_smoke(capsys, load_example):
+    """examples/bench_hb_soft_baseline.py (the issue-10 cost baseline, runnable against
+    any version of harmonic_balance): one soft row, the issue's 3.1-3.2 evaluations per
+    point (measured on the code of the issue's time and on today's)."""
+    rows = load_example("bench_hb_soft_baseline").main(["1"])
+    assert "ms/pt" in capsys.readouterr().out
+    (kt, n_t, points, evals, seconds, ms), = rows
+    assert kt == 1.0 and n_t == 512 and points > 200 and 2.5 < evals < 4.0 and seconds > 0
+
+
+def test_hb_against_den_hartog_table_smoke(load_example):
+    """Table 4's function on one small case: 1e3 k, H = 7, at resonance, where the
+    elastic model and the rigid one agree (README: 1.1e-4 at H = 21)."""
+    (kt, H, errs), = load_example("bench_hb_robust").hb_vs_den_hartog((1e3,), (7,), (1.0,))
+    assert kt == 1e3 and H == 7 and abs(errs[0]) < 1e-2
