@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MAX_SLIDERS", "STATE_VERSION", "Model", "State", "Output", "STATE_DTYPE",
-           "DoubleArray", "StateArray", "SizeArray", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
+           "DoubleArray", "StateArray", "SizeArray", "Int32Array", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
            "IwanNotConvergedError", "vec", "normal"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h (the header test checks it)
@@ -65,6 +65,8 @@ STATE_DTYPE = np.dtype(State)
 DoubleArray = ct.POINTER(ct.c_double)
 #: ``iwan_state *``: one state (``ct.byref``) or a batch (``arr(states, StateArray)``).
 StateArray = ct.POINTER(State)
+#: ``int32_t *``: small integer arrays (``arr(h, Int32Array)``, numpy dtype ``np.int32``).
+Int32Array = ct.POINTER(ct.c_int32)
 #: ``size_t *``: index arrays (``arr(rows, SizeArray)``, numpy dtype ``np.uintp``).
 SizeArray = ct.POINTER(ct.c_size_t)
 
@@ -81,7 +83,8 @@ def arr(a, kind=DoubleArray):
     """
     if a is None:
         return None
-    want = STATE_DTYPE if kind is StateArray else np.uintp if kind is SizeArray else np.float64
+    want = (STATE_DTYPE if kind is StateArray else np.uintp if kind is SizeArray
+            else np.int32 if kind is Int32Array else np.float64)
     if a.dtype != want or not a.flags.c_contiguous:
         raise TypeError(f"expected a C-contiguous {np.dtype(want)} array, got {a.dtype} "
                         f"(contiguous: {a.flags.c_contiguous})")
@@ -117,6 +120,8 @@ FUNCTIONS = {
     "iwan_periodic_branches": (_STATUS, [_PM, _S, DoubleArray, _S, SizeArray, SizeArray,
                                          DoubleArray, DoubleArray, DoubleArray, DoubleArray,
                                          DoubleArray, _PD]),
+    "iwan_periodic_fourier": (_STATUS, [_PM, _S, Int32Array, DoubleArray, _S, DoubleArray,
+                                        DoubleArray, _PD, SizeArray]),
     "iwan_status_text": (ct.c_char_p, [_STATUS]),
 }
 

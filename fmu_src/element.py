@@ -447,6 +447,25 @@ class IwanElement:
         return {"seg": seg[:k].astype(np.intp), "u_lo": lo[:k], "u_hi": hi[:k],
                 "slope": sl[:k], "icpt": c[:k], "A": A[:k], "W": w.value}
 
+    def periodic_fourier(self, harmonics, U, n_scan: int):
+        """Exact Fourier coefficients of the periodic loop (N_ref) for the input with
+        coefficients ``U`` (n_b,) over ``harmonics`` (ascending; per harmonic cos, sin, the
+        mean alone), and their Jacobian: (Fh (n_b,), dFh (n_b, n_b), W [J], extrema found;
+        0 for a constant input, then Fh and dFh are zero). ``n_scan`` > 2 max(harmonics):
+        the points of u' scanned for its sign changes."""
+        h = np.ascontiguousarray(harmonics, dtype=np.int32)
+        U = _vec(U, "U")
+        nb = int(np.sum(np.where(h == 0, 1, 2)))
+        if U.size != nb:
+            raise IwanInputError(f"U must have {nb} coefficients for harmonics {tuple(h)}, got {U.size}")
+        Fh, dFh = np.empty(nb), np.empty((nb, nb))
+        w, ne = ct.c_double(), ct.c_size_t()
+        _check(_lib.iwan_periodic_fourier(self._mp, h.size, arr(h, _clib.Int32Array), arr(U),
+                                          int(n_scan), arr(Fh), arr(dFh), ct.byref(w),
+                                          ct.byref(ne)),
+               "IwanElement.periodic_fourier")
+        return Fh, dFh, w.value, ne.value
+
     def virgin(self, u, N: float | None = None) -> np.ndarray:
         """Virgin-curve force [N] at normal load N (default N_ref), odd extension, shape (n,)."""
         u = _vec(u, "u")

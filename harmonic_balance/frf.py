@@ -19,11 +19,12 @@ peak two neighbouring ripple maxima can compete: measured 4e-5 in amplitude and
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.signal import find_peaks
 
+from .aft import FrictionLink
 from .continuation import Branch, ContinuationError, continuation, refine_max
 from .fourier import FourierBasis, default_samples, parse_harmonics
 from .homotopy import HomotopyError
@@ -145,8 +146,11 @@ class FRFProblem:
         return float(np.linalg.norm(self.residual.linear_guess(omega0)))
 
     def alias_ratio(self, x) -> float:
-        """Largest aliasing indicator of the links' sampled forces (FourierBasis.alias_ratio)."""
-        return max(self.basis.alias_ratio(F) for _, F, _ in self.residual.link_samples(x))
+        """Largest aliasing indicator of the links' sampled forces (FourierBasis.alias_ratio);
+        exact links (no sampling, ``FrictionLink.exact``) have none: 0."""
+        samples = self.residual.link_samples(x)
+        return max([self.basis.alias_ratio(F) for el, (_, F, _) in zip(self.residual.elements, samples)
+                    if not getattr(el, "exact", False)], default=0.0)
 
     def energy(self, x, omega) -> dict:
         """Energy per cycle [J]: excitation, viscous, friction (sampled loops), and the
@@ -186,6 +190,7 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if not (np.isfinite(w0) and np.isfinite(w1)) or w0 <= 0 or w1 <= 0 or w0 == w1:
         raise ValueError(f"omega range must be two different positive numbers, got {omega_range}")
     t0 = time.perf_counter()
+    model = exact_links(model)
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
     tries = 1 if n_t else 1 + min(GRID_DOUBLINGS, max(0, int(np.log2(GRID_MAX / n_base))))
     spent = 0
@@ -230,6 +235,29 @@ STIFF_SAMPLES_RATIO = 1e4
 STIFF_SAMPLES_BASE = 512
 
 
+def exact_links(model: Model) -> Model:
+    """``model`` with its Iwan friction links made ``exact`` (:func:`aft.aft_link`: the
+    loop's Fourier coefficients without sampling) when they are more than
+    STIFF_SAMPLES_RATIO times stiffer than the structure, else ``model`` itself.
+
+    Why there: a sampled loop needs a grid growing like sqrt(k_t / k) (below) and its
+    kinks, where a stick episode shorter than a sample starts or ends between samples,
+    cost the corrector evaluations. Measured on the Jenkins FRF (H = 15, 0.5 -> 2
+    rad/s, no refinement): 1e6 k sampled on 8192 samples 474 points, 5.4 evaluations
+    per point, 1.8 s; exact (512-sample scan) 401 points, 3.6 per point, ~1 s;
+    1e5 k 2048 samples 5.9 per point, exact 3.8. Below the ratio the sampled loop is
+    as good and the results of earlier rounds stay as they were.
+    """
+    from fmu_src.element import IwanElement
+
+    ratio = _stiffness_ratio(model)
+    if ratio is None or ratio <= STIFF_SAMPLES_RATIO:
+        return model
+    links = [replace(link, exact=True) if isinstance(link, FrictionLink)
+             and isinstance(link.element, IwanElement) else link for link in model.links]
+    return replace(model, links=links)
+
+
 def stiff_samples(model: Model, harmonics) -> int:
     """Default AFT samples for ``model``: 0 (the basis default) unless its friction links
     are more than STIFF_SAMPLES_RATIO times stiffer than the structure.
@@ -251,6 +279,8 @@ def stiff_samples(model: Model, harmonics) -> int:
     ratio = _stiffness_ratio(model)
     if ratio is None or ratio <= STIFF_SAMPLES_RATIO:
         return 0
+    if all(link.exact for link in model.links if isinstance(link, FrictionLink)):
+        return 0   # exact links: the grid only scans u' for its extrema
     need = STIFF_SAMPLES_BASE * np.sqrt(ratio / STIFF_SAMPLES_RATIO)
     default = default_samples(max(parse_harmonics(harmonics)))
     return int(max(default, 2 ** int(np.ceil(np.log2(need) - 1e-9))))

@@ -146,7 +146,7 @@ def _with_iwan_links(model, remake):
     """The model with every Iwan friction link's element replaced by ``remake(element)``."""
     from fmu_src.element import IwanElement
 
-    links = [FrictionLink(remake(link.element), link.dof_a, link.dof_b, link.name)
+    links = [FrictionLink(remake(link.element), link.dof_a, link.dof_b, link.name, link.exact)
              if isinstance(link, FrictionLink) and isinstance(link.element, IwanElement) else link
              for link in model.links]
     return replace(model, links=links)

@@ -203,6 +203,17 @@ iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const doub
                                    double *u_hi, double *slope, double *icpt, double *A,
                                    double *W_cycle);
 
+/* Exact Fourier coefficients of the periodic loop at N = n_ref for the input
+ * u(t) = sum over harm[k] of a cos(h t) + b sin(h t) (a alone for h = 0), coefficients
+ * U in that order (nb of them): Fh[p] = (1/pi) int F cos / sin (1/(2 pi) for the mean)
+ * and dFh[p*nb + q] = dFh[p]/dU[q], with no sampling error: the extrema of u are found
+ * by a sign scan of u' on n_scan points (> 2 max h) and Newton, the loop between them
+ * is iwan_periodic_branches and its pieces are integrated in closed form. n_ext = the
+ * extrema found; 0 for a constant input (outputs zero: the caller's convention). */
+iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int32_t *harm,
+                                  const double *U, size_t n_scan, double *Fh, double *dFh,
+                                  double *W_cycle, size_t *n_ext);
+
 /* Human-readable text of a status code (static string). */
 const char *iwan_status_text(iwan_status status);
 

@@ -20,7 +20,8 @@ _TEXT = re.sub(r"/\*.*?\*/", " ", HEADER.read_text(), flags=re.S)    # comments 
 _SCALARS = {"double": ct.c_double, "size_t": ct.c_size_t, "int": ct.c_int, "iwan_fit": ct.c_int,
             "iwan_status": ct.c_int, "int32_t": ct.c_int32}
 _POINTERS = {"iwan_model": ct.POINTER(_clib.Model), "iwan_output": ct.POINTER(_clib.Output),
-             "int": ct.POINTER(ct.c_int), "size_t": ct.POINTER(ct.c_size_t)}
+             "int": ct.POINTER(ct.c_int), "size_t": ct.POINTER(ct.c_size_t),
+             "int32_t": ct.POINTER(ct.c_int32)}
 
 
 def prototypes() -> dict[str, tuple[str, list[str]]]:
@@ -48,7 +49,7 @@ def _expected(c_type: str, name: str, position: int):
 
 def test_every_header_function_is_declared_once_with_matching_types():
     protos = prototypes()
-    assert len(protos) == 12 and set(protos) == set(_clib.FUNCTIONS)
+    assert len(protos) == 13 and set(protos) == set(_clib.FUNCTIONS)
     for name, (ret, params) in protos.items():
         restype, argtypes = _clib.FUNCTIONS[name]
         assert restype is (ct.c_char_p if ret == "constchar*" else _SCALARS[ret]), name
