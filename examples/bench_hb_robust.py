@@ -41,7 +41,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from harmonic_balance.denhartog import den_hartog  # noqa: E402
-from harmonic_balance.frf import TOL_REL, FRFError, FRFProblem, compute_frf, stiff_samples  # noqa: E402
+from harmonic_balance.frf import TOL_REL, FRFError, FRFProblem, compute_frf, exact_links, stiff_samples  # noqa: E402
 from harmonic_balance.model import sdof_model  # noqa: E402
 from harmonic_balance.start import homotopy_start  # noqa: E402
 from harmonic_balance.timeint import steady_curve  # noqa: E402
@@ -173,7 +173,7 @@ def den_hartog_table(kts=(1e3, 1e5), omegas=(0.5, 0.75, 1.0, 1.5, 2.0), H=21):
           f"{'TI/DH-1':>9} {'TI_step':>8}")
     out = []
     for kt in kts:
-        m = sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0)
+        m = exact_links(sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0))   # as compute_frf
         prob = FRFProblem(m, H, stiff_samples(m, H))
         ti, _, err, _ = steady_curve(m, np.array(omegas), 512)
         for w, a_ti, e in zip(omegas, ti, err):
@@ -192,7 +192,7 @@ def hb_vs_den_hartog(kts=(1e5, 1e6), Hs=(21, 51), omegas=(0.5, 0.75, 1.0, 1.5, 2
     print(f"{'kt/k':>8} {'H':>3} {'n_t':>5} " + " ".join(f"{w:>9.2f}" for w in omegas))
     out = []
     for kt in kts:
-        m = sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0)
+        m = exact_links(sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0))   # as compute_frf
         for H in Hs:
             prob = FRFProblem(m, H, stiff_samples(m, H))
             errs = []

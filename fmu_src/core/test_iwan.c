@@ -325,6 +325,30 @@ static void test_step_batch_equals_step(void)
     CHECK(iwan_step_batch(&m, sb, NB, u, N, NULL, kt) == IWAN_ERR_BAD_PARAM, "null F");
 }
 
+/* iwan_periodic_fourier: the Jenkins describing function exactly (references.md),
+ * a constant input (no extrema) and refused arguments. */
+static void test_periodic_fourier(void)
+{
+    const double k = 2e6, fs = 3.0, a = 4e-6;
+    iwan_model m;
+    CHECK(iwan_model_from_sliders(&m, &k, &fs, 1, 0.0, 1.0) == IWAN_OK, "jenkins model");
+    const int32_t harm[3] = {1, 2, 3};
+    double U[6] = {a, 0, 0, 0, 0, 0}, Fh[6], J[36], W;
+    size_t ne;
+    CHECK(iwan_periodic_fourier(&m, 3, harm, U, 64, Fh, J, &W, &ne) == IWAN_OK && ne == 2, "fourier");
+    const double th = acos(1.0 - 2.0 * fs / (k * a));
+    const double a1 = k * a / PI * (th - sin(2.0 * th) / 2.0), b1 = -k * a / PI * sin(th) * sin(th);
+    CHECK(close_to(Fh[0], a1, 1e-13, 0.0) && close_to(Fh[1], b1, 1e-13, 0.0), "DF %g %g vs %g %g",
+          Fh[0], Fh[1], a1, b1);
+    CHECK(close_to(W, -PI * a * b1, 1e-13, 0.0), "fourier W %g", W);
+    const int32_t h01[2] = {0, 1};
+    double C[3] = {0.5, 0.0, 0.0};
+    CHECK(iwan_periodic_fourier(&m, 2, h01, C, 16, Fh, J, &W, &ne) == IWAN_OK && ne == 0, "constant");
+    const int32_t bad[2] = {2, 1};
+    CHECK(iwan_periodic_fourier(&m, 2, bad, U, 16, Fh, J, &W, &ne) == IWAN_ERR_BAD_PARAM, "order");
+    CHECK(iwan_periodic_fourier(&m, 3, harm, U, 6, Fh, J, &W, &ne) == IWAN_ERR_BAD_PARAM, "scan");
+}
+
 int main(void)
 {
     test_step_batch_equals_step();
@@ -333,6 +357,7 @@ int main(void)
     test_bad_inputs();
     test_sampling_independence_and_lift_off();
     test_periodic_jacobian();
+    test_periodic_fourier();
     test_fast_step_equals_straight_path();
     if (failures == 0) printf("test_iwan: all checks passed\n");
     return failures;
