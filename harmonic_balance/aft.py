@@ -1,4 +1,4 @@
-"""Alternating frequency-time (AFT) evaluation of the friction elements.
+"""Alternating frequency-time (AFT) evaluation of the friction elements (or exact).
 
 One friction link joins DOF ``a`` to DOF ``b`` (or to the ground); its relative
 displacement is ``u = x_a - x_b`` and its force ``F(u)`` enters the internal force
@@ -12,6 +12,15 @@ For harmonics ``U`` (n_b,) of ``u`` the AFT is (symbols in :mod:`fourier`)::
 The C core returns dF/dU exactly, including the dependence of each sticking slider
 on the sample where it last stuck (its reversal point), so the Jacobian is exact for
 the sampled loop (not a tangent-stiffness approximation).
+
+Exact links
+-----------
+A link with ``exact=True`` skips the sampling: the C core locates the extrema of u(theta)
+(a trigonometric polynomial), runs the loop between them as piecewise-linear branches
+and integrates F(theta) in closed form (``IwanElement.periodic_fourier``): no sampling
+error and no kinks where a stick episode starts or ends between samples. Used for links
+more than 1e4 times stiffer than the structure (``frf.exact_links``) and to retry a
+sampled curve that stalled (``frf.compute_frf``).
 
 Zeroth-harmonic convention for a fully stuck element
 ----------------------------------------------------
