@@ -98,6 +98,7 @@ class FRFResult:
             "points": self.points, "newton_iterations": self.newton_iterations,
             "residual_evaluations": self.evaluations, "time_s": self.time_s,
             "harmonics": list(self.harmonics), "n_t": self.n_t, "alias_ratio": self.alias_ratio,
+            "aft": self.extra.get("aft"),
             "status": self.status, "stable": self.stable,
         }
         return {k: _finite(v) for k, v in out.items()}
@@ -224,6 +225,11 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.extra["gaps"] = gaps
     result.extra["grid_doublings"] = k
     result.extra["exact_retry"] = exact_retry
+    # how the friction links were evaluated: "exact" (no AFT sampling, n_t only scans
+    # for the extrema), "sampled", or "mixed"
+    kinds = {link.exact for link in prob.model.links if isinstance(link, FrictionLink)}
+    result.extra["aft"] = {frozenset({True}): "exact", frozenset({False}): "sampled"}.get(
+        frozenset(kinds), "mixed" if kinds else None)
     if gaps:
         result.status = (f"complete; {len(gaps)} restart(s) by homotopy after a stalled corrector, "
                          "no points in omega " + ", ".join(f"{a:.6g}-{b:.6g}" for a, b in gaps))

@@ -16,7 +16,9 @@ or ``all:H``.
 JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of the
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
 ``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
-refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``points``,
+refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``aft``
+("sampled", or "exact": the links' Fourier coefficients without sampling, used above
+1e4 k and to retry a stalled curve; n_t then only scans for extrema), ``points``,
 ``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
 (per point, Hill's method; null for models above 200 full unknowns or modal-only
 ones; unstable stretches are dashed in frf.png). The first point does not depend
@@ -135,7 +137,7 @@ def _emit(args, summary, print_json, atomic_write, dumps):
         return
     print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
           f"{_num(summary['time_s'], '.3f')} s, harmonics {summary['harmonics']}, "
-          f"n_t {summary['n_t']}")
+          f"n_t {summary['n_t']}" + (f", {summary['aft']} AFT" if summary.get("aft") else ""))
     print(f"peak: omega = {_num(summary['peak_omega'])} rad/s, amplitude = "
           f"{_num(summary['peak_amplitude'])} m (first harmonic "
           f"{_num(summary['peak_amplitude_h1'])} m)")
