@@ -111,12 +111,18 @@ static void stuck_interval(size_t nb, const int32_t *ord, const int8_t *kind, co
         trig[k] = k ? sin((double)k * L) / (double)k : L;
         trig[K + k] = k ? 2.0 * h * h / (double)k : 0.0;
     }
+    /* cos, sin of (order x a) per coefficient, once (scratch after the 2K above) */
+    double *ca = trig + 2 * K, *sa = ca + nb;
+    for (size_t q = 0; q < nb; ++q) {
+        ca[q] = cos(ord[q] * a);
+        sa[q] = sin(ord[q] * a);
+    }
 #define C_(k) trig[(size_t)abs(k)]
 #define S_(k) ((k) < 0 ? -trig[K + (size_t)(-(k))] : trig[K + (size_t)(k)])
     const double Fa = c + s * u_a;
     for (size_t pp = 0; pp < nb; ++pp) {
         const int32_t op = ord[pp];
-        const double cp = cos(op * a), sp = sin(op * a), wp = op == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
+        const double cp = ca[pp], sp = sa[pp], wp = op == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
         const double ipsi = kind[pp] ? sp * C_(op) + cp * S_(op) : cp * C_(op) - sp * S_(op);
         double acc = Fa * ipsi;
         for (size_t q = 0; q < nb; ++q) {
@@ -125,7 +131,7 @@ static void stuck_interval(size_t nb, const int32_t *ord, const int8_t *kind, co
                 dFh[pp * nb + q] += wp * ipsi * (dc[q] + s);
                 continue;
             }
-            const double cq = cos(oq * a), sq = sin(oq * a);
+            const double cq = ca[q], sq = sa[q];
             const double A = 0.5 * (C_(op - oq) + C_(op + oq)) - C_(op);     /* cos p (cos q - 1) */
             const double B = 0.5 * (S_(oq + op) + S_(oq - op));              /* cos p sin q */
             const double Cc = 0.5 * (S_(op + oq) + S_(op - oq)) - S_(op);    /* sin p (cos q - 1) */
@@ -173,7 +179,7 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
     double *u_e = malloc(n_scan * sizeof *u_e);
     int32_t *ord = malloc(nb * sizeof *ord);
     int8_t *kind = malloc(nb);
-    double *trig = malloc(3 * K * sizeof *trig);
+    double *trig = malloc((3 * K + 2 * nb) * sizeof *trig);
     if (!tab || !th_e || !u_e || !ord || !kind || !trig) {
         free(tab); free(th_e); free(u_e); free(ord); free(kind); free(trig);
         return IWAN_ERR_BAD_PARAM;
