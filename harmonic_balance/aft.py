@@ -153,8 +153,13 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
     """
     u = basis.E @ U
     el = link.element
-    if link.exact and hasattr(el, "periodic_fourier"):
+    exact = link.exact and hasattr(el, "periodic_fourier")
+    if exact:
         Fh, dFh, W, n_ext = el.periodic_fourier(basis.harmonics, U, basis.n_t)
+        # n_ext odd, or none for a varying u: the scan lost an extremum (the C core says
+        # so instead of a wrong number); this evaluation falls back to the sampled loop
+        exact = n_ext % 2 == 0 and (n_ext >= 2 or np.ptp(u) == 0.0)
+    if exact:
         F = None
         if not jac or (basis.harmonics[0] == 0 and W <= 0.0) or n_ext < 2:
             F = el.periodic(u).F

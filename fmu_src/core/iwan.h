@@ -209,7 +209,9 @@ iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const doub
  * and dFh[p*nb + q] = dFh[p]/dU[q], with no sampling error: the extrema of u are found
  * by a sign scan of u' on n_scan points (> 2 max h) and Newton, the loop between them
  * is iwan_periodic_branches and its pieces are integrated in closed form. n_ext = the
- * extrema found; 0 for a constant input (outputs zero: the caller's convention). */
+ * extrema found; 0 for a constant input and an odd number when the scan lost one (a
+ * root on a scan point counted twice or an unresolved cell): then the outputs are zero
+ * and the caller decides (harmonic balance falls back to the sampled loop). */
 iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int32_t *harm,
                                   const double *U, size_t n_scan, double *Fh, double *dFh,
                                   double *W_cycle, size_t *n_ext);

@@ -279,7 +279,10 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
         memmove(th_e + 1, th_e, (ne - 1) * sizeof *th_e);
         th_e[0] = r;
     }
-    if (ne < 2 || ne % 2) goto done;   /* constant input (or a scan that lost a root) */
+    if (ne < 2 || ne % 2) {   /* constant input, or a scan that lost a root: no integrals */
+        *n_ext_out = ne;
+        goto done;
+    }
     for (size_t e = 0; e < ne; ++e) u_e[e] = eval_u(&p, U, th_e[e], 0);
 
     /* 2. the loop between the extrema */
