@@ -232,7 +232,14 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
             x_end = _interpolate(branch, y_new[:-1] * s_x, lam_new, lam_end)
-            res = _solve_fixed(fun, x_end, lam_end, tol, branch)
+            try:
+                res = _solve_fixed(fun, x_end, lam_end, tol, branch)
+            except ContinuationError:
+                # From the last accepted point instead: measured on the Jenkins start at
+                # 100 k, f_s = P, c = 1e-4, H = 51, 2 rad/s (grazing slip), the
+                # interpolated guess stalled at |R| = 3e-4 while Newton from the last
+                # point (lam = -0.005) converged in 24 iterations.
+                res = _solve_fixed(fun, branch.x[-1], lam_end, tol, branch)
             branch.append(res.x, lam_end, res.iterations)
             if on_point is not None:
                 on_point(lam_end)

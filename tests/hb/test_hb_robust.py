@@ -157,3 +157,19 @@ def test_grazing_slip_at_h51_completes_by_the_exact_retry():
                     stability=False)
     assert r.status.startswith("complete") and r.extra["gaps"] == [] and r.omega[-1] == 2.0
     assert r.extra["exact_retry"]
+
+
+@pytest.mark.slow
+def test_homotopy_lands_from_its_last_point_when_the_interpolated_guess_stalls():
+    """100 k, f_s = P, c = 1e-4, H = 51 at 2 rad/s (grazing slip: k_t u = 1.0025 f_s at the
+    turning points): the stiffness homotopy reached 10^-0.005 of the stiffness and the
+    landing on 1 from the interpolated guess stalled at |R| = 3e-4 (the H = 51 map's last
+    failure); from the last accepted point Newton converges (measured 24 iterations)."""
+    from harmonic_balance.frf import TOL_REL, FRFProblem
+    from harmonic_balance.start import homotopy_start
+
+    p = FRFProblem(sdof_model(1, 1, 1e-4, 100.0, 1.0, 1.0), 51)
+    x, info = homotopy_start(p, 2.0, TOL_REL * p.reference(2.0))
+    assert info["method"] == "stiffness homotopy"
+    assert np.linalg.norm(p(x, 2.0)[0]) <= TOL_REL * p.reference(2.0)
+    assert abs(p.amplitude(x, 2.0) - 0.01003) < 1e-5     # k_t u ~ f_s: grazing
