@@ -79,21 +79,26 @@ def test_jacobian_matches_central_differences():
 
 
 def test_a_minor_loop_appears_continuously():
-    """u = cos t + eps cos 3t grows wiggles at t = pi/2, 3 pi/2 (two more extrema each:
-    u' = -sin t (1 + 9 eps - 12 eps sin^2 t)) at eps = 1/3: the loop's
-    coefficients must not jump there, even though the new extrema are closer than a scan
-    step at birth (found from the sign change of u''). A jump would stall Newton (the
-    sampled-style scan alone left gaps on a 1e6 k FRF)."""
-    el, hs = IwanElement.jenkins(1e3, 0.1), (1, 3)
+    """u = cos s + eps cos 3s, s = t - phi, grows wiggles at s = pi/2, 3 pi/2 (two more
+    extrema each: du/ds = -sin s (1 + 9 eps - 12 eps sin^2 s)) at eps = 1/3. With
+    phi = 0.05 the birth sits mid-way between two of the 64 scan points, where u' keeps
+    one sign at both: the pair must be found from the sign change of u'' (measured: the
+    scan alone finds 2 extrema just after the birth and this test fails). The loop's
+    coefficients must not jump there (a jump would stall Newton: the scan alone left
+    gaps on a 1e6 k FRF)."""
+    el, hs, phi = IwanElement.jenkins(1e3, 0.1), (1, 3), 0.05
+
+    def U(eps):
+        return [np.cos(phi), np.sin(phi), eps * np.cos(3 * phi), eps * np.sin(3 * phi)]
+
     eps = 1.0 / 3.0 + np.linspace(-2e-3, 2e-3, 41)
-    F = np.array([el.periodic_fourier(hs, [1.0, 0.0, e, 0.0], 64)[0] for e in eps])
-    n = [el.periodic_fourier(hs, [1.0, 0.0, e, 0.0], 64)[3] for e in eps]
+    F = np.array([el.periodic_fourier(hs, U(e), 64)[0] for e in eps])
+    n = [el.periodic_fourier(hs, U(e), 64)[3] for e in eps]
     assert n[0] == 2 and n[-1] == 6
-    # Continuous through the birth: across eps* = 1/3 +- 1e-8 the coefficients move by
-    # their slope times 2e-8 (a wiggle missed by the scan until it spans a cell would
-    # jump by ~f_s dt / pi = 3e-3 here)
-    Fm = el.periodic_fourier(hs, [1.0, 0.0, 1.0 / 3.0 - 1e-8, 0.0], 64)
-    Fp = el.periodic_fourier(hs, [1.0, 0.0, 1.0 / 3.0 + 1e-8, 0.0], 64)
+    # across eps* +- 1e-8 the coefficients move by their slope times 2e-8 (a wiggle
+    # missed by the scan until it spans a cell would jump by ~f_s dt / pi = 3e-3)
+    Fm = el.periodic_fourier(hs, U(1.0 / 3.0 - 1e-8), 64)
+    Fp = el.periodic_fourier(hs, U(1.0 / 3.0 + 1e-8), 64)
     assert Fm[3] == 2 and Fp[3] == 6
     slope = np.abs(np.diff(F, axis=0)).max() / 1e-4
     assert np.abs(Fp[0] - Fm[0]).max() < 10 * slope * 2e-8
