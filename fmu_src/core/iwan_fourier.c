@@ -7,13 +7,11 @@
  * loop between them is iwan_periodic_branches (the play operator itself): on interval
  * i, F = c_i + s_i u. Each interval end (a slider reaching its limit) is located in
  * theta (u is monotone between extrema) and the Fourier integrals of c_i + s_i u(theta)
- * are taken in closed form with the half-width formulas
- *     int_{m-w}^{m+w} cos(k t) dt = 2 cos(k m) sin(k w) / k,
- *     int_{m-w}^{m+w} sin(k t) dt = 2 sin(k m) sin(k w) / k,
- * (antiderivative differences lose eps |theta| absolutely, which a stiff slider turns
- * into residual noise). The Jacobian: F is continuous at every interval end and u' = 0
- * at the extrema, so no boundary terms: dF_p/dU_q = w_p sum_i (s_i D2_i[p][q] +
- * D1_i[p] dc_i/dU_q), dc_i/dU = -sum_e A[i][e] phi(theta_e).
+ * are taken in closed form in the interval's local variable t - a (interval_integrals:
+ * absolute theta in the arguments loses eps |theta| h of phase, which a stiff slider
+ * turns into residual noise). The Jacobian: F is continuous at every interval end and
+ * u' = 0 at the extrema, so no boundary terms: dF_p/dU_q = w_p sum_i int psi_p (s_i
+ * phi_q + dc_i/dU_q), dc_i/dU = -sum_e A[i][e] phi(theta_e).
  */
 #include "iwan_internal.h"
 
@@ -27,7 +25,7 @@
 #define TWO_PI 6.283185307179586476925286766559
 
 typedef struct {
-    size_t n_h, nb;
+    size_t n_h;
     const int32_t *harm;
     int32_t hmax;
     double *c, *s;     /* cos(h t), sin(h t) for h = 0 .. hmax (scratch) */
@@ -87,26 +85,21 @@ static double root(tpoly *p, const double *U, int d, double target, double lo, d
     return x;
 }
 
-/* int over [m-w, m+w] of cos(k t) (kind 0) or sin(k t) (kind 1), k any sign. */
-static double jtrig(int kind, int32_t k, double cm, double sm, double sw)
-{
-    /* cm = cos(|k| m), sm = sin(|k| m), sw = sin(|k| w) / |k| (or w for k = 0) */
-    if (k == 0) return kind == 0 ? 2.0 * sw : 0.0;
-    if (kind == 0) return 2.0 * cm * sw;
-    return (k > 0 ? 2.0 : -2.0) * sm * sw;
-}
-
-/* A stuck interval [a, a + L] (some slider stuck, slope s): F = F_a + s (u - u_a) with
- * F_a = c + s u_a, integrated in the local variable tau = t - a, so that every integral
+/* One interval [a, a + L] of the loop, F = c + s u: written F = F_a + s (u - u_a) with
+ * F_a = c + s u_a and integrated in the local variable tau = t - a, so that every integral
  * is over small arguments: int psi_p (phi_q(t) - phi_q(a)) is O(L^2) and computed
  * without the cancellation of c int psi + s int u psi (two terms of size s |u| L whose
  * phase rounding eps h t, times k_t, was ~1e-10 of residual noise at 1e6 k). With
- * C(k) = int_0^L cos k tau, S(k) = int_0^L sin k tau (trig scratch of 2K, K = 2 hmax + 1). */
-static void stuck_interval(size_t nb, const int32_t *ord, const int8_t *kind, const double *U,
+ * C(k) = int_0^L cos k tau, S(k) = int_0^L sin k tau (trig scratch of 2K + 2 nb,
+ * K = 2 hmax + 1). On a slipping interval (s = 0, every slider at its limit) F = c does
+ * not depend on U: no dc (its sliders' anchors), no q loop. */
+static void interval_integrals(size_t nb, const int32_t *ord, const int8_t *kind, const double *U,
                            double a, double L, double c, double s, const double *dc, double u_a,
                            double *trig, size_t K, double *Fh, double *dFh)
 {
-    for (size_t k = 0; k < K; ++k) {
+    /* a slipping interval needs orders up to hmax only (no products of two harmonics) */
+    const size_t kn = s == 0.0 ? (K + 1) / 2 : K;
+    for (size_t k = 0; k < kn; ++k) {
         const double h = sin(0.5 * (double)k * L);
         trig[k] = k ? sin((double)k * L) / (double)k : L;
         trig[K + k] = k ? 2.0 * h * h / (double)k : 0.0;
@@ -125,6 +118,10 @@ static void stuck_interval(size_t nb, const int32_t *ord, const int8_t *kind, co
         const double cp = ca[pp], sp = sa[pp], wp = op == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
         const double ipsi = kind[pp] ? sp * C_(op) + cp * S_(op) : cp * C_(op) - sp * S_(op);
         double acc = Fa * ipsi;
+        if (s == 0.0) {
+            Fh[pp] += wp * acc;
+            continue;
+        }
         for (size_t q = 0; q < nb; ++q) {
             const int32_t oq = ord[q];
             if (oq == 0) {   /* the mean does not vary over the interval */
@@ -179,12 +176,12 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
     double *u_e = malloc(n_scan * sizeof *u_e);
     int32_t *ord = malloc(nb * sizeof *ord);
     int8_t *kind = malloc(nb);
-    double *trig = malloc((3 * K + 2 * nb) * sizeof *trig);
+    double *trig = malloc((2 * K + 2 * nb) * sizeof *trig);
     if (!tab || !th_e || !u_e || !ord || !kind || !trig) {
         free(tab); free(th_e); free(u_e); free(ord); free(kind); free(trig);
         return IWAN_ERR_BAD_PARAM;
     }
-    tpoly p = {n_h, nb, harm, hmax, tab, tab + hmax + 1};
+    tpoly p = {n_h, harm, hmax, tab, tab + hmax + 1};
     for (size_t k = 0, q = 0; k < n_h; ++k) {
         ord[q] = harm[k];
         kind[q++] = 0;
@@ -292,9 +289,8 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
     double *sl = malloc(cap * sizeof *sl), *ic = malloc(cap * sizeof *ic);
     double *A = malloc(cap * ne * sizeof *A), *tl = malloc(cap * sizeof *tl);
     double *phie = malloc(ne * nb * sizeof *phie), *dc = malloc(nb * sizeof *dc);
-    double *d1 = malloc(nb * sizeof *d1);
     double W = 0.0;
-    if (!seg || !lo || !hi || !sl || !ic || !A || !tl || !phie || !dc || !d1) {
+    if (!seg || !lo || !hi || !sl || !ic || !A || !tl || !phie || !dc) {
         st = IWAN_ERR_BAD_PARAM;
         goto free_loop;
     }
@@ -321,45 +317,22 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
         const double a = tl[i];
         const double b = (i + 1 < m && seg[i + 1] == seg[i]) ? tl[i + 1]
                          : (e1 ? th_e[e1] : th_e[0] + TWO_PI);
-        const double mid = 0.5 * (a + b), w = 0.5 * (b - a);
-        if (!(w > 0.0)) continue;
-        for (size_t k = 0; k < K; ++k) {
-            trig[k] = cos((double)k * mid);
-            trig[K + k] = sin((double)k * mid);
-            trig[2 * K + k] = k ? sin((double)k * w) / (double)k : w;
-        }
-#define CM(k) trig[(size_t)abs(k)]
-#define SM(k) trig[K + (size_t)abs(k)]
-#define SW(k) trig[2 * K + (size_t)abs(k)]
-#define J(kd, k) jtrig(kd, k, CM(k), SM(k), SW(k))
-        int anchored = 0;
-        for (size_t q = 0; q < nb; ++q) {
+        if (!(b > a)) continue;
+        /* d c / dU: the stuck sliders' positions follow their anchors (a slipping
+         * interval has none: every slider has k_j > 0, so s = 0 means none is stuck) */
+        for (size_t q = 0; q < nb && sl[i] != 0.0; ++q) {
             double v = 0.0;
             for (size_t e = 0; e < ne; ++e) v -= A[i * ne + e] * phie[e * nb + q];
             dc[q] = v;
-            anchored |= v != 0.0;
         }
-        for (size_t pp = 0; pp < nb && sl[i] == 0.0; ++pp) {
-            /* every slider slipping: F = c, no dependence on U here (but through anchors) */
-            const double wp = ord[pp] == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
-            d1[pp] = J(kind[pp], ord[pp]);
-            if (anchored)
-                for (size_t q = 0; q < nb; ++q) dFh[pp * nb + q] += wp * d1[pp] * dc[q];
-            Fh[pp] += wp * ic[i] * d1[pp];
-        }
-        if (sl[i] != 0.0)
-            stuck_interval(nb, ord, kind, U, a, 2.0 * w, ic[i], sl[i], dc, eval_u(&p, U, a, 0),
-                           trig, K, Fh, dFh);
-#undef J
-#undef SW
-#undef SM
-#undef CM
+        const double u_a = sl[i] != 0.0 ? eval_u(&p, U, a, 0) : 0.0;
+        interval_integrals(nb, ord, kind, U, a, b - a, ic[i], sl[i], dc, u_a, trig, K, Fh, dFh);
     }
     *n_ext_out = ne;
     if (W_cycle) *W_cycle = W;
     if (iwanp_check_finite(Fh, nb) || iwanp_check_finite(dFh, nb * nb)) st = IWAN_ERR_NONFINITE;
 free_loop:
-    free(seg); free(lo); free(hi); free(sl); free(ic); free(A); free(tl); free(phie); free(dc); free(d1);
+    free(seg); free(lo); free(hi); free(sl); free(ic); free(A); free(tl); free(phie); free(dc);
 done:
     free(tab); free(th_e); free(u_e); free(ord); free(kind); free(trig);
     return st;
