@@ -153,6 +153,7 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
     """
     u = basis.E @ U
     el = link.element
+    stuck_test = basis.harmonics[0] == 0
     exact = link.exact and hasattr(el, "periodic_fourier")
     if exact:
         Fh, dFh, W, n_ext = el.periodic_fourier(basis.harmonics, U, basis.n_t)
@@ -160,15 +161,12 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
         # so instead of a wrong number); this evaluation falls back to the sampled loop
         exact = n_ext % 2 == 0 and (n_ext >= 2 or np.ptp(u) == 0.0)
     if exact:
-        F = None
-        if not jac or (basis.harmonics[0] == 0 and W <= 0.0) or n_ext < 2:
-            F = el.periodic(u).F
-        if n_ext < 2 or (basis.harmonics[0] == 0 and W <= 0.0 and _stuck(F, u, link.k0)):
-            # constant input, or fully stuck: the stuck line (module docstring)
-            F = link.k0 * u
-            return link.k0 * U, link.k0 * np.eye(basis.nb) if jac else None, float(W), F
-        return Fh, dFh if jac else None, float(W), F
-    if not jac and hasattr(el, "periodic"):
+        if n_ext == 0:   # u constant: the stuck line (the C core returns zeros there)
+            return link.k0 * U, link.k0 * np.eye(basis.nb) if jac else None, 0.0, link.k0 * u
+        dFh = dFh if jac else None
+        # samples only when asked for (no jac) or needed by the stuck test below
+        F = el.periodic(u).F if not jac or (stuck_test and W <= 0.0) else None
+    elif not jac and hasattr(el, "periodic"):
         loop = el.periodic(u)
         F, dFh, W = loop.F, None, loop.W_cycle
     elif not hasattr(el, "periodic_jac_rows"):   # e.g. the cubic spring: dense dF
@@ -180,11 +178,11 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
         # few per cent of them), so D dF costs O(stuck samples x n_b), not O(n_t x n_b).
         F, rows, dFr, _, W = el.periodic_jac_rows(u, basis.E)
         dFh = basis.D[:, rows] @ dFr
-    if basis.harmonics[0] == 0 and W <= 0.0 and _stuck(F, u, link.k0):
+    if stuck_test and W <= 0.0 and _stuck(F, u, link.k0):
         # Fully stuck: apply the virgin-state convention of the module docstring.
         F = link.k0 * u
-        dFh = link.k0 * (basis.D @ basis.E) if jac else None
-    return basis.D @ F, dFh, float(W), F
+        return basis.D @ F, link.k0 * (basis.D @ basis.E) if jac else None, float(W), F
+    return (Fh if exact else basis.D @ F), dFh, float(W), F
 
 
 def _project_rows(D, dF):
