@@ -116,3 +116,27 @@ def test_constant_input_and_bad_arguments():
         el.periodic_fourier((1, 9), [1.0, 0.0, 0.0, 0.0], 16)      # the scan cannot see h = 9
     with pytest.raises(IwanInputError, match="coefficients"):
         el.periodic_fourier((1, 2), [1.0, 0.0], 16)
+
+
+def test_branches_between_extrema_are_the_loop_on_any_path_through_them():
+    """iwan_periodic_branches against the sampled loop (iwan_periodic) on a dense straight
+    path through the same extrema, a minor loop (-0.4 -> 0.6) included: the play operator
+    is exact on straight paths, so F agrees to round-off, and so does W."""
+    el = IwanElement.from_sliders([1.0, 2.0, 0.5], [0.2, 0.3, 0.1], k_res=0.3)
+    ue = np.array([1.0, -0.4, 0.6, -1.0])
+    b = el.periodic_branches(ue)
+    n = 400
+    path = np.concatenate([np.linspace(ue[k], ue[(k + 1) % 4], n + 1)[:-1] for k in range(4)])
+    loop = el.periodic(path)
+    F = np.empty_like(path)
+    for k in range(4):
+        for j, u in enumerate(path[k * n:(k + 1) * n]):
+            i = [i for i in np.flatnonzero(b["seg"] == k)
+                 if min(b["u_lo"][i], b["u_hi"][i]) - 1e-12 <= u <= max(b["u_lo"][i], b["u_hi"][i]) + 1e-12][0]
+            F[k * n + j] = b["icpt"][i] + b["slope"][i] * u
+    np.testing.assert_allclose(F, loop.F, rtol=0, atol=1e-12)
+    assert b["W"] == pytest.approx(loop.W_cycle, rel=1e-12)
+    # the intervals cover each segment in travel order, and their slopes are the stuck ones
+    assert set(b["slope"]) <= {0.3 + s for s in (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5)}
+    with pytest.raises(IwanInputError, match="two extrema"):
+        el.periodic_branches([1.0])
