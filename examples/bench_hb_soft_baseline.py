@@ -21,17 +21,36 @@ import os
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+import argparse  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
+
+import numpy as np  # noqa: E402
 
 import harmonic_balance  # noqa: E402
 from harmonic_balance.frf import compute_frf  # noqa: E402
 from harmonic_balance.model import sdof_model  # noqa: E402
 
 
+def _ratios(text: str) -> list[float]:
+    """Comma-separated contact stiffness ratios, each a positive finite number."""
+    try:
+        kts = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated numbers, e.g. 1,10,1e6; "
+                                         f"got {text!r}") from None
+    bad = [k for k in kts if not (np.isfinite(k) and k > 0.0)]
+    if bad:
+        raise argparse.ArgumentTypeError(f"stiffness ratios must be positive and finite, got {bad}")
+    return kts
+
+
 def main(argv=None):
-    argv = sys.argv[1:] if argv is None else argv
-    kts = [float(v) for v in (argv[0] if argv else "1,10").split(",")]
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("ratios", nargs="?", type=_ratios, default=[1.0, 10.0],
+                    help="contact stiffness over structure stiffness, comma-separated "
+                         "(default 1,10)")
+    kts = ap.parse_args(sys.argv[1:] if argv is None else argv).ratios
     extra = {"stability": False} if "stability" in compute_frf.__code__.co_varnames else {}
     print(f"harmonic_balance from {os.path.dirname(harmonic_balance.__file__)}")
     print(f"{'kt/k':>8} {'n_t':>5} {'points':>6} {'eval/pt':>7} {'best s':>7} {'ms/pt':>6}")
