@@ -1,0 +1,230 @@
+"""Nonlinear harmonic balance of the full mistuned ring of N_b sectors, sparse.
+
+No cyclic symmetry: every blade and every damper has its own unknowns. The ring is a
+standard :class:`~harmonic_balance.model.Model` (blades of :mod:`.mistuning` (M1),
+dampers j between blade j and blade j + 1 mod N_b with the sector's
+:class:`~harmonic_balance.contact.ContactElement` points, :func:`.hb.contact_elements`;
+CF on every damper's y_d mean, F_j = F0 exp(i j phi) on blade j's forced DOF), with the
+residual of :class:`~harmonic_balance.residual.FullResidual`::
+
+    R = A(omega) x + T F(Q x) - F_ext,
+    A(omega) = I (x) K - omega^2 diag(h^2) (x) M + omega D_theta (x) C          (R1)
+
+Unknowns x: the ring's harmonics, coefficient-major (coefficient c of ring DOF i at
+``c n_ring + i``, as ``FullResidual``, which evaluates the same residual densely and is
+the reference of the tests). Here A is sparse and each contact point's Jacobian block
+``T_e dF_e/dU_e Q_e`` is dense on its own few DOFs' harmonics (n_b d_e, d_e = 5 for
+UPD-24), so the Jacobian has O(N_b) non-zeros: blade blocks coupled to their
+neighbours only. Its sparsity pattern is fixed: the assembly is one ``bincount`` of
+the element blocks and A's entries into that pattern (no COO -> CSC conversion per
+evaluation), and the Newton steps use a sparse LU (:mod:`.ring_solve`).
+
+The sliders start at the ring's own frictionless prestress state (as :mod:`.hb`).
+Time samples: n_t a multiple of N_r = N_b / gcd(N_b, EO) (:func:`.hb.sector_basis`), so
+each blade's tuned travelling-wave history is blade 0's shifted by a whole number of
+samples and the tuned ring reproduces the cyclic sector to round-off.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..contact import frictionless_statics
+from ..linear import LinearModel
+from ..model import Model
+from ..residual import FullResidual
+from .hb import contact_elements, neighbour_map, sector_basis
+from .mistuning import LinearRing, blade_stiffness, check_factors, ring_forcing, ring_structure
+from .sector import Sector
+
+
+class MistunedRingHB:
+    """HB residual (R1) of the mistuned ring with its sparse exact Jacobian.
+
+    Parameters
+    ----------
+    sector : Sector
+    kappa : (N_b,) stiffness factors (:mod:`.mistuning`; ones: the tuned ring)
+    H : int            highest harmonic (0..H retained)
+    cf, f0 : float     centrifugal load and EO force amplitude [N] (default: config)
+    mu : float         friction coefficient (default: config)
+    n_t : int          AFT samples (rounded up to a multiple of N_r)
+
+    Attributes
+    ----------
+    blades, ndof : int        N_b and the ring's DOFs n_dof N_b
+    nb, size : int            coefficients per DOF and unknowns n_b ndof
+    model : Model             the ring as a dense Model (statics, time integration, tests)
+    x_static : (ndof,) array  frictionless prestress state [m]
+    """
+
+    def __init__(self, sector: Sector, kappa, H: int = 7, cf=None, f0=None, mu=None,
+                 n_t: int = 0):
+        cfg = sector.cfg
+        self.sector, self.H = sector, int(H)
+        self.cf = cfg.cf if cf is None else float(cf)
+        self.f0 = cfg.f0 if f0 is None else float(f0)
+        self.mu = cfg.mu if mu is None else float(mu)
+        if not (np.isfinite(self.cf) and self.cf > 0 and np.isfinite(self.f0) and self.f0 > 0):
+            raise ValueError(f"CF and F0 must be finite and > 0, got CF={self.cf}, F0={self.f0}")
+        if not (np.isfinite(self.mu) and self.mu >= 0):
+            raise ValueError(f"mu must be finite and >= 0, got {self.mu}")
+        self.kappa = check_factors(kappa, cfg.blades)
+        self.blades = nbl = cfg.blades
+        self.basis = sector_basis(sector, self.H, n_t)
+        n = sector.n_dof
+        self.ndof, self.nb = n * nbl, self.basis.nb
+        self.size = self.nb * self.ndof
+        M, K, C = ring_structure(sector, self.kappa)
+        els = []
+        for j in range(nbl):
+            els += contact_elements(sector, self.mu, n * j, n * ((j + 1) % nbl))
+        f_static = np.zeros(self.ndof)
+        f_static[sector.y_d::n] = self.cf
+        self.model = Model(LinearModel(M=M.toarray(), C=C.toarray(), K=K.toarray()), els,
+                           {0: f_static, 1: ring_forcing(sector, nbl, n, self.f0)},
+                           sector.response)
+        self.x_static, _ = frictionless_statics(self.model, apply=True)
+        self.points = els
+        self._linear_operators(M, ring_structure(sector, np.ones(nbl))[1], C,
+                               blade_stiffness(sector, nbl))
+        self.set_scale(1.0)
+        self._element_operators()
+        self._pattern()
+        self.Fext = self.model.forcing_coeffs(self.basis).ravel()
+        self.evaluations = 0
+
+    # ------------------------------------------------------------ assembly
+    def _linear_operators(self, M, K_tuned, C, K0) -> None:
+        b = self.basis
+        h2 = sp.diags(b.order.astype(float) ** 2)
+        I = sp.eye(b.nb)
+        self._K = sp.kron(I, K_tuned, format="csr")
+        self._K0 = sp.kron(I, K0, format="csr")  # scaled row-wise by kappa - 1 (M1)
+        self._M = sp.kron(h2, M, format="csr")
+        self._C = sp.kron(sp.csr_matrix(b.dtheta), C, format="csr")
+
+    def set_scale(self, lam: float) -> None:
+        """Residual of the pattern scaled to kappa(lam) = 1 + lam (kappa - 1) (lam = 1: the
+        pattern; 0: tuned blades): a homotopy from the tuned ring. The prestress state,
+        the sliders' reference and :attr:`model` stay those of lam = 1."""
+        self.lam = float(lam)
+        c = np.repeat(self.lam * (self.kappa - 1.0), self.sector.n_dof)
+        self._c = np.tile(c, self.nb)
+
+    def _element_operators(self) -> None:
+        """Per element: global indices (n_b d,) of its DOFs' harmonics and Q_b = I (x) Q,
+        stacked by shape (one batched product per group)."""
+        nb, groups = self.nb, {}
+        for e, el in enumerate(self.points):
+            kin = el.kinematics
+            d = np.asarray(kin.dofs)
+            gidx = (np.arange(nb)[:, None] * self.ndof + d[None, :]).ravel()
+            groups.setdefault((el.m, d.size), []).append((e, gidx, np.kron(np.eye(nb), kin.Q)))
+        self._groups = [([e for e, _, _ in g], np.array([i for _, i, _ in g]),
+                         np.array([q for _, _, q in g])) for g in groups.values()]
+
+    def _pattern(self) -> None:
+        """Fixed CSC pattern of the Jacobian and each contribution's place in it."""
+        rows, cols = [], []
+        coo = [A.tocoo() for A in (self._K, self._K0, self._M, self._C)]
+        for c in coo:
+            rows.append(c.row)
+            cols.append(c.col)
+        self._lin_data = [c.data for c in coo]
+        self._K0_rows = coo[1].row
+        for _, G, _ in self._groups:
+            k = G.shape[1]
+            rows.append(np.repeat(G, k, axis=1).ravel())
+            cols.append(np.tile(G, (1, k)).ravel())
+        key = np.concatenate(cols).astype(np.int64) * self.size + np.concatenate(rows)
+        uniq, self._inv = np.unique(key, return_inverse=True)
+        self._nnz = uniq.size
+        self._indices = (uniq % self.size).astype(np.int32)
+        self._indptr = np.searchsorted(uniq // self.size, np.arange(self.size + 1)).astype(np.int32)
+
+    # ------------------------------------------------------------ residual
+    def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
+        """R (size,), and with ``jac`` dR/dx (size, size) sparse CSC and dR/domega (size,)."""
+        self.evaluations += 1
+        x = np.asarray(x, dtype=float)
+        w = float(omega)
+        Mx, Cx = self._M @ x, self._C @ x
+        R = self._K @ x + self._c * (self._K0 @ x) - w * w * Mx + w * Cx - self.Fext
+        Rw = -2.0 * w * Mx + Cx
+        blocks = []
+        for idx, G, Qb in self._groups:
+            U = np.einsum("eij,ej->ei", Qb, x[G])  # (n_e, n_b m)
+            m = self.points[idx[0]].m
+            res = [self.points[e].evaluate(u.reshape(self.nb, m), self.basis, w, jac)
+                   for e, u in zip(idx, U)]
+            F = np.einsum("eij,ei->ej", Qb, np.array([r.F.ravel() for r in res]))
+            np.add.at(R, G, F)
+            dws = [r.dF_domega for r in res]
+            if jac and any(d is not None for d in dws):
+                dw = np.array([np.zeros(Qb.shape[1]) if d is None else d for d in dws])
+                np.add.at(Rw, G, np.einsum("eij,ei->ej", Qb, dw))
+            if jac:
+                dF = np.array([r.dF for r in res])
+                blocks.append(np.einsum("eki,ekl,elj->eij", Qb, dF, Qb, optimize=True).ravel())
+        if not jac:
+            return R
+        K, K0, M, C = self._lin_data
+        wts = np.concatenate([K, self._c[self._K0_rows] * K0, -w * w * M, w * C] + blocks)
+        data = np.bincount(self._inv, weights=wts, minlength=self._nnz)
+        J = sp.csc_matrix((data, self._indices, self._indptr), shape=(self.size, self.size))
+        return R, J, Rw
+
+    def dense_residual(self) -> FullResidual:
+        """The same residual, dense (:class:`FullResidual` on :attr:`model`): the reference."""
+        return FullResidual(self.model, self.basis)
+
+    # ------------------------------------------------------------ starts
+    def static_guess(self) -> np.ndarray:
+        """The prestress state in the mean, no vibration."""
+        x = np.zeros((self.nb, self.ndof))
+        x[self.basis.index(0)[0]] = self.x_static
+        return x.ravel()
+
+    def stuck_guess(self, omega: float) -> np.ndarray:
+        """Prestress mean + the linear stuck ring's response at harmonic 1."""
+        x = self.static_guess().reshape(self.nb, self.ndof)
+        lin = LinearRing(self.sector, self.kappa, "stuck", self.f0)
+        from scipy.sparse.linalg import splu
+
+        Z = (lin.K - omega * omega * lin.M + 1j * omega * lin.C).tocsc()
+        U = splu(Z).solve(lin.F)
+        ic, isn = self.basis.index(1)
+        x[ic], x[isn] = U.real, -U.imag
+        return x.ravel()
+
+    def from_sector(self, x_sector: np.ndarray) -> np.ndarray:
+        """Ring unknowns of a cyclic sector solution: blade j = blade 0 advanced by j phi."""
+        X = np.asarray(x_sector).reshape(self.nb, self.sector.n_dof)
+        phi = self.sector.cfg.phi
+        return np.hstack([neighbour_map(self.basis, j * phi) @ X
+                          for j in range(self.blades)]).ravel()
+
+    # ------------------------------------------------------------ outputs
+    def blade(self, x: np.ndarray, j: int) -> np.ndarray:
+        """Harmonics (n_b, n_dof) of blade j."""
+        n = self.sector.n_dof
+        return x.reshape(self.nb, self.ndof)[:, n * j:n * (j + 1)]
+
+    def amplitudes(self, x: np.ndarray) -> np.ndarray:
+        """First-harmonic magnitude (N_b,) of every blade's response DOF [m]."""
+        X = x.reshape(self.nb, self.ndof)[:, self.sector.response::self.sector.n_dof]
+        return self.basis.magnitude(X, 1)
+
+    def friction_energy(self, x: np.ndarray, omega: float) -> np.ndarray:
+        """Friction energy per cycle [J] of every damper (N_b,) (its contact points' sampled
+        loops, dashpots excluded)."""
+        X = x.reshape(self.nb, self.ndof)
+        W = np.zeros(len(self.points))
+        for e, el in enumerate(self.points):
+            U = X[:, list(el.kinematics.dofs)] @ el.kinematics.Q.T
+            r = el.evaluate(U, self.basis, omega, jac=False)
+            W[e] = r.W - r.W_viscous
+        per = len(self.points) // self.blades
+        return W.reshape(self.blades, per).sum(axis=1)
+

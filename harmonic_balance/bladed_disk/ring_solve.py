@@ -1,0 +1,381 @@
+"""Forced response of the mistuned ring: sparse Newton, frequency sweep, per-blade peaks.
+
+Newton's method on (R1) of :mod:`.ring_hb` with a sparse LU (SuperLU, COLAMD column
+order) of the block-banded Jacobian, an Armijo line search and a Levenberg-Marquardt
+fallback (as :mod:`..newton`, whose dense algebra would cost O(N_b^3)).
+
+Starts: the tuned cyclic sector's solution at the same frequency mapped onto the ring
+(blade j = blade 0 advanced by j phi, the mean moved to the ring's own prestress
+state); where Newton fails from it, a homotopy in the scatter (the pattern scaled
+from 0 to 1, :meth:`.ring_hb.MistunedRingHB.set_scale`).
+
+Sweep: from the grid point nearest the tuned peak (the dampers slip there and the
+start converges) along both flanks with a secant predictor, a failed step bisected
+(as the sector's :func:`.solve.sweep`), then restarted from the tuned solution. At
+low amplitude on a flank the contacts are stuck with their sliders grazing the slip
+limit at single samples (the loop placement of the C core, :mod:`..contact`): the
+residual is then only piecewise smooth in many contacts at once and Newton can stall;
+such a flank ends there (reported), the curve keeps the solved part.
+
+Peaks: every blade's first-harmonic amplitude of its response DOF on the grid; each
+blade's peak from the parabola through its largest grid value and the two neighbours;
+the largest over blades and frequency refined by Brent's bounded search (each
+evaluation a Newton solve), which gives the worst blade and the amplification factor.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.optimize import minimize_scalar
+from scipy.sparse.linalg import splu
+
+from ..newton import ARMIJO, LM_ACCEPT, LM_MU_MAX, LM_TRIALS, MIN_ALPHA, STEP_RTOL, NewtonError
+from .hb import SectorHB
+from .ring_hb import MistunedRingHB
+from .solve import PEAK_XTOL, TOL_REL, SolverError, StartError, start_point
+
+
+@dataclass
+class RingCurve:
+    """Response curve of the ring (SI units; omega in rad/s).
+
+    Attributes
+    ----------
+    omega : (n_f,) array          frequencies of the points
+    amplitude : (n_f, N_b) array  first-harmonic |u| of every blade's response DOF [m]
+    peak_per_blade : (N_b,) array peak amplitude of each blade [m]
+    peak_omega_per_blade : (N_b,) array
+    worst : int                   blade with the largest peak
+    peak, peak_omega : float      its refined peak [m] and frequency
+    peak_x : (size,) array        solution at that peak
+    """
+
+    omega: np.ndarray
+    amplitude: np.ndarray
+    x: list
+    peak_per_blade: np.ndarray = None
+    peak_omega_per_blade: np.ndarray = None
+    worst: int = 0
+    peak: float = float("nan")
+    peak_omega: float = float("nan")
+    peak_x: np.ndarray | None = None
+    evaluations: int = 0
+    newton_iterations: int = 0
+    time_s: float = 0.0
+    extra: dict = field(default_factory=dict)
+
+
+def tolerance(ring: MistunedRingHB) -> float:
+    """|R| tolerance: the sector's (TOL_REL max(F0, CF)) per blade, in the 2-norm."""
+    return TOL_REL * max(ring.f0, ring.cf) * np.sqrt(ring.blades)
+
+
+def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40):
+    """Newton with a sparse LU, an Armijo line search and a Levenberg-Marquardt fallback;
+    (x, iterations).
+
+    ``fun(x) -> (R, J)`` with J scipy-sparse. As :func:`..newton.newton` with sparse
+    algebra: where the line search stalls (a kink of the piecewise-smooth friction
+    residual) Levenberg-Marquardt steps ``(J^T J + mu D) p = -J^T R`` (D the running
+    maximum of J's squared column norms) decrease |R| until Newton takes over again.
+    Stops at |R| <= tol or when the step is below STEP_RTOL |x| (round-off floor).
+
+    Raises
+    ------
+    NewtonError : singular Jacobian, no decrease by either step, iterations.
+    """
+    x = np.array(x0, dtype=float)
+    R, J = fun(x)
+    nr = _norm(R, x)
+    lm = _LM()
+    for it in range(max_iter + 1):
+        if nr <= tol:
+            return x, it
+        if it == max_iter:
+            break
+        try:
+            dx = splu(J.tocsc(), permc_spec="COLAMD").solve(-R)
+        except RuntimeError:
+            raise NewtonError("singular Jacobian", x, it, nr) from None
+        if not np.all(np.isfinite(dx)):
+            raise NewtonError("singular or non-finite Jacobian", x, it, nr)
+        if np.linalg.norm(dx) <= STEP_RTOL * np.linalg.norm(x):
+            return x + dx, it + 1
+        step = _line_search(fun, x, dx, nr) or lm.step(fun, x, R, J, nr)
+        if step is None:
+            raise NewtonError("no decrease, neither along Newton's direction nor by "
+                              "Levenberg-Marquardt steps", x, it, nr)
+        x, R, J, nr = step
+    raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
+
+
+def _line_search(fun, x, dx, nr):
+    """Armijo backtracking along dx; (x, R, J, |R|) or None below MIN_ALPHA."""
+    alpha = 1.0
+    while alpha >= MIN_ALPHA:
+        xt = x + alpha * dx
+        Rt, Jt = fun(xt)
+        nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
+        if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
+            return xt, Rt, Jt, nt
+        alpha *= 0.5
+    return None
+
+
+class _LM:
+    """Levenberg-Marquardt steps with Nielsen's damping update (:mod:`..newton`), sparse."""
+
+    def __init__(self):
+        self.mu, self.nu, self.d2 = 1e-3, 2.0, None
+
+    def step(self, fun, x, R, J, nr):
+        g = J.T @ R
+        A = (J.T @ J).tocsc()
+        d2 = A.diagonal()
+        self.d2 = d2 if self.d2 is None else np.maximum(self.d2, d2)
+        D = sp.diags(np.maximum(self.d2, 1e-300 * max(self.d2.max(), 1e-300)))
+        for _ in range(LM_TRIALS):
+            try:
+                p = splu((A + self.mu * D).tocsc()).solve(-g)
+            except RuntimeError:
+                p = None
+            if p is not None and np.all(np.isfinite(p)):
+                Rt, Jt = fun(x + p)
+                nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
+                pred = -(p @ g) - 0.5 * (p @ (A @ p))
+                rho = (0.5 * nr**2 - 0.5 * nt**2) / pred if pred > 0 else -1.0
+                if rho > LM_ACCEPT:
+                    self.mu *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
+                    self.nu = 2.0
+                    return x + p, Rt, Jt, nt
+            self.mu *= self.nu
+            self.nu *= 2.0
+            if self.mu > LM_MU_MAX:
+                break
+        self.mu, self.nu = 1e-3, 2.0
+        return None
+
+
+def _norm(R, x):
+    if not np.all(np.isfinite(R)):
+        raise NewtonError("non-finite residual at the initial guess", x, 0, np.inf)
+    return float(np.linalg.norm(R))
+
+
+#: Bisection levels of a failed sweep step (2^-4 of a grid step; each failed level costs
+#: a Newton solve's iteration limit).
+BISECT = 4
+#: Steps of the scatter homotopy from the tuned ring (:meth:`RingSolver.tuned_start`).
+HOMOTOPY_STEPS = 4
+
+
+class RingSolver:
+    """Solves the ring at frequencies; keeps the tuned sector for starts.
+
+    Parameters
+    ----------
+    ring : MistunedRingHB
+    tuned : SectorHB, optional   the tuned sector with the same H, CF, F0, mu, n_t
+        (built when None); its solutions map onto the ring as starts.
+    """
+
+    def __init__(self, ring: MistunedRingHB, tuned: SectorHB | None = None):
+        self.ring = ring
+        self.tuned = tuned or SectorHB(ring.sector, ring.H, cf=ring.cf, f0=ring.f0, mu=ring.mu,
+                                       n_t=ring.basis.n_t)
+        self.tol = tolerance(ring)
+        self.iterations = 0
+
+    def solve(self, omega: float, x0: np.ndarray, max_iter: int = 40) -> np.ndarray:
+        """Newton solve at one frequency; raises NewtonError."""
+        x, it = newton_sparse(lambda z: self.ring(z, omega)[:2], x0, self.tol, max_iter)
+        self.iterations += it
+        return x
+
+    def tuned_start(self, omega: float) -> np.ndarray:
+        """Ring solution at omega from the tuned sector's: mapped onto the ring, then
+        Newton; when that fails, a homotopy in the scatter (kappa(lam) = 1 + lam (kappa - 1),
+        lam = 0 -> 1 in :data:`HOMOTOPY_STEPS` steps, each bisected on failure)."""
+        x = self.tuned_start_shape(start_point(self.tuned, omega))
+        try:
+            return self.solve(omega, x, 80)
+        except NewtonError:
+            pass
+        try:
+            self.ring.set_scale(0.0)
+            x, done = self.solve(omega, x, 80), 0.0
+            for target in np.linspace(0.0, 1.0, HOMOTOPY_STEPS + 1)[1:]:
+                x, done = self._ramp(omega, x, done, target), target
+        finally:
+            self.ring.set_scale(1.0)
+        return x
+
+    def _ramp(self, omega, x, a, b, depth=0):
+        """Solution at scatter scale b from the one at a (bisection on failure)."""
+        self.ring.set_scale(b)
+        try:
+            return self.solve(omega, x)
+        except NewtonError:
+            if depth >= BISECT:
+                raise
+        m = 0.5 * (a + b)
+        xm = self._ramp(omega, x, a, m, depth + 1)
+        return self._ramp(omega, xm, m, b, depth + 1)
+
+    def tuned_start_shape(self, x_sector: np.ndarray) -> np.ndarray:
+        """Ring unknowns of a tuned sector solution with the ring's own prestress mean."""
+        ring = self.ring
+        x = ring.from_sector(x_sector).reshape(ring.nb, ring.ndof)
+        x[ring.basis.index(0)[0]] += ring.x_static - np.tile(self.tuned.x_static, ring.blades)
+        return x.ravel()
+
+    def start(self, omega: float) -> np.ndarray:
+        """Solution at omega from the tuned start, else from the stuck linear guess."""
+        try:
+            return self.tuned_start(omega)
+        except (NewtonError, SolverError):
+            pass
+        try:
+            return self.solve(omega, self.ring.stuck_guess(omega), 80)
+        except NewtonError as err:
+            raise StartError(f"no ring solution at {omega / 2 / np.pi:.6g} Hz ({err}); start "
+                             "the band further from resonance") from None
+
+    def step(self, w_a, x_a, dxdw, w_b, depth=0):
+        """Solution at w_b from (w_a, x_a) with slope dxdw; bisects on failure (at most
+        :data:`BISECT` levels)."""
+        try:
+            return self.solve(w_b, x_a + (w_b - w_a) * dxdw)
+        except NewtonError:
+            if depth >= BISECT:
+                raise
+        w_m = 0.5 * (w_a + w_b)
+        x_m = self.step(w_a, x_a, dxdw, w_m, depth + 1)
+        return self.step(w_m, x_m, (x_m - x_a) / (w_m - w_a), w_b, depth + 1)
+
+    def flank(self, omegas, x0: np.ndarray):
+        """Solutions from omegas[0] (solution x0) along the grid ``omegas`` until the end or
+        the first point that fails; (solutions, None or the failure's message)."""
+        xs, slope = [x0], np.zeros_like(x0)
+        for k in range(1, len(omegas)):
+            try:
+                x = self.step(omegas[k - 1], xs[-1], slope, omegas[k])
+            except NewtonError:
+                try:  # a kink the bisection cannot pass: restart from the tuned solution
+                    x = self.tuned_start(omegas[k])
+                except (NewtonError, SolverError) as err:
+                    return xs, f"failed at {omegas[k] / 2 / np.pi:.6g} Hz ({err})"
+            slope = (x - xs[-1]) / (omegas[k] - omegas[k - 1])
+            xs.append(x)
+        return xs, None
+
+    def at(self, omega: float, omegas, xs) -> np.ndarray:
+        """Solution at omega from the nearest grid solutions (secant start)."""
+        i = int(np.clip(np.searchsorted(omegas, omega), 1, len(omegas) - 1))
+        slope = (xs[i] - xs[i - 1]) / (omegas[i] - omegas[i - 1])
+        try:
+            return self.solve(omega, xs[i - 1] + (omega - omegas[i - 1]) * slope)
+        except NewtonError:
+            return self.step(omegas[i - 1], xs[i - 1], slope, omega)
+
+
+def parabola_peaks(omegas: np.ndarray, A: np.ndarray):
+    """Per column of A (n_f, N_b): the vertex of the parabola through the largest value
+    and its neighbours (kept inside them), else the grid maximum; (peaks, omegas)."""
+    nf, nb = A.shape
+    pk, wk = A.max(axis=0).copy(), omegas[A.argmax(axis=0)].copy()
+    for j in range(nb):
+        i = int(A[:, j].argmax())
+        if not 0 < i < nf - 1:
+            continue
+        w, a = omegas[i - 1:i + 2], A[i - 1:i + 2, j]
+        c2, c1, c0 = np.polyfit(w - w[1], a, 2)
+        if c2 < 0:
+            d = np.clip(-c1 / (2 * c2), w[0] - w[1], w[2] - w[1])
+            pk[j], wk[j] = max(c0 + c1 * d + c2 * d * d, a[1]), w[1] + d
+    return pk, wk
+
+
+def ring_frf(ring: MistunedRingHB, omegas, tuned: SectorHB | None = None,
+             start_omega: float | None = None, refine: bool = True) -> RingCurve:
+    """Response curve of every blade on the grid ``omegas`` [rad/s] with per-blade peaks.
+
+    Solved first at the grid point nearest ``start_omega`` (default: the band's middle;
+    best the tuned peak, where the dampers slip and the start converges), then along
+    both flanks. A flank that fails ends the curve there (``extra["truncated"]``);
+    SolverError when the largest peak lies at such an end (not resolved).
+    """
+    t0 = time.perf_counter()
+    e0 = ring.evaluations
+    solver = RingSolver(ring, tuned)
+    omegas = np.asarray(omegas, dtype=float)
+    if omegas.size < 3 or np.any(np.diff(omegas) <= 0):
+        raise ValueError("the frequency grid needs >= 3 increasing points")
+    i0 = omegas.size // 2 if start_omega is None else int(np.argmin(np.abs(omegas - start_omega)))
+    x0 = solver.start(omegas[i0])
+    down, err_d = solver.flank(omegas[i0::-1], x0)
+    up, err_u = solver.flank(omegas[i0:], x0)
+    lo = i0 - len(down) + 1
+    lam, xs = omegas[lo:i0 + len(up)], down[::-1] + up[1:]
+    A = np.array([ring.amplitudes(x) for x in xs])
+    c = RingCurve(lam, A, xs)
+    c.extra["truncated"] = [e for e in (err_d, err_u) if e]
+    c.peak_per_blade, c.peak_omega_per_blade = parabola_peaks(lam, A)
+    g = A.max(axis=1)
+    i = int(g.argmax())
+    c.worst, c.peak, c.peak_omega, c.peak_x = int(A[i].argmax()), float(g[i]), float(lam[i]), xs[i]
+    if (i == 0 and err_d) or (i == lam.size - 1 and err_u):
+        raise SolverError(f"the largest blade peak lies at the end of the solved band "
+                          f"{lam[0] / 2 / np.pi:.6g}-{lam[-1] / 2 / np.pi:.6g} Hz: the sweep "
+                          f"{(err_d if i == 0 else err_u)}")
+    if refine:
+        _refine(solver, c, A)
+    c.evaluations, c.newton_iterations = ring.evaluations - e0, solver.iterations
+    c.time_s = time.perf_counter() - t0
+    return c
+
+
+def _refine(solver: RingSolver, c: RingCurve, A: np.ndarray) -> None:
+    """Largest amplitude over blades and frequency, g(omega) = max_j a_j(omega), by Brent's
+    search between the grid neighbours of g's grid maximum; again in the interval of any
+    blade whose parabola estimate still exceeds the refined peak. Per-blade peaks are
+    then capped at the refined peak and raised to the exact values met on the way."""
+    ring, nf, seen, met = solver.ring, c.omega.size, set(), {}
+
+    def neg(w):
+        x = solver.at(w, c.omega, c.x)
+        met[w] = (x, ring.amplitudes(x))
+        return -met[w][1].max()
+
+    best = -np.inf
+    while True:
+        todo = [j for j in np.argsort(-c.peak_per_blade) if int(A[:, j].argmax()) not in seen]
+        if not todo or (best > -np.inf and c.peak_per_blade[todo[0]] <= best):
+            break
+        i = int(A[:, todo[0]].argmax())
+        seen.add(i)
+        if not 0 < i < nf - 1:
+            w, val = c.omega[i], A[i].max()
+            met.setdefault(w, (c.x[i], A[i]))
+        else:
+            try:
+                res = minimize_scalar(neg, bounds=(c.omega[i - 1], c.omega[i + 1]), method="bounded",
+                                      options={"xatol": PEAK_XTOL * c.omega[i]})
+            except (NewtonError, SolverError) as err:
+                raise SolverError(f"peak refinement near {c.omega[i] / 2 / np.pi:.6g} Hz failed "
+                                  f"({err}); use more points") from None
+            w, val = float(res.x), -float(res.fun)
+            if w not in met:
+                neg(w)
+        if val > best:
+            best = val
+            c.peak_omega, c.peak_x = w, met[w][0]
+            c.worst, c.peak = int(met[w][1].argmax()), float(met[w][1].max())
+    c.peak_per_blade = np.minimum(c.peak_per_blade, c.peak)
+    for w, (_, a) in met.items():
+        up = a > c.peak_per_blade
+        c.peak_per_blade[up], c.peak_omega_per_blade[up] = a[up], w
+    c.peak_omega_per_blade[c.worst] = c.peak_omega
