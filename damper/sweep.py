@@ -121,7 +121,7 @@ def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bo
     shared = {s.key: (i, s.name) for i, plan in reversed(list(enumerate(plans))) for s in plan.stages
               if count.get(s.key, 0) > 1}
     rec.shared = sorted({name for _, name in shared.values()})
-    submit, gather, close = _executor(scheduler, workers, serial)
+    submit, gather, close = executor(scheduler, workers, serial)
     try:
         waves = _waves(plans, shared)
         for n, wave in enumerate(waves, start=1):
@@ -165,14 +165,26 @@ def _waves(plans, shared) -> list[list[tuple[int, str]]]:
     return waves
 
 
-def _executor(scheduler, workers, serial):
-    """(submit, gather, close) for a Dask client, or plain calls for ``serial``."""
+#: Seconds to wait for a scheduler given by address before giving up.
+CONNECT_TIMEOUT = 10
+
+
+def executor(scheduler, workers, serial):
+    """(submit, gather, close) for a Dask client, or plain calls for ``serial``.
+
+    Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
+    be reached within :data:`CONNECT_TIMEOUT` seconds.
+    """
     if serial:
         return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
-        client = Client(scheduler)
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as err:
+            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
+                          "or give the right --scheduler address (tcp://host:8786)") from None
         cluster = None
     else:
         n = workers or os.cpu_count() or 1

@@ -6,6 +6,8 @@ Examples::
     damper upd frf --cf 120 --f0 30 --harmonics 7 --band 400 500 --json --plot out/upd
     damper upd frf --damper stuck --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
+    damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
+    damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
 """
 from __future__ import annotations
 
@@ -43,6 +45,82 @@ def register(sub) -> None:
     o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
     _contacts(o)
     o.set_defaults(func=run_optimize)
+    _mistuning(s)
+
+
+def _mistuning(s) -> None:
+    from .cache import add_cache_options
+
+    p = s.add_parser("mistuning", help="mistuned full ring: Monte Carlo of the blades' peaks (Dask)",
+                     description="Per sample the full ring's forced response (harmonic balance, or "
+                     "a linear limit) and every blade's peak; amplification = worst blade / tuned "
+                     "peak. Samples run as Dask tasks, each stored in the cache (a rerun resumes).")
+    _common(p)
+    p.add_argument("--std", type=float, help="standard deviation of the factors (default 0.02)")
+    p.add_argument("--samples", type=int, help="number of random patterns (default 20)")
+    p.add_argument("--seed", type=int, help="seed, >= 0; sample i draws from [seed, i] (default 1)")
+    p.add_argument("--kind", choices=("stiffness", "frequency"), default="stiffness",
+                   help="the factors scale the blades' stiffness, or their frequencies")
+    p.add_argument("--distribution", choices=("normal", "uniform"), default="normal")
+    p.add_argument("--factors", type=float, nargs="+", metavar="K",
+                   help="one given pattern, a factor per blade (instead of --std/--samples)")
+    p.add_argument("--blades", type=int, help="number of blades N_b (default: config)")
+    p.add_argument("--engine-order", type=int, help="engine order EO (default: config)")
+    p.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
+                   help="free: damper removed; stuck: contacts stuck (linear limits)")
+    p.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
+    p.add_argument("--f0", type=float, help="EO force amplitude [N] (default: config)")
+    p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H")
+    p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
+                   help="band [Hz] (default: around the tuned peak, widened with the scatter)")
+    p.add_argument("--points", type=int, default=41, help="frequency points per ring curve")
+    p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
+    p.add_argument("--workers", type=int, help="local Dask cluster workers (default: cores)")
+    p.add_argument("--serial", action="store_true", help="no Dask: the samples in this process")
+    p.add_argument("--plot", metavar="DIR", help="write mistuning_histogram.png, mistuning_blades.png")
+    add_cache_options(p)
+    p.set_defaults(func=run_mistuning)
+
+
+def run_mistuning(args) -> int:
+    import sys
+
+    from damper.mistuning import Study, plot_study, run_study
+
+    from .cache import store_from_args
+    from .common import print_json
+
+    given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
+                            ("--serial", args.serial)) if v]
+    if len(given) > 1:
+        raise ValueError(f"give one of --scheduler, --workers, --serial (got {', '.join(given)})")
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
+    if args.factors is not None and draw:
+        raise ValueError("give --factors or --std/--samples/--seed, not both")
+    study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
+                  **draw, kind=args.kind,
+                  distribution=args.distribution, factors=args.factors, damper=args.damper,
+                  cf=args.cf, f0=args.f0, harmonics=args.harmonics,
+                  band_hz=args.band, points=args.points)
+    echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
+    out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
+    if args.plot:
+        out["plots"] = plot_study(out, args.plot)
+    if args.json:
+        print_json(out)
+        return 0
+    for s in out["samples"]:
+        print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
+              f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
+              else f"failed: {s['error']}"))
+    q = out["quantiles"]
+    print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
+          f"max {out['max_amplification']:.4f}, mean {out['mean_amplification']:.4f}, median {q['0.5']:.4f}, "
+          f"95 % {q['0.95']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); {out['failed']} failed, "
+          f"{out['cached']} from the cache, {out['time_s']:.1f} s")
+    return 0
 
 
 def _common(p) -> None:

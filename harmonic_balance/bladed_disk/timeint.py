@@ -1,4 +1,5 @@
-"""Time-integration reference: the ring of N_r blades marched to its periodic steady state.
+"""Time-integration reference: the ring of N_r blades (tuned) or of all N_b blades with a
+mistuning pattern (:mod:`.mistuning`) marched to its periodic steady state.
 
 Explicit central differences (as :mod:`harmonic_balance.timeint`), vectorised over the
 frequencies of a curve (state (n_f, n))::
@@ -22,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from .ring import RingHB
+from .ring_hb import MistunedRingHB
 from .sector import Sector
 
 #: Fraction of the stability limit 2 / omega_max of the stuck ring.
@@ -29,9 +31,12 @@ CFL = 0.5
 
 
 def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int = 0,
-               max_periods: int = 3000, tol: float = 1e-6) -> dict:
+               max_periods: int = 3000, tol: float = 1e-6, kappa=None) -> dict:
     """Steady first-harmonic amplitude of the response DOF (u_a) of blade 0 at each
     frequency [rad/s].
+
+    ``kappa`` (N_b,): blade stiffness factors; the whole ring of N_b blades is marched
+    (:class:`.ring_hb.MistunedRingHB`'s model, the same elements as its HB).
 
     Returns
     -------
@@ -42,7 +47,9 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     cfg = sector.cfg
     cf = cfg.cf if cf is None else float(cf)
     f0 = cfg.f0 if f0 is None else float(f0)
-    ring = RingHB(sector, 1, cf=cf, f0=f0)  # the ring's model, its contacts and prestress
+    # the ring's model, its contacts and prestress
+    ring = (RingHB(sector, 1, cf=cf, f0=f0) if kappa is None
+            else MistunedRingHB(sector, kappa, 1, cf=cf, f0=f0))
     lin, n, nr = ring.model.linear, ring.ndof, ring.blades
     c = _contact_arrays(ring)
     M, K = lin.M, lin.K

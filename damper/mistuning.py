@@ -1,0 +1,314 @@
+"""Mistuning study of a UPD bladed disk: Monte Carlo samples as cached tasks on Dask.
+
+A study draws every mistuning pattern first (``harmonic_balance.bladed_disk.mistuning``:
+seeded per sample, so a resumed or extended study draws the same patterns) and refuses
+a bad one before any work. The tuned sector's peak on the band is the reference (the
+sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). Each
+sample is one task: the full ring's forced response (``ring_hb`` / ``ring_solve``, or
+the linear ring) and every blade's peak; its result is stored in the shared cache
+(:class:`damper.cache.Store`) under a key of the model, the solver settings, the
+pattern and the code version, so an interrupted study computes only the samples it has
+not stored. A sample whose solve fails is reported with its message (not cached: a
+later run tries it again), the study goes on.
+
+Symbols: N_b blades; a_j the peak first-harmonic amplitude of blade j's response DOF;
+amplification = max_j a_j / a_tuned; sigma_f the standard deviation of the blade
+frequencies (std / 2 for stiffness factors, std for frequency factors).
+
+Band: ``band_hz``, else the tuned peak f_t (found on the config's ``load.band_hz``)
+times (1 -/+ w) with w = :data:`BAND_HALF` + :data:`BAND_SIGMAS` sigma_f.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from damper.cache import Store, make_key
+from damper.provenance import code_version
+
+#: Part of every sample's key (bump when a sample's result format changes).
+VERSION = 1
+#: Modules a sample runs (their source hash is part of the key).
+MODULES = ("harmonic_balance", "fmu_src")
+#: Quantiles of the amplification factor reported.
+QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+#: Default band half-width: BAND_HALF + BAND_SIGMAS sigma_f around the tuned peak (the
+#: mistuned peaks of std = 0.02 lie within +-3 %; the flanks below ~0.93 f_t are stuck
+#: and slow to solve, ``ring_solve``).
+BAND_HALF, BAND_SIGMAS = 0.04, 3.0
+DAMPERS = ("nonlinear", "free", "stuck")
+#: Largest number of samples of one study (the patterns and tasks are built up front).
+MAX_SAMPLES = 100_000
+
+
+@dataclass
+class Study:
+    """What a mistuning study computes (SI units; frequencies in Hz).
+
+    ``factors`` (one pattern, N_b values) replaces the random draw; ``kind`` says whether
+    they (or the drawn ones) are stiffness or frequency factors.
+    """
+
+    config: str | None = None
+    blades: int | None = None
+    engine_order: int | None = None
+    std: float = 0.02
+    samples: int = 20
+    seed: int = 1
+    kind: str = "stiffness"
+    distribution: str = "normal"
+    factors: list | None = None
+    damper: str = "nonlinear"
+    cf: float | None = None
+    f0: float | None = None
+    harmonics: int = 7
+    band_hz: list | None = None
+    points: int = 41
+
+    def load(self):
+        """The validated UPD config with ``blades`` / ``engine_order`` applied (ValueError)."""
+        from harmonic_balance.bladed_disk.config import load_config
+
+        cfg = load_config(self.config)
+        changes = {}
+        if self.blades is not None:
+            changes["disk__blades"] = self.blades
+        if self.engine_order is not None:
+            changes["disk__engine_order"] = self.engine_order
+        return cfg.with_values(**changes) if changes else cfg
+
+    def check(self) -> None:
+        """ValueError naming the first unusable setting."""
+        if self.damper not in DAMPERS:
+            raise ValueError(f"damper must be one of {DAMPERS}, got {self.damper!r}")
+        for name in ("cf", "f0"):
+            v = getattr(self, name)
+            if v is not None and not (np.isfinite(v) and v > 0):
+                raise ValueError(f"--{name} must be finite and > 0, got {v}")
+        if self.harmonics < 1 or self.points < 3:
+            raise ValueError("--harmonics must be >= 1 and --points >= 3")
+        if self.factors is None and not (isinstance(self.samples, int) and 1 <= self.samples <= MAX_SAMPLES):
+            raise ValueError(f"--samples must be an integer in 1..{MAX_SAMPLES}, got {self.samples}")
+        if not (isinstance(self.seed, int) and self.seed >= 0):
+            raise ValueError(f"--seed must be an integer >= 0, got {self.seed}")
+        if self.band_hz is not None and not (len(self.band_hz) == 2 and np.all(np.isfinite(self.band_hz))
+                                            and 0 < self.band_hz[0] < self.band_hz[1]):
+            raise ValueError(f"--band needs 0 < LO < HI, got {self.band_hz}")
+
+    def patterns(self, n_blades: int) -> list[np.ndarray]:
+        """Stiffness factors of every sample (all drawn and checked before any work)."""
+        from harmonic_balance.bladed_disk.mistuning import KINDS, check_factors, draw_factors
+
+        if self.factors is not None:
+            if self.kind not in KINDS:
+                raise ValueError(f"mistuning kind must be one of {KINDS}, got {self.kind!r}")
+            f = check_factors(self.factors, n_blades, "--factors")
+            return [f if self.kind == "stiffness" else f * f]
+        return [draw_factors(n_blades, self.std, self.seed, i, self.kind, self.distribution)
+                for i in range(self.samples)]
+
+    def sigma_f(self) -> float:
+        """Standard deviation of the blade frequencies implied by the scatter."""
+        if self.factors is not None:
+            return float(np.std(np.sqrt(np.asarray(self.factors, float) ** (self.kind == "stiffness"))))
+        return self.std / 2.0 if self.kind == "stiffness" else self.std
+
+
+def fingerprint(cfg) -> str:
+    """Hash of a UPD config's numbers and its blade's matrices (a blade file enters by content)."""
+    from harmonic_balance.bladed_disk.blade import MATRICES
+
+    h = hashlib.sha256(json.dumps(cfg.data, sort_keys=True, default=str).encode())
+    b = cfg.blade()
+    for name in MATRICES:
+        A = getattr(b, name)
+        h.update(name.encode() + (b"-" if A is None else np.ascontiguousarray(A, float).tobytes()))
+    h.update(json.dumps([b.dofs, b.left, b.right, b.forced, b.response], default=str).encode())
+    return h.hexdigest()[:24]
+
+
+def tuned_reference(study: Study, cfg) -> dict:
+    """Tuned sector's peak [m] and frequency [Hz] and the study's band [Hz] and grid size."""
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.mistuning import tuned_linear_peak
+    from harmonic_balance.bladed_disk.sector import Sector
+    from harmonic_balance.bladed_disk.solve import frf
+
+    sector = Sector(cfg)
+    search = study.band_hz or cfg["load.band_hz"]
+    om = 2 * np.pi * np.linspace(search[0], search[1], max(study.points, 41))
+    if study.damper == "nonlinear":
+        c = frf(SectorHB(sector, study.harmonics, cf=study.cf, f0=study.f0), om)
+        w, a = c.peak_omega, c.peak_amplitude
+    else:
+        w, a = tuned_linear_peak(sector, om, study.damper, study.f0)
+    f_t = w / (2 * np.pi)
+    if study.band_hz is not None:
+        band = list(study.band_hz)
+    else:
+        half = BAND_HALF + BAND_SIGMAS * study.sigma_f()
+        band = [f_t * (1 - half), f_t * (1 + half)]
+    return {"tuned_peak": float(a), "tuned_frequency_hz": float(f_t), "band_hz": band}
+
+
+def sample_key(study: Study, fp: str, band: list, kappa) -> str:
+    """Cache key of one sample: model, solver settings, band, pattern, code version."""
+    settings = {k: v for k, v in asdict(study).items()
+                if k in ("damper", "cf", "f0", "harmonics", "points")}
+    return make_key("mistuning_sample", VERSION, fp, settings, [float(b) for b in band],
+                    [float(k) for k in kappa], code_version(MODULES))
+
+
+def run_sample(task: dict) -> dict:
+    """One sample (runs in a Dask worker or in this process): the cached result, or the
+    ring's per-blade peaks computed and stored; a failed solve is returned as ``error``."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    store = Store(task["folder"], task["max_bytes"])
+    hit = store.get(task["key"])
+    if hit is not None:
+        return hit[1]["data"] | {"cached": True}
+    t0 = time.perf_counter()
+    try:
+        out = _solve_sample(Study(**task["study"]), task["kappa"], task["band_hz"],
+                            task["tuned_frequency_hz"])
+    except (RuntimeError, ArithmeticError, np.linalg.LinAlgError) as err:
+        return {"index": task["index"], "error": f"{type(err).__name__}: {err}", "cached": False,
+                "time_s": time.perf_counter() - t0}
+    out |= {"index": task["index"], "error": None, "time_s": time.perf_counter() - t0}
+    store.put(task["key"], {}, {"data": out})
+    return out | {"cached": False}
+
+
+def _solve_sample(study: Study, kappa, band, f_tuned) -> dict:
+    """Per-blade peaks [m] and frequencies [Hz] of one pattern (raises on solver failure)."""
+    from harmonic_balance.bladed_disk.mistuning import LinearRing
+    from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
+    from harmonic_balance.bladed_disk.ring_solve import ring_frf
+    from harmonic_balance.bladed_disk.sector import Sector
+
+    sector = Sector(study.load())
+    om = 2 * np.pi * np.linspace(band[0], band[1], study.points)
+    if study.damper != "nonlinear":
+        lin = LinearRing(sector, kappa, study.damper, study.f0)
+        peaks, w = lin.peaks(om)
+        return {"peak_per_blade": peaks.tolist(), "peak_frequency_per_blade_hz": (w / 2 / np.pi).tolist(),
+                "evaluations": lin.solves, "truncated": []}
+    ring = MistunedRingHB(sector, kappa, study.harmonics, cf=study.cf, f0=study.f0)
+    c = ring_frf(ring, om, start_omega=2 * np.pi * f_tuned)
+    return {"peak_per_blade": c.peak_per_blade.tolist(),
+            "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
+            "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
+
+
+def run_study(study: Study, store: Store, scheduler: str | None = None, workers: int | None = None,
+              serial: bool = False, echo=print) -> dict:
+    """Run (or resume) the study; the JSON-able summary (module docstring)."""
+    t0 = time.perf_counter()
+    study.check()
+    cfg = study.load()
+    kappas = study.patterns(cfg.blades)           # every bad pattern refused before any work
+    from damper.sweep import executor
+
+    submit, gather, close = executor(scheduler, workers, serial)  # an unreachable scheduler: now
+    try:
+        ref = tuned_reference(study, cfg)
+        fp = fingerprint(cfg)
+        tasks = [{"study": asdict(study), "index": i, "kappa": k.tolist(), "band_hz": ref["band_hz"],
+                  "tuned_frequency_hz": ref["tuned_frequency_hz"], "folder": str(store.folder),
+                  "max_bytes": store.max_bytes, "key": sample_key(study, fp, ref["band_hz"], k)}
+                 for i, k in enumerate(kappas)]
+        done = sum(store.contains(t["key"]) for t in tasks)
+        where = ("this process" if serial else scheduler
+                 or f"a local Dask cluster ({workers or os.cpu_count()} workers)")
+        echo(f"mistuning: {len(tasks)} samples of {cfg.blades} blades, {done} in the cache, on {where}")
+        results = gather([submit(run_sample, t) for t in tasks])
+    finally:
+        close()
+    return summarize(study, cfg, ref, kappas, results, time.perf_counter() - t0)
+
+
+def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> dict:
+    """The study's JSON: tuned reference, samples, statistics."""
+    from harmonic_balance.bladed_disk.mistuning import frequency_factors, whitehead_bound
+
+    a_t = ref["tuned_peak"]
+    samples = []
+    for k, r in sorted(zip(kappas, results), key=lambda p: p[1]["index"]):
+        s = {"index": r["index"], "factors": k.tolist(),
+             "frequency_factors": frequency_factors(k).tolist(), "error": r.get("error"),
+             "cached": r.get("cached", False), "time_s": r.get("time_s")}
+        if s["error"] is None:
+            pk = np.asarray(r["peak_per_blade"])
+            j = int(pk.argmax())
+            s |= {"peak_per_blade": pk.tolist(), "amplification": float(pk[j] / a_t),
+                  "worst_blade": j, "frequency_hz": r["peak_frequency_per_blade_hz"][j],
+                  "peak_frequency_per_blade_hz": r["peak_frequency_per_blade_hz"],
+                  "evaluations": r["evaluations"], "truncated": r["truncated"]}
+        else:
+            s |= {"peak_per_blade": None, "amplification": None, "frequency_hz": None}
+        samples.append(s)
+    amp = np.array([s["amplification"] for s in samples if s["error"] is None])
+    if amp.size == 0:
+        raise RuntimeError(f"every sample failed; the first: {samples[0]['error']}")
+    return {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
+            "kind": study.kind, "distribution": study.distribution,
+            "std": None if study.factors is not None else study.std, "seed": study.seed,
+            "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
+            "band_hz": ref["band_hz"], "points": study.points,
+            "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
+            "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
+            "cached": int(sum(s["cached"] for s in samples)),
+            "max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
+            "std_amplification": float(amp.std()),
+            "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
+            "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}
+
+
+def plot_study(out: dict, folder) -> dict:
+    """``mistuning_histogram.png`` (amplification factors) and ``mistuning_blades.png``
+    (every sample's per-blade peaks over the tuned peak), written atomically."""
+    from pathlib import Path
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    from harmonic_balance.plots import _save
+
+    ok = [s for s in out["samples"] if s["error"] is None]
+    amp = np.array([s["amplification"] for s in ok])
+    folder = Path(folder)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.hist(amp, bins=max(5, min(40, amp.size // 4)), color="C0", alpha=0.8)
+    ax.axvline(1.0, color="k", lw=1, label="tuned")
+    ax.axvline(out["whitehead_bound"], color="C3", ls="--", lw=1, label="(1 + sqrt(N_b)) / 2")
+    ax.set_xlabel("amplification factor (worst blade / tuned peak)")
+    ax.set_ylabel("samples")
+    ax.set_title(f"{len(ok)} samples, N_b = {out['blades']}, damper {out['damper']}")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths = {"histogram": str(_save(fig, folder / "mistuning_histogram.png"))}
+    plt.close(fig)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    blades = np.arange(out["blades"])
+    for s in ok:
+        ax.plot(blades, np.array(s["peak_per_blade"]) / out["tuned_peak"], ".", color="0.6", ms=3)
+    worst = max(ok, key=lambda s: s["amplification"])
+    ax.plot(blades, np.array(worst["peak_per_blade"]) / out["tuned_peak"], "o-", color="C3",
+            label=f"sample {worst['index']} (max {worst['amplification']:.3f})")
+    ax.axhline(1.0, color="k", lw=1)
+    ax.xaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+    ax.set_xlabel("blade")
+    ax.set_ylabel("peak / tuned peak")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    paths["blades"] = str(_save(fig, folder / "mistuning_blades.png"))
+    plt.close(fig)
+    return paths
