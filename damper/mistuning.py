@@ -107,7 +107,7 @@ class Study:
         if self.factors is not None:
             if self.kind not in KINDS:
                 raise ValueError(f"mistuning kind must be one of {KINDS}, got {self.kind!r}")
-            f = check_factors(self.factors, n_blades, "--factors")
+            f = check_factors(self.factors, n_blades, "factors")
             return [f if self.kind == "stiffness" else f * f]
         return [draw_factors(n_blades, self.std, self.seed, i, self.kind, self.distribution)
                 for i in range(self.samples)]
@@ -117,6 +117,14 @@ class Study:
         if self.factors is not None:
             return float(np.std(np.sqrt(np.asarray(self.factors, float) ** (self.kind == "stiffness"))))
         return self.std / 2.0 if self.kind == "stiffness" else self.std
+
+
+def study_from_scene(data: dict) -> Study:
+    """The Study of a validated scene's [mistuning] table (the model from [upd].config)."""
+    m = dict(data["mistuning"])
+    if "band" in m:
+        m["band_hz"] = m.pop("band")
+    return Study(config=(data.get("upd") or {}).get("config"), **m)
 
 
 def fingerprint(cfg) -> str:
@@ -212,7 +220,7 @@ def run_study(study: Study, store: Store, scheduler: str | None = None, workers:
     study.check()
     cfg = study.load()
     kappas = study.patterns(cfg.blades)           # every bad pattern refused before any work
-    from damper.sweep import executor
+    from damper.tasks import executor
 
     submit, gather, close = executor(scheduler, workers, serial)  # an unreachable scheduler: now
     try:

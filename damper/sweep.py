@@ -17,13 +17,13 @@ import csv
 import io
 import itertools
 import json
-import logging
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from damper.cache import Store
 from damper.cli.common import atomic_write, dumps
+from damper.tasks import executor
 
 
 @dataclass
@@ -163,41 +163,6 @@ def _waves(plans, shared) -> list[list[tuple[int, str]]]:
             done.add(k)
             del todo[k]
     return waves
-
-
-#: Seconds to wait for a scheduler given by address before giving up.
-CONNECT_TIMEOUT = 10
-
-
-def executor(scheduler, workers, serial):
-    """(submit, gather, close) for a Dask client, or plain calls for ``serial``.
-
-    Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
-    be reached within :data:`CONNECT_TIMEOUT` seconds.
-    """
-    if serial:
-        return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
-    from dask.distributed import Client, LocalCluster
-
-    if scheduler:
-        try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, ValueError, TypeError) as err:
-            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
-                          "or give the right --scheduler address (tcp://host:8786)") from None
-        cluster = None
-    else:
-        n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.CRITICAL)
-        client = Client(cluster)
-
-    def close():
-        client.close()
-        if cluster is not None:
-            cluster.close()
-
-    return (lambda f, *a: client.submit(f, *a, pure=False)), client.gather, close
 
 
 def write_table(rec: SweepRecord, out: Path) -> None:

@@ -8,6 +8,8 @@ from __future__ import annotations
 from .backbone_stages import Backbone, OptimalLoad
 from .contact_stages import Condense, Normal, Tangential
 from .element_stages import FMU, Loop
+from .mistuning_stages import Mistuning
 from .response_stages import FRF
 
-KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone(), OptimalLoad())
+KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone(), OptimalLoad(),
+         Mistuning())

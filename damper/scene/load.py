@@ -244,6 +244,8 @@ def _check_wants(data: dict, problems: list) -> None:
             problems.append((("element", "loop_force_amplitude"), "missing: needed for loop"))
     if "backbone" in wants:
         _check_backbone(data, problems)
+    if "mistuning" in wants:
+        _check_mistuning(data, problems)
     if "optimal_load" in wants and "upd" not in data:
         problems.append((("upd",), "missing: needed for optimal_load (an empty [upd] table takes the "
                          "bundled UPD-24 model and the default CF range)"))
@@ -290,3 +292,27 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
         except OSError as err:
             problems.append((("upd", "config"), f"cannot read {path}: {err.strerror}"))
         u["config"] = str(path)
+
+
+def _check_mistuning(data: dict, problems: list) -> None:
+    """The [mistuning] table: every pattern drawn and checked now (a scatter so large that
+    a blade's stiffness is not positive is refused before any stage runs)."""
+    from damper.mistuning import study_from_scene
+
+    m = data.get("mistuning")
+    if m is None:
+        problems.append((("mistuning",), "missing: needed for mistuning (an empty [mistuning] table "
+                         "takes 20 samples of std 0.02 on the bundled UPD-24)"))
+        return
+    if "factors" in m and any(k in m for k in ("std", "samples", "seed")):
+        problems.append((("mistuning", "factors"), "give factors or std/samples/seed, not both"))
+        return
+    if "band" in m and not (len(m["band"]) == 2 and m["band"][1] > m["band"][0]):
+        problems.append((("mistuning", "band"), "must be [low, high] with high > low"))
+        return
+    try:
+        study = study_from_scene(data)
+        study.check()
+        study.patterns(study.load().blades)
+    except ValueError as err:
+        problems.append((("mistuning",), str(err)))

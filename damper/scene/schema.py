@@ -68,6 +68,8 @@ RESULTS = {
                  "frequency and damping ratio vs modal amplitude"),
     "optimal_load": ("optimal_load", False, "UPD bladed-disk sector: peak response against the "
                      "damper's centrifugal load CF and the optimal CF"),
+    "mistuning": ("mistuning", False, "UPD bladed disk: Monte Carlo of mistuning patterns on the "
+                  "full ring, every blade's peak and the amplification over the tuned peak"),
     "report": ("report", False, "one-page HTML report of the run"),
 }
 #: Results named by the issues but not built yet: a scene that wants one is refused
@@ -158,6 +160,27 @@ UPD = {
     "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3),
 }
 
+MISTUNING = {
+    "blades": Field("int", "number of blades N_b (default: the UPD model's)", ge=2),
+    "engine_order": Field("int", "engine order EO (default: the UPD model's)", ge=0),
+    "std": Field("float", "standard deviation of the random factors (default 0.02)", ge=0),
+    "samples": Field("int", "number of random patterns (default 20)", ge=1),
+    "seed": Field("int", "seed; sample i draws from [seed, i] (default 1)", ge=0),
+    "kind": Field("str", "the factors scale the blades' stiffness or their frequencies",
+                  default="stiffness", choices=("stiffness", "frequency")),
+    "distribution": Field("str", "distribution of the random factors", default="normal",
+                          choices=("normal", "uniform")),
+    "factors": Field("list[float]", "one given pattern, a factor per blade (instead of std, "
+                     "samples, seed)", gt=0),
+    "damper": Field("str", "nonlinear (harmonic balance), or the linear limits free (removed) and "
+                    "stuck", default="nonlinear", choices=("nonlinear", "free", "stuck")),
+    "cf": Field("float", "centrifugal load on the damper [N] (default: the UPD model's)", gt=0),
+    "f0": Field("float", "EO force amplitude [N] (default: the UPD model's)", gt=0),
+    "harmonics": Field("int", "highest harmonic", default=7, ge=1),
+    "band": Field("list[float]", "[low, high] band [Hz] (default: around the tuned peak)", gt=0),
+    "points": Field("int", "frequency points per ring curve", default=41, ge=3),
+}
+
 TOP = {
     "title": Field("str", "a name for the report", default=""),
     "want": Field("list[str]", "results wanted", required=True),
@@ -166,7 +189,7 @@ TOP = {
 #: Tables: name -> (fields, one table per named item?)
 TABLES = {"contact": (CONTACT, True), "element": (ELEMENT, False), "structure": (STRUCTURE, False),
           "excitation": (EXCITATION, False), "sweep": (SWEEP, False), "backbone": (BACKBONE, False),
-          "upd": (UPD, False)}
+          "upd": (UPD, False), "mistuning": (MISTUNING, False)}
 
 
 @dataclass

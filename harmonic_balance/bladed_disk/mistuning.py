@@ -82,7 +82,7 @@ def draw_factors(n_blades: int, std: float, seed: int, index: int, kind: str = "
     if bad.size:
         raise ValueError(f"mistuning sample {index}: blade {bad[0]} gets a {kind} factor "
                          f"{f[bad[0]]:.4g} <= 0 (std {std} is too large for a {distribution} "
-                         "scatter; use a smaller --std or --distribution uniform)")
+                         "scatter; use a smaller std or the uniform distribution)")
     return f if kind == "stiffness" else f * f
 
 

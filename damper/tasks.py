@@ -1,0 +1,45 @@
+"""Where a batch of independent tasks runs: a Dask cluster, or this process.
+
+``executor`` gives ``(submit, gather, close)``: a Dask local cluster (one single-threaded
+worker process per core by default), an existing cluster at a scheduler address, or
+plain calls in this process (``serial``, the reference tests compare against). Used by
+the scene sweeps (:mod:`damper.sweep`) and the mistuning study (:mod:`damper.mistuning`).
+"""
+from __future__ import annotations
+
+import logging
+import os
+
+#: Seconds to wait for a scheduler given by address before giving up.
+CONNECT_TIMEOUT = 10
+
+
+def executor(scheduler, workers, serial):
+    """(submit, gather, close) for a Dask client, or plain calls for ``serial``.
+
+    Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
+    be reached within :data:`CONNECT_TIMEOUT` seconds.
+    """
+    if serial:
+        return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, ValueError, TypeError) as err:
+            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
+                          "or give the right --scheduler address (tcp://host:8786)") from None
+        cluster = None
+    else:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                               silence_logs=logging.CRITICAL)
+        client = Client(cluster)
+
+    def close():
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+    return (lambda f, *a: client.submit(f, *a, pure=False)), client.gather, close
