@@ -15,8 +15,12 @@ Symbols: N_b blades; a_j the peak first-harmonic amplitude of blade j's response
 amplification = max_j a_j / a_tuned; sigma_f the standard deviation of the blade
 frequencies (std / 2 for stiffness factors, std for frequency factors).
 
-Band: ``band_hz``, else the tuned peak f_t (found on the config's ``load.band_hz``)
-times (1 -/+ w) with w = :data:`BAND_HALF` + :data:`BAND_SIGMAS` sigma_f.
+Band: ``band_hz``, else from the tuned linear peaks on the config's ``load.band_hz``:
+with the damper, from the damper-free peak f_free times (1 - w) to the stuck peak
+f_stuck times (1 + w) (the friction-damped peaks lie between the two linear limits,
+and mistuning can move a blade's peak up to the stuck one); a linear limit, its own
+peak f_t times (1 -/+ w); w = :data:`BAND_MARGIN` + :data:`BAND_SIGMAS` sigma_f. A
+sample whose largest peak lies at an end of the band fails (the peak is outside).
 """
 from __future__ import annotations
 
@@ -37,10 +41,9 @@ VERSION = 1
 MODULES = ("harmonic_balance", "fmu_src")
 #: Quantiles of the amplification factor reported.
 QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
-#: Default band half-width: BAND_HALF + BAND_SIGMAS sigma_f around the tuned peak (the
-#: mistuned peaks of std = 0.02 lie within +-3 %; the flanks below ~0.93 f_t are stuck
-#: and slow to solve, ``ring_solve``).
-BAND_HALF, BAND_SIGMAS = 0.04, 3.0
+#: Default band margin: BAND_MARGIN + BAND_SIGMAS sigma_f beyond the tuned linear peaks
+#: (module docstring; a blade's frequency scatters by sigma_f).
+BAND_MARGIN, BAND_SIGMAS = 0.01, 3.0
 DAMPERS = ("nonlinear", "free", "stuck")
 #: Largest number of samples of one study (the patterns and tasks are built up front).
 MAX_SAMPLES = 100_000
@@ -155,13 +158,15 @@ def tuned_reference(study: Study, cfg) -> dict:
         w, a = c.peak_omega, c.peak_amplitude
     else:
         w, a = tuned_linear_peak(sector, om, study.damper, study.f0)
-    f_t = w / (2 * np.pi)
+    margin = BAND_MARGIN + BAND_SIGMAS * study.sigma_f()
     if study.band_hz is not None:
         band = list(study.band_hz)
+    elif study.damper == "nonlinear":
+        lo, hi = (tuned_linear_peak(sector, om, d, study.f0)[0] / (2 * np.pi) for d in ("free", "stuck"))
+        band = [lo * (1 - margin), hi * (1 + margin)]
     else:
-        half = BAND_HALF + BAND_SIGMAS * study.sigma_f()
-        band = [f_t * (1 - half), f_t * (1 + half)]
-    return {"tuned_peak": float(a), "tuned_frequency_hz": float(f_t), "band_hz": band}
+        band = [w / (2 * np.pi) * (1 - margin), w / (2 * np.pi) * (1 + margin)]
+    return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band}
 
 
 def sample_key(study: Study, fp: str, band: list, kappa) -> str:
@@ -204,13 +209,22 @@ def _solve_sample(study: Study, kappa, band, f_tuned) -> dict:
     if study.damper != "nonlinear":
         lin = LinearRing(sector, kappa, study.damper, study.f0)
         peaks, w = lin.peaks(om)
+        _inside(w[peaks.argmax()], om)
         return {"peak_per_blade": peaks.tolist(), "peak_frequency_per_blade_hz": (w / 2 / np.pi).tolist(),
                 "evaluations": lin.solves, "truncated": []}
     ring = MistunedRingHB(sector, kappa, study.harmonics, cf=study.cf, f0=study.f0)
     c = ring_frf(ring, om, start_omega=2 * np.pi * f_tuned)
+    _inside(c.peak_omega, om)
     return {"peak_per_blade": c.peak_per_blade.tolist(),
             "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
             "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
+
+
+def _inside(w: float, om: np.ndarray) -> None:
+    """RuntimeError when the largest peak (at w [rad/s]) lies at an end of the band ``om``."""
+    if min(abs(w - om[0]), abs(w - om[-1])) <= 1e-9 * om[-1]:
+        raise RuntimeError(f"the largest blade peak lies at the band's end {w / 2 / np.pi:.6g} Hz "
+                           "(the peak is outside the band): give a wider --band")
 
 
 def run_study(study: Study, store: Store, scheduler: str | None = None, workers: int | None = None,

@@ -1,0 +1,118 @@
+"""damper upd mistuning: the issue's JSON keys, refused input (exit 2, nothing written),
+resumption from the cache, a failing sample in the table, Dask against serial, the scene."""
+import json
+
+import pytest
+
+from damper.cli import main
+from harmonic_balance.bladed_disk.mistuning import draw_factors
+
+#: A small study: four blades (EO 1, the interblade phase of UPD-24), H = 3, 11 points.
+SMALL = ["upd", "mistuning", "--blades", "4", "--engine-order", "1", "--harmonics", "3",
+         "--points", "11"]
+KEYS = ("tuned_peak", "samples", "max_amplification", "quantiles", "time_s")
+SAMPLE_KEYS = ("index", "factors", "peak_per_blade", "amplification", "frequency_hz")
+
+
+def _run(argv, capsys, code=0):
+    assert main(argv) == code
+    out = capsys.readouterr()
+    return json.loads(out.out) if code == 0 else out.err
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--factors", "1", "-1", "1", "1"], "blade 1 factor -1.0 must be finite and > 0"),
+    (["--factors", "1", "nan", "1", "1"], "blade 1 factor nan"),
+    (["--factors", "1", "1", "1"], "3 factors for 4 blades"),
+    (["--std", "0.6", "--samples", "50"], "too large"),
+    (["--std", "-0.01"], "must be finite and >= 0"),
+    (["--samples", "0"], "--samples must be an integer"),
+    (["--factors", "1", "1", "1", "1", "--std", "0.1"], "not both"),
+    (["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler"),
+    (["--workers", "2", "--serial"], "give one of"),
+])
+def test_refused_input_exit_2_nothing_written(tmp_path, capsys, monkeypatch, extra, message):
+    monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 1)   # the unreachable scheduler: 1 s
+    cache, plots = tmp_path / "cache", tmp_path / "plots"
+    err = _run(SMALL + extra + ["--json", "--cache-dir", str(cache), "--plot", str(plots)], capsys, 2)
+    assert message in err and "Traceback" not in err
+    assert not cache.exists() and not plots.exists()
+
+
+def test_study_json_keys(tmp_path, capsys):
+    out = _run(SMALL + ["--std", "0.02", "--samples", "2", "--serial", "--json", "--cache-dir",
+                        str(tmp_path / "c"), "--plot", str(tmp_path / "p")], capsys)
+    for k in KEYS:
+        assert k in out
+    assert set(out["quantiles"]) == {"0.05", "0.25", "0.5", "0.75", "0.95"}
+    for s in out["samples"]:
+        assert all(k in s for k in SAMPLE_KEYS) and s["error"] is None and len(s["factors"]) == 4
+        assert s["amplification"] == pytest.approx(max(s["peak_per_blade"]) / out["tuned_peak"], rel=1e-12)
+        assert out["band_hz"][0] <= s["frequency_hz"] <= out["band_hz"][1]
+    assert out["max_amplification"] == max(s["amplification"] for s in out["samples"])
+    assert (tmp_path / "p" / "mistuning_histogram.png").exists()
+    assert (tmp_path / "p" / "mistuning_blades.png").exists()
+
+
+def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
+    """An interrupted (or extended) study reads its stored samples; a failing sample is a
+    row with its message, not a crash, and is not stored (a later run tries it again).
+    Linear limit (stuck): the same tasks and cache as the harmonic balance, faster."""
+    import damper.mistuning as mt
+
+    args = SMALL + ["--damper", "stuck", "--std", "0.02", "--seed", "3", "--serial", "--json",
+                    "--cache-dir", str(tmp_path / "c")]
+    first = _run(args + ["--samples", "2"], capsys)
+    assert first["cached"] == 0 and first["failed"] == 0
+    solve, third = mt._solve_sample, draw_factors(4, 0.02, 3, 2).tolist()
+
+    def failing(study, kappa, band, f):
+        if kappa == third:
+            raise RuntimeError("ring harmonic balance failed (test)")
+        return solve(study, kappa, band, f)
+
+    monkeypatch.setattr(mt, "_solve_sample", failing)
+    again = _run(args + ["--samples", "3"], capsys)
+    assert again["cached"] == 2 and again["failed"] == 1
+    assert [s["amplification"] for s in again["samples"][:2]] == [s["amplification"] for s in first["samples"]]
+    bad = again["samples"][2]
+    assert bad["amplification"] is None and "failed (test)" in bad["error"]
+    monkeypatch.setattr(mt, "_solve_sample", solve)
+    last = _run(args + ["--samples", "3"], capsys)
+    assert last["cached"] == 2 and last["failed"] == 0
+
+
+def test_given_pattern_and_linear_limit(tmp_path, capsys):
+    """One given pattern of ones is the tuned disk (amplification 1); linear limit free."""
+    out = _run(SMALL + ["--factors", "1", "1", "1", "1", "--damper", "free", "--serial", "--json",
+                        "--cache-dir", str(tmp_path)], capsys)
+    assert len(out["samples"]) == 1 and out["max_amplification"] == pytest.approx(1.0, abs=1e-9)
+
+
+@pytest.mark.slow
+def test_dask_two_workers_equal_serial(tmp_path, capsys):
+    base = SMALL + ["--std", "0.02", "--samples", "4", "--json"]
+    serial = _run(base + ["--serial", "--cache-dir", str(tmp_path / "a")], capsys)
+    dask = _run(base + ["--workers", "2", "--cache-dir", str(tmp_path / "b")], capsys)
+    assert [s["peak_per_blade"] for s in dask["samples"]] == [s["peak_per_blade"] for s in serial["samples"]]
+    assert dask["cached"] == 0
+
+
+def test_scene_mistuning_stage(tmp_path, capsys):
+    scene = tmp_path / "s.toml"
+    scene.write_text('want = ["mistuning"]\n[mistuning]\nblades = 4\nengine_order = 1\nsamples = 2\n'
+                     'damper = "stuck"\npoints = 21\n')
+    args = ["run", str(scene), "--out", str(tmp_path / "out"), "--cache-dir", str(tmp_path / "c")]
+    assert main(args) == 0
+    res = json.loads((tmp_path / "out" / "mistuning" / "result.json").read_text())
+    data = res.get("data", res)
+    assert len(data["samples"]) == 2 and data["max_amplification"] > 1.0
+    assert (tmp_path / "out" / "mistuning" / "mistuning_histogram.png").exists()
+    capsys.readouterr()
+    assert main(args + ["--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert {s["name"]: s["action"] for s in rec["stages"]}["mistuning"] == "cached"
+    bad = tmp_path / "bad.toml"
+    bad.write_text('want = ["mistuning"]\n[mistuning]\nblades = 4\nengine_order = 1\nstd = 0.6\nsamples = 50\n')
+    assert main(["run", str(bad), "--out", str(tmp_path / "o2"), "--cache-dir", str(tmp_path / "c2")]) == 2
+    assert not (tmp_path / "o2").exists() and not (tmp_path / "c2").exists()
