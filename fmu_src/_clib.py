@@ -18,12 +18,14 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["MAX_SLIDERS", "STATE_VERSION", "Model", "State", "Output", "STATE_DTYPE",
+__all__ = ["MAX_SLIDERS", "STATE_VERSION", "STATE2_VERSION", "Model", "State", "Output", "State2",
+           "Output2", "STATE_DTYPE",
            "DoubleArray", "StateArray", "SizeArray", "Int32Array", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
            "IwanNotConvergedError", "vec", "normal"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h (the header test checks it)
 STATE_VERSION = 1          # IWAN_STATE_VERSION in iwan.h
+STATE2_VERSION = 1         # IWAN2_STATE_VERSION in iwan2d.h
 
 
 class IwanInputError(ValueError):
@@ -54,6 +56,19 @@ class State(ct.Structure):
 class Output(ct.Structure):
     """``iwan_output``."""
     _fields_ = [(name, ct.c_double) for name in ("F", "kt", "dFdN", "W", "E", "slip")]
+
+
+class State2(ct.Structure):
+    """``iwan2_state`` (iwan2d.h)."""
+    _fields_ = [("version", ct.c_int32), ("in_contact", ct.c_int32), ("u", ct.c_double * 2),
+                ("N", ct.c_double), ("u_contact", ct.c_double * 2), ("w_diss", ct.c_double),
+                ("dir", ct.c_double * 2), ("z", ct.c_double * (2 * MAX_SLIDERS))]
+
+
+class Output2(ct.Structure):
+    """``iwan2_output`` (iwan2d.h)."""
+    _fields_ = [("F", ct.c_double * 2), ("K", ct.c_double * 4), ("dFdN", ct.c_double * 2),
+                ("W", ct.c_double), ("E", ct.c_double), ("slip", ct.c_double)]
 
 
 #: numpy view of ``iwan_state`` (one record per state), derived from :class:`State`.
@@ -96,9 +111,10 @@ def arr(a, kind=DoubleArray):
 _S, _D, _I = ct.c_size_t, ct.c_double, ct.c_int
 _PM, _PS, _PO = ct.POINTER(Model), ct.POINTER(State), ct.POINTER(Output)
 _PD, _PI = ct.POINTER(ct.c_double), ct.POINTER(ct.c_int)
+_PS2, _PO2 = ct.POINTER(State2), ct.POINTER(Output2)
 _STATUS = ct.c_int   # iwan_status (an enum: int)
 
-#: name -> (restype, argtypes), in iwan.h order. The only declaration of each function.
+#: name -> (restype, argtypes), in iwan.h then iwan2d.h order. The only declaration of each function.
 FUNCTIONS = {
     "iwan_model_init": (_STATUS, [_PM, DoubleArray, DoubleArray, _S, _D, _I]),
     "iwan_model_from_sliders": (_STATUS, [_PM, DoubleArray, DoubleArray, _S, _D, _D]),
@@ -123,6 +139,12 @@ FUNCTIONS = {
     "iwan_periodic_fourier": (_STATUS, [_PM, _S, Int32Array, DoubleArray, _S, DoubleArray,
                                         DoubleArray, _PD, SizeArray]),
     "iwan_status_text": (ct.c_char_p, [_STATUS]),
+    # iwan2d.h: the 2D element (same model)
+    "iwan2_state_init": (_STATUS, [_PM, _PS2, _D]),
+    "iwan2_eval": (_STATUS, [_PM, _PS2, _D, _D, _D, _PS2, _PO2]),
+    "iwan2_step": (_STATUS, [_PM, _PS2, _D, _D, _D, _PO2]),
+    "iwan2_series": (_STATUS, [_PM, _PS2, _S, DoubleArray, DoubleArray, DoubleArray,
+                               DoubleArray, DoubleArray]),
 }
 
 
