@@ -171,6 +171,10 @@ FUNCTIONS = {
     "iwan2_step": (_STATUS, [_PM, _PS2, _D, _D, _D, _PO2]),
     "iwan2_series": (_STATUS, [_PM, _PS2, _S, DoubleArray, DoubleArray, DoubleArray,
                                DoubleArray, DoubleArray]),
+    "iwan2_periodic_work_size": (_S, [_S]),
+    "iwan2_periodic_jac": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, DoubleArray, DoubleArray,
+                                     DoubleArray, _S, DoubleArray, DoubleArray, _PD, _I, _D, _PI,
+                                     DoubleArray]),
     # contact_point.h: the 3D contact point (2D element + normal law)
     "cpoint_model_init": (_STATUS, [_PCM, _PM, DoubleArray, DoubleArray, _S, _D, _D]),
     "cpoint_normal": (_D, [_PCM, _D, _PD]),

@@ -29,7 +29,7 @@ from ._clib import check as _check
 from ._clib import vec as _vec
 from .element import IwanElement
 
-__all__ = ["IwanElement2D", "IwanState2D", "StepOutput2D", "SeriesResult2D"]
+__all__ = ["IwanElement2D", "IwanState2D", "StepOutput2D", "SeriesResult2D", "PeriodicResult2D"]
 
 _lib = _clib.lib
 
@@ -83,6 +83,15 @@ class SeriesResult2D:
     F: np.ndarray
     W: np.ndarray
     state: IwanState2D
+
+
+@dataclass(frozen=True)
+class PeriodicResult2D:
+    """Periodic loop: F (n, 2) [N], dF (n, 2, 3, n_b) or None, W_cycle [J], periods."""
+    F: np.ndarray
+    dF: np.ndarray | None
+    W_cycle: float
+    periods: int
 
 
 def _output(out: Output2) -> StepOutput2D:
@@ -173,3 +182,49 @@ class IwanElement2D:
         _check(_lib.iwan2_series(self._mp, ct.byref(state._raw), n, arr(ux), arr(uy), arr(Nv),
                                  arr(F), arr(W)), "IwanElement2D.series")
         return SeriesResult2D(F.reshape(n, 2), W, state)
+
+    def periodic_jac(self, ux, uy, E=None, N=None, EN=None, max_periods: int = 100,
+                     tol: float = 1e-12) -> PeriodicResult2D:
+        """Periodic loop of a sampled path and its exact Jacobian (``iwan2_periodic_jac``).
+
+        Parameters
+        ----------
+        ux, uy : array_like, shape (n,)
+            Slip samples over one period [m] (straight lines between them, sample n = 0).
+        E : array_like, shape (n, n_b), optional
+            Basis of u_x and u_y: u_x = E X_x, u_y = E X_y. None: no Jacobian.
+        N : None, float or array_like, shape (n,)
+            Normal load [N] (default N_ref).
+        EN : array_like, shape (n, n_b), optional
+            Basis of N = EN X_N (None: N does not depend on the coefficients).
+        max_periods, tol : int, float
+            Each slider is marched until its position at the sweep start recurs to
+            ``tol`` times its largest slip radius (iwan2d.h).
+
+        Returns
+        -------
+        PeriodicResult2D
+            F (n, 2) [N]; dF (n, 2, 3, n_b): dF_i(t) / d(X_x, X_y, X_N) (None without E);
+            W_cycle [J]; periods.
+        """
+        ux, uy = _vec(ux, "u_x"), _vec(uy, "u_y", ux.size)
+        n = ux.size
+        Nv = None if N is None else _clib.normal(N, n, self.N_ref)
+        Ea = ENa = work = dF = None
+        nb = 0
+        if E is not None:
+            Ea = np.ascontiguousarray(E, dtype=float)
+            if Ea.ndim != 2 or Ea.shape[0] != n:
+                raise _clib.IwanInputError(f"E must have shape ({n}, n_b), got {Ea.shape}")
+            nb = Ea.shape[1]
+            if EN is not None:
+                ENa = np.ascontiguousarray(EN, dtype=float)
+                if ENa.shape != Ea.shape:
+                    raise _clib.IwanInputError(f"EN must have the shape of E {Ea.shape}, got {ENa.shape}")
+            work = np.empty(_lib.iwan2_periodic_work_size(nb))
+            dF = np.empty((n, 2, 3, nb))
+        F, W, periods = np.empty((n, 2)), ct.c_double(), ct.c_int()
+        _check(_lib.iwan2_periodic_jac(self._mp, n, arr(ux), arr(uy), arr(Nv), arr(Ea), arr(ENa), nb,
+                                       arr(F), arr(dF), ct.byref(W), int(max_periods), float(tol),
+                                       ct.byref(periods), arr(work)), "IwanElement2D.periodic_jac")
+        return PeriodicResult2D(F, dF, W.value, periods.value)

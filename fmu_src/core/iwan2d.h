@@ -105,6 +105,30 @@ iwan_status iwan2_series(const iwan_model *model, iwan2_state *state, size_t n,
                          const double *ux, const double *uy, const double *N,
                          double *F, double *W);
 
+/* Doubles of workspace iwan2_periodic_jac needs for nb basis functions (48 nb). */
+size_t iwan2_periodic_work_size(size_t nb);
+
+/* Periodic steady state of a periodic path sampled at n >= 2 points (sample n would
+ * equal sample 0), straight lines between samples, and its exact Jacobian with respect
+ * to basis coefficients: u_x[t] = sum_c E[t*nb + c] X_x[c], u_y[t] = sum_c E[t*nb + c]
+ * X_y[c], N[t] = sum_c EN[t*nb + c] X_N[c] (EN NULL: N does not depend on X; N NULL:
+ * constant model->n_ref). Outputs: F[2t + i] = F_i(t) (i = 0: x, 1: y); when dF is not
+ * NULL, dF[(2t + i) * 3nb + c] = dF_i(t)/d(X_x, X_y, X_N)[c] (E and a workspace of
+ * iwan2_periodic_work_size(nb) doubles needed); W_cycle = energy dissipated per period.
+ * Convention: virgin at u = 0 under N[0], the straight path to sample 0, then each
+ * slider is marched on its own until its position at sample 0 recurs to tol times its
+ * largest slip radius (max_periods at most); one more period gives the outputs. On a
+ * line at constant N this is the 1D element's iwan_periodic (a slider that never slips
+ * sits at the point nearest to 0 it may occupy); the loop is continuous in the path.
+ * periods_used (may be NULL): the most periods any
+ * slider needed, the final one included. IWAN_ERR_NOT_CONVERGED: a slider did not
+ * close (the outputs hold its last period). */
+iwan_status iwan2_periodic_jac(const iwan_model *model, size_t n, const double *ux,
+                               const double *uy, const double *N, const double *E,
+                               const double *EN, size_t nb, double *F, double *dF,
+                               double *W_cycle, int max_periods, double tol, int *periods_used,
+                               double *work);
+
 #ifdef __cplusplus
 }
 #endif

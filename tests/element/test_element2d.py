@@ -262,3 +262,63 @@ def test_same_model_as_the_1d_element():
     assert el2.n_sliders == 1 and el2.N_ref == 1.0
     out = el2.step(el2.initial_state(), [0.5 * R_J, 0.0])
     assert np.allclose(out.F, [0.5 * FS_J, 0.0], rtol=ROUNDOFF)
+
+
+# ---------------------------------------------------------------- periodic loop
+def fourier_basis(n=64, h=2):
+    th = 2 * np.pi * np.arange(n) / n
+    cols = [np.ones(n)]
+    for j in range(1, h + 1):
+        cols += [np.cos(j * th), np.sin(j * th)]
+    return np.column_stack(cols)
+
+
+def test_periodic_jacobian_equals_central_differences(iwan):
+    """Slip in two directions, N varying through lift-off: dF/d(X_x, X_y, X_N)."""
+    E = fourier_basis()
+    r = iwan.element.slip_radii().max()
+    X = np.r_[np.array([0.1, 1.2, 0.3, 0.1, 0.0]) * r, np.array([0.0, 0.2, 0.9, 0.0, 0.1]) * r,
+              N_SPHERE * np.array([0.3, 0.5, 0.0, 0.1, 0.0])]
+
+    def loop(X):
+        return iwan.periodic_jac(E @ X[:5], E @ X[5:10], E, N=E @ X[10:], EN=E, tol=1e-13,
+                                 max_periods=400)
+
+    res = loop(X)
+    assert (E @ X[10:] < 0).any() and res.W_cycle > 0
+    J = res.dF.reshape(-1, 15)
+    fd = np.empty_like(J)
+    for c in range(15):
+        step = np.zeros(15)
+        step[c] = FD_STEP * (r if c < 10 else N_SPHERE)
+        fd[:, c] = (loop(X + step).F.ravel() - loop(X - step).F.ravel()) / (2 * step[c])
+    assert np.abs(fd - J).max() <= FD_RTOL * np.abs(J).max()
+
+
+@pytest.mark.parametrize("angle", [0.0, 0.7])
+def test_periodic_loop_on_a_line_is_the_1d_loop(iwan, angle):
+    E = fourier_basis()
+    r = iwan.element.slip_radii().max()
+    s = E @ (np.array([0.3, 1.2, 0.3, 0.1, 0.0]) * r)
+    t = np.array([np.cos(angle), np.sin(angle)])
+    F1, dF1, _, W1 = iwan.element.periodic_jac(s, E)
+    res = iwan.periodic_jac(s * t[0], s * t[1], E)
+    assert np.abs(res.F @ t - F1).max() <= ROUNDOFF * np.abs(F1).max()
+    assert abs(res.W_cycle - W1) <= ROUNDOFF * W1
+    dline = np.einsum("i,tijc,j->tc", t, res.dF[:, :, :2, :], t)   # along the line, both ways
+    assert np.abs(dline - dF1).max() <= ROUNDOFF * np.abs(dF1).max()
+
+
+def test_periodic_circle_energy():
+    el, a, n = IwanElement2D.jenkins(K_J, FS_J), 3 * R_J, 4000
+    t = 2 * np.pi * np.arange(n) / n
+    res = el.periodic_jac(a * np.cos(t), a * np.sin(t))
+    assert abs(res.W_cycle / (2 * np.pi * FS_J * math.sqrt(a * a - R_J * R_J)) - 1) < CIRCLE_RTOL
+
+
+def test_periodic_refuses_bad_input(iwan):
+    E = fourier_basis()
+    with pytest.raises(IwanInputError, match="shape"):
+        iwan.periodic_jac(np.zeros(64), np.zeros(64), E[:10])
+    with pytest.raises(IwanInputError, match="NaN or infinite"):
+        iwan.periodic_jac(np.full(64, np.nan), np.zeros(64), E)
