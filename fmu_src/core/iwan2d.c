@@ -43,12 +43,26 @@ static const double GL_X[5] = {0.14887433898163121088, 0.43339539412924719080,
 static const double GL_W[5] = {0.29552422471475287017, 0.26926671930999635509,
                                0.21908636251598204400, 0.14945134915058059315,
                                0.06667134430868813759};
+/* 5-point Gauss-Legendre rule on [-1, 1] (nodes +-GL5_X[i] and 0). */
+static const double GL5_X[2] = {0.53846931010568309104, 0.90617984593866399280};
+static const double GL5_W[3] = {0.47862867049936646804, 0.23692688505618908751,
+                                0.56888888888888888889};
 /* Most panels of (P5): the integrand is cut where it falls below e^-40 of its scale,
  * so X_eff max(1, |beta - 1|) stays below ~60 (this cap is never reached in practice). */
 #define KD_MAX_PANELS 128
+/* A panel this narrow (in units of the integrand's scale, pi/2 from its poles) is
+ * integrated to round-off by 5 points: error ~ (width / pi)^10 < 1e-17. */
+#define KD_NARROW 0.05
 /* Below this |x| the series of q(x) = ln(1 + x) / x and q'(x) (to x^9) is exact to
  * round-off; above it the closed forms lose at most eps / x. */
 #define LOGQ_SERIES 1e-2
+
+/* |(x, y)|: sqrt of the sum of squares (hypot's overflow guard is not needed at the
+ * element's scales, |u| <= 1e-6 r / eps, and costs several times more). */
+static double norm2(double x, double y)
+{
+    return sqrt(x * x + y * y);
+}
 
 /* q(x) = ln(1 + x) / x and its derivative (x > -1). */
 static void logq(double x, double *q, double *dq)
@@ -71,26 +85,52 @@ static void logq(double x, double *q, double *dq)
     }
 }
 
-/* (P5) without the factor r*^2, for beta != 0. */
+/* (P5) without the factor r*^2, for beta != 0: Gauss-Legendre panels of equal width.
+ * Integrand f(x) = e^{a x} / (c1p + c1m e^{-2 x}), a = 2 (beta - 1). The nodes sit at
+ * x_c +- h x_k about each panel's centre, so e^{a x} and e^{-2 x} are the centre's
+ * factors (advanced panel by panel) times the offsets' (the same for every panel):
+ * 4 + 2 (pairs) exponentials per call instead of 2 per node. */
 static double kd_quad(double c1m, double c1p, double beta, double X)
 {
-    double cut = X, width, sum = 0.0;
-    int np, i, k;
+    const double a = 2.0 * (beta - 1.0);
+    const double *xk = GL_X, *wk = GL_W;
+    double cut = X, width, half, wc = 0.0, sum = 0.0, A, B, SA = 1.0, SB = 1.0;
+    double ep[5], em[5], fp[5], fm[5];
+    int np = 1, npairs = 5, i, k;
     if (beta < 1.0)  /* integrand <= 2 (c1m / c1p) e^{2 (beta - 1) x} and <= 2 e^{2 beta x} */
         cut = fmin(cut, (20.0 + 0.5 * log(fmax(c1m / c1p, 1.0))) / (1.0 - beta));
     if (beta < 0.0) cut = fmin(cut, 20.0 / -beta);
     if (!(cut > 0.0)) return 0.0;
     width = 1.0 / fmax(1.0, fabs(beta - 1.0));
-    np = cut / width < KD_MAX_PANELS ? (int)ceil(cut / width) : KD_MAX_PANELS;
+    if (cut <= KD_NARROW * width) {  /* one narrow panel (the common small step): 5 points */
+        xk = GL5_X;
+        wk = GL5_W;
+        npairs = 2;
+        wc = GL5_W[2];
+    } else {
+        np = cut / width < KD_MAX_PANELS ? (int)ceil(cut / width) : KD_MAX_PANELS;
+    }
     width = cut / np;
+    half = 0.5 * width;
+    for (k = 0; k < npairs; ++k) {
+        ep[k] = exp(a * half * xk[k]);
+        em[k] = 1.0 / ep[k];
+        fp[k] = exp(-2.0 * half * xk[k]);
+        fm[k] = 1.0 / fp[k];
+    }
+    A = exp(a * half);       /* e^{a x_c} and e^{-2 x_c} at the first centre */
+    B = exp(-2.0 * half);
+    if (np > 1) {
+        SA = exp(a * width);
+        SB = exp(-2.0 * width);
+    }
     for (i = 0; i < np; ++i) {
-        const double xc = (i + 0.5) * width, half = 0.5 * width;
-        for (k = 0; k < 5; ++k) {
-            const double xa = xc - half * GL_X[k], xb = xc + half * GL_X[k];
-            const double fa = exp(2.0 * (beta - 1.0) * xa) / (c1p + c1m * exp(-2.0 * xa));
-            const double fb = exp(2.0 * (beta - 1.0) * xb) / (c1p + c1m * exp(-2.0 * xb));
-            sum += GL_W[k] * half * (fa + fb);
-        }
+        double s = wc > 0.0 ? wc * A / (c1p + c1m * B) : 0.0;
+        for (k = 0; k < npairs; ++k)
+            s += wk[k] * (A * em[k] / (c1p + c1m * B * fm[k]) + A * ep[k] / (c1p + c1m * B * fp[k]));
+        sum += half * s;
+        A *= SA;
+        B *= SB;
     }
     return 2.0 * c1m * sum;
 }
@@ -167,14 +207,14 @@ double iwan2p_slider(double *e, const double *d, double r0, double r1, double *J
     q.dx = d[0];
     q.dy = d[1];
     q.r1 = r1;
-    rho0 = hypot(q.ex, q.ey);
+    rho0 = norm2(q.ex, q.ey);
     if (rho0 > r0) {  /* outside only by round-off: onto the circle */
         const double f = r0 > 0.0 ? r0 / rho0 : 0.0;
         q.ex *= f;
         q.ey *= f;
         rho0 = r0;
     }
-    if (hypot(q.ex + q.dx, q.ey + q.dy) <= r1) {  /* sticks throughout */
+    if ((q.ex + q.dx) * (q.ex + q.dx) + (q.ey + q.dy) * (q.ey + q.dy) <= r1 * r1) {  /* sticks */
         e[0] = q.ex + q.dx;
         e[1] = q.ey + q.dy;
         if (J) set_stick_jacobian(J);
@@ -182,7 +222,7 @@ double iwan2p_slider(double *e, const double *d, double r0, double r1, double *J
         return 0.0;
     }
     *slipped = 1;
-    q.D = hypot(q.dx, q.dy);
+    q.D = norm2(q.dx, q.dy);
     if (q.D == 0.0) {
         e[0] = q.ex;
         e[1] = q.ey;
@@ -200,7 +240,7 @@ double iwan2p_slider(double *e, const double *d, double r0, double r1, double *J
     q.rs = r0 + q.s * q.dr;
     q.ux = q.dx / q.D;
     q.uy = q.dy / q.D;
-    q.rho = hypot(q.esx, q.esy);
+    q.rho = norm2(q.esx, q.esy);
     c = 1.0;
     sn = 0.0;
     if (q.rho > 0.0) {  /* angle t* of e* to d (re-contact from r* = 0: along d) */
@@ -213,7 +253,12 @@ double iwan2p_slider(double *e, const double *d, double r0, double r1, double *J
     q.qx = q.dq = q.xr = 0.0;
     if (q.rs > 0.0 && r1 > 0.0) {                           /* (P2) */
         q.xr = (1.0 - q.s) * q.dr / q.rs;
-        logq(q.xr, &q.qx, &q.dq);
+        if (q.dr == 0.0) {  /* constant radius: q(0) = 1, q'(0) = -1/2 */
+            q.qx = 1.0;
+            q.dq = -0.5;
+        } else {
+            logq(q.xr, &q.qx, &q.dq);
+        }
         q.X = (1.0 - q.s) * q.D * q.qx / q.rs;
     }
     q.E = exp(-q.X);
@@ -385,7 +430,7 @@ void iwan2p_advance(const iwan_model *m, iwan2_state *s, double ux, double uy, d
         release(m, s, ux, uy, sens);
     }
     if (d[0] != 0.0 || d[1] != 0.0) {
-        const double D = hypot(d[0], d[1]);
+        const double D = norm2(d[0], d[1]);
         s->dir[0] = d[0] / D;
         s->dir[1] = d[1] / D;
     }
@@ -401,7 +446,7 @@ void iwan2p_advance(const iwan_model *m, iwan2_state *s, double ux, double uy, d
 static int continued_tangent(const iwan_model *m, int32_t j, double ex, double ey, double r,
                              const double *dir, double *K, double *dFdN, int want)
 {
-    const double k = m->k[j], rho = hypot(ex, ey);
+    const double k = m->k[j], rho = norm2(ex, ey);
     const int slipping = r == 0.0 || (rho >= r * (1.0 - IWAN2_SLIP_RTOL)
                                       && ex * dir[0] + ey * dir[1] > 0.0);
     if (!want) return slipping;
@@ -471,7 +516,7 @@ iwan_status iwan2p_check_state(const iwan2_state *s)
         || !isfinite(s->u_contact[0]) || !isfinite(s->u_contact[1]))
         return IWAN_ERR_BAD_STATE;
     if ((s->in_contact == 1) != (s->N > 0.0) || s->w_diss < 0.0) return IWAN_ERR_BAD_STATE;
-    if (!(fabs(hypot(s->dir[0], s->dir[1]) - 1.0) <= 1e-12)) return IWAN_ERR_BAD_STATE;
+    if (!(fabs(norm2(s->dir[0], s->dir[1]) - 1.0) <= 1e-12)) return IWAN_ERR_BAD_STATE;
     return IWAN_OK;
 }
 
