@@ -120,7 +120,12 @@ class ContactPoint:
         p, Nt = self.table
         i = min(int(np.searchsorted(Nt, N)), p.size - 1)
         i = max(i, 1)
-        return float(p[i - 1] + (N - Nt[i - 1]) * (p[i] - p[i - 1]) / (Nt[i] - Nt[i - 1]))
+        with np.errstate(over="ignore"):
+            pen = float(p[i - 1] + (N - Nt[i - 1]) * (p[i] - p[i - 1]) / (Nt[i] - Nt[i - 1]))
+        if not np.isfinite(pen):
+            raise IwanInputError(f"the penetration at N = {N:g} N overflows: the normal law is too "
+                                 "soft for this load")
+        return pen
 
     def initial_state(self, p: float = 0.0) -> ContactPointState:
         """Virgin state at u = (0, 0) and penetration p [m]."""

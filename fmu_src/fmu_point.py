@@ -106,6 +106,11 @@ def build_point_fmu(u, T, n_ref: float, p, N, out: str | os.PathLike, fmi_versio
     p, N = point.table
     N_start = float(n_ref) if N_start is None else float(N_start)
     p_start = point.penetration(N_start)
+    start = point.eval(point.initial_state(p_start), [0.0, 0.0, p_start])
+    if not (np.all(np.isfinite(start.f)) and np.isfinite(start.E) and np.all(np.isfinite(start.K))):
+        raise ValueError(f"the start at N = {N_start:g} N (p = {p_start:g} m) overflows the "
+                         "contact point's outputs (stored energy): a smaller --preload or a "
+                         "stiffer normal law")
     bound = fmu_build.input_bound(point.tangential)
     iface = fmu_xml.POINT
     with tempfile.TemporaryDirectory(prefix="damper_point_") as tmp:
