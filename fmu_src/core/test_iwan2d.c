@@ -198,6 +198,50 @@ static void test_refused_inputs(void)
     CHECK(iwan2_step(&m, &s, 0.0, 0.0, 20.0, &o) == IWAN_ERR_BAD_STATE, "inconsistent state");
 }
 
+/* The periodic loop (with its Jacobian workspace) on a line equals the 1D loop; on a
+ * circle its energy is the steady circles' sum. */
+static void test_periodic_loop(void)
+{
+    enum { NT = 128, NB = 3 };
+    iwan_model m;
+    double u[NT], ux[NT], uy[NT], E[NT * NB], F1[NT], kt[NT], dfdn[NT], F2[2 * NT];
+    double dF[2 * NT * 3 * NB], work[48 * NB], W1, W2, err = 0.0, Fmax = 0.0, want = 0.0;
+    const double c = cos(0.4), sn = sin(0.4);
+    int i, j, p;
+    make_model(&m);
+    CHECK(iwan2_periodic_work_size(NB) <= 48 * NB, "workspace size");
+    for (i = 0; i < NT; ++i) {
+        const double t = 2.0 * PI * i / NT;
+        u[i] = 1e-7 + 1.5e-6 * cos(t) + 0.4e-6 * sin(t);
+        ux[i] = c * u[i];
+        uy[i] = sn * u[i];
+        E[NB * i] = 1.0;
+        E[NB * i + 1] = cos(t);
+        E[NB * i + 2] = sin(t);
+    }
+    CHECK(iwan_periodic(&m, NT, u, NULL, F1, kt, dfdn, &W1, 10, 1e-12, &p) == IWAN_OK, "1D loop");
+    CHECK(iwan2_periodic_jac(&m, NT, ux, uy, NULL, E, NULL, NB, F2, dF, &W2, 100, 1e-12, &p, work)
+              == IWAN_OK, "2D loop");
+    for (i = 0; i < NT; ++i) {
+        Fmax = fmax(Fmax, fabs(F1[i]));
+        err = fmax(err, fabs(c * F2[2 * i] + sn * F2[2 * i + 1] - F1[i]));
+    }
+    CHECK(err <= ROUNDOFF * Fmax && fabs(W2 - W1) <= ROUNDOFF * W1,
+          "periodic loop on a line: force %g of %g, W %g vs %g", err, Fmax, W2, W1);
+    for (i = 0; i < NT; ++i) {  /* a circle: the 128-gon's own error is a few 1e-4 */
+        const double t = 2.0 * PI * i / NT;
+        ux[i] = 1.5e-6 * cos(t);
+        uy[i] = 1.5e-6 * sin(t);
+    }
+    CHECK(iwan2_periodic_jac(&m, NT, ux, uy, NULL, NULL, NULL, 0, F2, NULL, &W2, 200, 1e-12, &p,
+                             NULL) == IWAN_OK, "circle loop");
+    for (j = 0; j < m.n; ++j) {
+        const double r = m.rad[j] * m.scale;
+        if (r < 1.5e-6) want += 2.0 * PI * m.fs[j] * sqrt(1.5e-6 * 1.5e-6 - r * r);
+    }
+    CHECK(fabs(W2 / want - 1.0) < 1e-3, "circle loop energy %g vs %g", W2, want);
+}
+
 int main(void)
 {
     test_line_is_the_1d_element();
@@ -205,6 +249,7 @@ int main(void)
     test_straight_path_sampling();
     test_tangent_central_differences();
     test_refused_inputs();
+    test_periodic_loop();
     if (failures == 0) printf("iwan2d: all tests passed\n");
     return failures;
 }
