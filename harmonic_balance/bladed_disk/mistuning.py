@@ -177,8 +177,8 @@ def ring_linear(sector: Sector, kappa, damper: str):
     if damper != "free":
         nb, size = len(kappa), M.shape[0]
         QtQ = lambda k: sector.Q.T @ (k[:, None] * sector.Q)  # noqa: E731
-        kn_only = sector.k.copy()
-        kn_only[1::2] = 0.0
+        kn_only = sector.k.copy()  # keep the normal row (the first of each point)
+        kn_only[np.arange(kn_only.size) % sector.rows_per_point != 0] = 0.0
         dofs = damper_dofs(sector, nb)
         K = K + scatter_local(size, dofs, [QtQ(sector.k if damper == "stuck" else kn_only)] * nb)
         C = C + sector.beta_c * scatter_local(size, dofs, [QtQ(sector.k)] * nb)
