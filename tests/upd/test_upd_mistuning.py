@@ -135,8 +135,9 @@ def test_linear_amplification_below_whitehead_and_growing(sector24, damper, band
 def test_mistuned_ring_hb_against_time_integration(sector4):
     """Four mistuned blades, CF/F0 = 4: the HB (H = 15) of the ring against the ring's time
     integration (the same model, march to a settled state) at the worst blade's peak
-    frequency and 1 % either side, every blade within 1 % (measured 0.9 % at most; H = 7:
-    4 %, H = 11: 1.7 %, the harmonic truncation)."""
+    frequency and 1 % either side, every blade within 1 % (measured 0.90 % at most; H = 7:
+    4.1 %, H = 11: 1.7 %: the harmonic truncation; the march settled to 1e-5: 881 periods,
+    25 s CPU)."""
     from harmonic_balance.bladed_disk.timeint import march_ring
 
     kappa = np.array([1.02, 0.985, 1.0, 0.995])
@@ -144,7 +145,7 @@ def test_mistuned_ring_hb_against_time_integration(sector4):
     ring = MistunedRingHB(sector4, kappa, 15, cf=120.0)
     solver = RingSolver(ring)
     hb = np.array([ring.amplitudes(solver.tuned_start(w)) for w in ws])
-    ti = march_ring(sector4, ws, cf=120.0, max_periods=2000, tol=1e-6, kappa=kappa)
-    assert np.all(ti["settle_error"] < 1e-5)
+    ti = march_ring(sector4, ws, cf=120.0, max_periods=2000, tol=1e-5, kappa=kappa)
+    assert np.all(ti["converged"])
     rel = np.abs(ti["amplitude_blades"] - hb) / hb
     assert rel.max() < TI_RTOL, rel
