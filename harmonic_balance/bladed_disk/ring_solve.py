@@ -73,7 +73,7 @@ def tolerance(ring: MistunedRingHB) -> float:
     return TOL_REL * max(ring.f0, ring.cf) * np.sqrt(ring.blades)
 
 
-def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40):
+def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40, lm: bool = True):
     """Newton with a sparse LU, an Armijo line search and a Levenberg-Marquardt fallback;
     (x, iterations).
 
@@ -82,6 +82,8 @@ def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40):
     residual) Levenberg-Marquardt steps ``(J^T J + mu D) p = -J^T R`` (D the running
     maximum of J's squared column norms) decrease |R| until Newton takes over again.
     Stops at |R| <= tol or when the step is below STEP_RTOL |x| (round-off floor).
+    ``lm=False``: fail at once where the line search stalls (a sweep step is then bisected,
+    which is cheaper).
 
     Raises
     ------
@@ -90,7 +92,7 @@ def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40):
     x = np.array(x0, dtype=float)
     R, J = fun(x)
     nr = _norm(R, x)
-    lm = _LM()
+    damped = _LM()
     for it in range(max_iter + 1):
         if nr <= tol:
             return x, it
@@ -104,10 +106,11 @@ def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40):
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         if np.linalg.norm(dx) <= STEP_RTOL * np.linalg.norm(x):
             return x + dx, it + 1
-        step = _line_search(fun, x, dx, nr) or lm.step(fun, x, R, J, nr)
-        if step is None:
+        step = _line_search(fun, x, dx, nr) or (lm and damped.step(fun, x, R, J, nr))
+        if not step:
             raise NewtonError("no decrease, neither along Newton's direction nor by "
-                              "Levenberg-Marquardt steps", x, it, nr)
+                              "Levenberg-Marquardt steps" if lm else "no decrease along "
+                              "Newton's direction", x, it, nr)
         x, R, J, nr = step
     raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
 
@@ -168,6 +171,8 @@ def _norm(R, x):
 #: Bisection levels of a failed sweep step (2^-4 of a grid step; each failed level costs
 #: a Newton solve's iteration limit).
 BISECT = 4
+#: Newton iterations of a sweep step before it is bisected.
+STEP_ITER = 15
 #: Steps of the scatter homotopy from the tuned ring (:meth:`RingSolver.tuned_start`).
 HOMOTOPY_STEPS = 4
 
@@ -189,9 +194,9 @@ class RingSolver:
         self.tol = tolerance(ring)
         self.iterations = 0
 
-    def solve(self, omega: float, x0: np.ndarray, max_iter: int = 40) -> np.ndarray:
+    def solve(self, omega: float, x0: np.ndarray, max_iter: int = 40, lm: bool = True) -> np.ndarray:
         """Newton solve at one frequency; raises NewtonError."""
-        x, it = newton_sparse(lambda z: self.ring(z, omega)[:2], x0, self.tol, max_iter)
+        x, it = newton_sparse(lambda z: self.ring(z, omega)[:2], x0, self.tol, max_iter, lm)
         self.iterations += it
         return x
 
@@ -246,9 +251,10 @@ class RingSolver:
 
     def step(self, w_a, x_a, dxdw, w_b, depth=0):
         """Solution at w_b from (w_a, x_a) with slope dxdw; bisects on failure (at most
-        :data:`BISECT` levels)."""
+        :data:`BISECT` levels; Newton without Levenberg-Marquardt, :data:`STEP_ITER`
+        iterations: a failing step costs little)."""
         try:
-            return self.solve(w_b, x_a + (w_b - w_a) * dxdw)
+            return self.solve(w_b, x_a + (w_b - w_a) * dxdw, STEP_ITER, lm=False)
         except NewtonError:
             if depth >= BISECT:
                 raise
@@ -264,8 +270,8 @@ class RingSolver:
             try:
                 x = self.step(omegas[k - 1], xs[-1], slope, omegas[k])
             except NewtonError:
-                try:  # a kink the bisection cannot pass: restart from the tuned solution
-                    x = self.tuned_start(omegas[k])
+                try:  # a kink the bisection cannot pass: once from the mapped tuned solution
+                    x = self.solve(omegas[k], self.tuned_start_shape(start_point(self.tuned, omegas[k])))
                 except (NewtonError, SolverError) as err:
                     return xs, f"failed at {omegas[k] / 2 / np.pi:.6g} Hz ({err})"
             slope = (x - xs[-1]) / (omegas[k] - omegas[k - 1])

@@ -1,0 +1,173 @@
+"""Benchmark of the mistuned full-ring harmonic balance (table; not a timed test).
+
+Rows:
+
+* ``scaling``: one ring curve (41 points, H = 7, CF/F0 = 4, one std-0.02 pattern) of
+  N_b = 4, 8, 24, 48 blades at the same interblade phase (EO = N_b / 4, so the tuned
+  sector is the same) against the tuned sector's curve on the same grid: CPU time,
+  evaluations, Newton iterations, one sparse LU of the ring Jacobian, its non-zeros.
+* ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
+  cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
+  time: why the solver factors the mistuned Jacobian instead.
+* ``throughput``: a Monte Carlo study (``damper.mistuning``, N_b = 24, std 0.02) on a
+  Dask local cluster of 1 and 2 workers, fresh caches: wall time and samples per
+  minute; the traced memory peak of one sample (tracemalloc, a separate run).
+
+Times are CPU (process_time) where one process works, wall time for the clusters: the
+machine is shared, compare within one run only.
+
+    OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
+        [--rows scaling precond throughput] [--samples 8] [--quick]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+from scipy.sparse.linalg import LinearOperator, gmres, splu
+
+from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.mistuning import draw_factors
+from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
+from harmonic_balance.bladed_disk.ring_solve import RingSolver, ring_frf
+from harmonic_balance.bladed_disk.sector import Sector
+from harmonic_balance.bladed_disk.solve import frf, start_point
+
+BAND = (426.0, 471.0)   # around the tuned peak (448 Hz at CF = 120 N)
+POINTS, H = 41, 7
+
+
+def sector_of(nb: int) -> Sector:
+    return Sector(load_config().with_values(disk__blades=nb, disk__engine_order=nb // 4))
+
+
+def lu_ms(J) -> float:
+    """CPU time of one sparse LU (COLAMD) [ms], the mean over >= 1 s of repeats."""
+    t, k = time.process_time(), 0
+    while time.process_time() - t < 1.0 or k == 0:
+        splu(J, permc_spec="COLAMD")
+        k += 1
+    return (time.process_time() - t) / k * 1e3
+
+
+def scaling_rows(blades) -> list:
+    om = 2 * np.pi * np.linspace(*BAND, POINTS)
+    rows = []
+    for nb in blades:
+        sector = sector_of(nb)
+        tuned = SectorHB(sector, H)
+        c0 = time.process_time()
+        ct = frf(tuned, om)
+        t_sector = time.process_time() - c0
+        ring = MistunedRingHB(sector, draw_factors(nb, 0.02, 1, 0), H)
+        c0 = time.process_time()
+        c = ring_frf(ring, om, tuned, start_omega=ct.peak_omega)
+        t_ring = time.process_time() - c0
+        J = ring(c.peak_x, c.peak_omega)[1].tocsc()
+        rows.append({"case": "ring curve", "blades": nb, "unknowns": ring.size, "jacobian_nnz": J.nnz,
+                     "sector_cpu_s": t_sector, "ring_cpu_s": t_ring, "ratio_ring_sector": t_ring / t_sector,
+                     "ring_cpu_per_blade_s": t_ring / nb, "evaluations": c.evaluations,
+                     "newton_iterations": c.newton_iterations, "lu_ms": lu_ms(J),
+                     "amplification": c.peak / ct.peak_amplitude, "truncated": c.extra["truncated"]})
+        print(_fmt(rows[-1]), flush=True)
+    return rows
+
+
+def precond_rows(stds, nb=24) -> list:
+    sector = sector_of(nb)
+    tuned_ring = MistunedRingHB(sector, np.ones(nb), H)
+    solver_t = RingSolver(tuned_ring)
+    rows = []
+    for f in (440.0, 448.25, 460.0):
+        w = 2 * np.pi * f
+        Jt = tuned_ring(tuned_ring.from_sector(start_point(solver_t.tuned, w)), w)[1].tocsc()
+        lut = splu(Jt, permc_spec="COLAMD")
+        for std in stds:
+            ring = MistunedRingHB(sector, draw_factors(nb, std, 1, 0), H)
+            x = RingSolver(ring, solver_t.tuned).tuned_start(w)
+            J = ring(x, w)[1].tocsc()
+            b = np.random.default_rng(0).standard_normal(ring.size)
+            count = [0]
+            y, _ = gmres(J, b, M=LinearOperator(J.shape, lut.solve), rtol=1e-10, restart=200,
+                         maxiter=1, callback=lambda _: count.__setitem__(0, count[0] + 1),
+                         callback_type="pr_norm")
+            rows.append({"case": "tuned preconditioner", "blades": nb, "frequency_hz": f, "std": std,
+                         "gmres_iterations": count[0],
+                         "gmres_residual": float(np.linalg.norm(J @ y - b) / np.linalg.norm(b)),
+                         "lu_ms": lu_ms(J)})
+            print(_fmt(rows[-1]), flush=True)
+    return rows
+
+
+def throughput_rows(samples: int, workers=(1, 2)) -> list:
+    from damper.cache import Store
+    from damper.mistuning import Study, run_sample, run_study
+
+    rows = []
+    study = Study(std=0.02, samples=samples, seed=1)
+    for n in workers:
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            out = run_study(study, Store(tmp), workers=n, echo=lambda t: None)
+            wall = time.perf_counter() - t0
+        ok = [s for s in out["samples"] if s["error"] is None]
+        rows.append({"case": "Monte Carlo", "blades": out["blades"], "workers": n, "samples": samples,
+                     "failed": out["failed"], "wall_s": wall, "samples_per_min": 60 * samples / wall,
+                     "sample_s_median": float(np.median([s["time_s"] for s in ok])),
+                     "max_amplification": out["max_amplification"], "load_avg": os.getloadavg()[0]})
+        print(_fmt(rows[-1]), flush=True)
+    # memory of one sample (tracemalloc traces numpy's buffers; a separate, untimed run)
+    from damper.mistuning import fingerprint, sample_key, tuned_reference
+
+    cfg = study.load()
+    ref = tuned_reference(study, cfg)
+    kappa = draw_factors(cfg.blades, 0.02, 1, 0)
+    with tempfile.TemporaryDirectory() as tmp:
+        task = {"study": study.__dict__, "index": 0, "kappa": kappa.tolist(), "band_hz": ref["band_hz"],
+                "tuned_frequency_hz": ref["tuned_frequency_hz"], "folder": tmp, "max_bytes": 2**30,
+                "key": sample_key(study, fingerprint(cfg), ref["band_hz"], kappa)}
+        tracemalloc.start()
+        run_sample(task)
+        _, peak = tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+    rows.append({"case": "memory per sample", "blades": cfg.blades, "traced_peak_mib": peak / 2**20})
+    print(_fmt(rows[-1]), flush=True)
+    return rows
+
+
+def _fmt(row: dict) -> str:
+    return "  ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items())
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
+    p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
+                   choices=("scaling", "precond", "throughput"))
+    p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
+    p.add_argument("--quick", action="store_true", help="N_b = 4, 8 only; 2 samples; one scatter")
+    a = p.parse_args(argv)
+    if a.samples < 1:
+        p.error("--samples must be >= 1")
+    rows = []
+    if "scaling" in a.rows:
+        rows += scaling_rows((4, 8) if a.quick else (4, 8, 24, 48))
+    if "precond" in a.rows:
+        rows += precond_rows((0.02,) if a.quick else (0.002, 0.005, 0.02), nb=8 if a.quick else 24)
+    if "throughput" in a.rows:
+        rows += throughput_rows(2 if a.quick else a.samples, (1,) if a.quick else (1, 2))
+    a.out.mkdir(parents=True, exist_ok=True)
+    (a.out / "bench_mistuning.json").write_text(json.dumps(rows, indent=1, default=str) + "\n")
+    print(f"table in {a.out / 'bench_mistuning.json'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,14 @@
+"""Smoke run of examples/bench_mistuning.py (ring scaling rows, N_b = 4, 8; the full
+benchmark with N_b = 24, 48 and the Dask throughput runs by hand)."""
+import pytest
+
+
+@pytest.mark.slow
+def test_bench_mistuning_quick_scaling(tmp_path, load_example):
+    bench = load_example("bench_mistuning")
+    assert bench.main(["--quick", "--rows", "scaling", "--out", str(tmp_path)]) == 0
+    import json
+
+    rows = json.loads((tmp_path / "bench_mistuning.json").read_text())
+    assert [r["blades"] for r in rows] == [4, 8]
+    assert all(r["ring_cpu_s"] > 0 and r["lu_ms"] > 0 and not r["truncated"] for r in rows)
