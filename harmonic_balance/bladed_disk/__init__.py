@@ -1,4 +1,4 @@
-"""Tuned bladed disk with underplatform dampers: cyclic-sector harmonic balance.
+"""Bladed disks with underplatform dampers: cyclic-sector and full-ring harmonic balance.
 
 Modules: :mod:`config` (TOML, bundled UPD-24), :mod:`blade` (the blade's reduced
 matrices with named platform DOFs: built-in lumped UPD-24, .npz or Matrix Market,
