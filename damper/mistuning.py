@@ -119,7 +119,8 @@ class Study:
     def sigma_f(self) -> float:
         """Standard deviation of the blade frequencies implied by the scatter."""
         if self.factors is not None:
-            return float(np.std(np.sqrt(np.asarray(self.factors, float) ** (self.kind == "stiffness"))))
+            f = np.asarray(self.factors, float)
+            return float(np.std(np.sqrt(f) if self.kind == "stiffness" else f))
         return self.std / 2.0 if self.kind == "stiffness" else self.std
 
 
@@ -190,7 +191,9 @@ def run_sample(task: dict) -> dict:
     try:
         out = _solve_sample(Study(**task["study"]), task["kappa"], task["band_hz"],
                             task["tuned_frequency_hz"])
-    except (RuntimeError, ArithmeticError, np.linalg.LinAlgError) as err:
+    except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as err:
+        # a diverged solve (the C core refuses a non-finite iterate: a ValueError); the
+        # model itself was checked by the study's tuned reference before any sample
         return {"index": task["index"], "error": f"{type(err).__name__}: {err}", "cached": False,
                 "time_s": time.perf_counter() - t0}
     out |= {"index": task["index"], "error": None, "time_s": time.perf_counter() - t0}
