@@ -11,7 +11,7 @@ from 0 to 1, :meth:`.ring_hb.MistunedRingHB.set_scale`).
 
 Sweep: from the grid point nearest the tuned peak (the dampers slip there and the
 start converges) along both flanks with a secant predictor, a failed step bisected
-(as the sector's :func:`.solve.sweep`), then restarted from the tuned solution. At
+(as the sector's :func:`.solve.sweep`), then tried once from the mapped tuned solution. At
 low amplitude on a flank the contacts are stuck with their sliders grazing the slip
 limit at single samples (the loop placement of the C core, :mod:`..contact`): the
 residual is then only piecewise smooth in many contacts at once and Newton can stall;
