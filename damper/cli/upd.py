@@ -105,7 +105,12 @@ def run_mistuning(args) -> int:
                   cf=args.cf, f0=args.f0, harmonics=args.harmonics,
                   band_hz=args.band, points=args.points)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
-    out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
+    try:
+        out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
+    except KeyboardInterrupt:
+        print("damper upd mistuning: interrupted; the samples finished so far are in the cache, "
+              "the same command resumes", file=sys.stderr)
+        return 130
     if args.plot:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
