@@ -266,7 +266,7 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
             (root / "resources" / "curve.json").write_text(curve_json)
         (root / "documentation").mkdir()
         (root / "documentation" / "index.html").write_text(_documentation(u_bound))
-        text = fmu_xml.render_model_description(fmi_version, n_ref, names, description,
+        text = fmu_xml.render_model_description(fmi_version, float(n_ref), names, description,
                                                 u_bound if model == "iwan" else None)
         (root / "modelDescription.xml").write_text(text)
         if fmi_version == 3:

@@ -7,6 +7,8 @@
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "damper_vr.h"
@@ -22,14 +24,103 @@
  * round-off of u - z at |u| (a deserialized history is checked against it). */
 #define STRETCH_RTOL 1e-9
 
+#define CURVE_FILE "curve.txt"
+#define MAX_CURVE_POINTS 4096    /* largest table read (fmu_build.check_curve says so too) */
+
+/* The resource table (resources/curve.txt, written by fmu_src/fmu_build.py). */
+typedef struct {
+    size_t n;          /* number of points */
+    double *u, *T;     /* the table [m], [N] */
+    double n_ref;      /* normal load it was computed at [N] */
+    int fit;           /* 0: refuse a non-concave table, 1: use its concave majorant */
+} curve_table;
+
 typedef struct {
     iwan_model m;
     double u_bound;   /* largest |u| accepted [m] */
     double T_top;     /* largest force of the table [N]: |F| <= T_top f(N) when k_res = 0 */
 } iwan_fmu_model;
 
-size_t model_size(void) { return sizeof(iwan_fmu_model); }
-size_t model_history_size(void) { return sizeof(iwan_state); }
+/* Read the table: damper-curve 1 / n_ref <N> / fit <0|1> / points <m> / m lines "u T". */
+static const char *scan_curve(curve_table *t, FILE *f, const char *path, char *why, size_t nw)
+{
+    int version = 0, fit = 0;
+    long m = 0, i;
+    if (fscanf(f, " damper-curve %d n_ref %lf fit %d points %ld", &version, &t->n_ref, &fit,
+               &m) != 4 || version != 1 || m < 2 || m > MAX_CURVE_POINTS) {
+        snprintf(why, nw, "'%s' is not a damper-curve 1 file with 2..%d points", path,
+                 MAX_CURVE_POINTS);
+        return why;
+    }
+    t->u = (double *)malloc((size_t)m * sizeof(double));
+    t->T = (double *)malloc((size_t)m * sizeof(double));
+    if (!t->u || !t->T) return "out of memory reading the curve";
+    for (i = 0; i < m; i++)
+        if (fscanf(f, "%lf %lf", &t->u[i], &t->T[i]) != 2) {
+            snprintf(why, nw, "'%s': point %ld of %ld unreadable", path, i, m);
+            return why;
+        }
+    t->n = (size_t)m;
+    t->fit = fit;
+    return NULL;
+}
+
+void model_unload(void *res)
+{
+    curve_table *t = (curve_table *)res;
+    if (!t) return;
+    free(t->u);
+    free(t->T);
+    free(t);
+}
+
+const char *model_load(void **res, const char *dir, char *why, size_t why_size)
+{
+    size_t len = strlen(dir);
+    char *path = (char *)malloc(len + sizeof(CURVE_FILE) + 2);
+    curve_table *t = (curve_table *)calloc(1, sizeof(curve_table));
+    const char *err = NULL;
+    FILE *f = NULL;
+    *res = NULL;
+    if (!path || !t) err = "out of memory reading the curve";
+    if (!err) {
+        memcpy(path, dir, len);
+        if (len == 0 || path[len - 1] != '/') path[len++] = '/';
+        memcpy(path + len, CURVE_FILE, sizeof(CURVE_FILE));
+        f = fopen(path, "r");
+        if (!f) {
+            snprintf(why, why_size, "cannot open the curve file '%s'", path);
+            err = why;
+        }
+    }
+    if (!err) err = scan_curve(t, f, path, why, why_size);
+    if (f) fclose(f);
+    free(path);
+    if (err) {
+        model_unload(t);
+        return err;
+    }
+    *res = t;
+    return NULL;
+}
+
+size_t model_size(const void *res) { (void)res; return sizeof(iwan_fmu_model); }
+size_t model_history_size(const void *res) { (void)res; return sizeof(iwan_state); }
+
+/* N and N_ref start at the curve's normal load. */
+double model_start(const void *res, unsigned int vr)
+{
+    (void)vr;
+    return ((const curve_table *)res)->n_ref;
+}
+
+const char *model_check_parameter(const void *res, unsigned int vr, double v)
+{
+    (void)res;
+    if (vr == VR_SCALE && !(v >= 0.0)) return "scale must be >= 0";
+    if (vr == VR_N_REF && !(v > 0.0)) return "N_ref must be > 0";
+    return NULL;
+}
 
 /* Header, the n sliders in use and dir: the rest of z stays zero in every history. */
 void model_copy_history(const void *model, void *dst, const void *src)
@@ -41,8 +132,9 @@ void model_copy_history(const void *model, void *dst, const void *src)
     d->dir = s->dir;
 }
 
-const char *model_build(void *model, const model_table *t, const double *value)
+const char *model_build(void *model, const void *res, const double *value)
 {
+    const curve_table *t = (const curve_table *)res;
     iwan_fmu_model *md = (iwan_fmu_model *)model;
     double rmin = HUGE_VAL;
     size_t i;
@@ -92,14 +184,27 @@ const char *model_eval(const void *model, const void *history, const double *val
     return NULL;
 }
 
-const char *model_commit(const void *model, void *history, const double *value, double *out)
+static const char *commit(const iwan_fmu_model *md, void *history, const double *value,
+                          double *out)
 {
-    const iwan_fmu_model *md = (const iwan_fmu_model *)model;
     iwan_output o;
     iwan_status st = iwan_step(&md->m, (iwan_state *)history, value[VR_U], value[VR_N], &o);
     if (st != IWAN_OK) return iwan_status_text(st);
     store(md, &o, value[VR_N], out);
     return NULL;
+}
+
+/* The path to the inputs at t, then along their straight lines to t + h: the core is
+ * exact along straight (u, N) paths, so h itself does not enter (rate independence). */
+const char *model_step(const void *model, void *history, const double *start,
+                       const double *end, double t, double h, double *out)
+{
+    const iwan_fmu_model *md = (const iwan_fmu_model *)model;
+    const char *why = commit(md, history, start, out);
+    (void)t; (void)h;
+    if (!why && (end[VR_U] != start[VR_U] || end[VR_N] != start[VR_N]))
+        why = commit(md, history, end, out);
+    return why;
 }
 
 /* dF = kt du + dF/dN dN; kt, slip are piecewise constant in (u, N) (zero derivative);

@@ -3,6 +3,7 @@
  * the cost of the FMI layer and the FMI calls alone (examples/bench_fmu.py). Its
  * history is the last committed input, nothing else. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "damper_vr.h"
@@ -12,8 +13,24 @@ typedef struct {
     double u;   /* last committed displacement [m] */
 } passthrough_history;
 
-size_t model_size(void) { return 1; }
-size_t model_history_size(void) { return sizeof(passthrough_history); }
+/* No resources: the FMU's curve file is not read. */
+const char *model_load(void **res, const char *dir, char *why, size_t why_size)
+{
+    (void)dir; (void)why; (void)why_size;
+    *res = malloc(1);
+    return *res ? NULL : "out of memory";
+}
+
+void model_unload(void *res) { free(res); }
+size_t model_size(const void *res) { (void)res; return 1; }
+size_t model_history_size(const void *res) { (void)res; return sizeof(passthrough_history); }
+double model_start(const void *res, unsigned int vr) { (void)res; (void)vr; return 1.0; }
+
+const char *model_check_parameter(const void *res, unsigned int vr, double v)
+{
+    (void)res; (void)vr; (void)v;
+    return NULL;
+}
 
 void model_copy_history(const void *model, void *dst, const void *src)
 {
@@ -21,9 +38,9 @@ void model_copy_history(const void *model, void *dst, const void *src)
     memcpy(dst, src, sizeof(passthrough_history));
 }
 
-const char *model_build(void *model, const model_table *table, const double *value)
+const char *model_build(void *model, const void *res, const double *value)
 {
-    (void)model; (void)table; (void)value;
+    (void)model; (void)res; (void)value;
     return NULL;
 }
 
@@ -43,10 +60,12 @@ const char *model_eval(const void *model, const void *history, const double *val
     return NULL;
 }
 
-const char *model_commit(const void *model, void *history, const double *value, double *out)
+const char *model_step(const void *model, void *history, const double *start,
+                       const double *end, double t, double h, double *out)
 {
-    ((passthrough_history *)history)->u = value[VR_U];
-    return model_eval(model, history, value, out);
+    (void)start; (void)t; (void)h;
+    ((passthrough_history *)history)->u = end[VR_U];
+    return model_eval(model, history, end, out);
 }
 
 const char *model_partial(const void *model, const void *history, const double *value,
