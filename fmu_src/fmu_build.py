@@ -36,8 +36,12 @@ FMI_DIR = Path(__file__).resolve().parent / "fmi"
 CORE_DIR = Path(__file__).resolve().parent / "core"
 HEADER_PATH = FMI_DIR / "damper_vr.h"
 
-#: Model hooks available to the wrapper (model.h): the element and a baseline.
-MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c"}
+#: Model hooks available to the wrapper (model.h): the element, a baseline, a linear
+#: blade (fmu_src.blade_fmu) and an underplatform damper (fmu_src.upd_fmu).
+MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c",
+          "blade": "model_blade.c", "upd": "model_upd.c"}
+#: Models that need the friction-law core compiled in.
+USES_CORE = ("iwan", "passthrough", "upd")
 #: Binary folder of each FMI version on 64-bit Linux.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 #: How a curve table that is not concave is handled (iwan.h iwan_fit).
@@ -72,7 +76,8 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *CORE_SOURCES]
+    core = CORE_SOURCES if model in USES_CORE else ()
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *core]
 
 
 def _check_version(fmi_version: int) -> None:
@@ -133,11 +138,19 @@ def curve_resource_text(u, T, n_ref: float, fit: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
-    """Copy the C sources and headers flat into ``dest``; return the .c names."""
+def _copy_sources(dest: Path, fmi_version: int, model: str,
+                  interface: fmu_xml.Interface = fmu_xml.IWAN) -> list[str]:
+    """Copy the C sources and headers flat into ``dest``; return the .c names.
+
+    The variable header ``damper_vr.h`` is the committed one for the friction element,
+    otherwise generated from ``interface``.
+    """
     dest.mkdir(parents=True)
     names = c_sources(fmi_version, model)
     for name in names + list(_WRAPPER_HEADERS + CORE_HEADERS):
+        if name == "damper_vr.h" and interface is not fmu_xml.IWAN:
+            (dest / name).write_text(fmu_xml.render_vr_header(interface))
+            continue
         src = CORE_DIR if name in CORE_SOURCES + CORE_HEADERS else FMI_DIR
         shutil.copy(src / name, dest / name)
     for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
@@ -210,6 +223,58 @@ def _zip_dir(root: Path) -> bytes:
     return buf.getvalue()
 
 
+def package_fmu(out: str | os.PathLike, fmi_version: int, model: str,
+                interface: fmu_xml.Interface, resources: dict, starts=None,
+                description: str = "", documentation: str = "", bounds: dict | None = None,
+                compiler: str | None = None) -> Path:
+    """Write a co-simulation FMU of ``model`` behind the FMI layer (atomically).
+
+    Parameters
+    ----------
+    out : path                 the ``.fmu`` file
+    fmi_version : {2, 3}
+    model : str                a key of :data:`MODELS`
+    interface : fmu_xml.Interface
+        Its variable table (``damper_vr.h`` and the model description come from it).
+    resources : dict           file name -> text, written under ``resources/``
+    starts : float or dict     start values of the variables of rule ``model``
+    description, documentation : str
+        Model description text; ``documentation/index.html``.
+    bounds : dict              input bounds by name (min/max in the model description)
+    compiler : str, optional   C compiler (default ``$CC`` or ``cc``)
+
+    Returns
+    -------
+    Path of the written FMU.
+
+    Raises
+    ------
+    RuntimeError
+        The compiler failed.
+    """
+    _check_version(fmi_version)
+    with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
+        root = Path(tmp) / "fmu"
+        names = _copy_sources(root / "sources", fmi_version, model, interface)
+        (root / "resources").mkdir()
+        for name, text in resources.items():
+            (root / "resources" / name).write_text(text)
+        if documentation:
+            (root / "documentation").mkdir()
+            (root / "documentation" / "index.html").write_text(documentation)
+        text = fmu_xml.render_model_description(fmi_version, starts, names, description,
+                                                interface=interface, bounds=bounds)
+        (root / "modelDescription.xml").write_text(text)
+        if fmi_version == 3:
+            (root / "sources" / "buildDescription.xml").write_text(
+                fmu_xml.render_build_description(names, interface.identifier))
+        binary = root / "binaries" / PLATFORM[fmi_version] / f"{interface.identifier}.so"
+        compile_binary(root / "sources", names, binary, compiler)
+        path = atomic_write(out, _zip_dir(root))
+    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
+    return path
+
+
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
               fit: str = "reject", model: str = "iwan", description: str = "",
               compiler: str | None = None, curve_json: str | None = None,
@@ -257,26 +322,12 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         from fmu_src.element import IwanElement
 
         u_bound = input_bound(IwanElement.from_curve(u, T, float(n_ref), fit=fit))
-    with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
-        root = Path(tmp) / "fmu"
-        names = _copy_sources(root / "sources", fmi_version, model)
-        (root / "resources").mkdir()
-        (root / "resources" / "curve.txt").write_text(curve_resource_text(u, T, n_ref, fit))
-        if curve_json is not None:
-            (root / "resources" / "curve.json").write_text(curve_json)
-        (root / "documentation").mkdir()
-        (root / "documentation" / "index.html").write_text(_documentation(u_bound))
-        text = fmu_xml.render_model_description(fmi_version, float(n_ref), names, description,
-                                                u_bound if model == "iwan" else None)
-        (root / "modelDescription.xml").write_text(text)
-        if fmi_version == 3:
-            (root / "sources" / "buildDescription.xml").write_text(
-                fmu_xml.render_build_description(names))
-        binary = root / "binaries" / PLATFORM[fmi_version] / f"{fmu_xml.MODEL_IDENTIFIER}.so"
-        compile_binary(root / "sources", names, binary, compiler)
-        path = atomic_write(out, _zip_dir(root))
-    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
-    return path
+    resources = {"curve.txt": curve_resource_text(u, T, n_ref, fit)}
+    if curve_json is not None:
+        resources["curve.json"] = curve_json
+    return package_fmu(out, fmi_version, model, fmu_xml.IWAN, resources, float(n_ref),
+                       description, _documentation(u_bound),
+                       {"u": u_bound} if model == "iwan" else None, compiler)
 
 
 def header_is_current() -> bool:
