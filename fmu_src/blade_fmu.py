@@ -20,10 +20,13 @@ Inputs, per communication step held as straight lines x + x_rate (s - t):
 
 Outputs ``q_<dof>``, ``v_<dof>`` [m, m/s] of the platform points, the response and
 the coupling DOFs, and the energies [J]: ``W_excitation`` (work of the EO force),
-``W_interface`` (of the interface forces), ``W_neighbours`` (of the coupling forces),
+``W_interface`` (of the interface forces), ``W_neighbours_stiffness`` and
+``W_neighbours_damping`` (of the coupling forces' K_next and C_next parts),
 ``W_damping`` (dissipated by C: the balance of the others and ``energy``), ``energy``
-(q'^T M q' + q^T K q) / 2. Parameters: ``F0`` [N], ``frequency`` [Hz],
-``blade_index`` and ``interblade_phase`` [rad]: the EO force
+(q'^T M q' + q^T K q) / 2. Over a ring in a periodic state the neighbours' stiffness
+works sum to zero and their damping works to minus the dissipation of C_next.
+Parameters: ``F0`` [N], ``frequency`` [Hz], ``blade_index`` and ``interblade_phase``
+[rad]: the EO force
 ``F0 cos(2 pi frequency t + blade_index interblade_phase)`` on the forced DOF.
 """
 from __future__ import annotations
@@ -48,9 +51,12 @@ ENERGY_OUTPUTS = (
     ("W_excitation", "J", "Work of the engine-order force (cumulative)"),
     ("W_damping", "J", "Energy dissipated by the blade's damping C (cumulative)"),
     ("W_interface", "J", "Work of the interface forces on the blade (cumulative)"),
-    ("W_neighbours", "J", "Work of the neighbours' coupling forces on the blade (cumulative)"),
+    ("W_neighbours_stiffness", "J", "Work of the neighbours' K_next coupling forces (cumulative)"),
+    ("W_neighbours_damping", "J", "Work of the neighbours' C_next coupling forces (cumulative)"),
     ("energy", "J", "Mechanical energy (q'^T M q' + q^T K q) / 2"),
 )
+#: Work groups of the inputs (resource blocks work_<group>_value / _rate, in this order).
+GROUPS = ("interface", "stiffness", "damping")
 AXES = ("x", "y")
 
 
@@ -168,29 +174,31 @@ def interface(b: BladeSpec, F0: float, frequency: float, blade_index: float,
     Returns
     -------
     interface : fmu_xml.Interface
-    maps : dict with ``value``, ``rate`` (n, n_in) generalized force per input (at the
-        step start and its rate), ``interface`` (n_in,) bool (interface-force inputs;
-        the others are the neighbours'), ``outputs`` list of (dof, kind) per kinematic output
+    maps : dict with, per work group of :data:`GROUPS`, ``(value, rate)`` (n, n_in): the
+        generalized force of each input at the step start and its rate; ``outputs`` list
+        of (dof, kind) per kinematic output
     """
-    rows, maps_v, maps_r, is_if = [], [], [], []
+    rows = []
     n = b.n
-
-    def add_input(name, unit, desc, value, fv, fr, interface_force):
-        rows.append((name, unit, desc, value))
-        maps_v.append(fv)
-        maps_r.append(fr)
-        is_if.append(interface_force)
-
+    parts = {g: ([], []) for g in GROUPS}
     zero = np.zeros(n)
+
+    def add_input(name, unit, desc, value, groups):
+        rows.append((name, unit, desc, value))
+        for g in GROUPS:
+            fv, fr = groups.get(g, (zero, zero))
+            parts[g][0].append(fv)
+            parts[g][1].append(fr)
+
     for point, dofs in b.points.items():
         f = np.asarray(b.f_points.get(point, (0.0, 0.0)), dtype=float)
         for k, (axis, d) in enumerate(zip(AXES, dofs)):
             e = np.zeros(n)
             e[d] = 1.0
             add_input(f"F_{point}_{axis}", "N", f"Force on the {point} platform point, "
-                      f"{axis} ({b.dofs[d]})", f[k], e, zero, True)
+                      f"{axis} ({b.dofs[d]})", f[k], {"interface": (e, zero)})
             add_input(f"F_{point}_{axis}_rate", "N/s", f"Rate of F_{point}_{axis} over the "
-                      "step", 0.0, zero, e, True)
+                      "step", 0.0, {"interface": (zero, e)})
     Kn = np.zeros((n, n)) if b.K_next is None else np.asarray(b.K_next, float)
     Cn = np.zeros((n, n)) if b.C_next is None else np.asarray(b.C_next, float)
     for side, Kc, Cc in (("next", Kn, Cn), ("prev", Kn.T, Cn.T)):
@@ -198,9 +206,9 @@ def interface(b: BladeSpec, F0: float, frequency: float, blade_index: float,
         for d in b.coupling_dofs():
             name = b.dofs[d]
             add_input(f"q_{side}_{name}", "m", f"Displacement {name} of blade {blade}",
-                      b.q_neighbour[d], -Kc[:, d], zero, False)
+                      b.q_neighbour[d], {"stiffness": (-Kc[:, d], zero)})
             add_input(f"v_{side}_{name}", "m/s", f"Velocity {name} of blade {blade}", 0.0,
-                      -Cc[:, d], -Kc[:, d], False)
+                      {"stiffness": (zero, -Kc[:, d]), "damping": (-Cc[:, d], zero)})
     variables = [fmu_xml.Variable("time", 0, "independent", "continuous", "s", "none",
                                   "Simulation time")]
     for name, unit, desc, value in rows:
@@ -229,8 +237,9 @@ def interface(b: BladeSpec, F0: float, frequency: float, blade_index: float,
                             units={"N/s": {"kg": 1, "m": 1, "s": -3},
                                    "m/s": {"m": 1, "s": -1}, "Hz": {"s": -1},
                                    "rad": {}})
-    return itf, {"value": np.array(maps_v).T, "rate": np.array(maps_r).T,
-                 "interface": np.array(is_if), "outputs": outputs}
+    maps = {g: (np.array(v).T, np.array(r).T) for g, (v, r) in parts.items()}
+    maps["outputs"] = outputs
+    return itf, maps
 
 
 def _block(name: str, A) -> str:
@@ -245,8 +254,10 @@ def resource_text(b: BladeSpec, itf: fmu_xml.Interface, maps: dict, modal: dict)
     m = lam.size
     Vq = V[:n]
     rows = np.array([V[d] if kind == "q" else V[n + d] for d, kind in maps["outputs"]])
-    Lv, Lr, is_if = maps["value"], maps["rate"], maps["interface"]
-    work = [(Lv * is_if).T @ Vq, (Lr * is_if).T @ Vq, (Lv * ~is_if).T @ Vq, (Lr * ~is_if).T @ Vq]
+    Lv = sum(maps[g][0] for g in GROUPS)
+    Lr = sum(maps[g][1] for g in GROUPS)
+    work = "".join(_block(f"work_{g}_value", maps[g][0].T @ Vq)
+                   + _block(f"work_{g}_rate", maps[g][1].T @ Vq) for g in GROUPS)
     S = V.conj().T @ sla.block_diag(b.K, b.M) @ V
     eta0 = np.linalg.solve(V, np.concatenate([np.asarray(b.q0, float), np.zeros(n)]))
     n_in = len(itf.by_causality("input"))
@@ -254,10 +265,7 @@ def resource_text(b: BladeSpec, itf: fmu_xml.Interface, maps: dict, modal: dict)
             + _block("lambda", lam) + _block("eta0", eta0)
             + _block("value_map", G @ Lv) + _block("rate_map", G @ Lr)
             + _block("excitation", G[:, b.forced]) + _block("outputs", rows)
-            + _block("forced", Vq[b.forced])
-            + _block("work_interface_value", work[0]) + _block("work_interface_rate", work[1])
-            + _block("work_neighbours_value", work[2]) + _block("work_neighbours_rate", work[3])
-            + _block("energy", S))
+            + _block("forced", Vq[b.forced]) + work + _block("energy", S))
     return text
 
 

@@ -20,7 +20,9 @@
  * + h^2 exp[0, L, +-iO] g+-; the excitation's work is [F q_f] - int F' q_f with
  * int e^(i Omega tau) eta in the same closed form; the mechanical energy E =
  * (q'^T M q' + q^T K q) / 2 = Re(eta^H S eta) / 2; the structural dissipation is the
- * balance W_excitation + W_interface + W_neighbours - (E - E(0)).
+ * balance W_excitation + W_interface + W_neighbours (stiffness and damping parts) -
+ * (E - E(0)). The inputs' works are kept in three groups (interface forces, the
+ * neighbours' K_next and C_next forces), each with a value and a rate map.
  * Divided differences are evaluated without cancellation: a Taylor series about the
  * points' mean when they lie within DD_SERIES_SPREAD of each other, else the
  * recursion on the two farthest points.
@@ -37,7 +39,8 @@
 #define BLADE_FILE "blade.txt"
 #define DD_SERIES_SPREAD 1.0  /* largest |x_i - x_j| summed by the series */
 #define DD_SERIES_TERMS 30    /* terms: spread^k / k! < 1e-32 at k = 30 */
-#define N_ENERGY_OUTPUTS 5    /* the last outputs: W_excitation .. energy */
+#define N_ENERGY_OUTPUTS 6    /* the last outputs: W_excitation .. energy */
+#define N_GROUPS 3            /* work groups: interface, neighbours K_next, C_next */
 #define MAX_MODES 4096
 #define TWO_PI 6.283185307179586476925286766559
 
@@ -52,7 +55,7 @@ typedef struct {
     cplx *exc;                /* (m): G column of the forced DOF [modal / N] */
     cplx *out_rows;           /* (n_out, m): rows of V of the outputs (q or q') */
     cplx *forced_row;         /* (m): row of V of the forced DOF's q */
-    cplx *work[4];            /* (n_in, m): interface value/rate, neighbour value/rate */
+    cplx *work[2 * N_GROUPS]; /* (n_in, m): value and rate map of each work group */
     cplx *energy;             /* (m, m): S = V^H blkdiag(K, M) V */
     double *buf;
 } blade_res;
@@ -70,7 +73,8 @@ typedef struct {
 } blade_model;
 
 typedef struct {
-    double W_exc, W_if, W_nb; /* cumulative works [J] */
+    double W_exc;             /* cumulative work of the excitation [J] */
+    double W[N_GROUPS];       /* cumulative works of the input groups [J] */
     double E0;                /* energy at the start [J] */
     double eta[];             /* (m) complex as (re, im) pairs */
 } blade_history;
@@ -171,7 +175,7 @@ static const char *read_blade(blade_res *r, FILE *f, char *why, size_t nw)
         return why;
     }
     m = (size_t)r->m; ni = (size_t)r->n_in; no = (size_t)r->n_out;
-    total = 2 * m + 2 * m * ni + m + no * m + m + 4 * ni * m + m * m;
+    total = 2 * m + 2 * m * ni + m + no * m + m + 2 * N_GROUPS * ni * m + m * m;
     r->buf = (double *)malloc(total * sizeof(cplx));
     if (!r->buf) return "out of memory reading the blade";
     p = (cplx *)r->buf;
@@ -179,7 +183,7 @@ static const char *read_blade(blade_res *r, FILE *f, char *why, size_t nw)
     r->lambda = TAKE(m); r->eta0 = TAKE(m);
     r->value_map = TAKE(m * ni); r->rate_map = TAKE(m * ni);
     r->exc = TAKE(m); r->out_rows = TAKE(no * m); r->forced_row = TAKE(m);
-    for (k = 0; k < 4; k++) r->work[k] = TAKE(ni * m);
+    for (k = 0; k < 2 * N_GROUPS; k++) r->work[k] = TAKE(ni * m);
     r->energy = TAKE(m * m);
 #undef TAKE
     if (!read_block(f, "lambda", r->lambda, m) || !read_block(f, "eta0", r->eta0, m)
@@ -190,8 +194,10 @@ static const char *read_blade(blade_res *r, FILE *f, char *why, size_t nw)
         || !read_block(f, "forced", r->forced_row, m)
         || !read_block(f, "work_interface_value", r->work[0], ni * m)
         || !read_block(f, "work_interface_rate", r->work[1], ni * m)
-        || !read_block(f, "work_neighbours_value", r->work[2], ni * m)
-        || !read_block(f, "work_neighbours_rate", r->work[3], ni * m)
+        || !read_block(f, "work_stiffness_value", r->work[2], ni * m)
+        || !read_block(f, "work_stiffness_rate", r->work[3], ni * m)
+        || !read_block(f, "work_damping_value", r->work[4], ni * m)
+        || !read_block(f, "work_damping_rate", r->work[5], ni * m)
         || !read_block(f, "energy", r->energy, m * m))
         return "blade file truncated or holding a non-finite number";
     return NULL;
@@ -292,7 +298,7 @@ const char *model_reset(const void *model, void *history, const double *value)
     blade_history *hs = (blade_history *)history;
     (void)value;
     memcpy(eta_of(history), b->r->eta0, (size_t)b->r->m * sizeof(cplx));
-    hs->W_exc = hs->W_if = hs->W_nb = 0.0;
+    hs->W_exc = hs->W[0] = hs->W[1] = hs->W[2] = 0.0;
     hs->E0 = energy(b->r, b->r->eta0);
     return NULL;
 }
@@ -317,10 +323,11 @@ const char *model_eval(const void *model, const void *history, const double *val
     for (i = 0; i < r->n_out; i++)
         out[damper_outputs[i]] = dot_re(r->out_rows + (size_t)i * (size_t)r->m, eta, r->m);
     out[VR_W_EXCITATION] = hs->W_exc;
-    out[VR_W_INTERFACE] = hs->W_if;
-    out[VR_W_NEIGHBOURS] = hs->W_nb;
+    out[VR_W_INTERFACE] = hs->W[0];
+    out[VR_W_NEIGHBOURS_STIFFNESS] = hs->W[1];
+    out[VR_W_NEIGHBOURS_DAMPING] = hs->W[2];
     out[VR_ENERGY] = E;
-    out[VR_W_DAMPING] = hs->W_exc + hs->W_if + hs->W_nb - (E - hs->E0);
+    out[VR_W_DAMPING] = hs->W_exc + hs->W[0] + hs->W[1] + hs->W[2] - (E - hs->E0);
     return NULL;
 }
 
@@ -402,8 +409,9 @@ const char *model_step(const void *model, void *history, const double *start,
         hq[k] = h * e1[k] - ie[k];
     }
     /* works of the inputs (value part on dq, rate part on h q(h) - int q) */
-    hs->W_if += work_term(r, r->work[0], start, dq) + work_term(r, r->work[1], start, hq);
-    hs->W_nb += work_term(r, r->work[2], start, dq) + work_term(r, r->work[3], start, hq);
+    for (i = 0; i < N_GROUPS; i++)
+        hs->W[i] += work_term(r, r->work[2 * i], start, dq)
+                    + work_term(r, r->work[2 * i + 1], start, hq);
     /* excitation: F q_f at the ends minus int F' q_f, F' = Re(i Omega F0 e^(i psi) e^(i Omega tau)) */
     Fs = b->F0 * cos(b->omega * t + b->psi0);
     Fe = b->F0 * cos(b->omega * (t + h) + b->psi0);
@@ -428,7 +436,8 @@ const char *model_check_history(const void *model, const void *history)
     int k;
     for (k = 0; k < 2 * b->r->m; k++)
         if (!isfinite(hs->eta[k])) return "modal state not finite";
-    if (!isfinite(hs->W_exc) || !isfinite(hs->W_if) || !isfinite(hs->W_nb) || !isfinite(hs->E0))
+    if (!isfinite(hs->W_exc) || !isfinite(hs->W[0]) || !isfinite(hs->W[1])
+        || !isfinite(hs->W[2]) || !isfinite(hs->E0))
         return "energy not finite";
     return NULL;
 }
