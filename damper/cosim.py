@@ -196,7 +196,7 @@ def energy_balance(e0: dict, e1: dict) -> dict:
             "damper_dashpots": d["damper_W_dashpots"], "stored_change": stored,
             "neighbours_stiffness": d["blade_W_neighbours_stiffness"],
             "interface_mismatch": d["blade_W_interface"] + d["damper_W_platforms"],
-            "residual": residual, "relative_residual": residual / exc if exc else float("nan")}
+            "residual": residual, "relative_residual": residual / exc if exc else None}
 
 
 def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force: bool = False,
@@ -258,7 +258,7 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
            "amplitude_blades": np.abs(h1).tolist(),
            "phase_steps": np.angle(h1[(np.arange(nr) + 1) % nr] / h1).tolist(),
            "interblade_phase": info["interblade_phase"], "periods": k, "settled": settled,
-           "settle_change": deltas[-1] if deltas else float("nan"),
+           "settle_change": deltas[-1] if deltas else None,
            "settle_estimate": est if np.isfinite(est) else None, "tol": tol,
            "steps_per_period": plan["steps_per_period"], "step": plan["step"],
            "step_limit": info["step_limit"], "period_error": plan["period_error"],

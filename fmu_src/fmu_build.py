@@ -160,8 +160,9 @@ def _copy_sources(dest: Path, fmi_version: int, model: str,
 
 
 def compile_binary(source_dir: Path, names: list[str], out: Path,
-                   compiler: str | None = None) -> None:
-    """Compile ``names`` from ``source_dir`` into the shared library ``out``.
+                   compiler: str | None = None, extra_flags: tuple = ()) -> None:
+    """Compile ``names`` from ``source_dir`` into the shared library ``out``
+    (``extra_flags``: e.g. ``-Werror`` in CI).
 
     Raises
     ------
@@ -170,7 +171,7 @@ def compile_binary(source_dir: Path, names: list[str], out: Path,
     """
     cc = compiler or os.environ.get("CC", "cc")
     out.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [cc, *CFLAGS, f"-I{source_dir}", *[str(source_dir / n) for n in names],
+    cmd = [cc, *CFLAGS, *extra_flags, f"-I{source_dir}", *[str(source_dir / n) for n in names],
            "-o", str(out), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:

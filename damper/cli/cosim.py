@@ -39,11 +39,13 @@ def run(args) -> int:
         print_json(r)
         return 0
     e = r["energy"]
+    change = "-" if r["settle_change"] is None else f"{r['settle_change']:.1e}"
+    residual = "-" if e["relative_residual"] is None else f"{e['relative_residual']:+.1e}"
     print(f"{r['frequency_hz']} Hz: first-harmonic amplitude {r['amplitude']:.6e} m "
           f"({r['response_dof']}), {r['periods']} periods ({'settled' if r['settled'] else 'NOT settled'}: "
-          f"change {r['settle_change']:.1e}), step {r['step']:.4g} s ({r['steps_per_period']} a period, "
+          f"change {change}), step {r['step']:.4g} s ({r['steps_per_period']} a period, "
           f"limit {r['step_limit']:.3g} s)")
     print(f"last period: excitation {e['excitation']:.6e} J = structural {e['structural']:.6e} + "
           f"dampers {e['damper_friction'] + e['damper_dashpots']:.6e} + stored {e['stored_change']:.1e} "
-          f"(residual {e['relative_residual']:+.1e}); wall {r['wall_time_s']:.1f} s")
+          f"(residual {residual}); wall {r['wall_time_s']:.1f} s")
     return 0
