@@ -18,11 +18,12 @@ remaining change of a transient decaying like rho^k; the ring time integration's
 Energy over the last period (differences of the FMUs' cumulative outputs):
 excitation = sum of the blades' W_excitation; structural = sum of W_damping (each
 blade's C) minus the neighbours' damping works (the blade-to-blade dashpots);
-dampers = sum of W_friction + W_dashpots; stored = change of every FMU's energy. In an
-exact coupling excitation = structural + dampers + stored; the residual is the
-coupling's inconsistency (the neighbours' stiffness works, which cancel around an
-exact ring, plus the mismatch between the work the dampers' forces do on the blades and
-the platforms' work on the dampers) and the dampers' quadrature error.
+dampers = sum of W_friction + W_dashpots; stored = change of every FMU's energy and of
+the ring's coupling energy U_c = sum_j q_j^T K_next q_(j+1) (from the blades' outputs;
+it changes in a transient, not over a steady period). In an exact coupling excitation =
+structural + dampers + stored; the residual is the coupling's inconsistency (the
+neighbours' stiffness works differ from -dU_c, the work the dampers' forces do on the
+blades from minus the platforms' work on the dampers) and the dampers' quadrature error.
 """
 from __future__ import annotations
 
@@ -181,7 +182,19 @@ class _Ring:
                 vals = self.last.last_real_values(self.idx[c], [self.vr[c][v] for v in names[kind]])
                 for v, x in zip(names[kind], vals):
                     out[f"{kind}_{v}"] = out.get(f"{kind}_{v}", 0.0) + x
+        out["coupling_energy"] = self._coupling_energy()
         return out
+
+    def _coupling_energy(self) -> float:
+        """U_c = sum_j q_j^T K_next q_(j+1) over the ring [J] (module docstring)."""
+        K = np.asarray(self.info.get("K_next_coupling") or [], dtype=float)
+        if K.size == 0:
+            return 0.0
+        blades = self.info["blades_components"]
+        q = [np.array(self.last.last_real_values(
+            self.idx[b], [self.vr[b][f"q_{d}"] for d in self.info["coupling_dofs"]]))
+            for b in blades]
+        return float(sum(q[j] @ K @ q[(j + 1) % len(q)] for j in range(len(q))))
 
 
 def energy_balance(e0: dict, e1: dict) -> dict:
@@ -190,11 +203,11 @@ def energy_balance(e0: dict, e1: dict) -> dict:
     exc = d["blade_W_excitation"]
     structural = d["blade_W_damping"] - d["blade_W_neighbours_damping"]
     dampers = d["damper_W_friction"] + d["damper_W_dashpots"]
-    stored = d["blade_energy"] + d["damper_energy"]
+    stored = d["blade_energy"] + d["damper_energy"] + d["coupling_energy"]
     residual = exc - structural - dampers - stored
     return {"excitation": exc, "structural": structural, "damper_friction": d["damper_W_friction"],
             "damper_dashpots": d["damper_W_dashpots"], "stored_change": stored,
-            "neighbours_stiffness": d["blade_W_neighbours_stiffness"],
+            "neighbours_mismatch": d["blade_W_neighbours_stiffness"] + d["coupling_energy"],
             "interface_mismatch": d["blade_W_interface"] + d["damper_W_platforms"],
             "residual": residual, "relative_residual": residual / exc if exc else None}
 

@@ -43,6 +43,14 @@ def coupling_limit(damper) -> float:
     return 2.0 / damper.omega_max()
 
 
+def _coupling_block(spec) -> list:
+    """K_next on the coupling DOFs (rows: blade j, columns: blade j+1) [N/m]."""
+    c = spec.coupling_dofs()
+    if spec.K_next is None or not c:
+        return []
+    return np.asarray(spec.K_next, dtype=float)[np.ix_(c, c)].tolist()
+
+
 def _components(cfg, blade_itf, damper_itf, f0, frequency_hz):
     nr = cfg.ring_blades
     b_con = {v.name: v.causality for v in blade_itf.variables if v.causality != "independent"}
@@ -131,7 +139,11 @@ def build_ring(cfg, cf: float, f0: float, out, fmi_version: int = 2,
             "blades_components": [f"blade{j}" for j in range(nr)],
             "damper_components": [f"damper{j}" for j in range(nr)],
             "response": response, "response_dof": bspec.dofs[bspec.response],
-            "contacts": [c.name for c in dspec.contacts]}
+            "contacts": [c.name for c in dspec.contacts],
+            # the ring's coupling energy sum_j q_j^T K_next q_(j+1) (on these DOFs) closes
+            # the energy balance of a transient
+            "coupling_dofs": [bspec.dofs[d] for d in bspec.coupling_dofs()],
+            "K_next_coupling": _coupling_block(bspec)}
     ssd = ssd_text("upd_ring", comps, _connections(nr, bspec), step, 100.0 / freq,
                    f"{config_name}: {nr} blades of {cfg.blades} (EO {cfg.engine_order}) "
                    f"with underplatform dampers, CF {cf} N, F0 {f0} N")
