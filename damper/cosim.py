@@ -43,6 +43,10 @@ FIT_HARMONICS = 9
 SETTLE_TOL = 1e-4
 #: Fewest periods before settling is tested (the start transient of the contacts).
 MIN_PERIODS = 5
+#: Fewest steps a period (the fit of the first harmonic needs samples of the period).
+MIN_STEPS_PER_PERIOD = 2 * FIT_HARMONICS + 2
+#: Most steps a period (the time-series buffer holds two periods of every blade's response).
+MAX_STEPS_PER_PERIOD = 1_000_000
 #: libcosim worker threads: eight small FMUs a step cost less on one thread than on a
 #: pool (measured on the shared 2-core machine: 136 us a step with 1, 184 with 0, 488
 #: with libcosim's default; tmp/speed run of the UPD-24 ring, 2000 steps).
@@ -116,10 +120,16 @@ def plan_step(info: dict, frequency_hz: float, step: float | None, force: bool) 
                          "on its stuck contacts); the explicit coupling would be unstable. Use "
                          f"a smaller step (default {info['default_step']:.4g} s) or --force")
     T_ns = 1e9 / frequency_hz
-    n = max(int(math.ceil(T_ns / (h * 1e9) - 1e-9)), 2)
+    if T_ns < MIN_STEPS_PER_PERIOD:
+        raise ValueError(f"--frequency-hz {frequency_hz:g}: a period of {T_ns:.3g} ns cannot hold "
+                         f"{MIN_STEPS_PER_PERIOD} of libcosim's whole-ns steps")
+    n = max(int(math.ceil(T_ns / (h * 1e9) - 1e-9)), MIN_STEPS_PER_PERIOD)
     h_ns = int(round(T_ns / n))
     if h_ns < 1:
-        raise ValueError(f"--step {h} s is below libcosim's resolution (1 ns)")
+        raise ValueError(f"--step {h} s is below libcosim's resolution (1 ns) at {frequency_hz} Hz")
+    if n > MAX_STEPS_PER_PERIOD:
+        raise ValueError(f"--step {h:.3g} s gives {n} steps a period at {frequency_hz} Hz (at most "
+                         f"{MAX_STEPS_PER_PERIOD}): use a larger step")
     return {"steps_per_period": n, "step_ns": h_ns, "step": h_ns * 1e-9,
             "period_error": (n * h_ns - T_ns) / T_ns}
 

@@ -28,16 +28,18 @@ from damper.ring_system import build_ring
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.solve import frf, solve_point
+from harmonic_balance.bladed_disk.solve import frf, solve_point, start_point
 from harmonic_balance.bladed_disk.timeint import march_ring
+from harmonic_balance.newton import NewtonError
 
 F0 = 30.0
 #: Frequencies relative to the HB peak: the peak, the parabola's neighbours, off the peak.
 FACTORS = (1.0, 0.995, 1.005, 0.98, 1.02)
 
 
-def hb_case(sector, cf, H=7, points=40):
-    """HB curve (band of the config) and HB solutions at the FACTORS frequencies."""
+def hb_case(sector, cf, H=7, points=40, freqs=None):
+    """HB curve (band of the config) and HB solutions at the FACTORS frequencies of its
+    peak (or at ``freqs`` [Hz])."""
     hb = SectorHB(sector, H, cf=cf, f0=F0)
     band = sector.cfg["load.band_hz"]
     t0 = time.perf_counter()
@@ -45,10 +47,16 @@ def hb_case(sector, cf, H=7, points=40):
     t_curve = time.perf_counter() - t0
     fpk = c.peak_omega / (2 * np.pi)
     amps, sols = [], []
-    for fac in FACTORS:
-        w = 2 * np.pi * fpk * fac
+    for k, fac in enumerate(FACTORS):
+        w = 2 * np.pi * (fpk * fac if freqs is None else freqs[k])
         i = int(np.argmin(np.abs(c.omega - w)))  # start from the nearest curve point
-        x = c.peak_x if fac == 1.0 else solve_point(hb, w, c.x[i])
+        if fac == 1.0 and freqs is None:
+            x = c.peak_x
+        else:
+            try:
+                x = solve_point(hb, w, c.x[i])
+            except NewtonError:  # far from the nearest curve point: the sweep's own start
+                x = start_point(hb, w)
         amps.append(hb.amplitude_h1(x))
         sols.append(x)
     return {"hb": hb, "peak_hz": fpk, "peak": c.peak_amplitude, "amplitude": amps,
@@ -70,10 +78,11 @@ def parabola_peak(f, a) -> float:
     return float(np.polyval(p, -p[1] / (2 * p[0])))
 
 
-def load_case(cfg, cf, out, periods, quick):
+def load_case(cfg, cf, out, periods, quick, h_ref):
     sector = Sector(cfg)
     h = hb_case(sector, cf)
     freqs = [h["peak_hz"] * fac for fac in FACTORS]
+    ref = hb_case(sector, cf, h_ref, freqs=freqs) if h_ref else None
     ssp = out / f"ring_cf{cf:g}.ssp"
     t0 = time.perf_counter()
     info = build_ring(cfg, cf, F0, ssp)
@@ -97,6 +106,9 @@ def load_case(cfg, cf, out, periods, quick):
            "cosim_wall_s": [r["wall_time_s"] for r in runs],
            "cosim_wall_per_period_s": float(np.mean([r["wall_time_per_period_s"] for r in runs])),
            "ti_run": ti, "hb_curve_s": h["curve_s"], "hb_curve_points": h["curve_points"]}
+    if ref is not None:  # the HB at a higher H: its truncation error at H = 7
+        row |= {"h_ref": h_ref, "hb_ref": ref["amplitude"], "hb_ref_peak": ref["peak"],
+                "cosim_vs_hb_ref": [a / b - 1 for a, b in zip(amp, ref["amplitude"])]}
     row["cosim_peak_vs_hb"] = row["cosim_peak"] / h["peak"] - 1
     row["cosim_peak_vs_ti"] = row["cosim_peak"] / row["ti_peak"] - 1
     return row, h, runs[0]
@@ -131,9 +143,12 @@ def print_table(rows):
           "| periods | energy residual")
     for r in rows:
         for k, f in enumerate(r["frequency_hz"]):
+            ref = (f" | HB H={r['h_ref']}: {r['hb_ref'][k] * 1e3:.5f} ({r['cosim_vs_hb_ref'][k]:+.2%})"
+                   if "h_ref" in r else "")
             print(f"{r['cf']:g} | {f:.3f} ({FACTORS[k]:g}) | {r['hb'][k] * 1e3:.5f} | "
                   f"{r['cosim'][k] * 1e3:.5f} | {r['cosim_vs_hb'][k]:+.2%} | {r['ti'][k] * 1e3:.5f} | "
-                  f"{r['cosim_vs_ti'][k]:+.3%} | {r['cosim_periods'][k]} | {r['energy_residual'][k]:+.1e}")
+                  f"{r['cosim_vs_ti'][k]:+.3%} | {r['cosim_periods'][k]} | {r['energy_residual'][k]:+.1e}"
+                  + ref)
         print(f"{r['cf']:g} | peak (parabola) | {r['hb_peak'] * 1e3:.5f} | {r['cosim_peak'] * 1e3:.5f} | "
               f"{r['cosim_peak_vs_hb']:+.2%} | {r['ti_peak'] * 1e3:.5f} | {r['cosim_peak_vs_ti']:+.3%} | | ")
     print("\ncase | size | time (wall, shared machine)")
@@ -153,6 +168,8 @@ def main(argv=None):
     ap.add_argument("--cf", type=float, nargs="+", default=[60.0, 120.0, 600.0])
     ap.add_argument("--periods", type=int, default=400, help="most co-simulated periods per point")
     ap.add_argument("--quick", action="store_true", help="smoke: CF 120 N, 3 periods")
+    ap.add_argument("--hb-ref", type=int, default=0, metavar="H",
+                    help="also the HB at this H at the same frequencies (its truncation at H = 7)")
     a = ap.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -160,7 +177,7 @@ def main(argv=None):
     cfs = [120.0] if a.quick else a.cf
     rows = []
     for cf in cfs:
-        row, h, run0 = load_case(cfg, cf, out, 3 if a.quick else a.periods, a.quick)
+        row, h, run0 = load_case(cfg, cf, out, 3 if a.quick else a.periods, a.quick, a.hb_ref)
         rows.append(row)
         print(json.dumps({k: v for k, v in row.items() if k != "ti_run"}, default=float), flush=True)
         if cf == 120.0:
