@@ -115,12 +115,12 @@ def test_refuses_what_it_cannot_represent(tmp_path):
 @pytest.mark.parametrize("model", ["blade", "upd"])
 def test_generated_sources_compile_without_warnings(specs, tmp_path, model):
     """The FMU build compiles without -Werror (users' compilers differ); CI compiles the
-    blade's and the damper's generated sources with it, as CMake does the element's."""
+    blade's and the damper's generated sources with it, as CMake does the element's (FMI 2:
+    the model and the layer are the same in both versions; CMake covers fmi3.c)."""
     from fmu_src import blade_fmu, fmu_build, upd_fmu
 
     b, d = specs
     itf = blade_fmu.interface(b, 30.0, 440.0, 0.0, 0.0)[0] if model == "blade" else upd_fmu.interface(d)
-    for v in (2, 3):
-        src = tmp_path / f"{model}{v}"
-        names = fmu_build._copy_sources(src, v, model, itf)
-        fmu_build.compile_binary(src, names, tmp_path / f"{model}{v}.so", extra_flags=("-Werror",))
+    src = tmp_path / model
+    names = fmu_build._copy_sources(src, 2, model, itf)
+    fmu_build.compile_binary(src, names, tmp_path / f"{model}.so", extra_flags=("-Werror",))

@@ -1,17 +1,11 @@
 """Smoke run of examples/upd_cosim.py (CF 120 N, 3 periods a frequency): the table's
 columns exist and the transient matches the ring time integration."""
-import sys
-from pathlib import Path
-
 import pytest
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
 
 
 @pytest.mark.slow
-def test_quick_run(tmp_path):
-    import upd_cosim
-
+def test_quick_run(tmp_path, load_example):
+    upd_cosim = load_example("upd_cosim")
     rows = upd_cosim.main(["--quick", "--out", str(tmp_path)])
     r = rows[0]
     assert r["cf"] == 120.0 and len(r["cosim"]) == len(upd_cosim.FACTORS)
