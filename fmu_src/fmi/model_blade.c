@@ -70,6 +70,7 @@ typedef struct {
     double F0;                /* [N] */
     double h;                 /* step size of the cached coefficients (0: none) */
     cplx *coef;               /* (C_N, m) */
+    cplx *scratch;            /* (4, m): a step's work arrays (no allocation per step) */
 } blade_model;
 
 typedef struct {
@@ -235,7 +236,7 @@ const char *model_load(void **res, const char *dir, char *why, size_t why_size)
 
 size_t model_size(const void *res)
 {
-    return sizeof(blade_model) + (size_t)C_N * (size_t)((const blade_res *)res)->m * sizeof(cplx);
+    return sizeof(blade_model) + (size_t)(C_N + 4) * (size_t)((const blade_res *)res)->m * sizeof(cplx);
 }
 
 size_t model_history_size(const void *res)
@@ -269,6 +270,7 @@ const char *model_build(void *model, const void *res, const double *value)
     b->psi0 = value[VR_BLADE_INDEX] * value[VR_INTERBLADE_PHASE];
     b->F0 = value[VR_F0];
     b->coef = (cplx *)((unsigned char *)model + sizeof(blade_model));
+    b->scratch = b->coef + (size_t)C_N * (size_t)b->r->m;
     b->h = 0.0;
     return NULL;
 }
@@ -375,7 +377,7 @@ static double work_term(const blade_res *r, const cplx *W, const double *x, cons
 const char *model_step(const void *model, void *history, const double *start,
                        const double *end, double t, double h, double *out)
 {
-    blade_model *b = (blade_model *)model;  /* the coefficient cache only */
+    blade_model *b = (blade_model *)model;  /* the coefficient cache and scratch only */
     const blade_res *r = b->r;
     const int m = r->m;
     blade_history *hs = (blade_history *)history;
@@ -387,8 +389,7 @@ const char *model_step(const void *model, void *history, const double *start,
     int i, k;
     (void)end;  /* inputs are held with their rate inputs (no FMI input derivatives) */
     if (b->h != h) coefficients(b, h);
-    e1 = (cplx *)malloc(4 * (size_t)m * sizeof(cplx));
-    if (!e1) return "out of memory";
+    e1 = b->scratch;
     ie = e1 + m; dq = ie + m; hq = dq + m;
     for (k = 0; k < m; k++) {
         const cplx *c = b->coef;
@@ -418,7 +419,6 @@ const char *model_step(const void *model, void *history, const double *start,
     hs->W_exc += Fe * dot_re(r->forced_row, e1, m) - Fs * dot_re(r->forced_row, eta, m)
                  - creal(I * b->omega * b->F0 * cexp(psi) * jf);
     memcpy(eta, e1, (size_t)m * sizeof(cplx));
-    free(e1);
     return model_eval(model, history, start, out);
 }
 

@@ -30,6 +30,7 @@
  * (energy - energy at the start) up to the O(dt^2) of the trapezoids.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
