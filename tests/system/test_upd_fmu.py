@@ -12,10 +12,11 @@ from harmonic_balance.bladed_disk.solve import start_point
 FORCES = ("F_left_x", "F_left_y", "F_right_x", "F_right_y")
 
 
-def test_prestress_stays(part_fmus, specs):
+@pytest.mark.parametrize("version", [2, 3])
+def test_prestress_stays(part_fmus, specs, version):
     """At the start inputs (the frictionless prestress) nothing moves: forces = k_n p0 ones."""
     _, d = specs
-    s = Slave(part_fmus["damper", 2], 2)
+    s = Slave(part_fmus["damper", version], version)
     s.start_stepping()
     F0 = np.array(s.get(*FORCES))
     for _ in range(200):
