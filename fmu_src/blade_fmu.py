@@ -228,15 +228,13 @@ def interface(b: BladeSpec, F0: float, frequency: float, blade_index: float,
             ("blade_index", "1", "Index j of this blade in the ring", blade_index),
             ("interblade_phase", "rad", "Phase step 2 pi EO / N_b between neighbours", phase)):
         variables.append(_var(name, len(variables), "parameter", unit, desc, value))
-    names = [fmu_xml._c_name(v.name) for v in variables]
+    names = [fmu_xml.c_name(v.name) for v in variables]
     if len(set(names)) != len(names):
         raise ValueError("blade DOF names collide once made C identifiers (letters, digits, _): "
                          "rename the DOFs")
-    itf = fmu_xml.Interface("blade", "damper linear blade", tuple(variables), feedthrough=False,
-                            directional=False, interpolates=False,
-                            units={"N/s": {"kg": 1, "m": 1, "s": -3},
-                                   "m/s": {"m": 1, "s": -1}, "Hz": {"s": -1},
-                                   "rad": {}})
+    itf = fmu_xml.Interface("blade", "damper linear blade", tuple(variables),
+                            fmu_xml.VALUE_START_RULES, "blade_vr.h", feedthrough=False,
+                            directional=False, interpolates=False)
     maps = {g: (np.array(v).T, np.array(r).T) for g, (v, r) in parts.items()}
     maps["outputs"] = outputs
     return itf, maps

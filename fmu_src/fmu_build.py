@@ -12,8 +12,10 @@ The curve is checked by building the element through :mod:`fmu_src.element`
 with a ``ValueError`` and no file is written. The ``.fmu`` is written through a
 temporary file and a rename: never half-written.
 
-Run ``python -m fmu_src.fmu_build --write-header`` after changing the variable
-table to regenerate ``fmu_src/fmi/damper_vr.h``.
+Run ``python -m fmu_src.fmu_build --write-header`` after changing a variable
+table to regenerate ``fmu_src/fmi/damper_vr.h`` and ``point_vr.h``. The contact-point
+FMU (2D element + normal law) is packaged by :mod:`fmu_src.fmu_point` with the same
+helpers.
 """
 from __future__ import annotations
 
@@ -36,12 +38,12 @@ FMI_DIR = Path(__file__).resolve().parent / "fmi"
 CORE_DIR = Path(__file__).resolve().parent / "core"
 HEADER_PATH = FMI_DIR / "damper_vr.h"
 
-#: Model hooks available to the wrapper (model.h): the element, a baseline, a linear
-#: blade (fmu_src.blade_fmu) and an underplatform damper (fmu_src.upd_fmu).
-MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c",
+#: Model hooks available to the wrapper (model.h): the element, the contact point, a
+#: baseline, a linear blade (fmu_src.blade_fmu) and an underplatform damper (fmu_src.upd_fmu).
+MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c", "point": "model_point.c",
           "blade": "model_blade.c", "upd": "model_upd.c"}
-#: Models that need the friction-law core compiled in.
-USES_CORE = ("iwan", "passthrough", "upd")
+#: Models that read the curve / normal-law resources (model_table.c).
+USES_TABLE = ("iwan", "passthrough", "point")
 #: Binary folder of each FMI version on 64-bit Linux.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 #: How a curve table that is not concave is handled (iwan.h iwan_fit).
@@ -50,13 +52,25 @@ _FMI_HEADERS = {
     2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
     3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
 }
-_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h", "damper_vr.h")
+_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h", "model_table.h")
 #: Input bound of the Iwan model (model_iwan.c U_BOUND_RTOL): the force error of a
 #: slider, about k eps |u|, stays below this fraction of its slip strength.
 U_BOUND_RTOL = 1e-6
 #: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
 CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
 CORE_HEADERS = ("iwan.h", "iwan_internal.h", "iwan_sweep.h")
+#: What the contact point adds to the core (the 2D element and the normal law).
+POINT_SOURCES = ("iwan2d.c", "contact_point.c")
+POINT_HEADERS = ("iwan2d.h", "iwan2d_internal.h", "contact_point.h")
+
+
+def core_files(model: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(C sources, headers) of fmu_src/core compiled into the FMU of ``model``."""
+    if model == "point":
+        return CORE_SOURCES + POINT_SOURCES, CORE_HEADERS + POINT_HEADERS
+    if model == "blade":
+        return (), ()
+    return CORE_SOURCES, CORE_HEADERS
 #: The one compile-flag list shared with CMake and the pip extension (one flag a line).
 CFLAGS_FILE = CORE_DIR / "cflags.txt"
 
@@ -76,8 +90,9 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    core = CORE_SOURCES if model in USES_CORE else ()
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *core]
+    table = ("model_table.c",) if model in USES_TABLE else ()
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *table,
+            *core_files(model)[0]]
 
 
 def _check_version(fmi_version: int) -> None:
@@ -139,20 +154,21 @@ def curve_resource_text(u, T, n_ref: float, fit: str) -> str:
 
 
 def _copy_sources(dest: Path, fmi_version: int, model: str,
-                  interface: fmu_xml.Interface = fmu_xml.IWAN) -> list[str]:
-    """Copy the C sources and headers flat into ``dest``; return the .c names.
-
-    The variable header ``damper_vr.h`` is the committed one for the friction element,
-    otherwise generated from ``interface``.
-    """
+                  iface: fmu_xml.Interface | None = None) -> list[str]:
+    """Copy the C sources and headers flat into ``dest`` (with the model's variable
+    table and the fmu_vars.h that picks it); return the .c names. ``iface`` (default:
+    the model's committed one) is written from its table when it has no committed header."""
     dest.mkdir(parents=True)
     names = c_sources(fmi_version, model)
-    for name in names + list(_WRAPPER_HEADERS + CORE_HEADERS):
-        if name == "damper_vr.h" and interface is not fmu_xml.IWAN:
-            (dest / name).write_text(fmu_xml.render_vr_header(interface))
-            continue
-        src = CORE_DIR if name in CORE_SOURCES + CORE_HEADERS else FMI_DIR
+    sources, headers = core_files(model)
+    iface = fmu_xml.INTERFACES[model] if iface is None else iface
+    committed = iface in HEADERS.values()
+    for name in names + list(_WRAPPER_HEADERS + headers) + ([iface.header] if committed else []):
+        src = CORE_DIR if name in sources + headers else FMI_DIR
         shutil.copy(src / name, dest / name)
+    if not committed:
+        (dest / iface.header).write_text(fmu_xml.render_vr_header(iface))
+    (dest / "fmu_vars.h").write_text(fmu_xml.render_fmu_vars(iface))
     for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
         shutil.copy(FMI_DIR / "headers" / name,
                     dest / ("FMI_HEADERS_LICENSE.txt" if name == "LICENSE.txt" else name))
@@ -225,28 +241,23 @@ def _zip_dir(root: Path) -> bytes:
 
 
 def package_fmu(out: str | os.PathLike, fmi_version: int, model: str,
-                interface: fmu_xml.Interface, resources: dict, starts=None,
-                description: str = "", documentation: str = "", bounds: dict | None = None,
+                iface: fmu_xml.Interface, resources: dict, description: str = "",
+                documentation: str = "", bounds: dict | None = None,
                 compiler: str | None = None) -> Path:
-    """Write a co-simulation FMU of ``model`` behind the FMI layer (atomically).
+    """Write a co-simulation FMU of ``model`` behind the FMI layer (atomically), for a
+    model whose start values are in its table (rules none / zero / one / value).
 
     Parameters
     ----------
     out : path                 the ``.fmu`` file
     fmi_version : {2, 3}
     model : str                a key of :data:`MODELS`
-    interface : fmu_xml.Interface
-        Its variable table (``damper_vr.h`` and the model description come from it).
+    iface : fmu_xml.Interface  its variable table (its header is generated into sources/)
     resources : dict           file name -> text, written under ``resources/``
-    starts : float or dict     start values of the variables of rule ``model``
     description, documentation : str
         Model description text; ``documentation/index.html``.
     bounds : dict              input bounds by name (min/max in the model description)
     compiler : str, optional   C compiler (default ``$CC`` or ``cc``)
-
-    Returns
-    -------
-    Path of the written FMU.
 
     Raises
     ------
@@ -256,20 +267,20 @@ def package_fmu(out: str | os.PathLike, fmi_version: int, model: str,
     _check_version(fmi_version)
     with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
         root = Path(tmp) / "fmu"
-        names = _copy_sources(root / "sources", fmi_version, model, interface)
+        names = _copy_sources(root / "sources", fmi_version, model, iface)
         (root / "resources").mkdir()
         for name, text in resources.items():
             (root / "resources" / name).write_text(text)
         if documentation:
             (root / "documentation").mkdir()
             (root / "documentation" / "index.html").write_text(documentation)
-        text = fmu_xml.render_model_description(fmi_version, starts, names, description,
-                                                interface=interface, bounds=bounds)
+        text = fmu_xml.render_model_description(fmi_version, 0.0, names, description,
+                                                iface=iface, bounds=bounds or {})
         (root / "modelDescription.xml").write_text(text)
         if fmi_version == 3:
             (root / "sources" / "buildDescription.xml").write_text(
-                fmu_xml.render_build_description(names, interface.identifier))
-        binary = root / "binaries" / PLATFORM[fmi_version] / f"{interface.identifier}.so"
+                fmu_xml.render_build_description(names, iface))
+        binary = root / "binaries" / PLATFORM[fmi_version] / f"{iface.model_identifier}.so"
         compile_binary(root / "sources", names, binary, compiler)
         path = atomic_write(out, _zip_dir(root))
     os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
@@ -323,17 +334,35 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         from fmu_src.element import IwanElement
 
         u_bound = input_bound(IwanElement.from_curve(u, T, float(n_ref), fit=fit))
-    resources = {"curve.txt": curve_resource_text(u, T, n_ref, fit)}
-    if curve_json is not None:
-        resources["curve.json"] = curve_json
-    return package_fmu(out, fmi_version, model, fmu_xml.IWAN, resources, float(n_ref),
-                       description, _documentation(u_bound),
-                       {"u": u_bound} if model == "iwan" else None, compiler)
+    with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
+        root = Path(tmp) / "fmu"
+        names = _copy_sources(root / "sources", fmi_version, model)
+        (root / "resources").mkdir()
+        (root / "resources" / "curve.txt").write_text(curve_resource_text(u, T, n_ref, fit))
+        if curve_json is not None:
+            (root / "resources" / "curve.json").write_text(curve_json)
+        (root / "documentation").mkdir()
+        (root / "documentation" / "index.html").write_text(_documentation(u_bound))
+        text = fmu_xml.render_model_description(fmi_version, n_ref, names, description,
+                                                u_bound if model == "iwan" else None)
+        (root / "modelDescription.xml").write_text(text)
+        if fmi_version == 3:
+            (root / "sources" / "buildDescription.xml").write_text(
+                fmu_xml.render_build_description(names))
+        binary = root / "binaries" / PLATFORM[fmi_version] / f"{fmu_xml.MODEL_IDENTIFIER}.so"
+        compile_binary(root / "sources", names, binary, compiler)
+        path = atomic_write(out, _zip_dir(root))
+    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
+    return path
+
+
+#: The generated variable headers, one per interface.
+HEADERS = {FMI_DIR / i.header: i for i in (fmu_xml.DAMPER, fmu_xml.POINT)}
 
 
 def header_is_current() -> bool:
-    """Whether the committed ``damper_vr.h`` equals the generated text."""
-    return HEADER_PATH.read_text() == fmu_xml.render_vr_header()
+    """Whether the committed variable headers equal the generated texts."""
+    return all(path.read_text() == fmu_xml.render_vr_header(i) for path, i in HEADERS.items())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -341,16 +370,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--write-header", action="store_true",
-                       help=f"regenerate {HEADER_PATH.name} from the variable table")
+                       help="regenerate " + ", ".join(p.name for p in HEADERS)
+                       + " from the variable tables")
     group.add_argument("--check-header", action="store_true",
                        help="exit 1 if the committed header is out of date")
     args = parser.parse_args(argv)
     if args.write_header:
-        atomic_write(HEADER_PATH, fmu_xml.render_vr_header())
+        for path, iface in HEADERS.items():
+            atomic_write(path, fmu_xml.render_vr_header(iface))
         return 0
     if header_is_current():
         return 0
-    print(f"{HEADER_PATH} is out of date: run python -m fmu_src.fmu_build --write-header",
+    print("a variable header is out of date: run python -m fmu_src.fmu_build --write-header",
           file=sys.stderr)
     return 1
 

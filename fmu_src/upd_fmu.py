@@ -183,9 +183,8 @@ def interface(d: DamperSpec, initial_forces: np.ndarray | None = None) -> fmu_xm
         v.append(_var(name, len(v), "output", "J", desc))
     v.append(_var("CF", len(v), "parameter", "N", "Centrifugal load on the damper (y_d)", d.cf))
     return fmu_xml.Interface("upd_damper", "damper underplatform damper", tuple(v),
-                             feedthrough=False, directional=False, interpolates=False,
-                             units={"N/s": {"kg": 1, "m": 1, "s": -3}, "m/s": {"m": 1, "s": -1},
-                                    "rad": {}})
+                             fmu_xml.VALUE_START_RULES, "upd_vr.h", feedthrough=False,
+                             directional=False, interpolates=False)
 
 
 def build_damper_fmu(d: DamperSpec, out: str | os.PathLike, *, fmi_version: int = 2,

@@ -119,9 +119,8 @@ void fmu_reset(fmu_instance *inst)
     for (vr = 0; vr < DAMPER_N_VARIABLES; vr++) {
         switch (damper_start_of[vr]) {
         case START_ONE: inst->h.value[vr] = 1.0; break;
-        case START_MODEL: inst->h.value[vr] = model_start(inst->res, (unsigned int)vr); break;
-        case START_VALUE: inst->h.value[vr] = damper_start_value[vr]; break;
-        default: inst->h.value[vr] = 0.0; break;
+        case START_NONE: case START_ZERO: inst->h.value[vr] = 0.0; break;
+        default: inst->h.value[vr] = model_start(inst->res, (unsigned int)vr); break;
         }
     }
     inst->h.mode = MODE_INSTANTIATED;
@@ -129,25 +128,23 @@ void fmu_reset(fmu_instance *inst)
     inst->out_valid = 0;
 }
 
-/* "name = value, ..." of the variables of one causality in `value` (first few). */
-const char *fmu_describe(const double *value, int causality, char *buf, size_t size)
+/* "name = value unit, ..." of the variables of one causality (C locale), for messages. */
+static const char *describe(const fmu_instance *inst, int causality, const double *value,
+                            char *buf, size_t size)
 {
     size_t used = 0;
-    int vr, shown = 0;
+    int vr;
+    locale_t old = inst->c_locale ? uselocale(inst->c_locale) : (locale_t)0;
     buf[0] = '\0';
-    for (vr = 0; vr < DAMPER_N_VARIABLES && used + 1 < size; vr++) {
-        int n;
+    for (vr = 0; vr < DAMPER_N_VARIABLES && used < size; vr++) {
+        int k;
         if ((int)damper_causality_of[vr] != causality) continue;
-        if (shown == 4) {
-            snprintf(buf + used, size - used, ", ...");
-            break;
-        }
-        n = snprintf(buf + used, size - used, "%s%s = %g", shown ? ", " : "", damper_name_of[vr],
-                     value[vr]);
-        if (n < 0) break;
-        used += (size_t)n;
-        shown++;
+        k = snprintf(buf + used, size - used, "%s%s = %g %s", used ? ", " : "",
+                     damper_name_of[vr], value[vr], damper_unit_of[vr]);
+        if (k < 0) break;
+        used += (size_t)k;
     }
+    if (inst->c_locale) uselocale(old);
     return buf;
 }
 
@@ -162,7 +159,7 @@ fmu_status fmu_ensure_model(fmu_instance *inst)
     if (why) {
         char params[256];
         return fmu_log(inst, FMU_ERROR, "cannot build the model (%s): %s",
-                       fmu_describe(inst->h.value, CAUS_PARAMETER, params, sizeof params), why);
+                       describe(inst, CAUS_PARAMETER, inst->h.value, params, sizeof params), why);
     }
     for (i = 0; i < DAMPER_N_INPUTS; i++)
         inst->bound[damper_inputs[i]] = model_input_bound(inst->model, damper_inputs[i]);
@@ -205,7 +202,7 @@ static fmu_status ensure_outputs(fmu_instance *inst)
     if (why) {
         char in[256];
         return fmu_log(inst, FMU_ERROR, "evaluating the model at %s: %s",
-                       fmu_describe(inst->h.value, CAUS_INPUT, in, sizeof in), why);
+                       describe(inst, CAUS_INPUT, inst->h.value, in, sizeof in), why);
     }
     inst->out_valid = 1;
     return FMU_OK;
@@ -373,7 +370,7 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
         char in[256];
         inst->out_valid = 0;
         return fmu_log(inst, FMU_ERROR, "DoStep from t = %g over h = %g with %s refused: %s",
-                       t, h, fmu_describe(end, CAUS_INPUT, in, sizeof in), why);
+                       t, h, describe(inst, CAUS_INPUT, end, in, sizeof in), why);
     }
     swap = inst->history;
     inst->history = inst->trial;

@@ -3,11 +3,12 @@
  *
  * Written once and shared by fmi2.c and fmi3.c (Reference-FMUs shape): the
  * instance, its mode (state machine), variable values by value reference
- * (damper_vr.h), the resource table, logging, doStep, FMU states and directional
+ * (fmu_vars.h), the model's resources, logging, doStep, FMU states and directional
  * derivatives. It knows nothing of the physics: that is behind the hooks of
- * model.h (model_iwan.c: the Masing/Iwan element; model_passthrough.c: F = u;
- * model_blade.c: a linear blade; model_upd.c: an underplatform damper), and the
- * variable table is the generated damper_vr.h of the model.
+ * model.h (model_iwan.c: the Masing/Iwan element; model_point.c: the 3D contact
+ * point; model_passthrough.c: F = u; model_blade.c: a linear blade; model_upd.c: an
+ * underplatform damper), and nothing of the variables but what the model's generated
+ * table (fmu_vars.h) lists.
  *
  * Co-simulation semantics:
  * - the committed history changes only in doStep; getters evaluate the outputs from
@@ -42,7 +43,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "model.h"
 
 #define FMU_STATE_MAGIC 0x46504d44u  /* "DMPF": marks a state of this FMU */

@@ -38,9 +38,6 @@ size_t fmu_state_bytes(const fmu_instance *inst);
  * while none has been committed). */
 fmu_status fmu_ensure_model(fmu_instance *inst);
 
-/* "name = value, ..." of the first variables of one causality (messages). */
-const char *fmu_describe(const double *value, int causality, char *buf, size_t size);
-
 /* Free every state the instance handed out (at fmu_free). */
 void fmu_free_states(fmu_instance *inst);
 

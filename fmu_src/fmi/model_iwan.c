@@ -7,13 +7,12 @@
 #include <float.h>
 #include <math.h>
 #include <stddef.h>
-#include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "iwan.h"
 #include "model.h"
+#include "model_table.h"
 
 /* Input bound: the force error of a slider, about k_j * eps * |u|, stays below this
  * fraction of its slip strength k_j r_j: |u| <= U_BOUND_RTOL * min_j r_j / eps, with
@@ -24,84 +23,17 @@
  * round-off of u - z at |u| (a deserialized history is checked against it). */
 #define STRETCH_RTOL 1e-9
 
-#define CURVE_FILE "curve.txt"
-#define MAX_CURVE_POINTS 4096    /* largest table read (fmu_build.check_curve says so too) */
-
-/* The resource table (resources/curve.txt, written by fmu_src/fmu_build.py). */
-typedef struct {
-    size_t n;          /* number of points */
-    double *u, *T;     /* the table [m], [N] */
-    double n_ref;      /* normal load it was computed at [N] */
-    int fit;           /* 0: refuse a non-concave table, 1: use its concave majorant */
-} curve_table;
-
 typedef struct {
     iwan_model m;
     double u_bound;   /* largest |u| accepted [m] */
     double T_top;     /* largest force of the table [N]: |F| <= T_top f(N) when k_res = 0 */
 } iwan_fmu_model;
 
-/* Read the table: damper-curve 1 / n_ref <N> / fit <0|1> / points <m> / m lines "u T". */
-static const char *scan_curve(curve_table *t, FILE *f, const char *path, char *why, size_t nw)
-{
-    int version = 0, fit = 0;
-    long m = 0, i;
-    if (fscanf(f, " damper-curve %d n_ref %lf fit %d points %ld", &version, &t->n_ref, &fit,
-               &m) != 4 || version != 1 || m < 2 || m > MAX_CURVE_POINTS) {
-        snprintf(why, nw, "'%s' is not a damper-curve 1 file with 2..%d points", path,
-                 MAX_CURVE_POINTS);
-        return why;
-    }
-    t->u = (double *)malloc((size_t)m * sizeof(double));
-    t->T = (double *)malloc((size_t)m * sizeof(double));
-    if (!t->u || !t->T) return "out of memory reading the curve";
-    for (i = 0; i < m; i++)
-        if (fscanf(f, "%lf %lf", &t->u[i], &t->T[i]) != 2) {
-            snprintf(why, nw, "'%s': point %ld of %ld unreadable", path, i, m);
-            return why;
-        }
-    t->n = (size_t)m;
-    t->fit = fit;
-    return NULL;
-}
-
-void model_unload(void *res)
-{
-    curve_table *t = (curve_table *)res;
-    if (!t) return;
-    free(t->u);
-    free(t->T);
-    free(t);
-}
+void model_unload(void *res) { model_table_free((model_table *)res); }
 
 const char *model_load(void **res, const char *dir, char *why, size_t why_size)
 {
-    size_t len = strlen(dir);
-    char *path = (char *)malloc(len + sizeof(CURVE_FILE) + 2);
-    curve_table *t = (curve_table *)calloc(1, sizeof(curve_table));
-    const char *err = NULL;
-    FILE *f = NULL;
-    *res = NULL;
-    if (!path || !t) err = "out of memory reading the curve";
-    if (!err) {
-        memcpy(path, dir, len);
-        if (len == 0 || path[len - 1] != '/') path[len++] = '/';
-        memcpy(path + len, CURVE_FILE, sizeof(CURVE_FILE));
-        f = fopen(path, "r");
-        if (!f) {
-            snprintf(why, why_size, "cannot open the curve file '%s'", path);
-            err = why;
-        }
-    }
-    if (!err) err = scan_curve(t, f, path, why, why_size);
-    if (f) fclose(f);
-    free(path);
-    if (err) {
-        model_unload(t);
-        return err;
-    }
-    *res = t;
-    return NULL;
+    return model_table_load((model_table **)res, dir, why, why_size);
 }
 
 size_t model_size(const void *res) { (void)res; return sizeof(iwan_fmu_model); }
@@ -111,7 +43,7 @@ size_t model_history_size(const void *res) { (void)res; return sizeof(iwan_state
 double model_start(const void *res, unsigned int vr)
 {
     (void)vr;
-    return ((const curve_table *)res)->n_ref;
+    return ((const model_table *)res)->n_ref;
 }
 
 const char *model_check_parameter(const void *res, unsigned int vr, double v)
@@ -134,7 +66,7 @@ void model_copy_history(const void *model, void *dst, const void *src)
 
 const char *model_build(void *model, const void *res, const double *value)
 {
-    const curve_table *t = (const curve_table *)res;
+    const model_table *t = (const model_table *)res;
     iwan_fmu_model *md = (iwan_fmu_model *)model;
     double rmin = HUGE_VAL;
     size_t i;
