@@ -29,6 +29,15 @@ from .hb import sector_model
 from .sector import Sector
 
 
+def planar(sector: Sector) -> None:
+    """Refuse a sector the FMUs cannot represent: the damper FMU's contacts slip in the
+    plane only (one tangent each), so a blade with an axial platform DOF is refused."""
+    if sector.rows_per_point != 2:
+        raise ValueError("the blade's platform points carry an axial DOF (left/right = [u, v, w]): "
+                         "the damper FMU slips in the plane only; name two DOFs [u, v] per point "
+                         "for damper system")
+
+
 def statics(sector: Sector, cf: float) -> dict:
     """Frictionless prestress of the tuned sector under CF [N] (every blade alike).
 
@@ -37,6 +46,7 @@ def statics(sector: Sector, cf: float) -> dict:
     dict: q (n_dof,) static displacements, P_left / P_right (2,) the platform points' (u, v)
     [m], and per contact s0 (slip), p0 (penetration) [m].
     """
+    planar(sector)
     model = sector_model(sector, cf, sector.cfg.f0, sector.cfg.mu)
     x, _ = frictionless_statics(model)
     b = sector.blade

@@ -148,3 +148,21 @@ def test_settled_peak_against_hb_and_ring_time_integration(ring_ssp, sector):
     assert r["amplitude"] == pytest.approx(c.peak_amplitude, rel=0.02)
     assert abs(r["energy"]["relative_residual"]) < 0.01
     assert np.array(r["phase_steps"]) == pytest.approx(np.full(4, sector.cfg.phi), abs=1e-4)
+
+
+def test_system_refuses_an_axial_platform_dof(tmp_path, sector, capsys):
+    """A bring-your-own blade whose platform points name an axial DOF (left/right = [u, v,
+    w]): the damper FMU slips in the plane only, so damper system refuses it."""
+    from harmonic_balance.bladed_disk.blade import blade_arrays
+
+    arr = blade_arrays(sector.blade)
+    n = arr["M"].shape[0]
+    grow = lambda A, d: np.pad(A, ((0, 1), (0, 1))) + np.diag([0.0] * n + [d])  # noqa: E731
+    arr.update(M=grow(arr["M"], 0.1), K=grow(arr["K"], 8e5), K_next=grow(arr["K_next"], 0.0),
+               dofs=np.append(arr["dofs"], "w_p"), left=np.array(["u_p", "v_p", "w_p"]),
+               right=np.array(["u_p", "v_p", "w_p"]))
+    np.savez(tmp_path / "axial.npz", **arr)
+    out = tmp_path / "ring.ssp"
+    code, _, err = _cli(["system", "--config", _config(tmp_path, 'file = "axial.npz"'), "-o",
+                         str(out)], capsys)
+    assert code == 2 and "axial" in err and not out.exists()
