@@ -1,4 +1,5 @@
 """Benchmark of the normal contact stage: error against Hertz vs time and memory.
+==============================================================================
 
 Each case runs in its own process twice: cold (empty cache: mesh, assembly,
 condensation, solve) and cached (the condensed matrices loaded from disk, then

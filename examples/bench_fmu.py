@@ -1,4 +1,5 @@
 """Benchmark: the cost of one doStep of the friction-element FMU.
+==============================================================
 
 Two masters drive the FMI 2 binary: a small C master (``fmu_src/fmi/bench_driver.c``:
 set u, doStep, get F and W per step) and fmpy's ``FMU2Slave`` from Python. Each

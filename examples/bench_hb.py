@@ -1,4 +1,5 @@
 """Harmonic-balance benchmark: accuracy vs H against time integration, cost vs model size.
+=======================================================================================
 
 Run:  .venv/bin/python examples/bench_hb.py [--smoke] [--no-ivp]
 

@@ -1,4 +1,5 @@
 """Robustness benchmark of the HB solver (issue 10): convergence map and cost vs contact stiffness.
+================================================================================================
 
 Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full] [--harmonics 1,3]
           [--log map.csv] [--no-cost | --cost-only] [--den-hartog | --den-hartog-hb]

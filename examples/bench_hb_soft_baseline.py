@@ -1,4 +1,5 @@
 """Cost per point of the issue-10 case, runnable against any version of harmonic_balance.
+======================================================================================
 
 Issue 10's cost goal compares the 1e6 k contact with "the current soft-contact cost",
 the cost when the issue was filed. This script uses only ``compute_frf`` and

@@ -1,4 +1,5 @@
 """Benchmark of the tangential stage: error against Cattaneo-Mindlin and time per grid.
+====================================================================================
 
 Sphere R = 10 mm on a plane, steel, N = 200 N, mu = 0.5. One line per model
 and grid: contact nodes, largest error of the virgin curve against Mindlin

@@ -1,4 +1,5 @@
 """Benchmark of the UPD-24 sector harmonic balance (table and plot; not a timed test).
+===================================================================================
 
 Cases: one 200-point curve (H = 7); the optimal-load curve (20 loads, H = 7); the
 optimum CF against H (5, 7, 9, 11, 15; 7 loads 80-250 N + Brent); the peak against
@@ -157,7 +158,7 @@ def ti_optimum(sector, cfs, tol=1e-3, periods=150):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/bench_upd")
     ap.add_argument("--quick", action="store_true", help="smoke version (seconds)")
     ap.add_argument("--periods", type=int, default=150, help="TI periods per load")

@@ -1,4 +1,5 @@
 """Bring your own blade: a scikit-fem FE blade, Craig-Bampton reduced, with the UPD-24 damper.
+===========================================================================================
 
 Run:  .venv/bin/python examples/craig_bampton_blade.py [--out out/cb_blade] [--modes 6]
 then: damper upd frf --config out/cb_blade/upd.toml

@@ -1,4 +1,5 @@
 """Masing loops of a sphere contact: the Iwan element against Mindlin-Deresiewicz.
+===============================================================================
 
 The Cattaneo-Mindlin virgin curve of a steel sphere (R = 10 mm, N = 100 N,
 mu = 0.5; references.md) is tabulated with m segments (uniform in T, flat after

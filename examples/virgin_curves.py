@@ -1,4 +1,5 @@
 """Virgin curves of the thesis's contacts: sphere and cylinder, CNF and CND.
+=========================================================================
 
 Prints one line per case (normal force, k_n, k_t, gross-slip displacement,
 points, error against Cattaneo-Mindlin for the sphere) and a hysteresis loop

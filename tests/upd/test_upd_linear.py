@@ -1,6 +1,7 @@
 """UPD-24 linear limits: direct solve against modal superposition, peaks against modes."""
 import numpy as np
 import pytest
+from refcheck import check
 
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.sector import (
@@ -37,7 +38,8 @@ def test_peak_at_natural_frequency(sector, damper):
     f_n = natural_frequencies(sector, sector.cfg.engine_order, damper)[0]
     w, a = peak_of(lambda om: abs(linear_response(sector, om, damper)[0, sector.response]),
                    2 * np.pi * 380, 2 * np.pi * 520)
-    assert w / (2 * np.pi) == pytest.approx(f_n, rel=PEAK_RTOL)
+    check(f"UPD-24 linear FRF peak [Hz], damper {damper}, EO 6", w / (2 * np.pi), f_n, rtol=PEAK_RTOL,
+          source="natural frequency of the cyclic sector (eigenvalue problem)")
     # Peak amplitude from the single-mode modal formula |phi_a|^2 F0 / (omega_r^2 2 zeta_r)
     # is checked against the modal superposition (all modes).
     am = abs(modal_response(sector, w, damper)[0, sector.response])
