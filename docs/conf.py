@@ -55,9 +55,7 @@ exclude_patterns = ["_build", "tools", "data", "_generated/*.md", "auto_examples
                     "auto_examples/*.zip", "auto_examples/*.codeobj.json", "auto_examples/*.md5",
                     "**/sg_execution_times.rst"]
 # config.cache: the gallery's settings hold callables, which Sphinx cannot pickle (harmless).
-# toc.empty_glob: the user guide's toctree also globs for pages that other parts of the
-# project add later (e.g. ``docs/mistuning.md``); a glob that matches nothing is no error.
-suppress_warnings = ["config.cache", "toc.empty_glob"]
+suppress_warnings = ["config.cache"]
 
 myst_enable_extensions = ["dollarmath", "amsmath", "deflist", "colon_fence"]
 myst_heading_anchors = 3
@@ -77,3 +75,36 @@ html_show_sourcelink = False
 html_last_updated_fmt = None
 
 sphinx_gallery_conf = gallery.config(ROOT, HERE)
+
+
+# The docstrings write magnitudes as |x| (plain-text mathematics), which reStructuredText
+# reads as substitution references. Escape every bar outside literal blocks and tables
+# before numpydoc and autodoc parse the docstring.
+def _escape_bars(lines: list[str]) -> None:
+    literal_indent = None
+    for i, line in enumerate(lines):
+        stripped = line.strip()
+        indent = len(line) - len(line.lstrip())
+        if literal_indent is not None:
+            if not stripped or indent > literal_indent:
+                continue
+            literal_indent = None
+        if stripped.endswith("::"):
+            literal_indent = indent
+        if "|" in line and not (stripped.startswith("|") and stripped.endswith("|")):
+            lines[i] = line.replace("\\|", "|").replace("|", "\\|")
+
+
+def _process_docstring(app, what, name, obj, options, lines):
+    _escape_bars(lines)
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _process_docstring, priority=100)
+
+
+import warnings  # noqa: E402
+
+# numpydoc reports sections it does not know (e.g. "Class Attributes") as Python warnings;
+# they are rendered as plain text, which is what the docstrings mean.
+warnings.filterwarnings("ignore", message="Unknown section", category=UserWarning)

@@ -13,7 +13,7 @@ compliance at its load (one displacement-controlled solve): the toolkit's
 projected Newton (``contact_core.qp``) against scipy's ``nnls`` and
 ``lsq_linear`` (bvls) on the Cholesky form, with their disagreement.
 
-Goal (issue 2): sphere, 41x41 grid, contact radius and p0 within 0.5 % of
+Goal: sphere, 41x41 grid, contact radius and p0 within 0.5 % of
 Hertz, 20 s cold and 1 s cached end to end on a 2-core machine.
 """
 from __future__ import annotations

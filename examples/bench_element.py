@@ -9,7 +9,7 @@ partial slip: about half the sliders slip in every cycle) is run through
 * the Python array API ``IwanElement.series`` (one ctypes call plus numpy
   allocation and checks), best of ``--repeats`` runs.
 
-Goals (issue 3): at most 2 ns per slider update; the Python entry point within
+Goals: at most 2 ns per slider update; the Python entry point within
 2x of the C driver. The error column checks the numbers: relative difference of
 the last F + W between the two paths (same C code: round-off only) -- and the
 loop energy of a harmonic cycle against Masing's integral 8 int g - 4 a g(a) of

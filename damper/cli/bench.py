@@ -1,4 +1,4 @@
-"""``damper bench``: every stage's accuracy against cost in one run, one report (issue 13).
+"""``damper bench``: every stage's accuracy against cost in one run, one report.
 
 Writes DIR/bench.json (``stages``: stage -> rows {case, size, error, time_s,
 memory_mb, cached}, plus the run's stamp) and DIR/bench.html (a plot of error

@@ -1,4 +1,4 @@
-"""``damper stress``: extreme but legal inputs over every stage, each case checked (issue 13).
+"""``damper stress``: extreme but legal inputs over every stage, each case checked.
 
 Each case runs in a child process with a time limit (a hang is detected, not
 suffered), ends converged and checked (equilibrium, force bounds, energy) or

@@ -55,7 +55,7 @@ class Field:
 
 
 #: Results a scene may want: name -> (producing stage kind, per contact?, doc).
-#: The blade-damper results (issue 15) join here with their stage kinds.
+#: The blade-damper results join here with their stage kinds.
 RESULTS = {
     "k_n": ("normal", True, "normal contact stiffness dN/d(approach), Hertz comparison"),
     "pressure_map": ("normal", True, "contact pressure map and area plots"),
@@ -70,7 +70,7 @@ RESULTS = {
                      "damper's centrifugal load CF and the optimal CF"),
     "report": ("report", False, "one-page HTML report of the run"),
 }
-#: Results named by the issues but not built yet: a scene that wants one is refused
+#: Results planned but not built yet: a scene that wants one is refused
 #: with this reason instead of an "unknown result".
 PLANNED: dict = {}
 

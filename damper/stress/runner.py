@@ -108,7 +108,7 @@ def run_case(case: Case, curves: dict[str, Path], work: Path) -> dict:
 def judge(row: dict) -> dict:
     """Set ``ok``, ``advice`` and ``known`` of a row from its outcome, expectation and message.
 
-    A legal input may be refused when the message says what to change (issue 13);
+    A legal input may be refused when the message says what to change;
     an input that must be refused needs only a message.
     """
     message = row["message"].removeprefix("error without advice: ")
@@ -140,7 +140,7 @@ def run(quick: bool = False, stages=None, log=print, match=None) -> list[dict]:
 
 
 def table(rows: list[dict]) -> str:
-    """Markdown table of the rows (what the README shows)."""
+    """Markdown table of the rows (DIR/stress.md)."""
     head = "| stage | case | outcome | expected | worst residual | time [s] | note |\n|---|---|---|---|---|---|---|\n"
     lines = []
     for r in rows:

@@ -9,6 +9,9 @@ whose PNG files become the page's figures (:func:`png_scraper`). A script missin
 """
 from __future__ import annotations
 
+import ast
+import atexit
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -44,8 +47,15 @@ def _out(script_vars) -> Path:
 
 
 def reset_argv(gallery_conf, script_vars) -> list[str]:
-    """sphinx-gallery hook: the example's arguments (:data:`ARGS`), with a fresh output folder."""
+    """sphinx-gallery hook: the example's arguments (:data:`ARGS`), with a fresh output folder
+    and ``__file__``, ``__doc__`` set."""
     name = Path(script_vars["src_file"]).name
+    # Scripts find the repository or re-run themselves through __file__, as when run from
+    # the command line (sphinx-gallery leaves it undefined).
+    src = Path(script_vars["src_file"])
+    script_vars["example_globals"]["__file__"] = str(src)
+    # ... and their argparse descriptions from __doc__ (sphinx-gallery blanks it).
+    script_vars["example_globals"]["__doc__"] = ast.get_docstring(ast.parse(src.read_text()), clean=False)
     out = _out(script_vars)
     shutil.rmtree(out, ignore_errors=True)
     out.mkdir(parents=True, exist_ok=True)
@@ -57,6 +67,8 @@ class _ExampleExit(RuntimeError):
 
 
 _real_exit = sys.exit
+#: The example running now (set and cleared by :func:`reset_exit`).
+_running: list[str] = []
 
 
 def _exit(code=0):
@@ -70,6 +82,22 @@ def reset_exit(gallery_conf, fname, when):
     """sphinx-gallery hook (before and after each example): route ``sys.exit`` through
     :func:`_exit` while an example runs (a ``SystemExit`` would end the whole build)."""
     sys.exit = _exit if when == "before" else _real_exit
+    if when == "before":
+        _running[:] = [str(fname)]
+    else:
+        _running.clear()
+
+
+def _ended_inside_an_example() -> None:
+    """At interpreter exit: an example that raised SystemExit itself (not through sys.exit)
+    ends the whole build, with exit code 0; turn that into a failure that names it."""
+    if _running:
+        print(f"gallery: the build ended inside the example {_running[0]} (SystemExit raised "
+              "directly): use sys.exit(main()) there", file=sys.stderr, flush=True)
+        os._exit(1)
+
+
+atexit.register(_ended_inside_an_example)
 
 
 def png_scraper(block, block_vars, gallery_conf):

@@ -81,6 +81,28 @@ def cli_page(docs: Path) -> None:
     _write(docs / "_generated" / "cli.md", "\n".join(lines))
 
 
+#: Pages the toctrees of index.md and user/index.md name; any other page found in docs/ or
+#: docs/user/ (added by a part of the project the index does not know yet) is listed
+#: under "More" in the user guide, so the build neither warns nor hides it.
+KNOWN = {
+    "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
+         "changes"},
+    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "scenes", "studies",
+             "bench_stress"},
+}
+
+
+def more_pages(docs: Path) -> None:
+    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages not in KNOWN."""
+    extra = []
+    for sub, known in KNOWN.items():
+        for p in sorted((docs / sub).glob("*.md")):
+            if p.stem not in known:
+                extra.append(p.stem if sub == "user" else f"../{p.stem}")
+    text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
+    _write(docs / "_generated" / "more.md", text)
+
+
 def data_page(docs: Path, name: str, render) -> None:
     """Render ``docs/data/<name>.json`` with ``render(data) -> markdown``, or say how to make it."""
     src = docs / "data" / f"{name}.json"
@@ -94,6 +116,7 @@ def data_page(docs: Path, name: str, render) -> None:
 def all_pages(docs: Path) -> None:
     api_pages(docs)
     cli_page(docs)
+    more_pages(docs)
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)
     data_page(docs, "stress", tables.stress)

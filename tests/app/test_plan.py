@@ -1,5 +1,5 @@
 """The plan and the cache: only the stages a scene needs run, and only when their
-inputs or code changed (issue 12's plan tests, on a coarse 7x7 contact grid)."""
+inputs or code changed (on a coarse 7x7 contact grid)."""
 import json
 
 import pytest

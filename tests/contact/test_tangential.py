@@ -20,7 +20,7 @@ A = (3 * F * R / (4 * E_STAR)) ** (1 / 3)
 P0 = 3 * F / (2 * np.pi * A**2)
 GRID = 21
 
-#: Virgin curve against Mindlin, over the whole curve: the issue's 1 % of mu N
+#: Virgin curve against Mindlin, over the whole curve: the required 1 % of mu N
 #: (0.24 % measured; kept at the requirement, as the gross-slip displacement and
 #: the Masing branch below share it and the step control targets 1 %).
 CURVE_TOL = 0.01

@@ -30,7 +30,7 @@ KT_RTOL = 0.017
 #: a kink at the stick edge x = +-c that a grid of spacing dx ~ 0.07 b smears
 #: (3.4 % measured).
 TRACTION_TOL = 0.05
-#: The small FE case (15 nodes per side, ~9 across the contact): the issue's
+#: The small FE case (15 nodes per side, ~9 across the contact): the required
 #: 1 % of mu N on the curve (0.4 % measured); k_t within 3 %: on grids this
 #: coarse it scatters by +-3 % between 11 and 15 nodes per side as the discrete
 #: contact boundary moves (0.06 % measured at 15).

@@ -46,7 +46,7 @@ def bouncing_mass(P, m=1.0, kn=1.0, c=0.1, weight=1.0):
 
 
 #: HB (H = 15) against time integration, bouncing mass: measured 8.1e-6 (peak |y|),
-#: 1.9e-5 (first harmonic), 8.2e-6 absolute (mean, static deflection 1); the issue
+#: 1.9e-5 (first harmonic), 8.2e-6 absolute (mean, static deflection 1); the requirement
 #: asks for 0.5 %: tolerances 1.5x measured.
 BOUNCE_PEAK_RTOL = 1.2e-5
 BOUNCE_H1_RTOL = 2.8e-5

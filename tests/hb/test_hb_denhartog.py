@@ -10,7 +10,7 @@ from harmonic_balance.model import sdof_model
 from harmonic_balance.start import homotopy_start
 from harmonic_balance.timeint import steady_curve
 
-#: The issue's single-DOF case: m = k = 1, c = 0.04, slip force 0.5, forcing 1.
+#: The reference single-DOF case: m = k = 1, c = 0.04, slip force 0.5, forcing 1.
 M, C, K, FS, P = 1.0, 0.04, 1.0, 0.5, 1.0
 
 
@@ -57,7 +57,7 @@ def test_stiff_jenkins_at_resonance_agrees_with_den_hartog():
     Away from resonance the elastic (Jenkins) steady state approaches the rigid one
     only like kt^-1/2 (time integration at omega = 2: 9 % at 1e3 k, 3 % at 1e4 k,
     0.9 % at 1e5 k: the stuck mode sqrt(kt / m) rings after each reversal), so the
-    issue's 1 % at 1e3 k holds at resonance, not over the whole band.
+    required 1 % at 1e3 k holds at resonance, not over the whole band.
     """
     r = compute_frf(sdof_model(M, K, C, 1e3, FS, P), 21, (0.98, 1.02), refine=False)
     a = np.interp(1.0, r.omega, r.amplitude)
@@ -71,9 +71,9 @@ def test_stiff_jenkins_off_resonance_hb_is_the_elastic_model_not_the_rigid_one()
     of the SAME elastic Jenkins model (measured 4.7e-3 and 3.5e-3; 8e-5 at H = 51 and
     omega = 2: the rest is the truncation of the stuck mode's ringing at
     sqrt(kt / m) / omega ~ 16-21 harmonics), while both differ from Den Hartog's rigid
-    Coulomb solution by 5-10 % (measured HB 5.7 %, 9.6 %; TI 5.2 %, 9.2 %): the issue's
+    Coulomb solution by 5-10 % (measured HB 5.7 %, 9.6 %; TI 5.2 %, 9.2 %): the required
     1 % at 1e3 k cannot hold off resonance for the elastic model itself (TI at 1e5 k:
-    within 0.95 % of Den Hartog over 0.5-2 rad/s, README)."""
+    within 0.95 % of Den Hartog over 0.5-2 rad/s, README.md at revision c58d443)."""
     omegas = np.array([1.5, 2.0])
     model = sdof_model(M, K, C, 1e3, FS, P)
     a_ti, _, err, _ = steady_curve(model, omegas, 512)

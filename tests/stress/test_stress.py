@@ -1,4 +1,4 @@
-"""`damper stress --quick`: no crash, hang, NaN, wrong number or unexplained failure (issue 13)."""
+"""`damper stress --quick`: no crash, hang, NaN, wrong number or unexplained failure."""
 import json
 
 import numpy as np

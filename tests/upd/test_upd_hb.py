@@ -9,11 +9,11 @@ from harmonic_balance.bladed_disk.solve import energy_balance, frf, start_point,
 
 #: Closed-form statics vs the linear solve (round-off; measured 2e-16).
 STATIC_RTOL = 1e-12
-#: Energy balance per cycle (the issue's number; measured 5e-16 at the Newton tolerance).
+#: Energy balance per cycle (the required bound; measured 5e-16 at the Newton tolerance).
 ENERGY_RTOL = 1e-6
 #: Homogeneity: amplitude / F0 at (F0, CF) and (3 F0, 3 CF); measured 3e-12.
 HOMOG_RTOL = 1e-8
-#: Linear limits, peaks to 0.1 % (the issue's number).
+#: Linear limits, peaks to 0.1 % (the required bound).
 LIMIT_RTOL = 1e-3
 
 

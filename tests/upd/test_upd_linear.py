@@ -16,7 +16,7 @@ from harmonic_balance.bladed_disk.sector import (
 #: Direct solve vs complex modal superposition; measured 2e-8 (free), 4e-7 (stuck).
 MODAL_RTOL = 1e-6
 #: Peak frequency vs undamped natural frequency: shift ~ zeta^2 ~ 4e-6 (0.2 % damping),
-#: measured 3e-6; the issue's 0.1 % is the bound.
+#: measured 3e-6; the required 0.1 % is the bound.
 PEAK_RTOL = 1e-3
 
 
@@ -47,7 +47,7 @@ def test_peak_at_natural_frequency(sector, damper):
 
 
 def test_free_nd6_damping_is_0p2_percent(sector):
-    """beta = 1.494e-6 s gives 0.2 % at the free ND6 first mode (the issue's number)."""
+    """beta = 1.494e-6 s gives 0.2 % at the free ND6 first mode (the model's specification)."""
     f = natural_frequencies(sector, 6, "free")[0]
     zeta = sector.beta * 2 * np.pi * f / 2
     assert zeta == pytest.approx(0.002, rel=1e-3)  # measured 2.00005e-3
