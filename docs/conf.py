@@ -1,6 +1,7 @@
 """Sphinx configuration of the damper-toolkit documentation (``make docs``).
 
-Built offline: no intersphinx, no remote images, nothing fetched. Before the build,
+Built offline: no intersphinx, no remote images, nothing fetched; MathJax is copied into
+the site (sphinx-mathjax-offline), so the pages render their equations offline too. Before the build,
 ``docs/tools/generate.py`` (run below) writes the pages that come from data:
 the API module lists (every module of the three libraries and the application),
 the validation table (``docs/data/validation.json``), the performance page
@@ -47,6 +48,7 @@ extensions = [
     "numpydoc",
     "myst_parser",
     "sphinx_gallery.gen_gallery",
+    "sphinx-mathjax-offline",   # MathJax 3 into _static/mathjax: equations render without network
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}

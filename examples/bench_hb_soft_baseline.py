@@ -4,7 +4,7 @@
 The stiff-contact cost goal compares the 1e6 k contact with the soft-contact cost of an
 older revision. This script uses only ``compute_frf`` and ``sdof_model`` (present in
 every version), so the same measurement runs on the code of any revision and on
-today's, on the same machine, back to back:
+today's, on the same machine, back to back::
 
     git worktree add /tmp/old 368c9f4^          # the revision to compare with
     mkdir -p /tmp/oldpath && ln -sfn /tmp/old/harmonic_balance /tmp/oldpath/ \

@@ -6,7 +6,7 @@ optimum CF against H (5, 7, 9, 11, 15; 7 loads 80-250 N + Brent); the peak again
 the ring time integration (TI) at CF/F0 = 2, 4, 20 for H = 1, 3, 5, 7, 9, 15, with the
 TI's step error (2x steps) and settling error, and the TI's cost against its own error
 (the same march stopped at looser settling tolerances) to compare TI and HB at equal
-accuracy. Times are CPU (process_time): the machine is shared.
+accuracy. Times are CPU (process_time): the machine is shared. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_upd.py --out out/bench_upd [--quick]
     ... bench_upd.py --scan 5 7 9 11 13 15            # the objective per H (25 loads 80-250 N)
