@@ -52,8 +52,7 @@ def modules(package: str, root: Path) -> list[str]:
 def api_pages(docs: Path) -> None:
     root = docs.parent
     for pkg, role in PACKAGES.items():
-        lines = [f"``{pkg}``", "=" * (len(pkg) + 4), "", role, "", ".. contents:: Modules", "   :local:",
-                 "   :depth: 1", ""]
+        lines = [f"``{pkg}``", "=" * (len(pkg) + 4), "", role, ""]   # the theme lists the modules at the side
         for name in modules(pkg, root):
             lines += [name, "-" * len(name), "", f".. automodule:: {name}", ""]
         _write(docs / "_generated" / "api" / f"{pkg}.rst", "\n".join(lines))

@@ -123,6 +123,16 @@ def test_equations_render_offline():
 
 
 @needs_site
+def test_no_page_shows_an_error_box():
+    """A markup error that Sphinx lets through is rendered into the page as a box: docutils'
+    system messages, and the theme's error box over a local table of contents (the theme
+    lists a page's sections itself); none may reach a reader."""
+    bad = [str(p.relative_to(SITE)) for p in SITE.rglob("*.html")
+           if re.search(r'class="system-message"|class="[^"]*\bcontents\b', p.read_text(errors="replace"))]
+    assert not bad, bad
+
+
+@needs_site
 def test_generated_pages_name_their_revision_and_command():
     for name, command in (("validation", "make validation"), ("performance", "damper bench"),
                           ("stability", "damper stress")):
