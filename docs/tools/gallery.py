@@ -32,6 +32,8 @@ ARGS: dict[str, list[str]] = {
     "craig_bampton_blade.py": ["--out", "{out}"],
     "upd_geometry_compare.py": ["--quick", "--cache-dir", "{out}/cache"],   # full: ~20 min of TI
     "bench_contact.py": ["--quick", "--out", "{out}"],               # full: grids to 41, minutes
+    "bench_contact2d.py": ["--sizes", "3", "16", "--cycles", "3", "--repeats", "1",   # full: about a minute
+                           "--fmu-sliders", "4", "--fmu-steps", "2000"],
     "bench_element.py": ["--sizes", "4", "64", "--samples", "2000", "--repeats", "3"],
     "bench_fmu.py": ["--sliders", "3,50", "--steps", "20000", "--py-steps", "2000", "--repeats", "1"],
     "bench_hb.py": ["--smoke"],                                      # full: with solve_ivp, minutes
