@@ -155,7 +155,7 @@ def run(args) -> int:
 
     # the application's store (same folder and format as contact_core's DiskCache) keeps
     # the cache under its size limit ($DAMPER_CACHE_MAX_MB)
-    cache = False if args.no_cache else Store(args.cache_dir)
+    cache = False if args.no_cache else Store(args.cache_dir).prepare()
     if args.stiffness or args.nodes:
         from contact_core import byo
         result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,

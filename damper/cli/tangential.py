@@ -75,7 +75,7 @@ def run(args) -> int:
     command = "damper " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     result = tangential_run.run(spec, args.mu, force=args.force, approach=args.approach,
                                 eccentricity=args.eccentricity, model=args.model,
-                                cache=False if args.no_cache else Store(args.cache_dir),
+                                cache=False if args.no_cache else Store(args.cache_dir).prepare(),
                                 tol=CURVE_TOL if args.tol is None else args.tol, command=command)
     for warning in result.warnings:
         print(f"damper tangential: warning: {warning}", file=sys.stderr)

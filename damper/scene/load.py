@@ -13,7 +13,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import schema
+from . import checks, schema
 from .lines import key_lines, line_of
 
 
@@ -65,6 +65,8 @@ def load_scene(path: str | Path, overrides: dict | None = None) -> Scene:
         text = path.read_text()
     except OSError as err:
         raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror}")]) from None
+    except UnicodeDecodeError:
+        raise SceneError(str(path), [("", None, "not a text file (a scene is TOML)")]) from None
     return parse_scene(text, str(path), overrides, base=path.parent)
 
 
@@ -136,6 +138,11 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         _check_structure(data, problems, base)
         _check_upd(data, problems, base)
         _check_wants(data, problems)
+    if not problems:   # what the stages would refuse only when they run
+        checks.check_contacts(data, problems)
+        checks.check_element(data, problems)
+        checks.check_response(data, problems)
+        checks.check_upd(data, problems)
     return data
 
 

@@ -208,8 +208,8 @@ def load_config(path=None) -> UPDConfig:
         path = Path(path)
         try:
             user = tomllib.loads(path.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as err:
-            raise ValueError(f"cannot read config {path}: {err}") from None
+        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+            raise ValueError(f"cannot read config {path} (TOML): {err}") from None
         for sec, table in user.items():
             if sec not in data or not isinstance(table, dict):
                 raise ValueError(f"config {path}: unknown section [{sec}] "
