@@ -342,6 +342,8 @@ class Store:
         is removed); files not named as entries stay, whatever the folder.
         """
         self._mem.clear()
+        if self.folder.exists() and not self.folder.is_dir():
+            raise NotACacheError(f"cache folder {self.folder} is a file, not a folder: nothing removed")
         if self.memory or not self.folder.is_dir():
             return 0
         if not is_cache_folder(self.folder):

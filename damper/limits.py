@@ -46,6 +46,9 @@ MAX_FORCE_LEVELS = 100
 MAX_OMEGA = 1e9
 #: Friction coefficient: dry contacts have mu below a few; beyond 100 the input is a typo.
 MAX_MU = 100.0
+#: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
+#: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
+MIN_CURVE_TOL = 1e-6
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 

@@ -223,12 +223,19 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
 
     path = Path(path)
     try:
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+    except OSError as err:
+        raise ValueError(f"cannot read model file {path}: {err.strerror or err}") from None
+    if magic != b"PK\x03\x04":  # every .npz is a zip archive
+        raise ValueError(f"{path}: not a numpy .npz archive (numpy.savez writes one)")
+    try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
-        raise ValueError(f"cannot read model file {path} (a numpy .npz file): {err}") from None
-    if not isinstance(arrays, dict) or not arrays:
-        raise ValueError(f"{path}: not a .npz archive of arrays")
+        raise ValueError(f"cannot read model file {path} (a numpy .npz archive): {err}") from None
+    if not arrays:
+        raise ValueError(f"{path}: an empty .npz archive")
     try:
         return _matrices_from(arrays, path)
     except (TypeError, ValueError) as err:

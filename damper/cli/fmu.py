@@ -42,11 +42,19 @@ def run(args) -> int:
     from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_build import build_fmu
 
+    from .common import check_out_file
+
+    if args.n_ref is not None and not (args.n_ref > 0 and args.n_ref < float("inf")):
+        raise ValueError(f"--n-ref must be a positive finite normal load [N], got {args.n_ref:g}")
+    check_out_file(args.output, "--output")
     source = read_curve(args.curve)
     n_ref = args.n_ref if args.n_ref is not None else source.N
     if n_ref is None:
         raise ValueError(f"{args.curve}: the curve has no normal load N; pass --n-ref")
-    curve, error = reduce_virgin_curve(source, fit=args.fit)
+    try:
+        curve, error = reduce_virgin_curve(source, fit=args.fit)
+    except ValueError as err:
+        raise ValueError(f"{args.curve}: {err}") from None
     reduced = (f", reduced from {source.u.size} points, largest force error {error:.3g} N"
                if curve is not source else "")
     description = (f"Masing/Iwan friction element from the virgin curve {args.curve} "

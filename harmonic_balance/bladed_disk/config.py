@@ -208,7 +208,9 @@ def load_config(path=None) -> UPDConfig:
         path = Path(path)
         try:
             user = tomllib.loads(path.read_text())
-        except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+        except OSError as err:
+            raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise ValueError(f"cannot read config {path} (TOML): {err}") from None
         for sec, table in user.items():
             if sec not in data or not isinstance(table, dict):
