@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import re
 import sys
 import warnings
 
@@ -107,6 +108,8 @@ def _text(err: BaseException) -> str:
         text = f"{err.filename}: {err.strerror}"
     else:
         text = str(err) or type(err).__name__
+    # a numpy scalar's repr (np.float64(7.0)) reads as the plain number it is
+    text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
     return " ".join(text.split())
 
 

@@ -30,7 +30,7 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from contact_core.fileio import atomic_write
-    from damper.stress import runner
+    from damper.stress import inputs, runner
 
     from .common import check_out_dir
 
@@ -43,7 +43,7 @@ def run(args) -> int:
     out = Path(args.out)
     result = {"cases": rows, "summary": summ, "quick": args.quick}
     atomic_write(out / "stress.json", json.dumps(result, indent=1) + "\n")
-    atomic_write(out / "stress.md", runner.table(rows))
+    atomic_write(out / "stress.md", inputs.group_table(rows) + "\n" + runner.table(rows))
     if args.json:
         print(json.dumps(result))
     else:

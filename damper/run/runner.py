@@ -105,7 +105,7 @@ def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progres
             if result is None:
                 if s.action == "cached":
                     s.action, s.reason = "compute", s.reason + " (entry unreadable or gone: recomputed)"
-                result = _compute(s, rec, ctx, _after(rec, out))
+                result = _compute(s, rec, ctx, _after(rec, out) if out is not None else "")
                 store.put(s.key, *result.encode(_stage_provenance(s, scene)), stage=s.kind.name)
             rec.results[s.name] = result
             rec.times[s.name] = time.perf_counter() - t0

@@ -69,6 +69,9 @@ def _child(argv: list[str], cwd: Path, env: dict, out: Path, err: Path) -> None:
             f = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
             os.dup2(f, fd)
             os.close(f)
+        # the streams themselves too (a test runner may have replaced them with its own objects)
+        sys.stdout = open(1, "w", closefd=False)  # noqa: SIM115
+        sys.stderr = open(2, "w", closefd=False)  # noqa: SIM115
         resource.setrlimit(resource.RLIMIT_AS, (MEMORY_CAP, MEMORY_CAP))
         sys.argv = ["damper", *argv]
         from damper.cli import main

@@ -64,12 +64,14 @@ def _normal() -> list[InputCase]:
         ("force -1", f"{SPHERE} --force -1"), ("force 0", f"{SPHERE} --force 0"),
         ("force nan", f"{SPHERE} --force nan"), ("force inf", f"{SPHERE} --force inf"),
         ("approach -1e-6", f"{SPHERE} --approach=-1e-6"), ("force and approach", f"{SPHERE} --force 1 --approach 1e-6"),
-        ("radius 0", "--body sphere --radius 0 --force 100"), ("radius -0.01", "--body sphere --radius=-0.01 --force 1"),
+        ("radius 0", "--body sphere --radius 0 --force 100"),
+        ("radius -0.01", "--body sphere --radius=-0.01 --force 1"),
         ("sphere without radius", "--body sphere --force 100"),
         ("radius and diameter", "--body sphere --radius 0.01 --diameter 0.02 --force 100"),
         ("E negative", f"{SPHERE} --force 100 --E=-2e11"), ("nu 0.5", f"{SPHERE} --force 100 --nu 0.5"),
         ("nu -1.5", f"{SPHERE} --force 100 --nu=-1.5"), ("grid 2", f"{SPHERE} --force 100 --grid 2"),
-        ("grid 100000", f"{SPHERE} --force 100 --grid 100000"), ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
+        ("grid 100000", f"{SPHERE} --force 100 --grid 100000"),
+        ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
         ("force 1e12 (Hertz radius > R)", f"{SPHERE} --force 1e12"),
         ("eccentricity on a sphere", f"{SPHERE} --force 100 --eccentricity 1e-4"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
@@ -82,7 +84,7 @@ def _normal() -> list[InputCase]:
         ("--out below a file", f"{SPHERE} --force 100 --out {{fx}}/a_file/r.json"),
         ("--plot a file", f"{SPHERE} --force 100 --plot {{fx}}/a_file"),
         ("--cache-dir a file", f"{SPHERE} --force 100 --cache-dir {{fx}}/a_file"),
-        ("stiffness without nodes", f"--body sphere --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz"),
+        ("stiffness without nodes", "--body sphere --force 100 --stiffness {fx}/m_good.npz {fx}/m_good.npz"),
         ("stiffness with radius", f"{SPHERE} --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz "
                                   "--nodes {fx}/m_good.npz {fx}/m_good.npz"),
         ("stiffness files not matrices", "--body sphere --force 100 --stiffness {fx}/binary.bin {fx}/binary.bin "
@@ -117,12 +119,13 @@ def _tangential() -> list[InputCase]:
 def _loop() -> list[InputCase]:
     a = "--amplitude 2e-6"
     rows = [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json {a}") for kind in
-            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT")]
+            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip")]
     return _table("loop", rows + [
         ("curve missing", f"--curve {{fx}}/nowhere.json {a}"), ("curve is a folder", f"--curve {{fx}} {a}"),
         ("amplitude 1e10", "--curve {fx}/curve.json --amplitude 1e10"),
         ("amplitude 1e30", "--curve {fx}/curve.json --amplitude 1e30"),
-        ("amplitude 0", "--curve {fx}/curve.json --amplitude 0"), ("amplitude -1", "--curve {fx}/curve.json --amplitude=-1"),
+        ("amplitude 0", "--curve {fx}/curve.json --amplitude 0"),
+        ("amplitude -1", "--curve {fx}/curve.json --amplitude=-1"),
         ("amplitude nan", "--curve {fx}/curve.json --amplitude nan"),
         ("amplitude inf", "--curve {fx}/curve.json --amplitude inf"),
         ("force amplitude = mu N", "--curve {fx}/curve.json --force-amplitude 100"),
@@ -210,7 +213,8 @@ def _upd() -> list[InputCase]:
         ("frf band nan 1", "frf --band nan 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
         ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
-        ("config missing", "modes --config {fx}/nowhere.toml"), ("config binary", "modes --config {fx}/upd_binary.toml"),
+        ("config missing", "modes --config {fx}/nowhere.toml"),
+        ("config binary", "modes --config {fx}/upd_binary.toml"),
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
         ("config bad TOML", "modes --config {fx}/upd_badtoml.toml"),
         ("config unknown section", "modes --config {fx}/upd_section.toml"),
@@ -275,7 +279,8 @@ def _sweep() -> list[InputCase]:
 
 def _cache_and_rest() -> list[InputCase]:
     cases = _table("cache", [
-        ("info --cache-max-mb -1", "cache info --cache-max-mb=-1"), ("clear a file", "cache clear --cache-dir {fx}/a_file"),
+        ("info --cache-max-mb -1", "cache info --cache-max-mb=-1"),
+        ("clear a file", "cache clear --cache-dir {fx}/a_file"),
         ("action bogus", "cache bogus"),
     ])
     cases.append(_case("cache", "clear a folder of the user's", "cache clear --cache-dir proj",

@@ -31,10 +31,11 @@ def curves() -> dict[str, str | bytes]:
     text = json.dumps(good)
     nan = dict(good, T=[float("nan")] + good["T"][1:])
     convex = dict(good, T=(MU * N0 * np.linspace(0, 1, 10) ** 2).tolist())
+    dip = dict(good, T=good["T"][:4] + [good["T"][2]] + good["T"][5:])
     return {"curve.json": text, "curve_binary.json": BINARY, "curve_trunc.json": text[: len(text) // 2],
             "curve_empty.json": "", "curve_list.json": "[1, 2, 3]", "curve_nan.json": json.dumps(nan),
             "curve_decreasing.json": json.dumps(dict(good, u=good["u"][::-1])),
-            "curve_convex.json": json.dumps(convex),
+            "curve_convex.json": json.dumps(convex), "curve_dip.json": json.dumps(dip),
             "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
             "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
             "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")})}

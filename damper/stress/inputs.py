@@ -165,13 +165,13 @@ def run_case(case: InputCase, fx: Path, work: Path, index: int) -> dict:
     kept += [c.split(" ", 1)[1] for c in changes if c.split(" ", 1)[1] in case.files]
     extra = check(case.check, case_dir, r) if case.check and r.code == 0 else ""
     outcome, message = classify(case, r, changes, kept, extra)
-    return _row(case, outcome, message, t0, fill)
+    return _row(case, outcome, message.replace(str(fx), "{fx}"), t0, fill)
 
 
-def _row(case: InputCase, outcome: str, message: str, t0: float, fill) -> dict:
+def _row(case: InputCase, outcome: str, message: str, t0: float, fill=None) -> dict:
     return {"stage": "inputs", "case": f"{case.group}: {case.name}", "outcome": outcome, "expected": case.expect,
             "message": message, "worst_residual": None, "time_s": round(time.perf_counter() - t0, 3),
-            "command": "damper " + " ".join(fill(case.argv)), "ok": outcome == case.expect, "advice": True,
+            "command": "damper " + " ".join(case.argv), "ok": outcome == case.expect, "advice": True,
             "known": None}
 
 
@@ -193,3 +193,24 @@ def run(log=print, match=None) -> list[dict]:
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return rows
+
+
+def group_table(rows: list[dict]) -> str:
+    """Markdown summary of the input rows by command: cases, outcomes, failures, one message each."""
+    groups: dict[str, list[dict]] = {}
+    for r in rows:
+        if r["stage"] == "inputs":
+            groups.setdefault(r["case"].split(":", 1)[0], []).append(r)
+    if not groups:
+        return ""
+    head = "| command | cases | outcomes | not as expected | a message |\n|---|---|---|---|---|\n"
+    lines = []
+    for g, rs in groups.items():
+        counts: dict[str, int] = {}
+        for r in rs:
+            counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
+        bad = [r["case"].split(": ", 1)[1] for r in rs if not r["ok"]]
+        sample = next((r["message"] for r in rs if r["outcome"] == "clear_error"), "")
+        lines.append(f"| {g} | {len(rs)} | {', '.join(f'{v} {k}' for k, v in counts.items())} | "
+                     f"{', '.join(bad) or 'none'} | {sample[:110].replace('|', '/')} |")
+    return head + "\n".join(lines) + "\n"

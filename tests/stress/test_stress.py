@@ -14,7 +14,8 @@ def test_stress_quick_has_no_unexplained_failure(tmp_path, capsys):
     code = main(["stress", "--quick", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)
     rows = out["cases"]
-    assert rows and {r["stage"] for r in rows} == {"normal", "tangential", "loop", "fmu", "frf"}
+    assert rows and {r["stage"] for r in rows} == {"inputs", "normal", "tangential", "loop", "fmu", "frf"}
+    assert sum(r["stage"] == "inputs" for r in rows) >= 150
     for r in rows:
         assert set(r) >= {"stage", "case", "outcome", "message", "worst_residual", "time_s"}
         assert r["outcome"] not in ("crash", "hang", "nan"), r
