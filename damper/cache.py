@@ -196,8 +196,9 @@ class Store:
             names = os.listdir(self.folder)
         except OSError:
             return
-        foreign = sorted(n for n in names if not (LEGACY_NAME.match(n) or TAG_TEMP.match(n)))
-        if foreign:
+        ours = (LEGACY_NAME, TAG_TEMP, ENTRY_NAME, TEMP_NAME)
+        foreign = sorted(n for n in names if not any(p.match(n) for p in ours))
+        if foreign and not is_cache_folder(self.folder):   # (another run may have tagged it meanwhile)
             shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
             raise NotACacheError(f"cache folder {self.folder} is not a damper cache (no {TAG_NAME}) and holds "
                                  f"other files ({shown}): give a new or empty folder (--cache-dir or "

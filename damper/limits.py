@@ -46,6 +46,10 @@ MAX_FORCE_LEVELS = 100
 MAX_OMEGA = 1e9
 #: Friction coefficient: dry contacts have mu below a few; beyond 100 the input is a typo.
 MAX_MU = 100.0
+#: Largest magnitude of a model parameter typed on the command line (mass, stiffness,
+#: force, ...): the harmonic balance squares forces and displacements (residual norms,
+#: omega^2 M), which overflows double precision above ~1e154.
+MAX_MAGNITUDE = 1e100
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6

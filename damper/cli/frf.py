@@ -77,6 +77,8 @@ def _dest(flag: str) -> str:
 
 def check_model_arguments(args) -> None:
     """Refuse, before any work, options that do not apply to the model (and fill the sdof defaults)."""
+    from damper import limits
+
     if args.model == "sdof":
         for flag in ("--elements", "--force-scale"):
             if getattr(args, _dest(flag)) is not None:
@@ -89,6 +91,9 @@ def check_model_arguments(args) -> None:
                 setattr(args, _dest(flag), value)
             elif not math.isfinite(v):
                 raise ValueError(f"{flag} must be finite, got {v:g}")
+            elif abs(v) > limits.MAX_MAGNITUDE:
+                raise ValueError(f"{flag} {v:g} is beyond the limit {limits.MAX_MAGNITUDE:g}: the harmonic "
+                                 "balance squares forces and displacements, which overflows above ~1e154")
         return
     given = [flag for flag in SDOF if getattr(args, _dest(flag)) is not None]
     if given:
@@ -98,8 +103,9 @@ def check_model_arguments(args) -> None:
         raise ValueError("a .npz model needs --elements FILE.toml")
     if args.force_scale is None:
         args.force_scale = 1.0
-    if not math.isfinite(args.force_scale):
-        raise ValueError(f"--force-scale must be finite, got {args.force_scale:g}")
+    if not (math.isfinite(args.force_scale) and abs(args.force_scale) <= limits.MAX_MAGNITUDE):
+        raise ValueError(f"--force-scale must be finite and at most {limits.MAX_MAGNITUDE:g} in magnitude, "
+                         f"got {args.force_scale:g}")
 
 
 def build_model(args):

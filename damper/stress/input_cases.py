@@ -172,6 +172,8 @@ def _frf() -> list[InputCase]:
         ("damping -1", SDOF.replace("--damping 0.01", "--damping=-1") + f" {o}"),
         ("contact stiffness 0", SDOF.replace("--contact-stiffness 1", "--contact-stiffness 0") + f" {o}"),
         ("slip force -1", SDOF.replace("--slip-force 0.05", "--slip-force=-1") + f" {o}"),
+        ("force 1e200", SDOF.replace("--force 0.05", "--force 1e200") + f" {o}"),
+        ("stiffness 1e300", SDOF.replace("--stiffness 1", "--stiffness 1e300") + f" {o}"),
         ("sdof with --elements", f"{SDOF} {o} --elements {{fx}}/el_good.toml"),
         ("sdof with --force-scale", f"{SDOF} {o} --force-scale 2"),
         ("sdof response DOF 3", f"{SDOF} {o} --response-dof 3"),
