@@ -92,7 +92,7 @@ def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progres
     rec = RunRecord(scene, plan, out=Path(out) if out is not None else None)
     ctx = Context(store, scene, {s.name for s in plan.stages if s.forced}, progress.step)
     rec.provenance = record(scene=scene.source, scene_hash=scene.hash(), scene_content=scene.raw,
-                            cache=str(store.folder.resolve()))
+                            cache=None if store.memory else str(store.folder.resolve()))
     current = None
     try:
         for s in plan.stages:

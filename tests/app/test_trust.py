@@ -290,3 +290,14 @@ def test_scene_problems_found_before_any_work_name_their_key_and_line(tmp_path):
     msg = str(info.value)
     assert "bb.toml:12: structure.matrices:" in msg and "K must be finite, got nan at entry (1, 1)" in msg
     assert json.dumps(msg)  # one message, all problems of the file
+
+
+def test_write_errors_name_the_target_never_the_temporary_file(tmp_path):
+    (tmp_path / "adir").mkdir()
+    (tmp_path / "afile").write_text("x")
+    for target in (tmp_path / "adir", tmp_path / "afile" / "r.json"):
+        with pytest.raises(OSError) as info:
+            atomic_write(target, "{}")
+        assert str(target) in str(info.value) and ".tmp" not in str(info.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["adir", "afile"]
+    assert damper(["frf", "--model", "sdof", "--omega", "0.9", "1.1", "--out", str(tmp_path / "adir")]) == 2
