@@ -83,6 +83,7 @@ def _normal() -> list[InputCase]:
         ("--out an existing folder", f"{SPHERE} --force 100 --out {{fx}}"),
         ("--out below a file", f"{SPHERE} --force 100 --out {{fx}}/a_file/r.json"),
         ("--plot a file", f"{SPHERE} --force 100 --plot {{fx}}/a_file"),
+        ("--normal-curve an existing folder", f"{SPHERE} --force 100 --normal-curve {{fx}}"),
         ("--cache-dir a file", f"{SPHERE} --force 100 --cache-dir {{fx}}/a_file"),
         ("stiffness without nodes", "--body sphere --force 100 --stiffness {fx}/m_good.npz {fx}/m_good.npz"),
         ("stiffness with radius", f"{SPHERE} --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz "
@@ -152,6 +153,14 @@ def _fmu() -> list[InputCase]:
         ("n-ref nan", "--curve {fx}/curve.json -o d.fmu --n-ref nan"),
         ("fmi version 4", "--curve {fx}/curve.json -o d.fmu --fmi-version 4"),
         ("curve without N", "--curve {fx}/curve_noN.json -o d.fmu"),
+        ("point: k-n 0", "--curve {fx}/curve.json -o d.fmu --k-n 0"),
+        ("point: k-n nan", "--curve {fx}/curve.json -o d.fmu --k-n nan"),
+        ("point: preload -1", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --preload=-1"),
+        ("point: preload without a normal law", "--curve {fx}/curve.json -o d.fmu --preload 100"),
+        ("point: normal curve binary", "--curve {fx}/curve.json -o d.fmu --normal {fx}/binary.bin"),
+        ("point: normal curve missing", "--curve {fx}/curve.json -o d.fmu --normal {fx}/nowhere.json"),
+        ("point: normal curve is a virgin curve", "--curve {fx}/curve.json -o d.fmu --normal {fx}/curve.json"),
+        ("point: k-n and normal", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --normal {fx}/curve.json"),
     ], "fmu")
 
 
