@@ -188,6 +188,14 @@ class Store:
                            "permission): reading it, keeping new results in memory for this run only")
         return self
 
+    def owned(self) -> bool:
+        """Whether the folder is (or may become) this cache: missing, tagged, or holding only its files."""
+        try:
+            self._check_owned()
+        except NotACacheError:
+            return False
+        return True
+
     def _check_owned(self) -> None:
         """NotACacheError if the folder exists, holds files of its own and no cache tag."""
         if not self.folder.is_dir() or is_cache_folder(self.folder):

@@ -59,7 +59,7 @@ def run(args) -> int:
     info = store.info()
     if args.json:
         print_json(info)
-    elif not info["is_cache"] and store.folder.exists():
+    elif not store.owned():
         print(f"{info['folder']}: not a damper cache (no CACHEDIR.TAG)")
     else:
         print(f"{info['folder']}: {info['entries']} entries, {info['bytes'] / 2**20:.1f} MiB "

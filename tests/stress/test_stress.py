@@ -24,7 +24,8 @@ def test_stress_quick_has_no_unexplained_failure(tmp_path, capsys):
     refused = [r for r in rows if r["expected"] == "clear_error"]
     assert refused and all(r["outcome"] == "clear_error" and r["message"] for r in refused)
     assert code == 0
-    assert (tmp_path / "stress.md").read_text().startswith("| stage |")
+    md = (tmp_path / "stress.md").read_text()        # the input stage by command, then every row
+    assert md.startswith("| command | cases |") and "\n| stage | case |" in md
 
 
 def test_classify_detects_each_failure_kind():
