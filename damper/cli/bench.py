@@ -37,7 +37,10 @@ def run(args) -> int:
     names = args.stage or [n for n in funcs if n != "solvers" or args.solvers]
     bad = [n for n in names if n not in funcs]
     if bad:
-        raise ValueError(f"unknown stage(s) {bad}: use {', '.join(funcs)}")
+        raise ValueError(f"unknown stage(s) {', '.join(bad)}: use {', '.join(funcs)}")
+    from .common import check_out_dir
+
+    check_out_dir(args.out, "--out")
     result = {"stamp": stamp(), "quick": args.quick, "stages": {}}
     with tempfile.TemporaryDirectory(prefix="damper_bench_") as work:
         for name in names:
