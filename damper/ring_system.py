@@ -6,7 +6,7 @@ ring (4 for UPD-24 at EO 6): blade j is forced by F0 cos(Omega t + j phi), phi =
 j+1's ``right`` one. The archive holds one blade FMU (:mod:`fmu_src.blade_fmu`, its
 ``blade_index`` set per component) and one damper FMU (:mod:`fmu_src.upd_fmu`), both
 from :mod:`harmonic_balance.bladed_disk.fmus` (the HB's matrices, kinematics and laws,
-starting in the frictionless prestress at the given CF), wired as
+starting in the frictionless prestress at the given CF), wired as::
 
     damper j  <- blade j:     q_left_{x,y}, v_left_{x,y}   (its left platform point)
     damper j  <- blade j+1:   q_right_{x,y}, v_right_{x,y} (its right platform point)

@@ -1,4 +1,5 @@
 """UPD-24 as a system of FMUs in libcosim against harmonic balance and the ring time integration.
+==============================================================================================
 
 For each centrifugal load (F0 = 30 N): the HB curve (H = 7, the `damper upd frf`
 solver) gives the peak; the ring archive of `damper system` is co-simulated
@@ -9,7 +10,7 @@ same ODE marched by central differences) at the same frequencies is the referenc
 the ODE both solve. Prints the comparison table and the cost rows (wall time per
 period and to the answer), writes ``upd_cosim.json`` and, at the CF = 120 N peak,
 ``upd_cosim_period.png`` (co-simulated steady state against the HB periodic solution
-over one period). Wall times: the machine is shared, compare within one run.
+over one period). Wall times: the machine is shared, compare within one run. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/upd_cosim.py --out out/upd_cosim [--cf 60 120 600]
     python examples/upd_cosim.py --quick --out out/upd_cosim_quick   # smoke: CF 120, 3 periods

@@ -21,7 +21,7 @@
  * - inputs beyond the model's bound (model_input_bound; stated in the FMU's
  *   documentation) are refused with a logged message.
  *
- * FMU state (issue 14): one flat block, fmu_header followed by the model's history
+ * FMU state: one flat block, fmu_header followed by the model's history
  * (model_history_size() bytes), no pointers; the serialized state is these bytes.
  * It carries the mode, time, values, input derivatives, whether a history has been
  * committed (after Exit Initialization Mode), and a 64-bit FNV-1a checksum of
