@@ -1,4 +1,5 @@
 """Benchmark of the mistuned full-ring harmonic balance (table; not a timed test).
+===================================================================================
 
 Rows:
 
@@ -14,7 +15,7 @@ Rows:
   minute; the traced memory peak of one sample (tracemalloc, a separate run).
 
 Times are CPU (process_time) where one process works, wall time for the clusters: the
-machine is shared, compare within one run only.
+machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
         [--rows scaling precond throughput] [--samples 8] [--quick]
