@@ -95,12 +95,11 @@ def precond_rows(stds, nb=24) -> list:
             x = RingSolver(ring, solver_t.tuned).tuned_start(w)
             J = ring(x, w)[1].tocsc()
             b = np.random.default_rng(0).standard_normal(ring.size)
-            count = [0]
+            residuals = []  # GMRES's preconditioned residual norms, one per inner iteration
             y, _ = gmres(J, b, M=LinearOperator(J.shape, lut.solve), rtol=1e-10, restart=200,
-                         maxiter=1, callback=lambda _: count.__setitem__(0, count[0] + 1),
-                         callback_type="pr_norm")
+                         maxiter=1, callback=residuals.append, callback_type="pr_norm")
             rows.append({"case": "tuned preconditioner", "blades": nb, "frequency_hz": f, "std": std,
-                         "gmres_iterations": count[0],
+                         "gmres_iterations": len(residuals),
                          "gmres_residual": float(np.linalg.norm(J @ y - b) / np.linalg.norm(b)),
                          "lu_ms": lu_ms(J)})
             print(_fmt(rows[-1]), flush=True)

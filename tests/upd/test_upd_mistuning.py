@@ -5,8 +5,13 @@ import pytest
 
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
-from harmonic_balance.bladed_disk.mistuning import (LinearRing, check_factors, draw_factors,
-                                                    tuned_linear_peak, whitehead_bound)
+from harmonic_balance.bladed_disk.mistuning import (
+    LinearRing,
+    check_factors,
+    draw_factors,
+    tuned_linear_peak,
+    whitehead_bound,
+)
 from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
 from harmonic_balance.bladed_disk.ring_solve import RingSolver, newton_sparse, ring_frf, tolerance
 from harmonic_balance.bladed_disk.sector import Sector, linear_response
