@@ -37,6 +37,14 @@ MAX_LOAD_POINTS = 200
 MAX_UPD_GRID = 2000
 #: Points of the F-approach curve of ``damper normal --curve``: one normal solve each.
 MAX_APPROACH_POINTS = 1000
+#: Samples of a mistuning study: each is a curve of the whole ring (~20 s CPU at 24
+#: blades, H = 7; 0.1-0.5 s in a linear limit), so 10000 samples is days of CPU.
+MAX_MISTUNING_SAMPLES = 10000
+#: Blades of a mistuned ring: its prestress statics use dense matrices ((7 N_b)^2 numbers,
+#: 190 MB for three at 400 blades) and a curve costs ~0.4 s CPU per blade at H = 7.
+MAX_RING_BLADES = 400
+RING_BLADES_WHY = ("the ring's statics are dense ((7 N_b)^2 numbers per matrix) and a curve costs "
+                   "~0.4 s CPU per blade")
 #: Variants of a sweep: each is one scene run (seconds to minutes).
 MAX_SWEEP_VARIANTS = 1000
 #: Forced-response levels of a scene (``excitation.forces``): one curve each.

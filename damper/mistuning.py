@@ -46,8 +46,6 @@ QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 #: docstring; a blade's frequency scatters by sigma_f).
 BAND_MARGIN, BAND_SIGMAS = 0.02, 3.0
 DAMPERS = ("nonlinear", "free", "stuck")
-#: Largest number of samples of one study (the patterns and tasks are built up front).
-MAX_SAMPLES = 100_000
 
 
 @dataclass
@@ -87,22 +85,29 @@ class Study:
         return cfg.with_values(**changes) if changes else cfg
 
     def check(self) -> None:
-        """ValueError naming the first unusable setting."""
+        """ValueError naming the first unusable setting (sizes bounded: :mod:`damper.limits`)."""
+        from damper import limits
+
         if self.damper not in DAMPERS:
             raise ValueError(f"damper must be one of {DAMPERS}, got {self.damper!r}")
         for name in ("cf", "f0"):
             v = getattr(self, name)
-            if v is not None and not (np.isfinite(v) and v > 0):
-                raise ValueError(f"--{name} must be finite and > 0, got {v}")
-        if self.harmonics < 1 or self.points < 3:
-            raise ValueError("--harmonics must be >= 1 and --points >= 3")
-        if self.factors is None and not (isinstance(self.samples, int) and 1 <= self.samples <= MAX_SAMPLES):
-            raise ValueError(f"--samples must be an integer in 1..{MAX_SAMPLES}, got {self.samples}")
-        if not (isinstance(self.seed, int) and self.seed >= 0):
-            raise ValueError(f"--seed must be an integer >= 0, got {self.seed}")
-        if self.band_hz is not None and not (len(self.band_hz) == 2 and np.all(np.isfinite(self.band_hz))
-                                            and 0 < self.band_hz[0] < self.band_hz[1]):
-            raise ValueError(f"--band needs 0 < LO < HI, got {self.band_hz}")
+            if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
+                raise ValueError(f"{name} must be finite and > 0, got {v}")
+        limits.check_size("harmonics", self.harmonics, 1, limits.MAX_UPD_HARMONICS,
+                          limits.harmonics_why(limits.MAX_UPD_HARMONICS))
+        limits.check_size("points", self.points, 3, limits.MAX_UPD_POINTS, "each point is a harmonic-"
+                          "balance solve of the whole ring (~0.2 s at 24 blades, H = 7)")
+        if self.blades is not None:
+            limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
+        if self.factors is None:
+            limits.check_size("samples", self.samples, 1, limits.MAX_MISTUNING_SAMPLES,
+                              "each sample is a ring curve (~20 s CPU at 24 blades, H = 7)")
+            limits.check_size("seed", self.seed, 0, 2**63 - 1, "a 64-bit seed")
+        if self.band_hz is not None:
+            limits.check_omega_range("band", *self.band_hz, unit="Hz", scale=2 * np.pi)
+            if not self.band_hz[0] < self.band_hz[1]:
+                raise ValueError(f"band {self.band_hz[0]:g} {self.band_hz[1]:g}: give LO < HI [Hz]")
 
     def patterns(self, n_blades: int) -> list[np.ndarray]:
         """Stiffness factors of every sample (all drawn and checked before any work)."""

@@ -88,14 +88,17 @@ def run_mistuning(args) -> int:
     from damper.mistuning import Study, plot_study, run_study
 
     from .cache import store_from_args
-    from .common import print_json
+    from .common import check_out_dir, print_json
 
     given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
                             ("--serial", args.serial)) if v]
     if len(given) > 1:
         raise ValueError(f"give one of --scheduler, --workers, --serial (got {', '.join(given)})")
-    if args.workers is not None and args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    from damper import limits
+
+    if args.workers is not None:
+        limits.check_workers("--workers", args.workers)
+    check_out_dir(args.plot, "--plot")
     draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
     if args.factors is not None and draw:
         raise ValueError("give --factors or --std/--samples/--seed, not both")
