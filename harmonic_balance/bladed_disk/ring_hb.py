@@ -1,7 +1,7 @@
 """Nonlinear harmonic balance of the full mistuned ring of N_b sectors, sparse.
 
 No cyclic symmetry: every blade and every damper has its own unknowns. The ring is a
-standard :class:`~harmonic_balance.model.Model` (blades of :mod:`.mistuning` (M1),
+standard :class:`~harmonic_balance.model.Model` (blades of :mod:`~harmonic_balance.bladed_disk.mistuning` (M1),
 dampers j between blade j and blade j + 1 mod N_b with the sector's
 :class:`~harmonic_balance.contact.ContactElement` points, :func:`.hb.contact_elements`;
 CF on every damper's y_d mean, F_j = F0 exp(i j phi) on blade j's forced DOF), with the
@@ -44,7 +44,7 @@ class MistunedRingHB:
     Parameters
     ----------
     sector : Sector
-    kappa : (N_b,) stiffness factors (:mod:`.mistuning`; ones: the tuned ring)
+    kappa : (N_b,) stiffness factors (:mod:`~harmonic_balance.bladed_disk.mistuning`; ones: the tuned ring)
     H : int            highest harmonic (0..H retained)
     cf, f0 : float     centrifugal load and EO force amplitude [N] (default: config)
     mu : float         friction coefficient (default: config)

@@ -1,5 +1,5 @@
 """Time-integration reference: the ring of N_r blades (tuned) or of all N_b blades with a
-mistuning pattern (:mod:`.mistuning`) marched to its periodic steady state.
+mistuning pattern (:mod:`~harmonic_balance.bladed_disk.mistuning`) marched to its periodic steady state.
 
 Explicit central differences (as :mod:`harmonic_balance.timeint`), vectorised over the
 frequencies of a curve (state (n_f, n))::
