@@ -191,7 +191,7 @@ def run_sample(task: dict) -> dict:
     store = Store(task["folder"], task["max_bytes"])
     hit = store.get(task["key"])
     if hit is not None:
-        return hit[1]["data"] | {"cached": True}
+        return hit[1]["data"] | {"cached": True, "index": task["index"]}
     t0 = time.perf_counter()
     try:
         out = _solve_sample(Study(**task["study"]), task["kappa"], task["band_hz"],

@@ -111,9 +111,10 @@ def run_mistuning(args) -> int:
     try:
         out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
     except KeyboardInterrupt:
-        print("damper upd mistuning: interrupted; the samples finished so far are in the cache, "
-              "the same command resumes", file=sys.stderr)
-        return 130
+        from damper.run.runner import Interrupted
+
+        raise Interrupted("mistuning interrupted; the samples finished so far are in the cache, "
+                          "the same command resumes") from None
     if args.plot:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
