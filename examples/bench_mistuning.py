@@ -12,7 +12,9 @@ Rows:
   time: why the solver factors the mistuned Jacobian instead.
 * ``throughput``: a Monte Carlo study (``damper.mistuning``, N_b = 24, std 0.02) on a
   Dask local cluster of 1 and 2 workers, fresh caches: wall time and samples per
-  minute; the traced memory peak of one sample (tracemalloc, a separate run).
+  minute; the traced memory peak of one sample (tracemalloc, a separate run). With
+  ``--quick`` the samples run in this process (``workers = 0``, the serial executor):
+  the quick mode starts no Dask cluster (the documentation build runs it).
 
 Times are CPU (process_time) where one process works, wall time for the clusters: the
 machine is shared, compare within one run only. ::
@@ -108,6 +110,8 @@ def precond_rows(stds, nb=24) -> list:
 
 
 def throughput_rows(samples: int, workers=(1, 2)) -> list:
+    """Monte Carlo rows; ``workers`` are Dask local-cluster sizes, 0 is this process
+    (serial executor, no cluster)."""
     from damper.cache import Store
     from damper.mistuning import Study, run_sample, run_study
 
@@ -116,7 +120,7 @@ def throughput_rows(samples: int, workers=(1, 2)) -> list:
     for n in workers:
         with tempfile.TemporaryDirectory() as tmp:
             t0 = time.perf_counter()
-            out = run_study(study, Store(tmp), workers=n, echo=lambda t: None)
+            out = run_study(study, Store(tmp), workers=n or None, serial=n == 0, echo=lambda t: None)
             wall = time.perf_counter() - t0
         ok = [s for s in out["samples"] if s["error"] is None]
         rows.append({"case": "Monte Carlo", "blades": out["blades"], "workers": n, "samples": samples,
@@ -153,7 +157,8 @@ def main(argv=None) -> int:
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
                    choices=("scaling", "precond", "throughput"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
-    p.add_argument("--quick", action="store_true", help="N_b = 4, 8 only; 2 samples; one scatter")
+    p.add_argument("--quick", action="store_true",
+                   help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
     a = p.parse_args(argv)
     if a.samples < 1:
         p.error("--samples must be >= 1")
@@ -163,7 +168,7 @@ def main(argv=None) -> int:
     if "precond" in a.rows:
         rows += precond_rows((0.02,) if a.quick else (0.002, 0.005, 0.02), nb=8 if a.quick else 24)
     if "throughput" in a.rows:
-        rows += throughput_rows(2 if a.quick else a.samples, (1,) if a.quick else (1, 2))
+        rows += throughput_rows(2 if a.quick else a.samples, (0,) if a.quick else (1, 2))
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "bench_mistuning.json").write_text(json.dumps(rows, indent=1, default=str) + "\n")
     print(f"table in {a.out / 'bench_mistuning.json'}")

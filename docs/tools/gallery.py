@@ -5,7 +5,9 @@ fails when one raises or exits with a non-zero code. :data:`ARGS` gives each scr
 command line there: the long ones run in their quick mode (the same code on smaller
 sizes), and every script writes its files into ``build/docs/gallery_out/<name>/``,
 whose PNG files become the page's figures (:func:`png_scraper`). A script missing from
-:data:`ARGS` runs without arguments.
+:data:`ARGS` runs without arguments. The build starts no process pool and no Dask
+cluster: the arguments keep such examples in this process (``--workers 1``, quick modes
+that run their samples serially).
 """
 from __future__ import annotations
 
@@ -40,7 +42,7 @@ ARGS: dict[str, list[str]] = {
     "bench_hb_robust.py": ["--smoke"],                               # full map: hours
     "bench_hb_soft_baseline.py": ["1"],                              # one stiffness ratio
     "bench_tangential.py": ["--smoke"],                              # full: BEM 61, FE 21
-    "bench_upd.py": ["--quick", "--out", "{out}"],                   # full: ~1 h of TI
+    "bench_upd.py": ["--quick", "--workers", "1", "--out", "{out}"],  # full: ~1 h of TI; no process pool
     "upd_cosim.py": ["--quick", "--out", "{out}"],                   # full: ~15 min of co-simulation
     "bench_mistuning.py": ["--quick", "--rows", "scaling", "--out", "{out}"],  # full: N_b to 48, Dask: ~15 min
 }
