@@ -67,8 +67,9 @@ class ChildResult:
 
 
 def run_child(argv: list[str], timeout: float, env: dict | None = None, python_code: str = _CLI,
-              cwd: str | Path | None = None) -> ChildResult:
-    """Run ``damper ARGV`` (or ``python -c python_code ARGV``) in a child; wall time and peak RSS.
+              cwd: str | Path | None = None, command: list[str] | None = None) -> ChildResult:
+    """Run ``damper ARGV`` (or ``python -c python_code ARGV``, or any ``command``) in a child;
+    wall time and peak RSS.
 
     The peak resident memory is read from ``ru_maxrss`` of a wrapper process
     that runs nothing else, so it is the child's own.
@@ -79,7 +80,8 @@ def run_child(argv: list[str], timeout: float, env: dict | None = None, python_c
                "sys.exit(p.returncode)\n")
     full_env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     full_env.update(env or {})
-    cmd = [sys.executable, "-c", wrapper, sys.executable, "-c", python_code, *map(str, argv)]
+    inner = command if command is not None else [sys.executable, "-c", python_code, *map(str, argv)]
+    cmd = [sys.executable, "-c", wrapper, *map(str, inner)]
     t0 = time.perf_counter()
     # own session: on a timeout the whole group (wrapper and command) is killed, no orphan left running
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=full_env, cwd=cwd,
@@ -104,6 +106,15 @@ def self_peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+def revision() -> str | None:
+    """``git describe --always --dirty`` of the code, or None outside a git checkout."""
+    try:
+        return subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"], capture_output=True,
+                              text=True, timeout=10).stdout.strip() or None
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+
+
 def stamp() -> dict:
     """Machine, cores, library versions and code revision of a run."""
     from importlib import metadata
@@ -114,11 +125,7 @@ def stamp() -> dict:
             versions[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:
             versions[pkg] = None
-    try:
-        rev = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"], capture_output=True,
-                             text=True, timeout=10).stdout.strip() or None
-    except (OSError, subprocess.TimeoutExpired):
-        rev = None
+    rev = revision()
     from contact_core import linsolve
 
     mem_total = None
