@@ -14,17 +14,18 @@ Cases
 -----
 * :func:`sdof` -- m = k = 1, c = 0.04, one link to the ground (f_s = 0.5, k_t given),
   F = 1, H = 15, 0.5 -> 2 rad/s (soft: k_t = k; stiff: k_t = 1e4 k, 1e6 k).
-* :func:`chain3` -- NLvib's friction example (``EXAMPLES/.../ChainOfOscillators``
-  with elastic dry friction): three unit masses on a chain of four unit springs
+* :func:`chain3` -- NLvib's friction chain (its example 07,
+  ``multiDOFoscillator_multipleNonlinearities``, with the two elastic dry-friction
+  elements only, no cubic or unilateral springs): three unit masses on four unit springs
   grounded at both ends, C = 0.02 K, force on mass 2 (the response), Jenkins links
   ground-mass 1 and mass 1-mass 2 of stiffness knl and slip force 1, H = 7,
   0.5 <-> 2 rad/s.
 * :func:`chain5` -- five unit masses on six unit springs grounded at both ends,
-  C = 0.02 K, force 0.5 on mass 3, three Jenkins links of different stiffness and
-  slip force (ground-mass 1: k = 20, f_s = 0.3; mass 2-mass 3: 50, 0.6; mass 4-mass 5:
-  200, 1.0), response mass 5, H = 7, 0.4 <-> 2 rad/s (all five modes of the free
-  chain, 2 sin(j pi / 12) = 0.52 ... 1.93 rad/s; the first two resonances lie between
-  the free and the stuck chain's, where the links stick and slip).
+  C = 0.02 K, force 1 on mass 3 (the response), three Jenkins links of different
+  stiffness and slip force (ground-mass 1: k = 50, f_s = 0.5; mass 2-mass 3: 500, 1;
+  mass 4-mass 5: 200, 2), H = 7, 0.3 <-> 2.2 rad/s (all five modes of the free chain,
+  2 sin(j pi / 12) = 0.52 ... 1.93 rad/s; the first two resonances lie between the
+  free and the stuck chain's, where the links stick and slip).
 """
 from __future__ import annotations
 
@@ -119,16 +120,16 @@ def chain3(force: float = 1.0, knl: float = 20.0, down: bool = False) -> BenchCa
 
 
 #: Links of the 5-mass chain: (a, b, k [N/m], f_s [N]), different stiffness and slip force.
-CHAIN5_LINKS = ((0, None, 20.0, 0.3), (2, 1, 50.0, 0.6), (4, 3, 200.0, 1.0))
+CHAIN5_LINKS = ((0, None, 50.0, 0.5), (2, 1, 500.0, 1.0), (4, 3, 200.0, 2.0))
 
 
 def chain5(down: bool = False) -> BenchCase:
     """Five masses, three Jenkins links (module docstring), swept up or down."""
     K = spring_chain(5)
     f = np.zeros(5)
-    f[2] = 0.5
+    f[2] = 1.0
     return BenchCase(f"chain5 {'down' if down else 'up'}", np.eye(5), K, 0.02 * K, f,
-                     tuple(Jenkins(*j) for j in CHAIN5_LINKS), 4, 7, (2.0, 0.4) if down else (0.4, 2.0))
+                     tuple(Jenkins(*j) for j in CHAIN5_LINKS), 2, 7, (2.2, 0.3) if down else (0.3, 2.2))
 
 
 #: The 3-mass chain's grid: excitation levels [N] and link stiffnesses [N/m].

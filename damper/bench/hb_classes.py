@@ -12,7 +12,9 @@ imports happen before the clock starts) -- so the rows follow whatever version o
 engine is installed. A row gives points, residual evaluations, the solver's time
 (``time_s``, wall; ``cpu_s``, process time: less sensitive to the load of a shared
 machine), the child's peak memory, and the first-harmonic peak of the response DOF
-with its error against the model's dense reference (:mod:`.hb_reference`).
+with its error against the model's dense reference (:mod:`.hb_reference`): ``error``
+against the high-H trace (truncation in H included), ``trace_error`` against the dense
+trace at the case's own H (what the curve's points, steps and AFT cost).
 
 The peak of a row: the engine's refined peak where it reports one (``peak_omega``,
 first harmonic there); else, and for peers (which report points only), the largest
@@ -94,9 +96,9 @@ def _write_model(case, folder: Path) -> list[str]:
     """``damper frf`` arguments of a case (files for a chain) with the command's defaults."""
     if case.name.startswith("sdof"):
         link = case.links[0]
-        model = ["--model", "sdof", "--mass", "1", "--stiffness", f"{case.K[0, 0]:.17g}",
-                 "--damping", f"{case.C[0, 0]:.17g}", "--contact-stiffness", f"{link.k:.17g}",
-                 "--slip-force", f"{link.fs:.17g}", "--force", f"{case.force[0]:.17g}"]
+        model = ["--model", "sdof", "--mass", _arg(case.M[0, 0]), "--stiffness", _arg(case.K[0, 0]),
+                 "--damping", _arg(case.C[0, 0]), "--contact-stiffness", _arg(link.k),
+                 "--slip-force", _arg(link.fs), "--force", _arg(case.force[0])]
     else:
         stem = folder / case.name.replace(" ", "_").replace("=", "")
         np.savez(stem.with_suffix(".npz"), M=case.M, K=case.K, C=case.C, force=case.force,
@@ -105,8 +107,12 @@ def _write_model(case, folder: Path) -> list[str]:
                   f"type = \"jenkins\"\nk = {j.k!r}\nfs = {j.fs!r}\n" for j in case.links]
         stem.with_suffix(".toml").write_text("\n".join(tables))
         model = ["--model", str(stem.with_suffix(".npz")), "--elements", str(stem.with_suffix(".toml"))]
-    return ["frf", *model, "--harmonics", str(case.harmonics), "--omega", *(f"{w:.17g}" for w in case.band),
-            "--json"]
+    return ["frf", *model, "--harmonics", str(case.harmonics), "--omega", *map(_arg, case.band), "--json"]
+
+
+def _arg(v) -> str:
+    """A number as a command-line argument, exactly (the shortest repr of the float)."""
+    return repr(float(v))
 
 
 def _cpu(stderr: str) -> float | None:
@@ -157,7 +163,9 @@ def _upd_numbers(j: dict) -> dict:
             "peak_omega": 2 * np.pi * j["peak_frequency_hz"], "peak_refined": True, "points_peak": [pa, pw]}
 
 
-def _peak_error(peak, ref) -> float | None:
+def _peak_error(peak, ref, key: str | None = None) -> float | None:
+    """|peak / reference - 1|: the high-H reference, or its entry ``key`` (``same_h``)."""
+    ref = ref.get(key) if ref is not None and key else ref
     if ref is None or peak is None or not math.isfinite(peak):
         return None
     return abs(peak / ref["amplitude"] - 1.0)
@@ -172,7 +180,8 @@ def _our_row(name: str, o: dict, ref: dict | None) -> Row:
     extra = {k: o.get(k) for k in ("tool", "dofs", "harmonics", "points", "evaluations", "cpu_s", "wall_s",
                                    "status", "complete", "gaps", "peak_amplitude", "peak_omega",
                                    "peak_refined")}
-    extra.update(model=name, points_error=_peak_error(pa, ref), **_ref_extra(ref))
+    extra.update(model=name, points_error=_peak_error(pa, ref),
+                 trace_error=_peak_error(o.get("peak_amplitude"), ref, "same_h"), **_ref_extra(ref))
     return Row(f"{name} [damper]", _unknowns(o["dofs"], o["harmonics"]),
                _peak_error(o.get("peak_amplitude"), ref), o.get("time_s"), o["memory_mb"], False, extra)
 
@@ -180,7 +189,8 @@ def _our_row(name: str, o: dict, ref: dict | None) -> Row:
 def _ref_extra(ref: dict | None) -> dict:
     if ref is None:
         return {"reference": None}
-    return {"reference": {k: ref.get(k) for k in ("amplitude", "omega", "error_estimate", "how", "revision")}}
+    return {"reference": {k: ref.get(k) for k in ("amplitude", "omega", "error_estimate", "same_h", "how",
+                                                  "revision")}}
 
 
 def _peer_row(name: str, kind: str, case, p: dict, ours: dict, ref: dict | None) -> Row:
@@ -192,6 +202,7 @@ def _peer_row(name: str, kind: str, case, p: dict, ours: dict, ref: dict | None)
              "wall_s": p.get("wall_s"), "status": p.get("status"), "complete": p.get("complete"),
              "start": p.get("start"), "failed_starts": p.get("failed_starts"),
              "peak_amplitude": pa, "peak_omega": pw, "peak_refined": False,
+             "trace_error": _peak_error(pa, ref, "same_h"),
              # ours against theirs, measured in this run (> 1: ours is faster)
              "speedup": t / ours["time_s"] if t and ours.get("time_s") else None,
              "speedup_cpu": c / ours["cpu_s"] if c and ours.get("cpu_s") else None, **_ref_extra(ref)}
@@ -227,7 +238,10 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
                  for k, p in (("pyharm", opts.pyharm), ("nlvib", opts.nlvib))}
     rows = []
     for name in case_names(quick, opts):
-        ref = load_reference(reference_key(name), log)
+        # a quick run never spends minutes on a missing reference: its rows then have no error
+        ref = load_reference(reference_key(name), log, compute_missing=not quick)
+        if ref is None:
+            log(f"{name}: no stored reference (python -m damper.bench.hb_reference --write)")
         sub = work / name.replace(" ", "_").replace("=", "")
         sub.mkdir(parents=True, exist_ok=True)
         ours = run_ours(name, sub, log)
@@ -257,7 +271,7 @@ def _num(v, fmt: str) -> str:
 
 
 HEAD = (f"{'case':26s} {'tool':7s} {'DOFs':>4s} {'H':>3s} {'points':>6s} {'evals':>6s} {'time_s':>7s} "
-        f"{'cpu_s':>7s} {'peak_a1':>11s} {'peak_w':>9s} {'error':>8s} {'pts_err':>8s} {'mem_MB':>6s} "
+        f"{'cpu_s':>7s} {'peak_a1':>11s} {'peak_w':>9s} {'error':>8s} {'trace':>8s} {'pts_err':>8s} {'mem_MB':>6s} "
         f"{'x_wall':>6s} {'x_cpu':>6s}  status")
 
 
@@ -266,7 +280,8 @@ def _line(r: dict) -> str:
             f"{_num(r.get('points'), 'd'):>6s} {_num(r.get('evaluations'), 'd'):>6s} "
             f"{_num(r.get('time_s'), '.2f'):>7s} {_num(r.get('cpu_s'), '.2f'):>7s} "
             f"{_num(r.get('peak_amplitude'), '.6e'):>11s} {_num(r.get('peak_omega'), '.6g'):>9s} "
-            f"{_num(r.get('error'), '.1e'):>8s} {_num(r.get('points_error'), '.1e'):>8s} "
+            f"{_num(r.get('error'), '.1e'):>8s} {_num(r.get('trace_error'), '.1e'):>8s} "
+            f"{_num(r.get('points_error'), '.1e'):>8s} "
             f"{_num(r.get('memory_mb'), '.0f'):>6s} {_num(r.get('speedup'), '.1f'):>6s} "
             f"{_num(r.get('speedup_cpu'), '.1f'):>6s}  "
             f"{(r.get('status') or '')[:90]}")
@@ -275,27 +290,31 @@ def _line(r: dict) -> str:
 def table(rows: list[dict]) -> str:
     """Plain-text table of the model rows, with the references they are measured against."""
     lines = [HEAD] + [_line(r) for r in rows]
-    lines.append("x_wall, x_cpu: the peer's time over ours (wall, CPU), measured in this run; pts_err: "
-                 "our points read the peers' way (parabola through the largest first harmonic)")
+    lines.append("error: against the dense high-H reference; trace: against the dense trace at the case's "
+                 "own H; pts_err: our points read the peers' way (parabola through the largest first "
+                 "harmonic); x_wall, x_cpu: the peer's time over ours (wall, CPU), measured in this run")
     refs = {r["model"]: r["reference"] for r in rows if r.get("reference")}
     lines.append("references (dense traces, hb_reference.py):")
     for name, ref in refs.items():
+        same = ref.get("same_h") or {}
         lines.append(f"  {name}: {ref['amplitude']:.9g} at {ref['omega']:.7g} rad/s, own error "
-                     f"<= {ref['error_estimate']:.1e}; {ref['how']}")
+                     f"<= {ref['error_estimate']:.1e}; at H = {same.get('H')}: {same.get('amplitude', 0):.9g}; "
+                     f"{ref['how']}")
     return "\n".join(lines)
 
 
 def markdown(rows: list[dict]) -> list[str]:
     """Markdown table of the model rows."""
     out = ["| case | tool | DOFs | H | points | evaluations | time [s] | CPU [s] | peak a1 | peak omega | "
-           "error | memory [MB] | speed-up (wall) | speed-up (CPU) | status |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "error | trace error | memory [MB] | speed-up (wall) | speed-up (CPU) | status |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         out.append(f"| {r['model']} | {r['tool']} | {_num(r.get('dofs'), 'd')} | {_num(r.get('harmonics'), 'd')} | "
                    f"{_num(r.get('points'), 'd')} | {_num(r.get('evaluations'), 'd')} | "
                    f"{_num(r.get('time_s'), '.2f')} | {_num(r.get('cpu_s'), '.2f')} | "
                    f"{_num(r.get('peak_amplitude'), '.6e')} | {_num(r.get('peak_omega'), '.6g')} | "
-                   f"{_num(r.get('error'), '.1e')} | {_num(r.get('memory_mb'), '.0f')} | "
+                   f"{_num(r.get('error'), '.1e')} | {_num(r.get('trace_error'), '.1e')} | "
+                   f"{_num(r.get('memory_mb'), '.0f')} | "
                    f"{_num(r.get('speedup'), '.1f')} | {_num(r.get('speedup_cpu'), '.1f')} | "
                    f"{(r.get('status') or '')[:80]} |")
     return out
