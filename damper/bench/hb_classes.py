@@ -197,17 +197,34 @@ def _peer_row(name: str, kind: str, case, p: dict, ours: dict, ref: dict | None)
     tool = {"pyharm": "pyHarm", "nlvib": "NLvib"}[kind]
     pa, pw, _ = curve_peak(p.get("omega") or [], p.get("a1") or [])
     t, c = p.get("time_s"), p.get("cpu_s")
+    both = p.get("complete") and ours.get("complete")
     extra = {"tool": tool, "model": name, "dofs": case.n, "harmonics": case.harmonics,
              "points": p.get("points"), "evaluations": p.get("evaluations"), "cpu_s": c,
              "wall_s": p.get("wall_s"), "status": p.get("status"), "complete": p.get("complete"),
              "start": p.get("start"), "failed_starts": p.get("failed_starts"),
              "peak_amplitude": pa, "peak_omega": pw, "peak_refined": False,
              "trace_error": _peak_error(pa, ref, "same_h"),
-             # ours against theirs, measured in this run (> 1: ours is faster)
-             "speedup": t / ours["time_s"] if t and ours.get("time_s") else None,
-             "speedup_cpu": c / ours["cpu_s"] if c and ours.get("cpu_s") else None, **_ref_extra(ref)}
+             # ours against theirs on a curve both complete, measured in this run (> 1: ours is faster)
+             "speedup": t / ours["time_s"] if both and t and ours.get("time_s") else None,
+             "speedup_cpu": c / ours["cpu_s"] if both and c and ours.get("cpu_s") else None, **_ref_extra(ref)}
     return Row(f"{name} [{tool}]", _unknowns(case.n, case.harmonics), _peak_error(pa, ref), t,
                p.get("memory_mb"), False, extra)
+
+
+def _finite(v):
+    """NaN / inf -> None, through dicts and lists (JSON has no NaN)."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if isinstance(v, dict):
+        return {k: _finite(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_finite(x) for x in v]
+    return v
+
+
+def _clean(row: Row) -> Row:
+    return Row(row.case, _finite(row.size), _finite(row.error), _finite(row.time_s), _finite(row.memory_mb),
+               row.cached, _finite(row.extra))
 
 
 def _absent_row(name: str, kind: str, dofs, H, why: str) -> Row:
@@ -247,7 +264,7 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
         ours = run_ours(name, sub, log)
         if name == "upd24":
             ours["dofs"] = _upd_dofs()
-        rows.append(_our_row(name, ours, ref))
+        rows.append(_clean(_our_row(name, ours, ref)))
         log(_line(rows[-1].as_dict()))
         for kind, (path, why) in kinds.items():
             if name == "upd24":
@@ -261,7 +278,7 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
                 rows.append(_absent_row(name, kind, case.n, case.harmonics, why))
                 continue
             p = peers.run(kind, case, path, sub, PEER_SETTINGS, octave, PEER_TIMEOUT_S)
-            rows.append(_peer_row(name, kind, case, p, ours, ref))
+            rows.append(_clean(_peer_row(name, kind, case, p, ours, ref)))
             log(_line(rows[-1].as_dict()))
     return rows
 
@@ -293,6 +310,16 @@ def table(rows: list[dict]) -> str:
     lines.append("error: against the dense high-H reference; trace: against the dense trace at the case's "
                  "own H; pts_err: our points read the peers' way (parabola through the largest first "
                  "harmonic); x_wall, x_cpu: the peer's time over ours (wall, CPU), measured in this run")
+    for tool in dict.fromkeys(r["tool"] for r in rows if r["tool"] != "damper"):
+        ran = [r for r in rows if r["tool"] == tool and r.get("time_s")]
+        done = [r for r in ran if r.get("complete")]
+        x = [r["speedup"] for r in done if r.get("speedup")]
+        xc = [r["speedup_cpu"] for r in done if r.get("speedup_cpu")]
+        if ran:
+            lines.append(f"{tool}: {len(done)} of {len(ran)} curves complete; ours faster by "
+                         f"{_num(float(np.median(x)) if x else None, '.1f')} (wall) and "
+                         f"{_num(float(np.median(xc)) if xc else None, '.1f')} (CPU), medians over "
+                         "the complete ones")
     refs = {r["model"]: r["reference"] for r in rows if r.get("reference")}
     lines.append("references (dense traces, hb_reference.py):")
     for name, ref in refs.items():

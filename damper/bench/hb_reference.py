@@ -194,12 +194,11 @@ def _chain_reference(key: str, log) -> dict:
     lo, hi = sorted(case.band)
     coarse = _trace(model, H, (lo, hi))
     log(f"  reference {key}: peak near {coarse['omega']:.6g} rad/s at H = {H} ({coarse['points']} points)")
-    mid = _dense(model, H_FACTORS[0] * H, coarse["omega"], lo, hi, log)
+    ref = _dense(model, H_FACTORS[0] * H, coarse["omega"], lo, hi, log)
     for f in H_FACTORS[1:]:
-        ref = _dense(model, f * H, mid["omega"], lo, hi, log)
+        mid, ref = ref, _dense(model, f * H, ref["omega"], lo, hi, log)
         if abs(ref["amplitude"] / mid["amplitude"] - 1.0) <= H_CONVERGED:
             break
-        mid = ref
     same = _dense(model, H, ref["omega"], lo, hi, log)
     return {"amplitude": ref["amplitude"], "omega": ref["omega"],
             "same_h": {"H": H, "amplitude": same["amplitude"], "omega": same["omega"]},
