@@ -63,8 +63,9 @@ def _complete(out: dict, band) -> bool:
 
 
 def run(kind: str, case, path: str, work: Path, settings: dict, octave: str | None = None,
-        timeout: float = 1800.0) -> dict:
-    """One curve by a peer: its points and costs; from the free start when the stuck one fails.
+        timeout: float = 600.0) -> dict:
+    """One curve by a peer: its points and costs; from the free start when the stuck one
+    fails within ``timeout`` [s] (each start has that much).
 
     Returns a dict with omega, a1, points, evaluations, time_s (the peer's solve, wall),
     cpu_s, wall_s (the whole process), memory_mb, start, complete, status, and
@@ -91,6 +92,8 @@ def run(kind: str, case, path: str, work: Path, settings: dict, octave: str | No
         reached = np.asarray(out.get("omega") or [np.nan], float)
         failed.append({"start": start, "error": out.get("error") or "stopped before the end of the band",
                        "omega_reached": float(reached[-1]), "time_s": r.time_s})
+        if r.code is None:
+            break   # out of time: another start would only spend as much again
     return {**out, "complete": False, "failed_starts": failed,
             "status": "; ".join(f"{f['start']} start: {f['error']} (last omega {f['omega_reached']:.5g})"
                                 for f in failed)[:400]}
