@@ -1,4 +1,5 @@
 """Bring your own blade: a scikit-fem FE blade, Craig-Bampton reduced, with the UPD-24 damper.
+===========================================================================================
 
 Run:  .venv/bin/python examples/craig_bampton_blade.py [--out out/cb_blade] [--modes 6]
 then: damper upd frf --config out/cb_blade/upd.toml
@@ -20,7 +21,7 @@ Load: F0 = 10 N at the tip (:data:`F0`), the default CF = 120 N.
 Harmonics: H = 3 by default. At H = 5 the fixed-grid Newton sweep of ``solve.frf``
 stops near 530 Hz ("harmonic balance failed near ..."), most likely at a 5:1
 superharmonic resonance of the blade's second bending family (free 2.09 kHz, stuck
-2.81 kHz); above CF/F0 ~ 20 the curve folds (README): such curves need arc-length
+2.81 kHz); above CF/F0 ~ 20 the curve folds (docs, user guide: the bladed disk): such curves need arc-length
 continuation.
 Prints the CB natural frequencies against the full FE model's, writes ``blade.npz``
 and ``upd.toml`` (the default damper, band around the free and stuck EO resonances)
@@ -34,6 +35,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import json  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -196,4 +198,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

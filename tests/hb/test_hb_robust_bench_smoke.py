@@ -11,9 +11,9 @@ def test_robustness_benchmark_smoke(capsys, load_example):
 
 
 def test_soft_baseline_benchmark_smoke(capsys, load_example):
-    """examples/bench_hb_soft_baseline.py (the issue-10 cost baseline, runnable against
-    any version of harmonic_balance): one soft row, the issue's 3.1-3.2 evaluations per
-    point (measured on the code of the issue's time and on today's)."""
+    """examples/bench_hb_soft_baseline.py (the soft-contact cost baseline, runnable against
+    any version of harmonic_balance): one soft row, the baseline's 3.1-3.2 evaluations per
+    point (measured on the older code and on today's)."""
     rows = load_example("bench_hb_soft_baseline").main(["1"])
     assert "ms/pt" in capsys.readouterr().out
     (kt, n_t, points, evals, seconds, ms), = rows
@@ -22,6 +22,6 @@ def test_soft_baseline_benchmark_smoke(capsys, load_example):
 
 def test_hb_against_den_hartog_table_smoke(load_example):
     """Table 4's function on one small case: 1e3 k, H = 7, at resonance, where the
-    elastic model and the rigid one agree (README: 1.1e-4 at H = 21)."""
+    elastic model and the rigid one agree (README.md at revision c58d443: 1.1e-4 at H = 21)."""
     (kt, H, errs), = load_example("bench_hb_robust").hb_vs_den_hartog((1e3,), (7,), (1.0,))
     assert kt == 1e3 and H == 7 and abs(errs[0]) < 1e-2
