@@ -118,14 +118,15 @@ def _arg(v) -> str:
 
 
 def _cpu(stderr: str) -> float | None:
-    head, sep, tail = stderr.rpartition("@@cpu ")
+    """The child's CPU time of the command [s] (the line _CHILD writes), or None."""
+    _, sep, tail = stderr.rpartition("@@cpu ")
     try:
         return float(tail.split()[0]) if sep else None
     except (ValueError, IndexError):
         return None
 
 
-def run_ours(name: str, work: Path, log=print) -> dict:
+def run_ours(name: str, work: Path) -> dict:
     """One curve of the engine through the CLI (module docstring): the row's numbers."""
     if name == "upd24":
         argv, dofs, H = ["upd", "frf", "--json"], None, 7
@@ -182,8 +183,10 @@ def _our_row(name: str, o: dict, ref: dict | None) -> Row:
     extra = {k: o.get(k) for k in ("tool", "dofs", "harmonics", "points", "evaluations", "cpu_s", "wall_s",
                                    "status", "complete", "gaps", "peak_amplitude", "peak_omega",
                                    "peak_refined")}
+    extra.update(_ref_extra(ref))
+    ref = ref if o.get("complete") else None   # a curve that stopped part-way has no peak error
     extra.update(model=name, points_error=_peak_error(pa, ref),
-                 trace_error=_peak_error(o.get("peak_amplitude"), ref, "same_h"), **_ref_extra(ref))
+                 trace_error=_peak_error(o.get("peak_amplitude"), ref, "same_h"))
     return Row(f"{name} [damper]", _unknowns(o["dofs"], o["harmonics"]),
                _peak_error(o.get("peak_amplitude"), ref), o.get("time_s"), o["memory_mb"], False, extra)
 
@@ -200,6 +203,7 @@ def _peer_row(name: str, kind: str, case, p: dict, ours: dict, ref: dict | None)
     pa, pw, _ = curve_peak(p.get("omega") or [], p.get("a1") or [])
     t, c = p.get("time_s"), p.get("cpu_s")
     both = p.get("complete") and ours.get("complete")
+    ref_shown, ref = ref, ref if p.get("complete") else None   # no peak error of a curve cut short
     extra = {"tool": tool, "model": name, "dofs": case.n, "harmonics": case.harmonics,
              "points": p.get("points"), "evaluations": p.get("evaluations"), "cpu_s": c,
              "wall_s": p.get("wall_s"), "status": p.get("status"), "complete": p.get("complete"),
@@ -208,7 +212,8 @@ def _peer_row(name: str, kind: str, case, p: dict, ours: dict, ref: dict | None)
              "trace_error": _peak_error(pa, ref, "same_h"),
              # ours against theirs on a curve both complete, measured in this run (> 1: ours is faster)
              "speedup": t / ours["time_s"] if both and t and ours.get("time_s") else None,
-             "speedup_cpu": c / ours["cpu_s"] if both and c and ours.get("cpu_s") else None, **_ref_extra(ref)}
+             "speedup_cpu": c / ours["cpu_s"] if both and c and ours.get("cpu_s") else None,
+             **_ref_extra(ref_shown)}
     return Row(f"{name} [{tool}]", _unknowns(case.n, case.harmonics), _peak_error(pa, ref), t,
                p.get("memory_mb"), False, extra)
 
@@ -263,7 +268,7 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
             log(f"{name}: no stored reference (python -m damper.bench.hb_reference --write)")
         sub = work / name.replace(" ", "_").replace("=", "")
         sub.mkdir(parents=True, exist_ok=True)
-        ours = run_ours(name, sub, log)
+        ours = run_ours(name, sub)
         if name == "upd24":
             ours["dofs"] = _upd_dofs()
         rows.append(_clean(_our_row(name, ours, ref)))
