@@ -327,7 +327,7 @@ def table(rows: list[dict]) -> str:
                          f"{_num(float(np.median(x)) if x else None, '.1f')} (wall) and "
                          f"{_num(float(np.median(xc)) if xc else None, '.1f')} (CPU), medians over "
                          "the complete ones")
-    refs = {r["model"]: r["reference"] for r in rows if r.get("reference")}
+    refs = {reference_key(r["model"]): r["reference"] for r in rows if r.get("reference")}
     lines.append("references (dense traces, hb_reference.py):")
     for name, ref in refs.items():
         same = ref.get("same_h") or {}
