@@ -20,7 +20,7 @@ The peak of a row: the engine's refined peak where it reports one (``peak_omega`
 first harmonic there); else, and for peers (which report points only), the largest
 first harmonic of the traced points refined by a parabola through its neighbours
 (:func:`.hb_reference.curve_peak`). ``points_error`` gives the engine's points read the
-peers' way, so both can be compared alike.
+peers' way (against the dense trace at the same H), so both can be compared alike.
 
 Peers (optional, never in CI): pyHarm (``pyharm`` = path of a Python that has
 ``pyharm-os``; :mod:`.peer_pyharm`, pseudo-arclength) and NLvib (``nlvib`` = its folder,
@@ -160,7 +160,10 @@ def _upd_numbers(j: dict) -> dict:
     """Row numbers of a ``damper upd frf --json`` result."""
     f = np.asarray(j["frequency_hz"], float)
     pa, pw, _ = curve_peak(2 * np.pi * f, j["amplitude"])
-    return {"points": int(f.size), "evaluations": j.get("evaluations"), "time_s": j.get("time_s"),
+    # the solved points: the curve's own count where the command reports one (a continuation
+    # interpolated on the output grid), else the grid's
+    points = j.get("branch_points") or j.get("points") or int(f.size)
+    return {"points": points, "evaluations": j.get("evaluations"), "time_s": j.get("time_s"),
             "status": j.get("method", ""), "complete": True, "gaps": False, "dofs": j.get("dofs"),
             "harmonics": j.get("harmonics", 7), "peak_amplitude": j["peak_amplitude"],
             "peak_omega": 2 * np.pi * j["peak_frequency_hz"], "peak_refined": True, "points_peak": [pa, pw]}
@@ -185,7 +188,7 @@ def _our_row(name: str, o: dict, ref: dict | None) -> Row:
                                    "peak_refined")}
     extra.update(_ref_extra(ref))
     ref = ref if o.get("complete") else None   # a curve that stopped part-way has no peak error
-    extra.update(model=name, points_error=_peak_error(pa, ref),
+    extra.update(model=name, points_error=_peak_error(pa, ref, "same_h"),
                  trace_error=_peak_error(o.get("peak_amplitude"), ref, "same_h"))
     return Row(f"{name} [damper]", _unknowns(o["dofs"], o["harmonics"]),
                _peak_error(o.get("peak_amplitude"), ref), o.get("time_s"), o["memory_mb"], False, extra)
@@ -316,7 +319,8 @@ def table(rows: list[dict]) -> str:
     lines = [HEAD] + [_line(r) for r in rows]
     lines.append("error: against the dense high-H reference; trace: against the dense trace at the case's "
                  "own H; pts_err: our points read the peers' way (parabola through the largest first "
-                 "harmonic); x_wall, x_cpu: the peer's time over ours (wall, CPU), measured in this run")
+                 "harmonic), against the same; x_wall, x_cpu: the peer's time over ours (wall, CPU), "
+                 "measured in this run")
     for tool in dict.fromkeys(r["tool"] for r in rows if r["tool"] != "damper"):
         ran = [r for r in rows if r["tool"] == tool and r.get("time_s")]
         done = [r for r in ran if r.get("complete")]
