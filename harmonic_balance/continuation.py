@@ -27,8 +27,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import lu_factor, lu_solve
-from scipy.optimize import minimize_scalar
 
 from .newton import NewtonError, newton
 
@@ -111,6 +109,8 @@ class _Scaled:
         same along a regular branch, through turning points and peaks, whatever the
         scaling (positive column scales change det([J; t]) by a positive factor).
         """
+        from scipy.linalg import lu_factor, lu_solve  # after the first point: start-up
+
         A = np.vstack([J, t_prev])
         rhs = np.zeros(A.shape[0])
         rhs[-1] = 1.0
@@ -356,6 +356,8 @@ def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: floa
     -------
     x : (N,) array, lam : float, amp : float, evaluations : int
     """
+    from scipy.optimize import minimize_scalar
+
     if not 0 < i < len(branch.lam) - 1:
         raise ValueError("refinement needs a point with neighbours on both sides")
     pts = [np.append(branch.x[j], branch.lam[j]) for j in (i - 1, i, i + 1)]

@@ -22,7 +22,6 @@ sliders' mean position, counts as stable).
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 #: Largest real part of a Floquet exponent, relative to omega, still counted as
 #: stable: round-off of the eigensolver on the (2N)^2 companion matrix is ~1e-12;
@@ -62,7 +61,7 @@ def floquet_exponents(J, d1, d2, n: int, omega: float) -> np.ndarray:
     A[:N, N:] = np.eye(N)
     A[N:, :N] = -np.linalg.solve(d2, J)
     A[N:, N:] = -np.linalg.solve(d2, d1)
-    lam = sla.eigvals(A)
+    lam = np.linalg.eigvals(A)  # LAPACK geev, as scipy's, without its import
     order = np.argsort(np.abs(lam.imag))
     return lam[order[:2 * n]]
 

@@ -110,3 +110,24 @@ def test_tiny_force_refines_the_stuck_linear_peak():
     lin = 1e-4 / (C * w_n)  # |P / Z| at w_n; the damped maximum differs by O(zeta^2) ~ 1e-5
     assert r.peak_interior and abs(r.peak_omega / w_n - 1) < 1e-4
     assert abs(r.peak_amplitude / lin - 1) < 1e-4
+
+
+#: Random curves compared with scipy's peak finder (the definition peak_indices follows).
+PEAK_FINDER_TRIALS = 2000
+
+
+def test_peak_indices_agree_with_scipy_find_peaks():
+    """Same peaks and prominence rule as scipy.signal.find_peaks (plateaus, ties, edges)
+    on random curves, integer-valued ones included (plateaus and equal bases)."""
+    from scipy.signal import find_peaks
+
+    from harmonic_balance.frf import peak_indices
+
+    rng = np.random.default_rng(20261122)
+    for trial in range(PEAK_FINDER_TRIALS):
+        n = int(rng.integers(3, 60))
+        a = rng.integers(0, 6, n).astype(float) if trial % 2 else rng.normal(size=n)
+        p = float(rng.uniform(0.0, 2.0))
+        idx, props = find_peaks(a, prominence=0.0)
+        want = [int(i) for i, q in zip(idx, props["prominences"]) if q > p]
+        assert peak_indices(a, p) == want, (a, p)
