@@ -8,13 +8,14 @@ above :data:`PEAK_PROMINENCE`) to :data:`PEAK_TOL_REL` in frequency
 (:func:`continuation.refine_max`); the highest is ``peak_omega``/``peak_amplitude``.
 
 Accuracy of the peak: the refinement locates the maximum of the *discrete* HB
-curve (given H and n_t) to PEAK_TOL_REL in frequency, hence its amplitude to
-~1e-12. The discrete curve differs from the exact one by the truncation in H and
-by the AFT sampling error, O(n_t^-2) (2e-4 relative at n_t = 256 on the Jenkins
-describing function). The sampling also puts ripples of that order on the curve
-(the reversal point moves between samples as omega changes), so on a very flat
-peak two neighbouring ripple maxima can compete: measured 4e-5 in amplitude and
-3e-4 in frequency between two runs of the same model.
+curve (given H) to PEAK_TOL_REL in frequency, hence its amplitude to ~1e-12. The
+discrete curve differs from the exact one by the truncation in H only when the friction
+links are exact (the default, :func:`exact_links`); a sampled AFT (``aft="sampled"``,
+and contacts whose normal load varies) adds an O(n_t^-2) error (2e-4 relative at
+n_t = 256 on the Jenkins describing function) and ripples of that order on the curve
+(the reversal point moves between samples as omega changes), so on a very flat peak two
+neighbouring ripple maxima can compete: measured 4e-5 in amplitude and 3e-4 in
+frequency between two runs of the same model.
 """
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .aft import FrictionLink
+from .contact import ContactElement
 from .continuation import Branch, ContinuationError, continuation, refine_max
 from .fourier import FourierBasis, default_samples, parse_harmonics
 from .homotopy import HomotopyError
@@ -170,7 +172,7 @@ STABILITY_AUTO_MAX = 200
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
                 ds_max: float = 0.1, max_points: int = 2000, refine: bool = True,
-                stability="auto", progress=None) -> FRFResult:
+                stability="auto", progress=None, aft: str = "exact") -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
@@ -180,6 +182,10 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     stability of every point (``result.stable``). ``progress(done, total, label)``, if
     given, is called after every continuation point with the share of the frequency
     range covered, in percent (``total`` = 100), as ``contact_core``'s long stages do.
+    ``aft``: "exact" (default) evaluates every Iwan friction link by its exact periodic
+    loop (:func:`exact_links`), "sampled" by the sampled AFT on ``n_t`` samples (the
+    reference of the sampling error); contacts with a normal load varying in time and
+    elements without the exact path are sampled either way.
 
     Raises
     ------
@@ -189,25 +195,16 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     w0, w1 = (float(w) for w in omega_range)
     if not (np.isfinite(w0) and np.isfinite(w1)) or w0 <= 0 or w1 <= 0 or w0 == w1:
         raise ValueError(f"omega range must be two different positive numbers, got {omega_range}")
+    if aft not in ("exact", "sampled"):
+        raise ValueError(f"aft must be 'exact' or 'sampled', got {aft!r}")
     t0 = time.perf_counter()
-    model = exact_links(model)
+    model = exact_links(model, aft == "exact")
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
     tries = 1 if n_t else 1 + min(GRID_DOUBLINGS, max(0, int(np.log2(GRID_MAX / n_base))))
-    spent, exact_retry = 0, False
+    spent = 0
     for k in range(tries):
         prob = FRFProblem(model, harmonics, n_base * 2**k, condensed)
         branch, gaps, error, start, tol = _trace(prob, w0, w1, ds_max, max_points, progress)
-        if k == 0 and not n_t and (error is not None or gaps) and _has_sampled_links(model):
-            # First remedy of a stalled sampled curve: the same grid with exact links
-            # (no sampling kinks); measured on the H = 51 map at 1e4 k with f_s = P (the
-            # grazing-slip class): 5 of 75 curves failed sampled, all completed exact.
-            spent += prob.evaluations
-            ex = FRFProblem(exact_links(model, every=True), harmonics, n_base, condensed)
-            ex_trace = _trace(ex, w0, w1, ds_max, max_points, progress)
-            if ex_trace[2] is None and not ex_trace[1]:
-                prob, (branch, gaps, error, start, tol), exact_retry = ex, ex_trace, True
-                break
-            spent += ex.evaluations
         if not _grid_limited(error, gaps) or k == tries - 1:
             break
         spent += prob.evaluations
@@ -223,10 +220,10 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.extra["start"] = start
     result.extra["gaps"] = gaps
     result.extra["grid_doublings"] = k
-    result.extra["exact_retry"] = exact_retry
     # how the friction links were evaluated: "exact" (no AFT sampling, n_t only scans
-    # for the extrema), "sampled", or "mixed"
-    kinds = {link.exact for link in prob.model.links if isinstance(link, FrictionLink)}
+    # for the extrema), "sampled", or "mixed" (e.g. exact links and sampled contacts)
+    kinds = {link.exact if isinstance(link, FrictionLink) else False for link in prob.model.links
+             if isinstance(link, (FrictionLink, ContactElement))}
     result.extra["aft"] = {frozenset({True}): "exact", frozenset({False}): "sampled"}.get(
         frozenset(kinds), "mixed" if kinds else None)
     if gaps:
@@ -252,34 +249,25 @@ STIFF_SAMPLES_RATIO = 1e4
 STIFF_SAMPLES_BASE = 512
 
 
-def _has_sampled_links(model: Model) -> bool:
-    from fmu_src.element import IwanElement
+def exact_links(model: Model, exact: bool = True) -> Model:
+    """``model`` with every Iwan friction link's ``exact`` flag set to ``exact`` (links of
+    other elements and other force elements as they are).
 
-    return any(isinstance(link, FrictionLink) and isinstance(link.element, IwanElement)
-               and not link.exact for link in model.links)
-
-
-def exact_links(model: Model, every: bool = False) -> Model:
-    """``model`` with its Iwan friction links made ``exact`` (:func:`aft.aft_link`: the
-    loop's Fourier coefficients without sampling) when they are more than
-    STIFF_SAMPLES_RATIO times stiffer than the structure, else ``model`` itself.
-
-    Why there: a sampled loop needs a grid growing like sqrt(k_t / k) (below) and its
-    kinks, where a stick episode shorter than a sample starts or ends between samples,
-    cost the corrector evaluations. Measured on the Jenkins FRF (H = 15, 0.5 -> 2
-    rad/s, no refinement): 1e6 k sampled on 8192 samples 474 points, 5.4 evaluations
-    per point, 1.8 s; exact (512-sample scan) 401 points, 3.6 per point, ~1 s;
-    1e5 k 2048 samples 5.9 per point, exact 3.8. Below the ratio the sampled loop is
-    as good and the results of earlier rounds stay as they were; ``every``: all Iwan
-    links (compute_frf's retry of a stalled sampled curve).
+    Exact (:func:`aft.aft_link`): the loop's Fourier coefficients from the C core, the
+    extrema of u located exactly and the loop between them integrated in closed form: no
+    sampling error and no kinks where a stick episode starts or ends between samples, at
+    the cost of a sampled evaluation (measured per link evaluation, H = 7, 256 samples:
+    30 us sampled, 50 us exact; H = 15, 512: 90 us both). The sampled loop carries an
+    O(n_t^-2) error that grows with the link's stiffness (a stick episode spans fewer
+    samples): first-harmonic force of a Jenkins link at H = 7, 256 samples, k_t = 20:
+    7e-4 relative, 2000: 1.2e-2; a stiff sampled curve needs thousands of samples
+    (:func:`stiff_samples`) and stalls at its kinks.
     """
     from fmu_src.element import IwanElement
 
-    ratio = _stiffness_ratio(model)
-    if not every and (ratio is None or ratio <= STIFF_SAMPLES_RATIO):
-        return model
-    links = [replace(link, exact=True) if isinstance(link, FrictionLink)
-             and isinstance(link.element, IwanElement) else link for link in model.links]
+    links = [replace(link, exact=exact) if isinstance(link, FrictionLink)
+             and isinstance(link.element, IwanElement) and link.exact != exact else link
+             for link in model.links]
     return replace(model, links=links)
 
 

@@ -17,8 +17,8 @@ JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of 
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
 ``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``aft``
-("sampled", or "exact": the links' Fourier coefficients without sampling, used above
-1e4 k and to retry a stalled curve; n_t then only scans for extrema), ``points``,
+("exact": the links' Fourier coefficients without sampling, the default, n_t then only
+scans for extrema; "sampled" with ``--aft sampled``; "mixed" with contacts), ``points``,
 ``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
 (per point, Hill's method; null for models above 200 full unknowns or modal-only
 ones; unstable stretches are dashed in frf.png). The first point does not depend
@@ -40,7 +40,11 @@ def register(subparsers) -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_model_arguments(p)
     p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
-    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--samples", type=int, default=0,
+                   help="AFT samples per period (0: auto); exact links only scan them for the extrema")
+    p.add_argument("--aft", choices=("exact", "sampled"), default="exact",
+                   help="friction links: exact periodic loop (default) or sampled AFT on --samples "
+                   "(contacts with a varying normal load are sampled either way)")
     p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
                    help="frequency range [rad/s]")
     p.add_argument("--max-step", type=float, default=0.1,
@@ -105,7 +109,7 @@ def run(args) -> int:
     _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
-                             ds_max=args.max_step, max_points=args.max_points)
+                             ds_max=args.max_step, max_points=args.max_points, aft=args.aft)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
