@@ -532,6 +532,10 @@ def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
     if not (np.isfinite(l0) and np.isfinite(l1)) or l0 == l1:
         raise ValueError(f"parameter range must be two different finite numbers, got {lam_range}")
     t0 = time.perf_counter()
+    given = model_at
+
+    def model_at(lam):  # exact friction links, as compute_frf's
+        return exact_links(given(lam))
     pp = ParameterProblem(model_at, harmonics, omega, n_t, condensed, affine)
     start = FRFProblem(model_at(l0), harmonics, n_t, condensed)
     tol = TOL_REL * max(float(np.linalg.norm(start.residual.linear_guess(omega))), 1e-300)
