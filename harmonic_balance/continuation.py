@@ -78,18 +78,24 @@ class Branch:
     x : list of (N,) arrays
     lam : list of float
     iterations : list of int   corrector iterations per point
+    det_sign : list of float   sign of det(dR/dx) per point (+1, -1; 0: not known), free
+        by-product of the tangent (:meth:`_Scaled.tangent`): it changes where a real Floquet
+        multiplier crosses +1 (folds, branch points), so Hill's stability is only needed
+        where it changes (:func:`stability.along_branch`)
     status : str               'complete', or why it stopped
     """
 
     x: list = field(default_factory=list)
     lam: list = field(default_factory=list)
     iterations: list = field(default_factory=list)
+    det_sign: list = field(default_factory=list)
     status: str = "running"
 
-    def append(self, x, lam, it):
+    def append(self, x, lam, it, det_sign=0.0):
         self.x.append(np.array(x))
         self.lam.append(float(lam))
         self.iterations.append(int(it))
+        self.det_sign.append(float(det_sign))
 
 
 class _Scaled:
@@ -103,11 +109,14 @@ class _Scaled:
         return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
 
     def tangent(self, J, t_prev):
-        """Unit tangent t (N+1,) with t . t_prev > 0, and the sign of det([J; t^T]).
+        """Unit tangent t (N+1,) with t . t_prev > 0, the sign of det([J; t^T]) and the
+        sign of det(J_x) (J without its last column).
 
-        The sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays the
-        same along a regular branch, through turning points and peaks, whatever the
-        scaling (positive column scales change det([J; t]) by a positive factor).
+        The first sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays
+        the same along a regular branch, through turning points and peaks, whatever the
+        scaling (positive column scales change det([J; t]) by a positive factor). The
+        second is free: by Cramer's rule the last component of the solution of
+        [J; t_prev] t = e_(N+1) is det(J_x) / det([J; t_prev]).
         """
         from scipy.linalg import lu_factor, lu_solve  # after the first point: start-up
 
@@ -124,7 +133,7 @@ class _Scaled:
         # which the LU gives.
         perm = np.count_nonzero(piv != np.arange(len(piv))) % 2
         sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
-        return t / n, float(sign)
+        return t / n, float(sign), float(np.sign(t[-1]) * sign)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
         """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
@@ -220,7 +229,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         col = np.append(np.full(len(x0), s_x), s_lam)
         J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
         try:
-            t, d = sc.tangent(J, t_prev)
+            t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
         except (np.linalg.LinAlgError, ValueError):
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
         if not orient:
@@ -240,7 +249,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
                 # interpolated guess stalled at |R| = 3e-4 while Newton from the last
                 # point (lam = -0.005) converged in 24 iterations.
                 res = _solve_fixed(fun, branch.x[-1], lam_end, tol, branch)
-            branch.append(res.x, lam_end, res.iterations)
+            branch.append(res.x, lam_end, res.iterations, np.linalg.slogdet(res.J)[0])
             if on_point is not None:
                 on_point(lam_end)
             branch.status = "complete"
@@ -299,7 +308,7 @@ def _rejected(sc, res, t, ds, max_turn, orient):
     if max_turn >= np.pi and not orient:
         return None
     try:
-        t_new, d_new = sc.tangent(res.J[:-1], t)
+        t_new, d_new, _ = sc.tangent(res.J[:-1], t)
     except (np.linalg.LinAlgError, ValueError):
         return "singular extended Jacobian at the corrected point"
     if ds > KINK_STEP and max_turn < np.pi and abs(t_new @ t) < np.cos(max_turn):

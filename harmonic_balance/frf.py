@@ -101,6 +101,7 @@ class FRFResult:
             "harmonics": list(self.harmonics), "n_t": self.n_t, "alias_ratio": self.alias_ratio,
             "aft": self.extra.get("aft"),
             "status": self.status, "stable": self.stable,
+            "stability_checks": self.extra.get("stability_checks", 0),
         }
         return {k: _finite(v) for k, v in out.items()}
 
@@ -177,9 +178,13 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
     end of a homotopy in the excitation level (:mod:`homotopy`), so the curve does
-    not depend on where the sweep starts. ``stability`` (True, False or "auto": when
-    the model has matrices and at most STABILITY_AUTO_MAX full unknowns) adds Hill's
-    stability of every point (``result.stable``). ``progress(done, total, label)``, if
+    not depend on where the sweep starts. ``stability`` adds Hill's stability of every
+    point (``result.stable``): "auto" (default) when the model has matrices and at most
+    STABILITY_AUTO_MAX full unknowns, True at any size, both by Hill checks only where
+    it can change (:func:`stability.along_branch`: the sign changes of det(dR/dx), the
+    local maxima of the amplitude, the ends, every CHECK_SPACING points, bisection
+    between checks that disagree), "all" by Hill's method at every point, False or
+    "off" not at all. ``progress(done, total, label)``, if
     given, is called after every continuation point with the share of the frequency
     range covered, in percent (``total`` = 100), as ``contact_core``'s long stages do.
     ``aft``: "exact" (default) evaluates every Iwan friction link by its exact periodic
@@ -214,7 +219,7 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
         result.status = branch.status = error
         result.extra["gaps"] = gaps
         result.extra["grid_doublings"] = k
-        result.stable = _stability(prob, branch, stability) if branch.lam else None
+        result.stable = _stability(prob, branch, stability)[0] if branch.lam else None
         raise FRFError(error, result)
     result = _collect(prob, branch, t0)
     result.extra["start"] = start
@@ -229,7 +234,8 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if gaps:
         result.status = (f"complete; {len(gaps)} restart(s) by homotopy after a stalled corrector, "
                          "no points in omega " + ", ".join(f"{a:.6g}-{b:.6g}" for a, b in gaps))
-    result.stable = _stability(prob, branch, stability)
+    result.stable, result.extra["stability_checks"] = _stability(
+        prob, branch, stability, peak_indices(result.amplitude, 0.0))
     if refine:
         _refine_peak(prob, branch, result, tol)
     result.alias_ratio = prob.alias_ratio(result.peak_solution)
@@ -389,8 +395,8 @@ def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
 
 
 def _extend(merged, br):
-    for x, w, it in zip(br.x, br.lam, br.iterations):
-        merged.append(x, w, it)
+    for x, w, it, d in zip(br.x, br.lam, br.iterations, br.det_sign or [0.0] * len(br.x)):
+        merged.append(x, w, it, d)
 
 
 def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
@@ -475,28 +481,34 @@ def _side_min(side: np.ndarray, top: float) -> float:
     return float(side[:above[0] if above.size else side.size].min())
 
 
-def _stability(prob: FRFProblem, branch, mode):
-    """Hill stability per branch point (list of bool), or None when not computed."""
+def _stability(prob: FRFProblem, branch, mode, anchors=()):
+    """Hill stability per branch point (list of bool) and the number of Hill checks, or
+    (None, 0) when not computed (``mode`` as :func:`compute_frf`'s ``stability``)."""
     from .residual import FullResidual
-    from .stability import is_stable
+    from .stability import along_branch, is_stable
 
     lin = prob.model.linear
-    if mode is False or lin.M is None or lin.K is None:
-        return None
+    if mode in (False, None, "off") or lin.M is None or lin.K is None:
+        return None, 0
     full = prob.residual if isinstance(prob.residual, FullResidual) else None
     size = prob.basis.nb * prob.model.n
     if mode == "auto" and size > STABILITY_AUTO_MAX:
-        return None
+        return None, 0
     if full is None:
         full = FullResidual(prob.model, prob.basis)
     V = full.viscous_operator()
     V = V if np.any(V) else None
-    out = []
-    for x, w in zip(branch.x, branch.lam):
+
+    def check(i):
+        x, w = branch.x[i], branch.lam[i]
         X = prob.residual.displacements(x, w).ravel() if full is not prob.residual else x
         _, J, _ = full(X, w)
-        out.append(is_stable(J, lin, prob.basis, w, V)[0])
-    return out
+        return is_stable(J, lin, prob.basis, w, V)[0]
+    n = len(branch.lam)
+    if mode == "all":
+        return [check(i) for i in range(n)], n
+    det = branch.det_sign if len(branch.det_sign) == n else [0.0] * n
+    return along_branch(n, det, check, anchors)
 
 
 @dataclass

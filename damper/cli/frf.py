@@ -20,8 +20,11 @@ refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``a
 ("exact": the links' Fourier coefficients without sampling, the default, n_t then only
 scans for extrema; "sampled" with ``--aft sampled``; "mixed" with contacts), ``points``,
 ``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
-(per point, Hill's method; null for models above 200 full unknowns or modal-only
-ones; unstable stretches are dashed in frf.png). The first point does not depend
+(per point, Hill's method, solved where stability can change: sign changes of the
+Jacobian's determinant, peaks, ends, every 25 points, bisection where two checks
+disagree; ``stability_checks`` counts them; ``--stability all`` solves it at every
+point; null for models above 200 full unknowns with ``auto``, modal-only ones, or
+``--stability off``; unstable stretches are dashed in frf.png). The first point does not depend
 on where the sweep starts: Newton from the stuck linear guess, else a homotopy in
 the excitation level or in the contact stiffness (harmonic_balance.start). A run
 that fails part-way prints the points computed so far (``status`` says where and
@@ -50,6 +53,9 @@ def register(subparsers) -> None:
     p.add_argument("--max-step", type=float, default=0.1,
                    help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
     p.add_argument("--max-points", type=int, default=2000)
+    p.add_argument("--stability", choices=("auto", "all", "off"), default="auto",
+                   help="Hill stability per point: auto (checked where it can change, models up "
+                   "to 200 full unknowns), all (Hill at every point, any size), off")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", help="also write the JSON to this file")
     p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
@@ -109,7 +115,8 @@ def run(args) -> int:
     _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
-                             ds_max=args.max_step, max_points=args.max_points, aft=args.aft)
+                             ds_max=args.max_step, max_points=args.max_points, aft=args.aft,
+                             stability=args.stability)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
