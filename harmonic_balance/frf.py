@@ -3,12 +3,13 @@
 ``compute_frf(model, harmonics, (omega_start, omega_end))`` traces the branch with
 :func:`continuation.continuation`, reports for the response DOF the peak absolute
 displacement over the period (``amplitude``) and the first-harmonic magnitude
-(``amplitude_h1``), and refines every resonance peak of ``amplitude`` (prominence
-above :data:`PEAK_PROMINENCE`) to :data:`PEAK_TOL_REL` in frequency
-(:func:`continuation.refine_max`); the highest is ``peak_omega``/``peak_amplitude``.
+(``amplitude_h1``), and refines the resonance peaks of ``amplitude``
+(:func:`peaks.refine_peaks`); the highest is ``peak_omega``/``peak_amplitude``. The
+points are as many as the curve's shape needs at the curve ``tolerance``
+(:mod:`continuation`), at least ~1 / LAM_STEP.
 
 Accuracy of the peak: the refinement locates the maximum of the *discrete* HB
-curve (given H) to PEAK_TOL_REL in frequency, hence its amplitude to ~1e-12. The
+curve (given H) to peaks.PEAK_TOL_REL in frequency, hence its amplitude to ~1e-12. The
 discrete curve differs from the exact one by the truncation in H only when the friction
 links are exact (the default, :func:`exact_links`); a sampled AFT (``aft="sampled"``,
 and contacts whose normal load varies) adds an O(n_t^-2) error (2e-4 relative at
@@ -26,23 +27,18 @@ import numpy as np
 
 from .aft import FrictionLink
 from .contact import ContactElement
-from .continuation import Branch, ContinuationError, continuation, refine_max
+from .continuation import CURVE_TOL, Branch, ContinuationError, continuation
 from .fourier import FourierBasis, default_samples, parse_harmonics
 from .homotopy import HomotopyError
 from .model import Model
 from .parameter import ParameterProblem
-from .residual import FullResidual, energy_per_cycle, make_residual
+from .peaks import peak_indices, refine_peaks
+from .residual import CondensedResidual, FullResidual, energy_per_cycle, make_residual
 from .start import _stiffness_ratio, homotopy_start
 
 #: Newton tolerance relative to the residual's reference size (|F_ext| for the
 #: full residual, |X| of the stuck linear response for the condensed one).
 TOL_REL = 1e-10
-#: Peak frequency located to this relative tolerance (the amplitude error is second
-#: order in it, ~1e-12 relative).
-PEAK_TOL_REL = 1e-6
-#: A local maximum is a resonance peak (refined, listed in ``peaks``) when its
-#: prominence exceeds this fraction of the curve's maximum; AFT ripples are ~1e-4.
-PEAK_PROMINENCE = 0.01
 
 
 #: Aliasing indicator (FourierBasis.alias_ratio at the peak) above which the
@@ -102,6 +98,7 @@ class FRFResult:
             "aft": self.extra.get("aft"),
             "status": self.status, "stable": self.stable,
             "stability_checks": self.extra.get("stability_checks", 0),
+            "peak_refined": self.extra.get("peak_refined"),
         }
         return {k: _finite(v) for k, v in out.items()}
 
@@ -166,14 +163,23 @@ class FRFProblem:
         return out
 
 
+#: Smallest curve tolerance: finer steps would resolve the corrector's own accuracy
+#: (TOL_REL of the residual, ~1e-8 of the response near a resonance).
+MIN_TOLERANCE = 1e-6
+#: Default largest continuation step (scaled arclength, :mod:`continuation`): the
+#: curve tolerance sizes the steps; this only bounds them on straight stretches.
+DS_MAX = 0.5
+
+
 #: Largest number of full-residual unknowns for which ``stability="auto"`` runs
 #: Hill's method at every point (a (2N)^2 eigenproblem: ~5 ms at N = 200).
 STABILITY_AUTO_MAX = 200
 
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
-                ds_max: float = 0.1, max_points: int = 2000, refine: bool = True,
-                stability="auto", progress=None, aft: str = "exact") -> FRFResult:
+                ds_max: float = DS_MAX, max_points: int = 2000, refine: bool = True,
+                stability="auto", progress=None, aft: str = "exact",
+                tolerance: float = CURVE_TOL) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
@@ -202,6 +208,9 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
         raise ValueError(f"omega range must be two different positive numbers, got {omega_range}")
     if aft not in ("exact", "sampled"):
         raise ValueError(f"aft must be 'exact' or 'sampled', got {aft!r}")
+    if not (MIN_TOLERANCE <= tolerance < 1 and np.isfinite(ds_max) and ds_max > 0):
+        raise ValueError(f"the curve tolerance must be in [{MIN_TOLERANCE:g}, 1) and the largest "
+                         f"step a finite number > 0, got {tolerance}, {ds_max}")
     t0 = time.perf_counter()
     model = exact_links(model, aft == "exact")
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
@@ -209,7 +218,8 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     spent = 0
     for k in range(tries):
         prob = FRFProblem(model, harmonics, n_base * 2**k, condensed)
-        branch, gaps, error, start, tol = _trace(prob, w0, w1, ds_max, max_points, progress)
+        branch, gaps, error, start, tol = _trace(prob, w0, w1, (ds_max, tolerance), max_points,
+                                                 progress)
         if not _grid_limited(error, gaps) or k == tries - 1:
             break
         spent += prob.evaluations
@@ -237,7 +247,10 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.stable, result.extra["stability_checks"] = _stability(
         prob, branch, stability, peak_indices(result.amplitude, 0.0))
     if refine:
-        _refine_peak(prob, branch, result, tol)
+        exact = None if all(getattr(el, "exact", True) for el in prob.model.links) else (
+            lambda: FRFProblem(exact_links(prob.model), prob.basis.harmonics, prob.basis.n_t,
+                               isinstance(prob.residual, CondensedResidual)))
+        refine_peaks(prob, branch, result, tol, exact)
     result.alias_ratio = prob.alias_ratio(result.peak_solution)
     if result.alias_ratio > ALIAS_WARN:
         result.status += (f"; warning: AFT grid of {prob.basis.n_t} samples leaves "
@@ -325,7 +338,7 @@ def _grid_limited(error, gaps) -> bool:
     return error is not None and ("step below minimum" in error or "before the first point" in error)
 
 
-def _trace(prob, w0, w1, ds_max, max_points, progress):
+def _trace(prob, w0, w1, steps, max_points, progress):
     """First point and continuation on one grid: (branch, gaps, error or None, start, tol)."""
     tol = TOL_REL * max(prob.reference(w0), 1e-300)
     try:
@@ -337,10 +350,14 @@ def _trace(prob, w0, w1, ds_max, max_points, progress):
     if progress is not None:
         def on_point(w):
             progress(min(100, round(100 * abs(w - w0) / abs(w1 - w0))), 100, "continuation")
-    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point)
+    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, steps, max_points, on_point)
     return branch, gaps, error, start, tol
 
 
+#: Largest continuation step in frequency, as a fraction of the range: a resonance of
+#: 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force 0.5, ~7 % of the range
+#: wide) was stepped over by the shape control alone; at least ~1 / LAM_STEP points.
+LAM_STEP = 0.03
 #: Restarts allowed per curve after a stalled corrector (:func:`_sweep`).
 MAX_RESTARTS = 100
 #: Frequency jumps tried for a restart, as fractions of the range: the smallest
@@ -348,7 +365,7 @@ MAX_RESTARTS = 100
 RESTART_JUMPS = (1e-3, 4e-3, 1.6e-2)
 
 
-def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
+def _sweep(prob, x0, w0, w1, tol, steps, max_points, on_point=None):
     """Continuation from (x0, w0) to w1 with restarts: (Branch, gaps, error or None).
 
     When the corrector stalls ("step below minimum": on a stiff contact the residual
@@ -362,8 +379,9 @@ def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
     sign = 1.0 if w1 > w0 else -1.0
     for _ in range(MAX_RESTARTS + 1):
         try:
-            br = continuation(prob, x0, w0, w1, tol, ds_max=ds_max,
-                              max_points=max_points - len(merged.lam), on_point=on_point)
+            br = continuation(prob, x0, w0, w1, tol, ds_max=steps[0], tolerance=steps[1],
+                              max_points=max_points - len(merged.lam), on_point=on_point,
+                              rtol=TOL_REL, lam_step=LAM_STEP)
             error = None
         except ContinuationError as err:
             br, error = err.branch, str(err)
@@ -415,72 +433,6 @@ def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
                      status=branch.status)
 
 
-def _refine_peak(prob, branch, result, tol):
-    """Refine every resonance peak (interior maxima with prominence above
-    :data:`PEAK_PROMINENCE` of the highest amplitude, so AFT ripples are skipped);
-    the highest refined one becomes the result's peak. Updates ``result`` in place."""
-    amp = result.amplitude
-    idx = peak_indices(amp, PEAK_PROMINENCE * amp.max())
-    # a peak next to a restart gap has no continuous neighbours to refine between
-    edges = {w for gap in result.extra.get("gaps", ()) for w in gap}
-    idx = [i for i in idx if not edges & {result.omega[i - 1], result.omega[i], result.omega[i + 1]}]
-    peaks, nfev = [], 0
-    for i in idx:
-        try:
-            x, w, a, n = refine_max(prob, branch, int(i), prob.amplitude, tol,
-                                    PEAK_TOL_REL * abs(result.omega[i]))
-        except RuntimeError as err:
-            raise FRFError(f"peak refinement near omega = {result.omega[i]:.6g} rad/s failed: "
-                           f"{err}", result) from None
-        peaks.append((a, w, x))
-        nfev += n
-    result.extra["peak_refinement_evaluations"] = nfev
-    result.peaks = [{"omega": w, "amplitude": a} for a, w, _ in sorted(peaks, key=lambda p: p[1])]
-    if not peaks or max(peaks, key=lambda p: p[0])[0] < amp.max():
-        return  # the maximum is at an end of the range: no interior peak to refine
-    a, w, x = max(peaks, key=lambda p: p[0])
-    r = prob.response(x, w)
-    result.peak_omega, result.peak_amplitude, result.peak_solution = w, a, x
-    result.peak_amplitude_h1 = (float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics
-                                else float("nan"))
-    result.peak_interior = True
-
-
-def peak_indices(a: np.ndarray, prominence: float) -> list[int]:
-    """Interior local maxima of ``a`` (n,) whose prominence exceeds ``prominence``.
-
-    A plateau counts once (its middle point, rounded down). The prominence of a maximum
-    is its height over the higher of the two lowest points between it and the nearest
-    higher point on each side (or the end of the curve): the definition of
-    ``scipy.signal.find_peaks``, whose import alone costs ~0.7 s of a command's start.
-    O(n x peak width), n ~ a few hundred curve points.
-    """
-    a = np.asarray(a, dtype=float)
-    out, n, i = [], a.size, 1
-    while i < n - 1:
-        if a[i] > a[i - 1]:
-            j = i
-            while j + 1 < n and a[j + 1] == a[i]:
-                j += 1  # plateau i..j
-            if j < n - 1 and a[j + 1] < a[i]:
-                k = (i + j) // 2
-                left = _side_min(a[:i][::-1], a[i])
-                right = _side_min(a[j + 1:], a[i])
-                if a[i] - max(left, right) > prominence:
-                    out.append(k)
-            i = j + 1
-        else:
-            i += 1
-    return out
-
-
-def _side_min(side: np.ndarray, top: float) -> float:
-    """Lowest value of ``side`` (walking away from a maximum of height ``top``) before
-    the first value above ``top``."""
-    above = np.flatnonzero(side > top)
-    return float(side[:above[0] if above.size else side.size].min())
-
-
 def _stability(prob: FRFProblem, branch, mode, anchors=()):
     """Hill stability per branch point (list of bool) and the number of Hill checks, or
     (None, 0) when not computed (``mode`` as :func:`compute_frf`'s ``stability``)."""
@@ -525,7 +477,7 @@ class ParameterCurve:
 
 
 def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
-                    condensed=None, affine: bool = False, ds_max: float = 0.1,
+                    condensed=None, affine: bool = False, ds_max: float = DS_MAX,
                     max_points: int = 2000, stability: bool = True) -> ParameterCurve:
     """Continuation in lam over ``lam_range = (start, end)`` at fixed ``omega`` [rad/s].
 

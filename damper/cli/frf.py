@@ -50,8 +50,13 @@ def register(subparsers) -> None:
                    "(contacts with a varying normal load are sampled either way)")
     p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
                    help="frequency range [rad/s]")
-    p.add_argument("--max-step", type=float, default=0.1,
-                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
+    p.add_argument("--tolerance", type=float,
+                   help="curve accuracy: the points' polyline deviates from the curve by about this "
+                   "much, relative to the response and the range (default 0.01, "
+                   "harmonic_balance.continuation.CURVE_TOL); peaks are refined whatever it is")
+    p.add_argument("--max-step", type=float,
+                   help="largest continuation step (scaled arclength; default 0.5, "
+                   "harmonic_balance.frf.DS_MAX)")
     p.add_argument("--max-points", type=int, default=2000)
     p.add_argument("--stability", choices=("auto", "all", "off"), default="auto",
                    help="Hill stability per point: auto (checked where it can change, models up "
@@ -109,13 +114,15 @@ def run(args) -> int:
 
     if args.model == "sdof" and args.response_dof not in (None, 0):
         raise ValueError("the sdof model has one DOF (0)")
-    if args.max_step <= 0 or args.max_points < 2 or args.samples < 0:
-        raise ValueError("--max-step must be > 0, --max-points >= 2, --samples >= 0")
+    steps = {k: v for k, v in (("ds_max", args.max_step), ("tolerance", args.tolerance))
+             if v is not None}
+    if args.max_points < 2 or args.samples < 0:
+        raise ValueError("--max-points must be >= 2 and --samples >= 0")
     model = build_model(args)
     _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
-                             ds_max=args.max_step, max_points=args.max_points, aft=args.aft,
+                             max_points=args.max_points, aft=args.aft, **steps,
                              stability=args.stability)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
@@ -123,7 +130,7 @@ def run(args) -> int:
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
         raise RuntimeError(f"{err} ({err.result.points} points kept); try fewer --harmonics, "
-                           "a narrower --omega range or a smaller --max-step") from None
+                           "a narrower --omega range or a smaller --tolerance") from None
     summary = result.summary()
     if args.plot:
         from harmonic_balance.plots import plot_frf

@@ -130,7 +130,8 @@ SWEEP = {
     "f_min": Field("float", "start frequency [Hz]", required=True, gt=0),
     "f_max": Field("float", "end frequency [Hz]", required=True, gt=0),
     "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1),
-    "max_step": Field("float", "largest continuation step (scaled arclength)", default=0.1, gt=0),
+    "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
+                      "sizes the steps below it)", default=0.5, gt=0),
 }
 
 BACKBONE = {

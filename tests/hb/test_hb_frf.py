@@ -136,7 +136,7 @@ def test_peak_indices_agree_with_scipy_find_peaks():
     on random curves, integer-valued ones included (plateaus and equal bases)."""
     from scipy.signal import find_peaks
 
-    from harmonic_balance.frf import peak_indices
+    from harmonic_balance.peaks import peak_indices
 
     rng = np.random.default_rng(20261122)
     for trial in range(PEAK_FINDER_TRIALS):
