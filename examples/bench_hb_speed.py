@@ -23,8 +23,9 @@ Cases (SI units; H harmonics 0..H):
   c = 0.04, slip 0.5, F = 1, 0.9 -> 1.1 rad/s (curves whose peak refinement failed).
 
 The peak error is that of the first-harmonic amplitude at the refined peak against a
-dense trace of the same model (same H, ``ds_max`` = REF_STEP), computed once per case
-and kept in ``--ref-file``. Times are wall-clock of one run in this process (noisy on a
+dense trace of the same model (same H and friction-link evaluation, ``ds_max`` =
+REF_STEP, curve tolerance REF_TOL where there is one), computed once per case and kept
+in ``--ref-file``. Times are wall-clock of one run in this process (noisy on a
 shared machine: compare revisions side by side, in one run).
 """
 from __future__ import annotations
@@ -93,10 +94,15 @@ def run(model, H, rng, **kw):
     return r, err, time.perf_counter() - t0
 
 
+#: Curve tolerance of the dense references (where compute_frf has one).
+REF_TOL = 1e-4
+
+
 def reference(label, model, H, rng, refs):
     """Dense first-harmonic peak (omega, amplitude) of the case, cached in ``refs``."""
     if label not in refs:
-        r, err, _ = run(model, H, rng, ds_max=REF_STEP, max_points=200000, stability=False)
+        dense = {"tolerance": REF_TOL} if "tolerance" in compute_frf.__code__.co_varnames else {}
+        r, err, _ = run(model, H, rng, ds_max=REF_STEP, max_points=200000, stability=False, **dense)
         refs[label] = None if err else [r.peak_omega, r.peak_amplitude_h1]
     return refs[label]
 
@@ -105,8 +111,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("cases", nargs="*", default=["sdof", "p3", "p5", "stiff"],
                     choices=["sdof", "p3", "p5", "stiff"])
-    ap.add_argument("--ref-file", default="/tmp/bench_hb_speed_refs.json",
-                    help="dense reference peaks, computed when missing")
+    exact = "aft" in compute_frf.__code__.co_varnames  # exact friction links by default
+    ap.add_argument("--ref-file", default=f"/tmp/bench_hb_speed_refs_{'exact' if exact else 'sampled'}.json",
+                    help="dense reference peaks, computed when missing (one file per AFT kind: "
+                    "the exact links' references for a version with them)")
     ap.add_argument("--no-ref", action="store_true", help="skip the dense references")
     ap.add_argument("--json", help="write the rows to this file")
     a = ap.parse_args(sys.argv[1:] if argv is None else argv)

@@ -27,7 +27,7 @@ import numpy as np
 
 from .aft import FrictionLink
 from .contact import ContactElement
-from .continuation import CURVE_TOL, Branch, ContinuationError, continuation
+from .continuation import CURVE_TOL, LAM_STEP, Branch, ContinuationError, continuation
 from .fourier import FourierBasis, default_samples, parse_harmonics
 from .homotopy import HomotopyError
 from .model import Model
@@ -354,10 +354,6 @@ def _trace(prob, w0, w1, steps, max_points, progress):
     return branch, gaps, error, start, tol
 
 
-#: Largest continuation step in frequency, as a fraction of the range: a resonance of
-#: 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force 0.5, ~7 % of the range
-#: wide) was stepped over by the shape control alone; at least ~1 / LAM_STEP points.
-LAM_STEP = 0.03
 #: Restarts allowed per curve after a stalled corrector (:func:`_sweep`).
 MAX_RESTARTS = 100
 #: Frequency jumps tried for a restart, as fractions of the range: the smallest
@@ -413,8 +409,10 @@ def _sweep(prob, x0, w0, w1, tol, steps, max_points, on_point=None):
 
 
 def _extend(merged, br):
-    for x, w, it, d in zip(br.x, br.lam, br.iterations, br.det_sign or [0.0] * len(br.x)):
-        merged.append(x, w, it, d)
+    n = len(br.x)
+    for x, w, it, d, t in zip(br.x, br.lam, br.iterations, br.det_sign or [0.0] * n,
+                              br.tangent or [None] * n):
+        merged.append(x, w, it, d, t)
 
 
 def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
