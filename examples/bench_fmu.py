@@ -26,6 +26,7 @@ import numpy as np
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
+from fmu_src import fmu_xml
 from fmu_src.element import IwanElement
 from fmu_src.fmu_build import FMI_DIR, build_fmu
 
@@ -54,20 +55,23 @@ def history(steps: int) -> np.ndarray:
     return AMPLITUDE * np.sin(2.0 * np.pi / POINTS_PER_CYCLE * (np.arange(steps) % POINTS_PER_CYCLE))
 
 
-def compile_driver(workdir: Path) -> Path:
-    exe = workdir / "bench_driver"
+def compile_driver(workdir: Path, iface=fmu_xml.DAMPER) -> Path:
+    """The C master for the FMUs of ``iface`` (its fmu_vars.h written into ``workdir``)."""
+    exe = workdir / f"bench_driver_{iface.model_identifier}"
+    (workdir / "fmu_vars.h").write_text(fmu_xml.render_fmu_vars(iface))
     cmd = [os.environ.get("CC", "cc"), "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror",
-           f"-I{FMI_DIR}", f"-I{FMI_DIR / 'headers'}", str(FMI_DIR / "bench_driver.c"),
-           "-o", str(exe), "-ldl", "-lm"]
+           f"-I{workdir}", f"-I{FMI_DIR}", f"-I{FMI_DIR / 'headers'}",
+           str(FMI_DIR / "bench_driver.c"), "-o", str(exe), "-ldl", "-lm"]
     subprocess.run(cmd, check=True)
     return exe
 
 
-def run_c_master(exe: Path, unzipdir: str, steps: int, repeats: int):
+def run_c_master(exe: Path, unzipdir: str, steps: int, repeats: int, name: str = "damper",
+                 amplitude: float = AMPLITUDE):
     """(ns per step, last F, last W, peak RSS in MiB) from the C master."""
-    binary = Path(unzipdir) / "binaries" / "linux64" / "damper.so"
+    binary = Path(unzipdir) / "binaries" / "linux64" / f"{name}.so"
     uri = Path(unzipdir, "resources").as_uri()
-    out = subprocess.run([str(exe), str(binary), uri, str(steps), repr(AMPLITUDE),
+    out = subprocess.run([str(exe), str(binary), uri, str(steps), repr(amplitude),
                           str(POINTS_PER_CYCLE), str(repeats)],
                          check=True, capture_output=True, text=True).stdout
     ns, F, W, kib = (float(x) for x in out.split())

@@ -18,12 +18,15 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["MAX_SLIDERS", "STATE_VERSION", "Model", "State", "Output", "STATE_DTYPE",
+__all__ = ["MAX_SLIDERS", "STATE_VERSION", "STATE2_VERSION", "Model", "State", "Output", "State2",
+           "Output2", "MAX_NORMAL", "CPOINT_STATE_VERSION", "CPointModel", "CPointState",
+           "CPointOutput", "STATE_DTYPE",
            "DoubleArray", "StateArray", "SizeArray", "Int32Array", "arr", "FUNCTIONS", "lib", "check", "IwanInputError",
            "IwanNotConvergedError", "vec", "normal"]
 
 MAX_SLIDERS = 256          # IWAN_MAX_SLIDERS in iwan.h (the header test checks it)
 STATE_VERSION = 1          # IWAN_STATE_VERSION in iwan.h
+STATE2_VERSION = 1         # IWAN2_STATE_VERSION in iwan2d.h
 
 
 class IwanInputError(ValueError):
@@ -54,6 +57,43 @@ class State(ct.Structure):
 class Output(ct.Structure):
     """``iwan_output``."""
     _fields_ = [(name, ct.c_double) for name in ("F", "kt", "dFdN", "W", "E", "slip")]
+
+
+class State2(ct.Structure):
+    """``iwan2_state`` (iwan2d.h)."""
+    _fields_ = [("version", ct.c_int32), ("in_contact", ct.c_int32), ("u", ct.c_double * 2),
+                ("N", ct.c_double), ("u_contact", ct.c_double * 2), ("w_diss", ct.c_double),
+                ("dir", ct.c_double * 2), ("z", ct.c_double * (2 * MAX_SLIDERS))]
+
+
+class Output2(ct.Structure):
+    """``iwan2_output`` (iwan2d.h)."""
+    _fields_ = [("F", ct.c_double * 2), ("K", ct.c_double * 4), ("dFdN", ct.c_double * 2),
+                ("W", ct.c_double), ("E", ct.c_double), ("slip", ct.c_double)]
+
+
+MAX_NORMAL = 256           # CPOINT_MAX_NORMAL in contact_point.h
+CPOINT_STATE_VERSION = 1   # CPOINT_STATE_VERSION in contact_point.h
+
+
+class CPointModel(ct.Structure):
+    """``cpoint_model`` (contact_point.h)."""
+    _fields_ = [("t", Model), ("n_normal", ct.c_int32), ("p", ct.c_double * MAX_NORMAL),
+                ("N", ct.c_double * MAX_NORMAL), ("E_n", ct.c_double * MAX_NORMAL),
+                ("c_t", ct.c_double), ("c_n", ct.c_double)]
+
+
+class CPointState(ct.Structure):
+    """``cpoint_state`` (contact_point.h)."""
+    _fields_ = [("version", ct.c_int32), ("reserved", ct.c_int32), ("p", ct.c_double),
+                ("s", State2)]
+
+
+class CPointOutput(ct.Structure):
+    """``cpoint_output`` (contact_point.h)."""
+    _fields_ = [("f", ct.c_double * 3), ("K", ct.c_double * 9), ("C", ct.c_double * 3),
+                ("W", ct.c_double), ("E", ct.c_double), ("slip", ct.c_double),
+                ("state", ct.c_int32)]
 
 
 #: numpy view of ``iwan_state`` (one record per state), derived from :class:`State`.
@@ -96,9 +136,11 @@ def arr(a, kind=DoubleArray):
 _S, _D, _I = ct.c_size_t, ct.c_double, ct.c_int
 _PM, _PS, _PO = ct.POINTER(Model), ct.POINTER(State), ct.POINTER(Output)
 _PD, _PI = ct.POINTER(ct.c_double), ct.POINTER(ct.c_int)
+_PS2, _PO2 = ct.POINTER(State2), ct.POINTER(Output2)
+_PCM, _PCS, _PCO = ct.POINTER(CPointModel), ct.POINTER(CPointState), ct.POINTER(CPointOutput)
 _STATUS = ct.c_int   # iwan_status (an enum: int)
 
-#: name -> (restype, argtypes), in iwan.h order. The only declaration of each function.
+#: name -> (restype, argtypes), in iwan.h, iwan2d.h, contact_point.h order. The only declaration of each function.
 FUNCTIONS = {
     "iwan_model_init": (_STATUS, [_PM, DoubleArray, DoubleArray, _S, _D, _I]),
     "iwan_model_from_sliders": (_STATUS, [_PM, DoubleArray, DoubleArray, _S, _D, _D]),
@@ -123,6 +165,23 @@ FUNCTIONS = {
     "iwan_periodic_fourier": (_STATUS, [_PM, _S, Int32Array, DoubleArray, _S, DoubleArray,
                                         DoubleArray, _PD, SizeArray]),
     "iwan_status_text": (ct.c_char_p, [_STATUS]),
+    # iwan2d.h: the 2D element (same model)
+    "iwan2_state_init": (_STATUS, [_PM, _PS2, _D]),
+    "iwan2_eval": (_STATUS, [_PM, _PS2, _D, _D, _D, _PS2, _PO2]),
+    "iwan2_step": (_STATUS, [_PM, _PS2, _D, _D, _D, _PO2]),
+    "iwan2_series": (_STATUS, [_PM, _PS2, _S, DoubleArray, DoubleArray, DoubleArray,
+                               DoubleArray, DoubleArray]),
+    "iwan2_periodic_work_size": (_S, [_S]),
+    "iwan2_periodic_jac": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, DoubleArray, DoubleArray,
+                                     DoubleArray, _S, DoubleArray, DoubleArray, _PD, _I, _D, _PI,
+                                     DoubleArray]),
+    # contact_point.h: the 3D contact point (2D element + normal law)
+    "cpoint_model_init": (_STATUS, [_PCM, _PM, DoubleArray, DoubleArray, _S, _D, _D]),
+    "cpoint_normal": (_D, [_PCM, _D, _PD]),
+    "cpoint_state_init": (_STATUS, [_PCM, _PCS, _D]),
+    "cpoint_eval": (_STATUS, [_PCM, _PCS, DoubleArray, DoubleArray, _PCS, _PCO]),
+    "cpoint_step": (_STATUS, [_PCM, _PCS, DoubleArray, DoubleArray, _PCO]),
+    "cpoint_check_state": (_STATUS, [_PCM, _PCS]),
 }
 
 

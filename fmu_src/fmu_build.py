@@ -12,8 +12,10 @@ The curve is checked by building the element through :mod:`fmu_src.element`
 with a ``ValueError`` and no file is written. The ``.fmu`` is written through a
 temporary file and a rename: never half-written.
 
-Run ``python -m fmu_src.fmu_build --write-header`` after changing the variable
-table to regenerate ``fmu_src/fmi/damper_vr.h``.
+Run ``python -m fmu_src.fmu_build --write-header`` after changing a variable
+table to regenerate ``fmu_src/fmi/damper_vr.h`` and ``point_vr.h``. The contact-point
+FMU (2D element + normal law) is packaged by :mod:`fmu_src.fmu_point` with the same
+helpers.
 """
 from __future__ import annotations
 
@@ -36,8 +38,8 @@ FMI_DIR = Path(__file__).resolve().parent / "fmi"
 CORE_DIR = Path(__file__).resolve().parent / "core"
 HEADER_PATH = FMI_DIR / "damper_vr.h"
 
-#: Model hooks available to the wrapper (model.h): the element and a baseline.
-MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c"}
+#: Model hooks available to the wrapper (model.h): the element, the contact point, a baseline.
+MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c", "point": "model_point.c"}
 #: Binary folder of each FMI version on 64-bit Linux.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 #: How a curve table that is not concave is handled (iwan.h iwan_fit).
@@ -46,13 +48,23 @@ _FMI_HEADERS = {
     2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
     3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
 }
-_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h", "damper_vr.h")
+_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h")
 #: Input bound of the Iwan model (model_iwan.c U_BOUND_RTOL): the force error of a
 #: slider, about k eps |u|, stays below this fraction of its slip strength.
 U_BOUND_RTOL = 1e-6
 #: The friction-law core compiled into every FMU (fmu_src/core), and its headers.
 CORE_SOURCES = ("iwan.c", "iwan_periodic.c")
 CORE_HEADERS = ("iwan.h", "iwan_internal.h", "iwan_sweep.h")
+#: What the contact point adds to the core (the 2D element and the normal law).
+POINT_SOURCES = ("iwan2d.c", "contact_point.c")
+POINT_HEADERS = ("iwan2d.h", "iwan2d_internal.h", "contact_point.h")
+
+
+def core_files(model: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """(C sources, headers) of fmu_src/core compiled into the FMU of ``model``."""
+    if model == "point":
+        return CORE_SOURCES + POINT_SOURCES, CORE_HEADERS + POINT_HEADERS
+    return CORE_SOURCES, CORE_HEADERS
 #: The one compile-flag list shared with CMake and the pip extension (one flag a line).
 CFLAGS_FILE = CORE_DIR / "cflags.txt"
 
@@ -72,7 +84,8 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *CORE_SOURCES]
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model],
+            *core_files(model)[0]]
 
 
 def _check_version(fmi_version: int) -> None:
@@ -134,12 +147,16 @@ def curve_resource_text(u, T, n_ref: float, fit: str) -> str:
 
 
 def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
-    """Copy the C sources and headers flat into ``dest``; return the .c names."""
+    """Copy the C sources and headers flat into ``dest`` (with the model's variable
+    table and the fmu_vars.h that picks it); return the .c names."""
     dest.mkdir(parents=True)
     names = c_sources(fmi_version, model)
-    for name in names + list(_WRAPPER_HEADERS + CORE_HEADERS):
-        src = CORE_DIR if name in CORE_SOURCES + CORE_HEADERS else FMI_DIR
+    sources, headers = core_files(model)
+    iface = fmu_xml.INTERFACES[model]
+    for name in names + list(_WRAPPER_HEADERS + headers) + [iface.header]:
+        src = CORE_DIR if name in sources + headers else FMI_DIR
         shutil.copy(src / name, dest / name)
+    (dest / "fmu_vars.h").write_text(fmu_xml.render_fmu_vars(iface))
     for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
         shutil.copy(FMI_DIR / "headers" / name,
                     dest / ("FMI_HEADERS_LICENSE.txt" if name == "LICENSE.txt" else name))
@@ -279,9 +296,13 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
     return path
 
 
+#: The generated variable headers, one per interface.
+HEADERS = {FMI_DIR / i.header: i for i in (fmu_xml.DAMPER, fmu_xml.POINT)}
+
+
 def header_is_current() -> bool:
-    """Whether the committed ``damper_vr.h`` equals the generated text."""
-    return HEADER_PATH.read_text() == fmu_xml.render_vr_header()
+    """Whether the committed variable headers equal the generated texts."""
+    return all(path.read_text() == fmu_xml.render_vr_header(i) for path, i in HEADERS.items())
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -289,16 +310,18 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     group = parser.add_mutually_exclusive_group(required=True)
     group.add_argument("--write-header", action="store_true",
-                       help=f"regenerate {HEADER_PATH.name} from the variable table")
+                       help="regenerate " + ", ".join(p.name for p in HEADERS)
+                       + " from the variable tables")
     group.add_argument("--check-header", action="store_true",
                        help="exit 1 if the committed header is out of date")
     args = parser.parse_args(argv)
     if args.write_header:
-        atomic_write(HEADER_PATH, fmu_xml.render_vr_header())
+        for path, iface in HEADERS.items():
+            atomic_write(path, fmu_xml.render_vr_header(iface))
         return 0
     if header_is_current():
         return 0
-    print(f"{HEADER_PATH} is out of date: run python -m fmu_src.fmu_build --write-header",
+    print("a variable header is out of date: run python -m fmu_src.fmu_build --write-header",
           file=sys.stderr)
     return 1
 

@@ -2,8 +2,10 @@
 
 Local displacements (from :meth:`.kinematics.Kinematics.contact`): ``q = [s, p]``,
 the slip ``s = t . Delta`` and the penetration ``p = -n . Delta`` of a contact point
-(Delta = body 1 minus body 2, n from body 2 into body 1). Local forces ``f = [f_t, N]``
-(conjugate to q; the internal force on body 1 is ``f_t t - N n``)::
+(Delta = body 1 minus body 2, n from body 2 into body 1), or with two tangents
+``q = [s_x, s_y, p]`` (the slip in the contact plane: the 2D element of the C core,
+``iwan2d.h``, each slider with a circular slip limit). Local forces ``f = [f_t, N]``
+(``[f_x, f_y, N]``; conjugate to q; the internal force on body 1 is ``f_t t - N n``)::
 
     N(theta)   = k_n max(p_0 + p(theta), 0)                              (C1)
     f_t(theta) = Iwan/Jenkins element at slip s - s_0, slip limits x N/N_ref   (C2)
@@ -21,6 +23,9 @@ element's state recurs (closure to ``tol`` of the force range, ``max_periods`` a
 most, else ``IwanNotConvergedError``); with N constant over the period the loop is
 exact in one pass. It returns dF/dU_s and dF/dU_p exactly, including the
 dependence of each sticking slider on N where it stuck and of the re-contact point.
+With two tangents the 2D loop (``IwanElement2D.periodic_jac``: each slider marched on
+its own from the same start convention; on a line it is the 1D loop) gives
+d(f_x, f_y)/d(U_sx, U_sy, U_p) exactly, by sensitivities carried through the march.
 The C core gets the *unclamped* ``k_n (p_0 + p)``, linear in the harmonics
 (EN = k_n E): it treats N <= 0 as lift-off and locates re-contact on the straight
 path between samples; (C1) itself is clamped.
@@ -33,8 +38,11 @@ sliders are virgin (tangential force zero). A periodic loop is then placed by th
 core's convention (``iwan_periodic``): starting from that virgin state, each slider is
 moved by the least amount that keeps it within its slip limits over the loop. So a
 contact that stays stuck with ``|s - s_0|`` below the slip radii has the defined mean
-force ``k_t (mean(s) - s_0)``; a slider that slips in every cycle forgets s_0.
-Two tangential directions are not supported (the C element is one-dimensional).
+force ``k_t (mean(s) - s_0)``; a slider that slips in every cycle forgets s_0. With
+two tangents s_0 is a 2-vector; the loop starts virgin at s_0 and moves straight to the
+first sample before the periods are marched (``iwan2_periodic_jac``): at constant N on a
+line this is the 1D convention; a slider that never slips keeps where the first period
+left it.
 """
 from __future__ import annotations
 
@@ -61,8 +69,8 @@ class ContactElement(ForceElement):
     Parameters
     ----------
     kinematics : Kinematics
-        Local q = [s, p] (m = 2) or [p] (m = 1, normal only); see
-        :meth:`Kinematics.contact`.
+        Local q = [s, p] (m = 2), [s_x, s_y, p] (m = 3: two tangents) or [p] (m = 1,
+        normal only); see :meth:`Kinematics.contact`.
     k_n : float
         Normal penalty stiffness [N/m] (> 0).
     friction : object, optional
@@ -71,8 +79,9 @@ class ContactElement(ForceElement):
         scale with N / N_ref. Required when m = 2. See :meth:`jenkins`.
     preload : float
         Static penetration p_0 [m] at x = 0 (C1).
-    slip_ref : float
-        Prestress slip s_0 [m] where the sliders are virgin (module docstring).
+    slip_ref : float or array_like, shape (2,)
+        Prestress slip s_0 [m] where the sliders are virgin (module docstring); a
+        2-vector (or a scalar for both) with two tangents.
     beta_c : float
         Contact damping [s]: dashpots beta_c k_t and beta_c k_n in parallel (C3),
         k_t the friction element's stuck stiffness.
@@ -85,21 +94,30 @@ class ContactElement(ForceElement):
                  slip_ref: float = 0.0, beta_c: float = 0.0, max_periods: int = MAX_PERIODS,
                  tol: float = CLOSURE_TOL, name: str = ""):
         m = kinematics.m
-        if m not in (1, 2):
-            raise ValueError(f"contact kinematics must give [p] or [s, p] (m = 1 or 2), got m = {m}; "
-                             "two tangential directions are not supported")
-        if (m == 2) != (friction is not None):
-            raise ValueError("a contact with a slip coordinate (m = 2) needs a friction element, "
+        if m not in (1, 2, 3):
+            raise ValueError(f"contact kinematics must give [p], [s, p] or [s_x, s_y, p] (m = 1, 2 "
+                             f"or 3), got m = {m}")
+        if (m >= 2) != (friction is not None):
+            raise ValueError("a contact with slip coordinates (m = 2 or 3) needs a friction element, "
                              "a normal-only contact (m = 1) none")
         for label, v, lo in (("k_n", k_n, 0.0), ("beta_c", beta_c, None)):
             if not np.isfinite(v) or v < 0 or (lo is not None and v <= lo):
                 raise ValueError(f"{label} must be finite and {'> 0' if lo is not None else '>= 0'}, "
                                  f"got {v}")
-        if not (np.isfinite(preload) and np.isfinite(slip_ref)):
+        ref = np.asarray(slip_ref, dtype=float)
+        if not (np.isfinite(preload) and np.all(np.isfinite(ref))):
             raise ValueError("preload and slip_ref must be finite")
+        if ref.ndim > 1 or (ref.ndim == 1 and (m != 3 or ref.size != 2)):
+            raise ValueError(f"slip_ref must be a number{' or 2 numbers' if m == 3 else ''}, "
+                             f"got shape {ref.shape}")
         self.kinematics, self.name = kinematics, name
         self.k_n, self.friction = float(k_n), friction
-        self.preload, self.slip_ref, self.beta_c = float(preload), float(slip_ref), float(beta_c)
+        self.preload, self.beta_c = float(preload), float(beta_c)
+        self.slip_ref = np.broadcast_to(ref, (2,)).copy() if m == 3 else float(ref)
+        self.friction2d = None
+        if m == 3:
+            from fmu_src.element2d import IwanElement2D
+            self.friction2d = IwanElement2D(friction)
         self.max_periods, self.tol = int(max_periods), float(tol)
         self.k_t = 0.0 if friction is None else float(np.sum(friction.k) + friction.k_res)
 
@@ -114,8 +132,8 @@ class ContactElement(ForceElement):
 
     # ------------------------------------------------------------ ForceElement
     def stuck_stiffness(self) -> np.ndarray:
-        """diag(k_t, k_n): in contact and stuck."""
-        return np.diag([self.k_t, self.k_n][2 - self.m:])
+        """diag(k_t, k_n) (diag(k_t, k_t, k_n) with two tangents): in contact and stuck."""
+        return np.diag([self.k_t] * (self.m - 1) + [self.k_n])
 
     def local_damping(self):
         if self.beta_c == 0.0:
@@ -123,7 +141,7 @@ class ContactElement(ForceElement):
         return self.beta_c * self.stuck_stiffness()
 
     def static_force(self) -> np.ndarray:
-        return np.array([0.0, self.k_n * max(self.preload, 0.0)][2 - self.m:])
+        return np.array([0.0] * (self.m - 1) + [self.k_n * max(self.preload, 0.0)])
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
         """AFT of (C1)-(C3) on local harmonics U (n_b, m); exact Jacobian.
@@ -144,7 +162,9 @@ class ContactElement(ForceElement):
         if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
             dF[m - 1::m, m - 1::m] = self._normal_block(basis, on)
         W, s = 0.0, None
-        if m == 2:
+        if m == 3:
+            s, W = self._evaluate_plane(U, basis, p, f, dF, D)
+        elif m == 2:
             s = E @ U[:, 0]
             Ft, dFs, dFp, W = self.friction.periodic_jac(
                 s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
@@ -162,6 +182,24 @@ class ContactElement(ForceElement):
             if jac:
                 dF += omega * op
         return ContactForce(F, dF, dw, f, float(W), (C, U, basis, omega), (s, pl))
+
+
+    def _evaluate_plane(self, U, basis: FourierBasis, p, f, dF, D):
+        """Friction of two tangents (m = 3) into f[:, :2] and the blocks of dF (if any).
+
+        Returns the sampled slips (n_t, 2) and the friction work per cycle [J]."""
+        E = basis.E
+        s = np.column_stack([E @ U[:, 0], E @ U[:, 1]])
+        res = self.friction2d.periodic_jac(s[:, 0] - self.slip_ref[0], s[:, 1] - self.slip_ref[1],
+                                           E if dF is not None else None, N=self.k_n * p,
+                                           EN=self._cached(basis, "EN"), max_periods=self.max_periods,
+                                           tol=self.tol)
+        f[:, :2] = res.F
+        if dF is not None:  # dF[j::3, k::3]: force j (x, y) against coordinate k (x, y, p)
+            for j in range(2):
+                for k in range(3):
+                    dF[j::3, k::3] = D @ res.dF[:, j, k, :]
+        return s, res.W_cycle
 
     def _cached(self, basis: FourierBasis, what: str, on=None) -> np.ndarray:
         """Per-basis constants, rebuilt when k_n or the basis change: ``EN`` = k_n E
@@ -199,6 +237,7 @@ class ContactElement(ForceElement):
     def stepper(self):
         """Time-domain law: one C-element step per call at N = k_n (p_0 + p)."""
         el, kn, p0, s0, m = self.friction, self.k_n, self.preload, self.slip_ref, self.m
+        el = self.friction2d if m == 3 else el
         state = None if el is None else el.initial_state(kn * p0 if p0 > 0 else None)
 
         class _Contact:
@@ -207,6 +246,8 @@ class ContactElement(ForceElement):
                 N = kn * max(pen, 0.0)
                 if m == 1:
                     return np.array([N])
+                if m == 3:
+                    return np.append(el.step(state, (q[0] - s0[0], q[1] - s0[1]), kn * pen).F, N)
                 return np.array([el.step(state, q[0] - s0, kn * pen).F, N])
 
             def dissipated(self) -> float:
@@ -248,10 +289,11 @@ class ContactForce(LocalForce):
     def q(self) -> np.ndarray:
         if self._q is None:
             s, pl = self._samples
-            self._q = np.empty((pl.size, 1 if s is None else 2))
+            s = None if s is None else s.reshape(pl.size, -1)
+            self._q = np.empty((pl.size, 1 if s is None else 1 + s.shape[1]))
             self._q[:, -1] = pl
             if s is not None:
-                self._q[:, 0] = s
+                self._q[:, :-1] = s
         return self._q
 
 
@@ -261,7 +303,8 @@ class ContactBatchStepper:
     For vectorised time integration (many frequencies or variants marched together):
     ``force(q)`` advances history i to the local displacement ``q[i]`` exactly as
     :meth:`ContactElement.stepper` would (the C core's ``iwan_step_batch`` runs the
-    same code as ``iwan_step``: the same bits), at ``N = k_n (p_0 + p)``.
+    same code as ``iwan_step``: the same bits), at ``N = k_n (p_0 + p)``. With two
+    tangents (m = 3) each history is a 2D state stepped by ``iwan2_step`` in turn.
 
     Attributes
     ----------
@@ -273,8 +316,12 @@ class ContactBatchStepper:
         self.element, self.n = element, int(n)
         el, kn, p0 = element.friction, element.k_n, element.preload
         self.f = np.zeros((self.n, element.m))
-        self._st = None
-        if el is not None:
+        self._st = self._st2 = None
+        if element.m == 3:
+            el2 = element.friction2d
+            self._st2 = states if states is not None else [
+                el2.initial_state(kn * p0 if p0 > 0 else None) for _ in range(self.n)]
+        elif el is not None:
             if states is None:
                 states = el.initial_states(self.n, kn * p0 if p0 > 0 else None)
             self._st = el.batch_stepper(states, N=np.zeros(self.n))
@@ -289,10 +336,15 @@ class ContactBatchStepper:
             np.subtract(q[:, 0], e.slip_ref, out=self._st.u)
             np.multiply(pen, e.k_n, out=self._st.N)
             self.f[:, 0] = self._st.step()
+        if self._st2 is not None:
+            for i, st in enumerate(self._st2):
+                self.f[i, :2] = e.friction2d.step(st, q[i, :2] - e.slip_ref, e.k_n * pen[i]).F
         return self.f
 
     def dissipated(self) -> np.ndarray:
         """Cumulative friction energy [J] of each history, shape (n,)."""
+        if self._st2 is not None:
+            return np.array([st.W for st in self._st2])
         if self._st is None:
             return np.zeros(self.n)
         return self._st.states["w_diss"].copy()
@@ -300,6 +352,8 @@ class ContactBatchStepper:
     def keep(self, idx) -> ContactBatchStepper:
         """A stepper continuing only the histories ``idx`` (e.g. those not yet settled)."""
         idx = np.asarray(idx, dtype=int)
+        if self._st2 is not None:
+            return ContactBatchStepper(self.element, idx.size, [self._st2[i] for i in idx])
         states = None if self._st is None else np.ascontiguousarray(self._st.states[idx])
         return ContactBatchStepper(self.element, idx.size, states)
 
@@ -349,7 +403,8 @@ def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
     Returns
     -------
     x : (n,) array               static displacements [m]
-    slip : dict {index: float}   s_0 of each ContactElement with friction (index in model.elements)
+    slip : dict {index: float or (2,) array}   s_0 of each ContactElement with friction
+        (index in model.elements; two tangents: the 2-vector)
     """
     Klin, rows = _static_parts(model)
     n = model.n
@@ -373,8 +428,9 @@ def frictionless_statics(model, apply: bool = False, max_iter: int = 100):
         raise ValueError(f"frictionless statics: contact set still changing after {max_iter} iterations")
     slip = {}
     for i, el, Q, _, _ in rows:
-        if el.m == 2:
-            slip[i] = float(Q[0] @ x[list(el.kinematics.dofs)])
+        if el.m >= 2:
+            s = Q[:-1] @ x[list(el.kinematics.dofs)]
+            slip[i] = float(s[0]) if el.m == 2 else s
             if apply:
                 el.slip_ref = slip[i]
     return x, slip

@@ -39,13 +39,14 @@ File formats
     type = "contact"         # penalty normal with lift-off + friction following N
     dofs = [0, 1]            # DOFs of the contact point's relative displacement Delta
     normal = [0.0, 1.0]      # unit normal n from body 2 into body 1 (k = 2 or 3 entries)
-    tangent = [1.0, 0.0]     # unit tangent (omit it, and the friction, for normal only)
+    tangent = [1.0, 0.0]     # unit tangent (omit it, and the friction, for normal only);
+                             # two tangents [[1, 0, 0], [0, 0, 1]] (k = 3): slip in the plane
     delta = [[1, 0], [0, 1]] # (k, len(dofs)): Delta = delta @ x[dofs]; default identity
     k_n = 1.0e8              # normal penalty stiffness [N/m]
     k_t = 8.0e7              # Jenkins friction k_t [N/m] and mu, or instead
     mu = 0.5                 #   curve = "curves/flat.json" (Iwan, scaled by N / N_ref)
     preload = 0.0            # static penetration at x = 0 [m]
-    slip_ref = 0.0           # prestress slip where the sliders are virgin [m]
+    slip_ref = 0.0           # prestress slip where the sliders are virgin [m] ([sx, sy]: two tangents)
     beta_c = 0.0             # contact dashpots beta_c k_n, beta_c k_t [s]
 
 DOFs are 0-based. Symbols as in :mod:`harmonic_balance.fourier` and
@@ -293,7 +294,8 @@ def _contact_element(t: dict, i: int, base: Path):
         delta = np.asarray(t["delta"], dtype=float) if "delta" in t else np.eye(normal.size, len(dofs))
         tangent = np.asarray(t["tangent"], dtype=float) if "tangent" in t else np.zeros((0, normal.size))
         kin = Kinematics.contact(dofs, normal, tangent, delta)
-        kw = {k: float(t.get(k, 0.0)) for k in ("preload", "slip_ref", "beta_c")}
+        kw = {k: float(t.get(k, 0.0)) for k in ("preload", "beta_c")}
+        kw["slip_ref"] = np.asarray(t.get("slip_ref", 0.0), dtype=float)
         kw["name"] = t.get("name", f"element{i}")
         if "tangent" not in t:
             return ContactElement(kin, float(t["k_n"]), **kw)

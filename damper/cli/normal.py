@@ -11,6 +11,9 @@ cylinder: contact_halfwidth (mid-length), contact_halfwidth_end [m], p_mid_max,
 p_end_max [Pa]; flat: rotation [rad], moment [N m], eccentricity [m]; hertz
 (reference values, relative errors), timings [s], meta (mesh, DOFs, solver,
 cache). ``--out`` adds the per-node maps and the F-approach curve.
+``--normal-curve FILE`` writes the normal approach curve N(p) from first touch
+(``contact_core.normal_curve``: the normal law of the contact-point FMU, ``damper fmu
+--normal FILE``); it takes ``--curve`` points (20 when not given).
 """
 from __future__ import annotations
 
@@ -36,6 +39,8 @@ def register(subparsers) -> None:
     p.add_argument("--curve", type=int, default=0, help="points of an F-approach curve up to the load")
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
     p.add_argument("--out", default=None, help="write the full result (with maps, curve) as JSON")
+    p.add_argument("--normal-curve", default=None, metavar="FILE",
+                   help="write the normal approach curve N(p) (the contact-point FMU's normal law)")
     p.add_argument("--plot", default=None, metavar="DIR", help="write pressure map, contact area, F-approach plots")
     p.add_argument("--no-cache", action="store_true", help="do not use the condensation cache")
     p.add_argument("--cache-dir", default=None,
@@ -109,6 +114,9 @@ def spec_from_args(args):
     return spec
 
 
+#: Points of the normal approach curve when --normal-curve is given without --curve.
+NORMAL_CURVE_POINTS = 20
+
 #: The thesis's design peak pressure sizing the potential contact zone [Pa].
 DEFAULT_P_DESIGN = 2000e6
 #: A zone sized from a load holds the Hertz contact of this many times the load:
@@ -160,14 +168,21 @@ def run(args) -> int:
                                     args.approach, cache)
     else:
         spec = spec_from_args(args)
+        points = args.curve or (NORMAL_CURVE_POINTS if args.normal_curve else (8 if args.plot else 0))
         result = api.run_normal(spec, force=args.force, approach=args.approach,
-                                eccentricity=args.eccentricity, cache=cache,
-                                curve_points=args.curve if (args.curve or not args.plot) else 8)
+                                eccentricity=args.eccentricity, cache=cache, curve_points=points)
+    normal = None
+    if args.normal_curve:  # built before anything is written: a bad curve writes nothing
+        from contact_core.normal_curve import NormalCurve
+        normal = NormalCurve.from_result(result)
     if args.plot:
         from contact_core.plots import plot_all
         plot_all(result, args.body, args.plot)
     if args.out:
         atomic_write(args.out, dumps(result, indent=1) + "\n")
+    if normal is not None:
+        from contact_core.normal_curve import write_normal_curve
+        write_normal_curve(normal, args.normal_curve)
     if args.json:
         print_json(_brief(result))
     else:

@@ -6,7 +6,10 @@
  *
  * Loads the FMI 2 binary with dlopen, then per step: fmi2SetReal(u), fmi2DoStep,
  * fmi2GetReal(F, W), with u = amplitude sin(2 pi k / points) (one cycle tabulated
- * before timing, so libm is not timed). Prints the best (over
+ * before timing, so libm is not timed). Built against the variable table of fmu_vars.h:
+ * for the contact point (point_vr.h) a step sets u_x = amplitude cos, u_y = amplitude
+ * sin and p = p0 (1 + 0.2 sin 3 t) (p0 its start value) and gets F_x and W. Prints the
+ * best (over
  * `repeats` fresh instances) wall time per step in ns, F and W of the last step (so
  * the caller can check the numbers against the array API) and the peak RSS in KiB.
  */
@@ -17,8 +20,18 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "damper_vr.h"
 #include "fmi2FunctionTypes.h"
+#include "fmu_vars.h"
+
+#ifdef VR_U_X  /* the contact point: an orbit in the plane, the penetration varying */
+#define N_IN 3
+#define N_TAB 3
+static const fmi2ValueReference VR_IN[N_IN] = {VR_U_X, VR_U_Y, VR_P}, VR_OUT[2] = {VR_F_X, VR_W};
+#else          /* the 1D element (and the pass-through baseline): u */
+#define N_IN 1
+#define N_TAB 1
+static const fmi2ValueReference VR_IN[N_IN] = {VR_U}, VR_OUT[2] = {VR_F, VR_W};
+#endif
 
 static void quiet_logger(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
                          fmi2String category, fmi2String message, ...)
@@ -50,25 +63,34 @@ static double run(const api *f, const char *uri, long steps, double amp, long po
                   double out[2])
 {
     static const fmi2CallbackFunctions cb = {quiet_logger, NULL, NULL, NULL, NULL};
-    const fmi2ValueReference vr_u = VR_U, vr_out[2] = {VR_F, VR_W};
     const double h = 1e-3, w = 2.0 * acos(-1.0) / (double)points;
-    double t0, t1, *cycle = (double *)malloc((size_t)points * sizeof(double));
+    double t0, t1, *cycle = (double *)malloc((size_t)points * N_TAB * sizeof(double));
     long k;
     int bad = 0;
     fmi2Component c;
     if (!cycle) return -1.0;
-    for (k = 0; k < points; k++) cycle[k] = amp * sin(w * (double)k);
     c = f->instantiate("bench", fmi2CoSimulation, DAMPER_TOKEN, uri, &cb,
                                      fmi2False, fmi2False);
     if (!c || f->setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) || f->enter(c) || f->exit_init(c)) {
         free(cycle);
         return -1.0;
     }
+    for (k = 0; k < points; k++) {
+#ifdef VR_U_X
+        double p0 = 0.0;
+        f->get(c, &VR_IN[2], 1, &p0);
+        cycle[3 * k] = amp * cos(w * (double)k);
+        cycle[3 * k + 1] = amp * sin(w * (double)k);
+        cycle[3 * k + 2] = p0 * (1.0 + 0.2 * sin(3.0 * w * (double)k));
+#else
+        cycle[k] = amp * sin(w * (double)k);
+#endif
+    }
     t0 = now();
     for (k = 0; k < steps; k++) {
-        bad |= f->set(c, &vr_u, 1, &cycle[k % points]);
+        bad |= f->set(c, VR_IN, N_IN, &cycle[N_TAB * (k % points)]);
         bad |= f->step(c, (double)k * h, h, fmi2True);
-        bad |= f->get(c, vr_out, 2, out);
+        bad |= f->get(c, VR_OUT, 2, out);
     }
     t1 = now();
     f->free_instance(c);

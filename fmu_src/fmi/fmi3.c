@@ -222,7 +222,7 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueRef
     UNSUPPORTED("fmi3SetClock");
 }
 
-/* Every output depends on both inputs (direct feedthrough), as in ModelStructure. */
+/* Every output depends on every input (direct feedthrough), as in ModelStructure. */
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
                                                fmi3ValueReference valueReference,
                                                size_t *nDependencies)
@@ -230,7 +230,7 @@ fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
     WRAPPER(instance);
     if (valueReference >= DAMPER_N_VARIABLES || !nDependencies)
         RET(fmu_log(w->inst, FMU_ERROR, "unknown value reference %u", valueReference));
-    *nDependencies = damper_causality_of[valueReference] == CAUS_OUTPUT ? 2 : 0;
+    *nDependencies = damper_causality_of[valueReference] == CAUS_OUTPUT ? DAMPER_N_INPUTS : 0;
     return fmi3OK;
 }
 
@@ -241,17 +241,16 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
                                        fmi3DependencyKind dependencyKinds[],
                                        size_t nDependencies)
 {
-    static const fmi3ValueReference inputs[2] = {VR_U, VR_N};
     size_t i;
     WRAPPER(instance);
     if (dependent >= DAMPER_N_VARIABLES || damper_causality_of[dependent] != CAUS_OUTPUT
-        || nDependencies != 2 || !elementIndicesOfDependent || !independents
+        || nDependencies != DAMPER_N_INPUTS || !elementIndicesOfDependent || !independents
         || !elementIndicesOfIndependents || !dependencyKinds)
         RET(fmu_log(w->inst, FMU_ERROR, "fmi3GetVariableDependencies: only outputs have "
-                    "dependencies (2: u and N)"));
-    for (i = 0; i < 2; i++) {
+                    "dependencies (%d: every input)", DAMPER_N_INPUTS));
+    for (i = 0; i < DAMPER_N_INPUTS; i++) {
         elementIndicesOfDependent[i] = 0;
-        independents[i] = inputs[i];
+        independents[i] = damper_inputs[i];
         elementIndicesOfIndependents[i] = 0;
         dependencyKinds[i] = fmi3Dependent;
     }

@@ -68,27 +68,77 @@ static int scan_curve(fmu_instance *inst, FILE *f, const char *path)
     return 1;
 }
 
-static int load_curve(fmu_instance *inst, const char *resource_dir)
+/* Read the normal law written by fmu_src/fmu_point.py, in the C locale:
+ *   damper-normal 1 / p_start <p> / points <m> / m lines "p N". */
+static int scan_normal(fmu_instance *inst, FILE *f, const char *path)
 {
-    size_t len = strlen(resource_dir);
-    char *path = (char *)malloc(len + sizeof(FMU_CURVE_FILE) + 2);
+    int version = 0;
+    long m = 0, i;
+    model_table *t = &inst->table;
+    if (fscanf(f, " damper-normal %d p_start %lf points %ld", &version, &t->p_start, &m) != 3
+        || version != 1 || m < 2 || m > FMU_MAX_CURVE_POINTS)
+        return fmu_log(inst, FMU_ERROR, "'%s' is not a damper-normal 1 file with 2..%d points",
+                       path, FMU_MAX_CURVE_POINTS), 0;
+    t->p = (double *)malloc((size_t)m * sizeof(double));
+    t->N = (double *)malloc((size_t)m * sizeof(double));
+    if (!t->p || !t->N) return fmu_log(inst, FMU_ERROR, "out of memory reading the normal law"), 0;
+    for (i = 0; i < m; i++)
+        if (fscanf(f, "%lf %lf", &t->p[i], &t->N[i]) != 2)
+            return fmu_log(inst, FMU_ERROR, "'%s': point %ld of %ld unreadable", path, i, m), 0;
+    t->n_normal = (size_t)m;
+    return 1;
+}
+
+/* Read resources/<name> with `scan` (in the C locale). A missing optional file is no
+ * error (returns 1 with nothing read). */
+static int load_resource(fmu_instance *inst, const char *resource_dir, const char *name,
+                         int (*scan)(fmu_instance *, FILE *, const char *), int optional)
+{
+    size_t len = strlen(resource_dir), nlen = strlen(name);
+    char *path = (char *)malloc(len + nlen + 2);
     FILE *f;
-    int ok = 0;
+    int ok = optional;
     if (!path) return 0;
     memcpy(path, resource_dir, len);
     if (len == 0 || path[len - 1] != '/') path[len++] = '/';
-    memcpy(path + len, FMU_CURVE_FILE, sizeof(FMU_CURVE_FILE));
+    memcpy(path + len, name, nlen + 1);
     f = fopen(path, "r");
     if (!f) {
-        fmu_log(inst, FMU_ERROR, "cannot open the curve file '%s'", path);
+        if (!optional) fmu_log(inst, FMU_ERROR, "cannot open the resource file '%s'", path);
     } else {
         locale_t old = uselocale(inst->c_locale);  /* whatever setlocale the importer did */
-        ok = scan_curve(inst, f, path);
+        ok = scan(inst, f, path);
         uselocale(old);
         fclose(f);
     }
     free(path);
     return ok;
+}
+
+static int load_curve(fmu_instance *inst, const char *resource_dir)
+{
+    return load_resource(inst, resource_dir, FMU_CURVE_FILE, scan_curve, 0)
+           && load_resource(inst, resource_dir, FMU_NORMAL_FILE, scan_normal, 1);
+}
+
+/* "name = value unit, ..." of the variables of one causality (C locale), for messages. */
+static const char *describe(const fmu_instance *inst, int causality, const double *value,
+                            char *buf, size_t size)
+{
+    size_t used = 0;
+    int vr;
+    locale_t old = inst->c_locale ? uselocale(inst->c_locale) : (locale_t)0;
+    buf[0] = '\0';
+    for (vr = 0; vr < DAMPER_N_VARIABLES && used < size; vr++) {
+        int k;
+        if ((int)damper_causality_of[vr] != causality) continue;
+        k = snprintf(buf + used, size - used, "%s%s = %g %s", used ? ", " : "",
+                     damper_name_of[vr], value[vr], damper_unit_of[vr]);
+        if (k < 0) break;
+        used += (size_t)k;
+    }
+    if (inst->c_locale) uselocale(old);
+    return buf;
 }
 
 fmu_instance *fmu_new(const char *name, const char *token, const char *resource_dir,
@@ -129,6 +179,8 @@ void fmu_free(fmu_instance *inst)
     fmu_free_states(inst);  /* states the importer did not free */
     free(inst->table.u);
     free(inst->table.T);
+    free(inst->table.p);
+    free(inst->table.N);
     free(inst->history);
     free(inst->trial);
     free(inst->model);
@@ -148,7 +200,8 @@ void fmu_reset(fmu_instance *inst)
         switch (damper_start_of[vr]) {
         case START_ONE: inst->h.value[vr] = 1.0; break;
         case START_CURVE_N: inst->h.value[vr] = inst->table.n_ref; break;
-        default: inst->h.value[vr] = 0.0; break;
+        case START_NONE: case START_ZERO: inst->h.value[vr] = 0.0; break;
+        default: inst->h.value[vr] = model_start_value(&inst->table, (unsigned int)vr); break;
         }
     }
     inst->h.mode = MODE_INSTANTIATED;
@@ -159,13 +212,14 @@ void fmu_reset(fmu_instance *inst)
 fmu_status fmu_ensure_model(fmu_instance *inst)
 {
     const char *why;
+    char text[256];
     int i;
     if (inst->model_ready) return FMU_OK;
     why = model_build(inst->model, &inst->table, inst->h.value);
     if (!why && !inst->h.has_history) why = model_reset(inst->model, inst->history, inst->h.value);
     if (why)
-        return fmu_log(inst, FMU_ERROR, "cannot build the model (scale = %g, N_ref = %g N): %s",
-                       inst->h.value[VR_SCALE], inst->h.value[VR_N_REF], why);
+        return fmu_log(inst, FMU_ERROR, "cannot build the model (%s): %s",
+                       describe(inst, CAUS_PARAMETER, inst->h.value, text, sizeof text), why);
     for (i = 0; i < DAMPER_N_INPUTS; i++)
         inst->bound[damper_inputs[i]] = model_input_bound(inst->model, damper_inputs[i]);
     inst->model_ready = 1;
@@ -200,14 +254,15 @@ static int outputs_finite(const double *out)
 static fmu_status ensure_outputs(fmu_instance *inst)
 {
     const char *why;
+    char text[256];
     if (inst->out_valid) return FMU_OK;  /* implies model_ready */
     if (fmu_ensure_model(inst) != FMU_OK) return FMU_ERROR;
     if (check_bounds(inst, inst->h.value, "evaluating the outputs") != FMU_OK) return FMU_ERROR;
     why = model_eval(inst->model, inst->history, inst->h.value, inst->out);
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
     if (why)
-        return fmu_log(inst, FMU_ERROR, "evaluating the model at u = %g m, N = %g N: %s",
-                       inst->h.value[VR_U], inst->h.value[VR_N], why);
+        return fmu_log(inst, FMU_ERROR, "evaluating the model at %s: %s",
+                       describe(inst, CAUS_INPUT, inst->h.value, text, sizeof text), why);
     inst->out_valid = 1;
     return FMU_OK;
 }
@@ -256,9 +311,7 @@ static const char *set_refusal(const fmu_instance *inst, unsigned int vr, double
     case CAUS_PARAMETER:
         if (!(inst->h.mode & (MODE_INSTANTIATED | MODE_INIT)))
             return "fixed parameters can only be set before initialization ends";
-        if (vr == VR_SCALE && v < 0.0) return "scale must be >= 0";
-        if (vr == VR_N_REF && v <= 0.0) return "N_ref must be > 0";
-        return NULL;
+        return model_check_parameter(vr, v);
     default:
         return "only inputs and parameters can be set";
     }
@@ -343,6 +396,7 @@ fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double 
 fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
 {
     double end[DAMPER_N_VARIABLES];
+    char text[256];
     const char *why = NULL;
     unsigned char *swap;
     int i, moves = 0;
@@ -374,8 +428,8 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
     if (why) {
         inst->out_valid = 0;
-        return fmu_log(inst, FMU_ERROR, "DoStep to u = %g m, N = %g N refused: %s",
-                       (moves ? end : inst->h.value)[VR_U], (moves ? end : inst->h.value)[VR_N],
+        return fmu_log(inst, FMU_ERROR, "DoStep to %s refused: %s",
+                       describe(inst, CAUS_INPUT, moves ? end : inst->h.value, text, sizeof text),
                        why);
     }
     swap = inst->history;

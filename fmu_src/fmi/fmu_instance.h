@@ -5,7 +5,9 @@
  * instance, its mode (state machine), variable values by value reference
  * (damper_vr.h), the resource table, logging, doStep, FMU states and directional
  * derivatives. It knows nothing of the physics: that is behind the hooks of
- * model.h (model_iwan.c: the Masing/Iwan element; model_passthrough.c: F = u).
+ * model.h (model_iwan.c: the Masing/Iwan element; model_point.c: the 3D contact
+ * point; model_passthrough.c: F = u), and nothing of the variables but what the
+ * model's generated table (fmu_vars.h) lists.
  *
  * Co-simulation semantics (rate-independent element, see issue 5):
  * - the committed history changes only in doStep; getters evaluate a trial update
@@ -40,13 +42,14 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "model.h"
 
 #define FMU_STATE_MAGIC 0x46504d44u  /* "DMPF": marks a state of this FMU */
 #define FMU_STATE_VERSION 2          /* bump when fmu_header or a history changes layout */
 #define FMU_MAX_CURVE_POINTS 4096    /* largest curve table read from the resources */
 #define FMU_CURVE_FILE "curve.txt"
+#define FMU_NORMAL_FILE "normal.txt"   /* optional: the normal law of a contact point */
 
 typedef enum { FMU_OK = 0, FMU_WARNING = 1, FMU_ERROR = 2 } fmu_status;
 

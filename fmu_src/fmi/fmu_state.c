@@ -148,9 +148,10 @@ static const char *header_refusal(const fmu_header *h, const unsigned char *byte
         if (!isfinite(h->value[vr]) || !isfinite(h->deriv[vr])) return "a value is not finite";
         if (damper_causality_of[vr] != CAUS_INPUT && h->deriv[vr] != 0.0)
             return "derivative of a non-input";
+        if (damper_causality_of[vr] == CAUS_PARAMETER
+            && model_check_parameter((unsigned int)vr, h->value[vr]))
+            return "parameter out of range";
     }
-    if (!(h->value[VR_SCALE] >= 0.0) || !(h->value[VR_N_REF] > 0.0))
-        return "parameter out of range";
     return NULL;
 }
 

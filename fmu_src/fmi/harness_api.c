@@ -198,7 +198,7 @@ int dir_deriv(inst *x, unsigned int unknown, unsigned int known, double seed, do
                         : (int)x->a->dd3(x->c, &unknown, 1, &known, 1, &seed, 1, d, 1);
 }
 
-/* A ready instance in step mode (u = 0, N = N_CURVE), or c == NULL on failure. */
+/* A ready instance in step mode (inputs at their start values), or c == NULL on failure. */
 inst start(const api *a, const char *name)
 {
     inst x;
@@ -209,21 +209,4 @@ inst start(const api *a, const char *name)
     if (!x.c) return x;
     CHECK(enter_init(&x) == 0 && exit_init(&x) == 0, "FMI %d: initialization failed", a->v);
     return x;
-}
-
-/* u (and N) of sample k of the test history: reversals, minor loops, varying N. */
-double hist_u(int k) { return 1.3 * U_SLIP * sin(0.21 * k) * (1.0 + 0.4 * sin(0.9 * k)); }
-double hist_N(int k) { return N_CURVE * (1.0 + 0.25 * sin(0.13 * k)); }
-
-/* Run samples k0..k0+n-1: set u, N, doStep; F and W after each into out[2n]. */
-void run(inst *x, int k0, int n, double *out)
-{
-    int k;
-    for (k = 0; k < n; k++) {
-        int ok = set(x, VR_U, hist_u(k0 + k)) == 0 && set(x, VR_N, hist_N(k0 + k)) == 0
-                 && do_step(x, 1e-3) == 0 && get(x, VR_F, &out[2 * k]) == 0
-                 && get(x, VR_W, &out[2 * k + 1]) == 0;
-        CHECK(ok, "FMI %d: step %d failed: %s", x->a->v, k0 + k, g_last_log);
-        if (!ok) return;
-    }
 }

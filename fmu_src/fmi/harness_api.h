@@ -1,5 +1,7 @@
 /*
- * harness_api.h -- the FMI 2 / FMI 3 driver of the C test harness (test_harness.c):
+ * harness_api.h -- the FMI 2 / FMI 3 driver of the C test harnesses (test_harness.c
+ * for the 1D element, test_point_harness.c for the contact point; fmu_vars.h gives the
+ * variable table each is compiled with):
  * one `api` per dlopen'ed binary, one `inst` per instance, and calls that return
  * the FMI status as int for both versions (OK = 0, Error = 3 in both).
  */
@@ -8,7 +10,7 @@
 
 #include <stddef.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "fmi2FunctionTypes.h"
 #include "fmi3FunctionTypes.h"
 
@@ -76,12 +78,7 @@ void free_state(inst *x, void **s);
 int serialize(inst *x, void *s, unsigned char **bytes, size_t *size);
 int deserialize(inst *x, const unsigned char *bytes, size_t size, void **s);
 int dir_deriv(inst *x, unsigned int unknown, unsigned int known, double seed, double *d);
-/* A ready instance in step mode (u = 0, N = N_CURVE), or c == NULL on failure. */
+/* A ready instance in step mode (inputs at their start values), or c == NULL on failure. */
 inst start(const api *a, const char *name);
-/* u and N of sample k of the test history: reversals, minor loops, varying N. */
-double hist_u(int k);
-double hist_N(int k);
-/* Run samples k0..k0+n-1: set u, N, doStep; F and W after each into out[2n]. */
-void run(inst *x, int k0, int n, double *out);
 
 #endif /* HARNESS_API_H */

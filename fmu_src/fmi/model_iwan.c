@@ -9,7 +9,7 @@
 #include <stddef.h>
 #include <string.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "iwan.h"
 #include "model.h"
 
@@ -156,4 +156,17 @@ const char *model_check_history(const void *model, const void *history)
 double model_input_bound(const void *model, unsigned int vr)
 {
     return vr == VR_U ? ((const iwan_fmu_model *)model)->u_bound : HUGE_VAL;
+}
+
+const char *model_check_parameter(unsigned int vr, double v)
+{
+    if (vr == VR_SCALE && !(v >= 0.0)) return "scale must be >= 0";
+    if (vr == VR_N_REF && !(v > 0.0)) return "N_ref must be > 0";
+    return NULL;
+}
+
+double model_start_value(const model_table *table, unsigned int vr)
+{
+    (void)table; (void)vr;
+    return 0.0;  /* every start rule of this model is the layer's own */
 }

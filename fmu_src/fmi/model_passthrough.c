@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "damper_vr.h"
+#include "fmu_vars.h"
 #include "model.h"
 
 typedef struct {
@@ -67,4 +67,16 @@ double model_input_bound(const void *model, unsigned int vr)
 {
     (void)model; (void)vr;
     return HUGE_VAL;
+}
+
+const char *model_check_parameter(unsigned int vr, double v)
+{
+    (void)vr; (void)v;
+    return NULL;
+}
+
+double model_start_value(const model_table *table, unsigned int vr)
+{
+    (void)table; (void)vr;
+    return 0.0;
 }

@@ -30,6 +30,24 @@
  * increment crosses no slider switch; relative tolerance for that round-off. */
 #define FD_RTOL 1e-6
 
+/* ------------------------------------------------------------ test history */
+/* u (and N) of sample k of the test history: reversals, minor loops, varying N. */
+static double hist_u(int k) { return 1.3 * U_SLIP * sin(0.21 * k) * (1.0 + 0.4 * sin(0.9 * k)); }
+static double hist_N(int k) { return N_CURVE * (1.0 + 0.25 * sin(0.13 * k)); }
+
+/* Run samples k0..k0+n-1: set u, N, doStep; F and W after each into out[2n]. */
+static void run(inst *x, int k0, int n, double *out)
+{
+    int k;
+    for (k = 0; k < n; k++) {
+        int ok = set(x, VR_U, hist_u(k0 + k)) == 0 && set(x, VR_N, hist_N(k0 + k)) == 0
+                 && do_step(x, 1e-3) == 0 && get(x, VR_F, &out[2 * k]) == 0
+                 && get(x, VR_W, &out[2 * k + 1]) == 0;
+        CHECK(ok, "FMI %d: step %d failed: %s", x->a->v, k0 + k, g_last_log);
+        if (!ok) return;
+    }
+}
+
 /* ------------------------------------------------------------------ tests */
 /* Calls the FMU must refuse, each with fmi?Error and a logged message. */
 static void expect_error(inst *x, int status, const char *what)

@@ -20,7 +20,9 @@ DOFs plus the damper's three (x_d, y_d, theta_d). A blade is
   ``left = [u, v]`` the platform point of blade j that damper j's left (cylinder)
   contact touches, ``right = [u, v]`` the platform point of blade j that damper
   j-1's flat touches (so damper j's flat touches it on blade j+1); u tangential
-  (towards blade j+1), v radial outward [m] (the damper's x and y axes);
+  (towards blade j+1), v radial outward [m] (the damper's x and y axes); with a
+  third name each, ``[u, v, w]``, w axial [m]: the damper is held axially, so its
+  contacts slip along (in the plane) and across (axially; two tangents each);
   ``forced`` the DOF of the EO force F0; ``response`` the amplitude output
   (default: the forced DOF).
 
@@ -63,7 +65,7 @@ class Blade:
     ----------
     M, K : (n, n) arrays; C, K_next, C_next : (n, n) arrays or None
     dofs : tuple of str (n,)
-    left, right : (2,) int     (u, v) platform DOF indices of the two contacts
+    left, right : (2,) or (3,) int   (u, v[, w]) platform DOF indices of the two contacts
     forced, response : int
     source : str               where it came from (messages)
     """
@@ -243,15 +245,19 @@ def make_blade(arrays: dict, source: str = "arrays") -> Blade:
                 return None
             raise ValueError(f"{where}: the DOF role {role!r} is not given")
         v = [v] if isinstance(v, str) else list(v)
-        if len(v) != count:
-            raise ValueError(f"{where}: {role} must name {count} DOF(s), got {v}")
+        if len(v) not in ((count,) if isinstance(count, int) else count):
+            want = count if isinstance(count, int) else " or ".join(map(str, count))
+            raise ValueError(f"{where}: {role} must name {want} DOF(s), got {v}")
         for s in v:
             if str(s) not in idx:
                 raise ValueError(f"{where}: {role} names unknown DOF {s!r} "
                                  f"(known: {', '.join(names[:12])}{' ...' if n > 12 else ''})")
         return tuple(idx[str(s)] for s in v)
 
-    left, right = lookup("left", 2), lookup("right", 2)
+    left, right = lookup("left", (2, 3)), lookup("right", (2, 3))
+    if len(left) != len(right):
+        raise ValueError(f"{where}: left and right must both name (u, v) or both (u, v, w), "
+                         f"got {len(left)} and {len(right)} DOFs")
     forced = lookup("forced", 1)[0]
     response = lookup("response", 1)
     blade = Blade(mats["M"], mats["K"], mats["C"], mats["K_next"], mats["C_next"], tuple(names),

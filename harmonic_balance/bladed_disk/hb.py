@@ -56,8 +56,9 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
     """ContactElements of one damper (cylinder line + the flat's two end points).
 
     Their kinematics are the sector's rows of slip and penetration (``Sector.Q``, the
-    only copy of the contact geometry), local order [s, p], restricted to the DOFs
-    they touch (the damper's and one platform point's).
+    only copy of the contact geometry), local order [s, p] ([s, s_a, p] with axial
+    platform DOFs: two tangents), restricted to the DOFs they touch (the damper's and
+    one platform point's).
 
     Parameters
     ----------
@@ -71,10 +72,11 @@ def contact_elements(sector: Sector, mu: float, offset: int = 0, next_offset: in
         First DOF of blade j+1 in a ring model; None: cyclic sector (blade j+1 through
         ``Q_next`` and the phase phi).
     """
-    n, right = sector.n_dof, list(sector.blade.right)
+    n, right, r = sector.n_dof, list(sector.blade.right), sector.rows_per_point
     els = []
     for i, c in enumerate(sector.points):
-        rows = sector.Q[[2 * i + 1, 2 * i]]  # local q = [s, p] (ContactElement order)
+        # local q = [s, p] or [s, s_a, p] (ContactElement order: slips, then penetration)
+        rows = sector.Q[[r * i + 1, r * i + 2, r * i] if r == 3 else [2 * i + 1, 2 * i]]
         own, nxt = rows[:, :n], rows[:, n:]  # nxt: blade j+1's right platform point (u, v)
         used = np.flatnonzero(np.any(own != 0.0, axis=0))
         if not c.neighbour:

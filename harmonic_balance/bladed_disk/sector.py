@@ -4,7 +4,8 @@ Sector DOFs ``q`` (n_dof = n + 3): the blade's n reduced DOFs (:mod:`.blade`; UP
 u_r rim tangential, u_p platform tangential, v_p platform radial, u_a airfoil
 first-bending modal DOF), then x_d, y_d, theta_d of damper j (between blade j and
 blade j+1). The contact kinematics also use blade j+1's ``right`` platform point
-(u', v'), so the *extended* vector is ``q_ext = [q, u', v']`` (n + 5 entries).
+(u', v'), so the *extended* vector is ``q_ext = [q, u', v']`` (n + 5 entries; n + 6
+with axial platform DOFs, below).
 
 Cyclic symmetry (symbols in :mod:`config`): blade j+1's harmonic-h complex amplitude
 is exp(i h phi) times blade j's, so per harmonic ``q_ext = S(h phi) q`` with
@@ -19,6 +20,12 @@ penetration p = -n . Delta, slip s = t . Delta. ``Q`` (2 n_c, n + 5) stacks the 
 of p and s per contact point (rows 2c, 2c + 1), so the stuck contact stiffness is
 ``S^H Q^T diag(k) Q S`` and a contact force pair (N, f_t) enters the internal force as
 ``Q^T [N, f_t]`` (virtual work of V = k_n p^2 / 2 + k_t (s - z)^2 / 2).
+
+A blade whose platform points carry an axial DOF w (``left = [u, v, w]``,
+:mod:`.blade`) adds the axial slip s_a = -w of the touched platform point (the damper
+is held axially: no axial DOF of its own): three rows per point (p, s, s_a; rows 3c ..
+3c + 2, stiffness k_n, k_t, k_t), ``q_ext = [q, u', v', w']`` and each contact slips in
+two directions (:class:`~harmonic_balance.contact.ContactElement` with two tangents).
 """
 from __future__ import annotations
 
@@ -46,8 +53,10 @@ class Sector:
     y_d, forced, response : int  indices of y_d, of the EO force and of the output DOF
     M : (n_dof, n_dof) array   mass [kg, kg m^2]
     points : list of ContactPoint
-    Q : (2 n_c, n_dof + 2) array  rows of penetration p and slip s per contact point
-    k : (2 n_c,) array        stiffness of each row (k_n, k_t per point) [N/m]
+    Q : (r n_c, n_dof + r) array  rows of penetration p and slip s (and the axial slip
+        s_a) per contact point, r = 2 (3 with axial platform DOFs)
+    k : (r n_c,) array        stiffness of each row (k_n, k_t[, k_t] per point) [N/m]
+    rows_per_point : int      r
     """
 
     cfg: UPDConfig
@@ -63,16 +72,17 @@ class Sector:
         self.M[:n, :n] = b.M
         self.M[n:, n:] = np.diag([d["m_d"], d["m_d"], d["I_d"]])
         self.points = self.cfg.contact_points()
+        r = self.rows_per_point = len(b.left)   # 2, or 3 with the axial DOF w
         rows, k = [], []
         for c in self.points:
-            J = np.zeros((2, n + 5))  # Delta = J q_ext
-            J[:, n:n + 2] = np.eye(2)
-            J[:, n + 2] = (-c.r[1], c.r[0])
-            cols = (n + 3, n + 4) if c.neighbour else b.left
-            J[0, cols[0]] -= 1.0
-            J[1, cols[1]] -= 1.0
-            rows += [-c.n @ J, c.t @ J]
-            k += [c.kn, c.kt]
+            J = np.zeros((r, n + 3 + r))  # Delta = J q_ext (axial row: the damper is held)
+            J[:2, n:n + 2] = np.eye(2)
+            J[:2, n + 2] = (-c.r[1], c.r[0])
+            cols = tuple(range(n + 3, n + 3 + r)) if c.neighbour else b.left
+            for a in range(r):
+                J[a, cols[a]] -= 1.0
+            rows += [-c.n @ J[:2], c.t @ J[:2]] + ([J[2]] if r == 3 else [])
+            k += [c.kn, c.kt] + ([c.kt] if r == 3 else [])
         self.Q = np.array(rows)
         self.k = np.array(k, dtype=float)
 
@@ -103,10 +113,12 @@ class Sector:
         return self._pad(self.blade.damping(psi, self.beta))
 
     def S(self, psi: float) -> np.ndarray:
-        """Extension (n_dof + 2, n_dof) complex: q_ext = S q for phase psi of blade j+1."""
-        S = np.zeros((self.n_dof + 2, self.n_dof), dtype=complex)
+        """Extension (n_dof + r, n_dof) complex: q_ext = S q for phase psi of blade j+1."""
+        r = self.rows_per_point
+        S = np.zeros((self.n_dof + r, self.n_dof), dtype=complex)
         S[:self.n_dof, :self.n_dof] = np.eye(self.n_dof)
-        S[self.n_dof, self.blade.right[0]] = S[self.n_dof + 1, self.blade.right[1]] = np.exp(1j * psi)
+        for a in range(r):
+            S[self.n_dof + a, self.blade.right[a]] = np.exp(1j * psi)
         return S
 
     def K_contact(self, psi: float, normal_only: bool = False) -> np.ndarray:
@@ -114,8 +126,8 @@ class Sector:
         (only the normal springs with ``normal_only``)."""
         QS = self.Q @ self.S(psi)
         k = self.k.copy()
-        if normal_only:
-            k[1::2] = 0.0
+        if normal_only:  # keep the first row (p) of each point
+            k[np.arange(k.size) % self.rows_per_point != 0] = 0.0
         return QS.conj().T @ (k[:, None] * QS)
 
     def matrices(self, psi: float, damper: str):

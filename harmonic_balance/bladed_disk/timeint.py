@@ -116,6 +116,10 @@ def _contact_arrays(ring: RingHB) -> dict:
     by_kt = {}
     for i, el in enumerate(ring.points):
         kin = el.kinematics
+        if el.m != 2:
+            raise ValueError("the ring's time integration handles one slip direction per contact; "
+                             "a blade with axial platform DOFs (two slip directions) is solved by "
+                             "harmonic balance (damper upd without --timeint)")
         rows = np.zeros((2, n))
         rows[:, list(kin.dofs)] = kin.Q
         Qs.append(rows[0])
