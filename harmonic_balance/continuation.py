@@ -49,9 +49,6 @@ import numpy as np
 
 from .newton import NewtonError, newton
 
-#: Floor of the x scale relative to the largest RMS met on the branch (the scale
-#: is the current point's RMS above it).
-S_X_FLOOR = 1.0
 #: Largest step in lam of a forced-response curve (frf, bladed_disk.solve), as a fraction
 #: of the range: a resonance of 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force
 #: 0.5, ~7 % of the range wide) was stepped over by the shape control alone; at least
@@ -60,7 +57,8 @@ LAM_STEP = 0.03
 #: Corrector iterations the step control aims at.
 TARGET_ITER = 4
 #: Default curve accuracy: the polyline of the points deviates from the branch by
-#: about this much in scaled variables (x relative to its current RMS, lam to the range).
+#: about this much in scaled variables (x relative to the largest RMS met, lam to the
+#: range).
 CURVE_TOL = 1e-2
 #: Nominal angle between successive tangents in scaled variables [rad].
 TURN = 0.5
@@ -302,9 +300,8 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         branch.append(y_new[:-1] * s_x, lam_new, it)
         if on_point is not None:
             on_point(lam_new)
-        s_now = _rms(branch.x[-1])
-        s_max = max(s_max, s_now)
-        s_x = max(s_now, S_X_FLOOR * s_max, x_scale, 1e-300)
+        s_max = max(s_max, _rms(branch.x[-1]))
+        s_x = max(s_max, x_scale, 1e-300)
         # Tangent expressed in the (possibly updated) scaling, for the next orientation.
         t_prev = t * np.append(np.full(len(x0), sc.s_x / s_x), 1.0)
         t_prev /= np.linalg.norm(t_prev)
