@@ -119,3 +119,15 @@ def test_long_curve_is_reduced_and_the_fit_error_printed(tmp_path, capsys):
     cap = capsys.readouterr()
     assert code == 0 and json.loads(cap.out)["status"] == "complete"
     assert "reduced" in cap.err and "fit" in cap.err
+
+
+def test_stability_modes(capsys):
+    """--stability all solves Hill at every point, auto where stability can change (the
+    same flags here: a stable friction curve), off not at all."""
+    base = SDOF + ["--harmonics", "3", "--omega", "0.9", "1.3", "--json"]
+    _, auto = run_json(capsys, base)
+    _, every = run_json(capsys, base + ["--stability", "all"])
+    _, off = run_json(capsys, base + ["--stability", "off"])
+    assert every["stability_checks"] == every["points"] == auto["points"]
+    assert 2 <= auto["stability_checks"] < auto["points"] and auto["stable"] == every["stable"]
+    assert off["stable"] is None and off["stability_checks"] == 0
