@@ -28,3 +28,12 @@ def test_hb_against_den_hartog_table_smoke(load_example):
     elastic model and the rigid one agree (README: 1.1e-4 at H = 21)."""
     (kt, H, errs), = load_example("bench_hb_robust").hb_vs_den_hartog((1e3,), (7,), (1.0,))
     assert kt == 1e3 and H == 7 and abs(errs[0]) < 1e-2
+
+
+def test_speed_benchmark_smoke(capsys, load_example):
+    """examples/bench_hb_speed.py on the soft sdof row, without its dense references:
+    a complete curve with a refined interior peak (the describing-function peak of
+    this oscillator, 1.008 rad/s)."""
+    (row,) = load_example("bench_hb_speed").main(["sdof", "--no-ref"])
+    assert "peak omega" in capsys.readouterr().out
+    assert row["ok"] and row["points"] >= 30 and 1.0 < row["peak_omega"] < 1.02
