@@ -84,14 +84,15 @@ def cases(names):
 
 
 def run(model, H, rng, **kw):
-    t0 = time.perf_counter()
+    """(result, error message or None, wall time [s], CPU time of this process [s])."""
+    t0, c0 = time.perf_counter(), time.process_time()
     try:
         r = compute_frf(model, H, rng, **kw)
         err = None
     except RuntimeError as e:
         r = getattr(e, "result", None)
         err = str(e)
-    return r, err, time.perf_counter() - t0
+    return r, err, time.perf_counter() - t0, time.process_time() - c0
 
 
 #: Curve tolerance of the dense references (where compute_frf has one).
@@ -102,7 +103,7 @@ def reference(label, model, H, rng, refs):
     """Dense first-harmonic peak (omega, amplitude) of the case, cached in ``refs``."""
     if label not in refs:
         dense = {"tolerance": REF_TOL} if "tolerance" in compute_frf.__code__.co_varnames else {}
-        r, err, _ = run(model, H, rng, ds_max=REF_STEP, max_points=200000, stability=False, **dense)
+        r, err, _, _ = run(model, H, rng, ds_max=REF_STEP, max_points=200000, stability=False, **dense)
         refs[label] = None if err else [r.peak_omega, r.peak_amplitude_h1]
     return refs[label]
 
@@ -123,11 +124,11 @@ def main(argv=None):
         with open(a.ref_file) as f:
             refs = json.load(f)
     print(f"harmonic_balance from {os.path.dirname(harmonic_balance.__file__)}")
-    print(f"{'case':<26} {'points':>6} {'time s':>7} {'peak omega':>10} {'peak h1':>11} "
+    print(f"{'case':<26} {'points':>6} {'time s':>7} {'cpu s':>6} {'peak omega':>10} {'peak h1':>11} "
           f"{'err h1 %':>8} {'err w %':>7}  status")
     rows = []
     for label, model, H, rng in cases(a.cases):
-        r, err, dt = run(model, H, rng)
+        r, err, dt, cpu = run(model, H, rng)
         ref = None if a.no_ref else reference(label, model, H, rng, refs)
         if not a.no_ref:
             with open(a.ref_file, "w") as f:
@@ -138,9 +139,9 @@ def main(argv=None):
         e_a = 100 * (a1 / ref[1] - 1) if ref else float("nan")
         e_w = 100 * (w / ref[0] - 1) if ref else float("nan")
         status = ("FAIL: " + err[:70]) if err else r.status[:70]
-        rows.append({"case": label, "points": pts, "time_s": dt, "peak_omega": w, "peak_h1": a1,
+        rows.append({"case": label, "points": pts, "time_s": dt, "cpu_s": cpu, "peak_omega": w, "peak_h1": a1,
                      "err_h1_pct": e_a, "err_omega_pct": e_w, "ok": err is None, "status": status})
-        print(f"{label:<26} {pts:>6} {dt:>7.3f} {w:>10.6g} {a1:>11.6g} {e_a:>8.3f} {e_w:>7.3f}  "
+        print(f"{label:<26} {pts:>6} {dt:>7.3f} {cpu:>6.3f} {w:>10.6g} {a1:>11.6g} {e_a:>8.3f} {e_w:>7.3f}  "
               f"{status}", flush=True)
     if a.json:
         with open(a.json, "w") as f:
