@@ -25,7 +25,7 @@ Cases (SI units; H harmonics 0..H):
 The peak error is that of the first-harmonic amplitude at the refined peak against a
 dense trace of the same model (same H and friction-link evaluation, ``ds_max`` =
 REF_STEP, curve tolerance REF_TOL where there is one), computed once per case and kept
-in ``--ref-file``. Times are wall-clock of one run in this process (noisy on a
+in ``--ref-file``. Times: wall clock and this process's CPU time of one run (noisy on a
 shared machine: compare revisions side by side, in one run).
 """
 from __future__ import annotations
