@@ -196,12 +196,16 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     ``aft``: "exact" (default) evaluates every Iwan friction link by its exact periodic
     loop (:func:`exact_links`), "sampled" by the sampled AFT on ``n_t`` samples (the
     reference of the sampling error); contacts with a normal load varying in time and
-    elements without the exact path are sampled either way.
+    elements without the exact path are sampled either way. ``tolerance``: the curve's
+    accuracy, which sizes the continuation's steps (:mod:`continuation`, at least
+    MIN_TOLERANCE); ``ds_max`` bounds them (scaled arclength). A peak refinement that
+    fails keeps the curve's highest point (``extra["peak_refined"]`` False, a warning in
+    the status; :mod:`peaks`).
 
     Raises
     ------
-    ValueError for bad input; FRFError (a RuntimeError) when the continuation or the
-    peak refinement fails, carrying the points computed so far and the frequency reached.
+    ValueError for bad input; FRFError (a RuntimeError) when the continuation fails,
+    carrying the points computed so far and the frequency reached.
     """
     w0, w1 = (float(w) for w in omega_range)
     if not (np.isfinite(w0) and np.isfinite(w1)) or w0 <= 0 or w1 <= 0 or w0 == w1:
