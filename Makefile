@@ -13,7 +13,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale
+.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale docs validation docs-bench docs-stress
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -41,13 +41,16 @@ cbuild: $(CBUILD)/.built
 ctest: cbuild
 	cd $(CBUILD) && ctest --output-on-failure
 
+# The run records its reference checks (tests/refcheck.py); the check after it fails when
+# docs/data/validation.json (the documentation's validation table) no longer lists them.
 pytest: $(STAMP) cbuild browser
-	OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
+	DAMPER_VALIDATION_JSON=build/validation.json OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
+	$(PY) docs/tools/validation_check.py build/validation.json docs/data/validation.json
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 
-test: lint locale ctest pytest
+test: lint locale ctest docs pytest
 
 # A decimal-comma locale for the FMU locale tests (tests/fmu/test_fmu_trust.py):
 # generated with localedef when missing; as root on a fresh Debian/Ubuntu machine the
@@ -75,6 +78,25 @@ browser:
 	    (apt-get update -qq && apt-get install -y -qq chromium) >/dev/null 2>&1; } || \
 	  echo "note: no chromium (needs root and apt-get): the HTML report browser test will skip"
 
+# The documentation site (docs/, Sphinx): offline, warnings are errors, every example in
+# examples/ runs (the long ones in their quick mode: docs/tools/gallery.py). Opens at
+# build/docs/html/index.html.
+docs: $(STAMP) cbuild
+	OPENBLAS_NUM_THREADS=1 $(VENV)/bin/sphinx-build -W --keep-going -q -b html docs build/docs/html
+	@echo "documentation: build/docs/html/index.html"
+
+# The data behind the generated documentation pages, one command each (stamped with
+# command, revision, date and machine; commit the JSON, then `make docs`):
+# validation: the tests that make reference checks (tests/refcheck.py), recorded;
+# docs-bench / docs-stress: the full `damper bench` / `damper stress` runs (long).
+validation: $(STAMP) cbuild
+	DAMPER_VALIDATION_JSON=docs/data/validation.json DAMPER_VALIDATION_COMMAND="make validation" \
+	  OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q -p no:cacheprovider $$(grep -rl --include='test_*.py' 'from refcheck import' tests)
+docs-bench: $(STAMP) cbuild
+	nice $(PY) docs/tools/record.py docs/data/bench.json -- $(VENV)/bin/damper bench --json --out out/bench
+docs-stress: $(STAMP) cbuild
+	nice $(PY) docs/tools/record.py docs/data/stress.json -- $(VENV)/bin/damper stress --json --out out/stress
+
 # Benchmarks print tables (case, size, error, time, memory); long, never in CI.
 # One report of every stage (out/bench/bench.html, bench.json), sparse back ends included.
 bench: $(STAMP) cbuild
@@ -87,4 +109,4 @@ accel: $(STAMP)
 	$(PY) -m pip install -q 'scikit-sparse<0.5'
 
 clean:
-	rm -rf build out .damper_cache
+	rm -rf build out .damper_cache docs/_generated docs/auto_examples

@@ -98,7 +98,7 @@ class DiskCache:
             with np.load(path, allow_pickle=False) as data:
                 arrays = {k: data[k] for k in data.files if k != "meta"}
                 meta = json.loads(str(data["meta"]))
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile):
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
             return None
         return arrays, meta
 

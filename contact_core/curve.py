@@ -223,7 +223,10 @@ def read_curve(path: str | Path) -> VirginCurve:
         The file cannot be read.
     """
     path = Path(path)
-    text = path.read_text()
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file (a curve file is JSON)") from None
     try:
         data = json.loads(text)
     except json.JSONDecodeError as err:

@@ -138,6 +138,8 @@ def read_normal_curve(path: str | Path) -> NormalCurve:
         data = json.loads(path.read_text())
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not JSON ({err})") from None
+    except UnicodeDecodeError:
+        raise ValueError(f"{path}: not a text file (a normal curve is JSON)") from None
     if not isinstance(data, dict):
         raise ValueError(f"{path}: not a {SCHEMA} file")
     return NormalCurve.from_dict(data, str(path))

@@ -5,15 +5,15 @@ forces do not change with the tangential load; exact for like materials, whose
 Johnson coupling constant beta vanishes). The distant faces are moved by a rigid
 tangential displacement ``delta`` [m] along x.
 
-Symbols (SI units; n_c contact nodes, those with a normal force f_i > 0):
+Symbols (SI units; n_c contact nodes, those with a normal force f_i > 0)::
 
-f      (n_c,) nodal normal forces of the modelled part [N] (fixed)
-mu     friction coefficient [-]
-q      (n_c,) nodal tangential forces [N]: the force the contact exerts on the
-       plane (body 2) along +x, and on the curved body along -x
-C      (n_c, n_c) combined tangential compliance ``Cxx`` [m/N]
-w      (n_c,) full-model weights ``mult``; T = sum(w q) is the full tangential force
-s      (n_c,) accumulated relative slip of body 1 over body 2 [m]
+    f      (n_c,) nodal normal forces of the modelled part [N] (fixed)
+    mu     friction coefficient [-]
+    q      (n_c,) nodal tangential forces [N]: the force the contact exerts on the
+           plane (body 2) along +x, and on the curved body along -x
+    C      (n_c, n_c) combined tangential compliance Cxx [m/N]
+    w      (n_c,) full-model weights mult; T = sum(w q) is the full tangential force
+    s      (n_c,) accumulated relative slip of body 1 over body 2 [m]
 
 Kinematics: the surfaces' relative x displacement at node i is
 ``delta - (C q)_i``, the rigid motion minus the elastic give of both bodies;

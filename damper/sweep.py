@@ -7,6 +7,10 @@ changes) is *shared* and runs once, in dependency waves of one task per distinct
 then every variant runs as one task, reading the shared results from the cache that
 all workers use. Results are gathered into one table (CSV and JSON) and a plot.
 
+A variant that fails while it runs (or whose shared stage failed) does not stop the
+others: its row holds the message in the ``error`` column (None for the others) and
+the table is still written; ``fail_fast`` stops at the first failure instead.
+
 The scheduler is a Dask local cluster (one single-threaded worker process per core by
 default), an existing cluster (``scheduler`` address), or none (``serial``: the same
 tasks in this process, the reference the tests compare against).
@@ -18,12 +22,14 @@ import io
 import itertools
 import json
 import logging
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from damper.cache import Store
 from damper.cli.common import atomic_write, dumps
+from damper.limits import MAX_SWEEP_VARIANTS
 
 
 @dataclass
@@ -52,6 +58,10 @@ def variants(specs: list[tuple[str, list]], grid: bool = True) -> list[dict]:
         raise ValueError(f"a parameter is given twice: {names}")
     if not grid and len({len(v) for v in lists}) > 1:
         raise ValueError("--zip needs the same number of values for every parameter")
+    count = math.prod(len(v) for v in lists) if grid else len(lists[0])
+    if count > MAX_SWEEP_VARIANTS:
+        raise ValueError(f"the sweep has {count} variants, above the limit {MAX_SWEEP_VARIANTS}: each variant "
+                         "is one scene run (seconds to minutes); sweep fewer values")
     combos = itertools.product(*lists) if grid else zip(*lists)
     return [dict(zip(names, c)) for c in combos]
 
@@ -60,7 +70,7 @@ def _restricted_plan(text, source, overrides, store, only):
     from damper.run.runner import plan_scene
     from damper.scene import parse_scene
 
-    scene = parse_scene(text, source, overrides)
+    scene = parse_scene(text, source, overrides, base=Path(source).parent)
     plan = plan_scene(scene, store)
     if only is not None:
         keep = _closure(plan, set(only))
@@ -100,17 +110,32 @@ def run_task(text: str, source: str, overrides: dict, folder: str, max_bytes: in
     return {"computed": [(s.name, s.key) for s in plan.stages if s.action == "compute"], "scalars": scalars}
 
 
+def run_task_or_error(*args, **kwargs) -> dict:
+    """:func:`run_task`, with a failure returned as ``{"error": message}`` (the sweep goes on)."""
+    try:
+        return run_task(*args, **kwargs)
+    except Exception as err:  # noqa: BLE001 - the failure becomes the variant's row
+        kind = "" if isinstance(err, (ValueError, RuntimeError, OSError)) else f"{type(err).__name__}: "
+        return {"error": f"{kind}{' '.join(str(err).split())}", "computed": [], "scalars": {}}
+
+
 def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bool = True,
               scheduler: str | None = None, workers: int | None = None, serial: bool = False,
-              echo=print) -> SweepRecord:
-    """Run the sweep of ``specs`` ([(dotted parameter, values)]) over the scene file."""
-    from damper.scene import parse_scene
+              echo=print, fail_fast: bool = False) -> SweepRecord:
+    """Run the sweep of ``specs`` ([(dotted parameter, values)]) over the scene file.
 
-    text = Path(scene_path).read_text()
+    Each row holds the variant's parameters, its stages' headline numbers and ``error``
+    (None, or why the variant failed); ``fail_fast`` raises the first failure instead.
+    """
+    from damper.scene import parse_scene
+    from damper.scene.load import read_scene_text
+
     source = str(scene_path)
+    text = read_scene_text(scene_path)
     combos = variants(specs, grid)
     for ov in combos:             # validate every variant before any work
-        parse_scene(text, source, ov)
+        parse_scene(text, source, ov, base=Path(source).parent)
+    task = run_task if fail_fast else run_task_or_error
     rec = SweepRecord([n for n, _ in specs])
     plans = [_restricted_plan(text, source, ov, store, None)[1] for ov in combos]
     count: dict[str, int] = {}
@@ -122,24 +147,45 @@ def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bo
               if count.get(s.key, 0) > 1}
     rec.shared = sorted({name for _, name in shared.values()})
     submit, gather, close = _executor(scheduler, workers, serial)
+    failed: dict[str, str] = {}                  # shared stage key -> its error
     try:
         waves = _waves(plans, shared)
         for n, wave in enumerate(waves, start=1):
+            wave = [(i, name) for i, name in wave if not _failed_dep(plans[i], name, failed)]
             echo(f"sweep: shared wave {n}: {', '.join(name for _, name in wave)}")
-            futures = [submit(run_task, text, source, combos[i], str(store.folder), store.max_bytes, [name])
+            futures = [submit(task, text, source, combos[i], str(store.folder), store.max_bytes, [name])
                        for i, name in wave]
-            for r in gather(futures):
+            for (i, name), r in zip(wave, gather(futures)):
                 _tally(rec, r)
+                if r.get("error"):
+                    failed[plans[i][name].key] = f"shared stage {name}: {r['error']}"
         echo(f"sweep: {len(combos)} variants on {'this process' if serial else 'Dask'}")
-        futures = [submit(run_task, text, source, ov, str(store.folder), store.max_bytes) for ov in combos]
-        for ov, r in zip(combos, gather(futures)):
+        blocked = {i: _failed_in(plan, failed) for i, plan in enumerate(plans)}
+        todo = [i for i in range(len(combos)) if not blocked[i]]
+        futures = [submit(task, text, source, combos[i], str(store.folder), store.max_bytes) for i in todo]
+        results = dict(zip(todo, gather(futures)))
+        for i, ov in enumerate(combos):
+            r = results.get(i) or {"error": blocked[i], "computed": [], "scalars": {}}
             _tally(rec, r)
-            rec.rows.append(ov | r["scalars"])
+            rec.rows.append(ov | r["scalars"] | {"error": r.get("error")})
     finally:
         close()
     if out is not None:
         write_table(rec, Path(out))
     return rec
+
+
+def _failed_dep(plan, name: str, failed: dict) -> bool:
+    """Whether a stage depends (directly or not) on a failed shared stage."""
+    return any(plan[n].key in failed for n in _closure(plan, {name}) if n != name)
+
+
+def _failed_in(plan, failed: dict) -> str | None:
+    """The error of a failed shared stage the variant's plan runs, or None."""
+    for s in plan.stages:
+        if s.action != "skip" and s.key in failed:
+            return failed[s.key]
+    return None
 
 
 def _tally(rec: SweepRecord, r: dict) -> None:
@@ -190,7 +236,8 @@ def _executor(scheduler, workers, serial):
 
 def write_table(rec: SweepRecord, out: Path) -> None:
     """``sweep.csv``, ``sweep.json`` and ``sweep.png`` (each column against the first parameter)."""
-    cols = list(rec.params) + sorted({k for r in rec.rows for k in r if k not in rec.params})
+    cols = list(rec.params) + sorted({k for r in rec.rows for k in r if k not in rec.params and k != "error"})
+    cols.append("error")
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=cols)
     w.writeheader()
@@ -209,12 +256,13 @@ def _plot(rec, cols, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
     x = rec.params[0]
-    ys = [c for c in cols if c not in rec.params and all(isinstance(r.get(c), (int, float)) for r in rec.rows)
-          and len({r.get(c) for r in rec.rows}) > 1][:6]
+    rows = [r for r in rec.rows if not r.get("error")]   # failed variants have no numbers
+    ys = [c for c in cols if c not in rec.params and rows and all(isinstance(r.get(c), (int, float)) for r in rows)
+          and len({r.get(c) for r in rows}) > 1][:6]
     fig, axes = plt.subplots(max(len(ys), 1), 1, figsize=(6, 2.2 * max(len(ys), 1)), squeeze=False)
     for ax, c in zip(axes[:, 0], ys):
         groups = {}
-        for r in rec.rows:
+        for r in rows:
             groups.setdefault(tuple(r[p] for p in rec.params[1:]), []).append((r[x], r[c]))
         for g, pts in groups.items():
             pts.sort()

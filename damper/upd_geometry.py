@@ -180,7 +180,7 @@ def solve_contact(name: str, spec, model: str, N: float, mu: float, store=None) 
     t0 = time.perf_counter()
     key = make_key("upd-geometry-contact", ENTRY_VERSION, spec.key_dict(), spec.p_design, model,
                    float(N), float(mu), code_version(("contact_core",)))
-    hit = store.get(key) if store is not None else None
+    hit = store.get(key, stage="upd_contact") if store is not None else None
     if hit is not None:
         arrays, meta = hit
         curve = VirginCurve(u=arrays["u"], T=arrays["T"], N=meta["N"], mu=mu, k_t=meta["k_t"],
@@ -198,7 +198,7 @@ def solve_contact(name: str, spec, model: str, N: float, mu: float, store=None) 
     meta = {"N": run.curve.N, "k_n": run.k_n, "k_t": run.problem.k_t, "contact_nodes": int(run.problem.n_c),
             "warnings": list(run.warnings)}
     if store is not None:
-        store.put(key, {"u": np.asarray(run.curve.u), "T": np.asarray(run.curve.T)}, meta)
+        store.put(key, {"u": np.asarray(run.curve.u), "T": np.asarray(run.curve.T)}, meta, stage="upd_contact")
     return {"curve": run.curve, **meta, "cached": False, "time_s": time.perf_counter() - t0}
 
 
@@ -290,7 +290,7 @@ def apply_to_args(args, cfg):
         return cfg
     from damper.cache import Store
 
-    cfg, report = with_geometry_contacts(cfg, getattr(args, "cf", None), Store())
+    cfg, report = with_geometry_contacts(cfg, getattr(args, "cf", None), Store().prepare())
     args.contact_report = report
     if not getattr(args, "json", False):
         print("\n".join(report_lines(report)))

@@ -1,4 +1,5 @@
 """Benchmark of the normal contact stage: error against Hertz vs time and memory.
+==============================================================================
 
 Each case runs in its own process twice: cold (empty cache: mesh, assembly,
 condensation, solve) and cached (the condensed matrices loaded from disk, then
@@ -12,7 +13,7 @@ compliance at its load (one displacement-controlled solve): the toolkit's
 projected Newton (``contact_core.qp``) against scipy's ``nnls`` and
 ``lsq_linear`` (bvls) on the Cholesky form, with their disagreement.
 
-Goal (issue 2): sphere, 41x41 grid, contact radius and p0 within 0.5 % of
+Goal: sphere, 41x41 grid, contact radius and p0 within 0.5 % of
 Hertz, 20 s cold and 1 s cached end to end on a 2-core machine.
 """
 from __future__ import annotations

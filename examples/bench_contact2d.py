@@ -1,4 +1,5 @@
 """Benchmark: the 2D element and the contact point against the 1D element, and their FMUs.
+=======================================================================================
 
 Table 1 (C driver ``fmu_src/core/bench_iwan2d.c``, every case in one process, best of
 ``--repeats``): one step with outputs and tangent, per slider count, for the 1D element
@@ -132,7 +133,7 @@ def print_tables(rows, frows) -> None:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 16, 64])
     p.add_argument("--samples-per-cycle", type=int, default=1000)
     p.add_argument("--cycles", type=int, default=10)

@@ -1,4 +1,5 @@
 """Benchmark: cost of the Iwan element's time-series entry point (iwan_series).
+============================================================================
 
 For each slider count, one 10,000-sample history (two incommensurate sines,
 partial slip: about half the sliders slip in every cycle) is run through
@@ -8,7 +9,7 @@ partial slip: about half the sliders slip in every cycle) is run through
 * the Python array API ``IwanElement.series`` (one ctypes call plus numpy
   allocation and checks), best of ``--repeats`` runs.
 
-Goals (issue 3): at most 2 ns per slider update; the Python entry point within
+Goals: at most 2 ns per slider update; the Python entry point within
 2x of the C driver. The error column checks the numbers: relative difference of
 the last F + W between the two paths (same C code: round-off only) -- and the
 loop energy of a harmonic cycle against Masing's integral 8 int g - 4 a g(a) of
@@ -113,7 +114,7 @@ def print_table(rows) -> None:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 16, 64, 128, 256])
     p.add_argument("--samples", type=int, default=10_000)
     p.add_argument("--repeats", type=int, default=30)

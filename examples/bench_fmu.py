@@ -1,9 +1,10 @@
 """Benchmark: the cost of one doStep of the friction-element FMU.
+==============================================================
 
 Two masters drive the FMI 2 binary: a small C master (``fmu_src/fmi/bench_driver.c``:
 set u, doStep, get F and W per step) and fmpy's ``FMU2Slave`` from Python. Each
 runs the friction element and a pass-through FMU (F = u) built the same way, so
-the element's own cost is the difference. Goal (issue 5): the element adds less
+the element's own cost is the difference. Goal: the element adds less
 than 100 ns a step for a 50-slider curve.
 
 The error column checks the numbers: the FMU's last F and W against the array API
@@ -36,7 +37,7 @@ MU, N_REF, U_SLIP = 0.5, 200.0, 2.0e-6
 AMPLITUDE = 0.8 * U_SLIP
 #: Samples per cycle of the sinusoid.
 POINTS_PER_CYCLE = 64
-#: The element's budget per step (issue 5) [ns].
+#: The element's budget per step [ns].
 GOAL_NS = 100.0
 
 

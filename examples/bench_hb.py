@@ -1,4 +1,5 @@
 """Harmonic-balance benchmark: accuracy vs H against time integration, cost vs model size.
+=======================================================================================
 
 Run:  .venv/bin/python examples/bench_hb.py [--smoke] [--no-ivp]
 
@@ -14,7 +15,7 @@ receptance-condensed onto the 12 element DOFs, over the first resonance (from th
 free to the stuck natural frequency). Point counts differ (adaptive steps), so the
 cost is also given per 200 points.
 
-Table 3, speed-up (issue 6 goals: >= 10x over a well-vectorised time integration,
+Table 3, speed-up (goals: >= 10x over a well-vectorised time integration,
 >= 1000x over scipy's solve_ivp run to steady state frequency by frequency):
 (a) the HB curve (its wall time, peak refinement included) against the vectorised
 time integration (harmonic_balance.timeint.march_curve: every frequency of the curve
@@ -23,7 +24,7 @@ exactly the HB curve's frequencies plus its peak frequency, at a few step sizes 
 steady-state tolerances; each row gives its accuracy (worst first-harmonic
 difference to the HB curve over the curve, peak error against the Table 1 reference)
 and the fair row is picked by rule: the coarsest setting whose worst deviation
-from the HB curve and peak error are within the issue's 0.5 %.
+from the HB curve and peak error are within the required 0.5 %.
 Columns: h1_dev_% = worst first-harmonic difference to the HB curve over the curve,
 peak_err_% = time-integration amplitude at the HB peak frequency against the Table 1
 reference (sdof) or against the HB peak (2-DOF: no separate reference), both in % of
@@ -175,10 +176,10 @@ TI_SETTINGS = ((128, 1e-5), (256, 1e-6), (512, 1e-8))
 SMOKE_TI_SETTINGS = ((64, 1e-4),)
 #: solve_ivp is run at every IVP_EVERY-th point of the HB curve (mean scaled to the curve).
 IVP_EVERY = 10
-#: Accuracy [%] a time integration must reach to count as the same curve (issue 6:
+#: Accuracy [%] a time integration must reach to count as the same curve (the goal:
 #: HB and the reference agree within 0.5 % of the peak amplitude).
 ACCURACY_PCT = 0.5
-#: Speed-up goals of issue 6.
+#: Speed-up goals.
 GOAL_TI, GOAL_IVP = 10.0, 1000.0
 
 
@@ -351,7 +352,7 @@ def table_ivp(model, hb, t_hb, steps, tol):
 def summarise_vectorised(cases, vec):
     """Speed-up over the fair row of Table 3a per case, against the goal."""
     # the fair row per case: the coarsest time integration whose worst deviation
-    # from the HB curve and peak error are within the issue's 0.5 % (ACCURACY_PCT);
+    # from the HB curve and peak error are within the required 0.5 % (ACCURACY_PCT);
     # a coarser one would be cheaper but not an equally accurate curve
     for name, *_ in cases:
         ok = [v for v in vec if v[0] == name and v[6] < ACCURACY_PCT

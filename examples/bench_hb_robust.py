@@ -1,4 +1,5 @@
-"""Robustness benchmark of the HB solver (issue 10): convergence map and cost vs contact stiffness.
+"""Robustness benchmark of the HB solver: convergence map and cost vs contact stiffness.
+================================================================================================
 
 Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full] [--harmonics 1,3]
           [--log map.csv] [--no-cost | --cost-only] [--den-hartog | --den-hartog-hb]
@@ -11,12 +12,12 @@ Table 1 (convergence map): contact stiffness ratio kt/k, slip force fs/P, dampin
 harmonics H and the three starts; per (H, kt/k) the number of curves converged over
 the whole range (complete AND without restart gaps), and every failure with where it
 stopped. Default grid: kt/k in {1e-3, 1, 30, 1e3, 1e4, 1e6}, fs/P in {1e-3, 0.5, 10},
-c in {1e-4, 0.04, 0.5}, H in {1, 7, 21}; ``--full`` the issue's whole grid (kt/k
+c in {1e-4, 0.04, 0.5}, H in {1, 7, 21}; ``--full`` the whole grid (kt/k
 1e-3..1e6 by decades, fs/P 1e-3..10, c 1e-4..0.5, H = 1, 3, 7, 21, 51: 3750 curves,
 many hours; ``--harmonics`` picks a subset of H, ``--log`` keeps one CSV line per
 curve).
 
-Table 2 (cost vs stiffness): the issue's case (c = 0.04, fs = 0.5, H = 15,
+Table 2 (cost vs stiffness): the reference case (c = 0.04, fs = 0.5, H = 15,
 0.5 -> 2 rad/s): points, Newton iterations and residual evaluations per point, and
 time per point against kt/k (goal: no worse than 2x the soft-contact cost at 1e6).
 
@@ -25,8 +26,8 @@ model against Den Hartog's rigid-Coulomb steady state at 1e3 and 1e5 k, 0.5-2 ra
 Table 4 (``--den-hartog-hb``): the HB alone against Den Hartog at 1e5 and 1e6 k, H = 21
 and 51 (how the error falls with H where the elastic model is near the rigid one).
 
-Wall times depend on the machine's load; nothing here gates CI. Measured numbers and
-their history: README, "Harmonic balance on stiff contacts".
+Wall times depend on the machine's load; nothing here gates CI. The last full run's
+numbers: README.md at revision c58d443, section "Harmonic balance on stiff contacts".
 """
 from __future__ import annotations
 
@@ -208,7 +209,7 @@ def hb_vs_den_hartog(kts=(1e5, 1e6), Hs=(21, 51), omegas=(0.5, 0.75, 1.0, 1.5, 2
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="tiny grid (the test)")
-    ap.add_argument("--full", action="store_true", help="the issue's whole grid (hours)")
+    ap.add_argument("--full", action="store_true", help="the whole grid (hours)")
     ap.add_argument("--harmonics", help="comma-separated subset of the grid's H (e.g. 1,3)")
     ap.add_argument("--stiffness", help="comma-separated subset of the grid's kt/k (e.g. 1e5,1e6): "
                     "split a long map over processes or finish a partial one")

@@ -1,11 +1,12 @@
-"""Cost per point of the issue-10 case, runnable against any version of harmonic_balance.
+"""Cost per point of the stiff-contact case, runnable against any version of harmonic_balance.
+=============================================================================================
 
-Issue 10's cost goal compares the 1e6 k contact with "the current soft-contact cost",
-the cost when the issue was filed. This script uses only ``compute_frf`` and
-``sdof_model`` (present in every version), so the same measurement runs on the code of
-that time and on today's, on the same machine, back to back:
+The stiff-contact cost goal compares the 1e6 k contact with the soft-contact cost of an
+older revision. This script uses only ``compute_frf`` and ``sdof_model`` (present in
+every version), so the same measurement runs on the code of any revision and on
+today's, on the same machine, back to back::
 
-    git worktree add /tmp/old 368c9f4^          # main when issue 10 was filed
+    git worktree add /tmp/old 368c9f4^          # the revision to compare with
     mkdir -p /tmp/oldpath && ln -sfn /tmp/old/harmonic_balance /tmp/oldpath/ \
         && ln -sfn "$PWD/fmu_src" /tmp/oldpath/
     PYTHONPATH=/tmp/oldpath .venv/bin/python examples/bench_hb_soft_baseline.py 1,10

@@ -1,11 +1,12 @@
 """Benchmark of the tangential stage: error against Cattaneo-Mindlin and time per grid.
+====================================================================================
 
 Sphere R = 10 mm on a plane, steel, N = 200 N, mu = 0.5. One line per model
 and grid: contact nodes, largest error of the virgin curve against Mindlin
 (fraction of mu N), k_t against 8 G* a, time per stage (condense, normal,
 tangential) cold and cached (FE models: second run from the condensation
 cache; the BEM has no cache, its build is the cold figure), and the process's
-peak memory so far (ru_maxrss, so it only grows down the table).
+peak memory so far (ru_maxrss, so it only grows down the table). ::
 
     python examples/bench_tangential.py                       # BEM 21/41/61, FE 11/21
     python examples/bench_tangential.py --bem 21 41 --fe 21 --fe-models halfspace real

@@ -1,11 +1,12 @@
 """Benchmark of the UPD-24 sector harmonic balance (table and plot; not a timed test).
+===================================================================================
 
 Cases: one 200-point curve (H = 7); the optimal-load curve (20 loads, H = 7); the
 optimum CF against H (5, 7, 9, 11, 15; 7 loads 80-250 N + Brent); the peak against
 the ring time integration (TI) at CF/F0 = 2, 4, 20 for H = 1, 3, 5, 7, 9, 15, with the
 TI's step error (2x steps) and settling error, and the TI's cost against its own error
 (the same march stopped at looser settling tolerances) to compare TI and HB at equal
-accuracy. Times are CPU (process_time): the machine is shared.
+accuracy. Times are CPU (process_time): the machine is shared. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_upd.py --out out/bench_upd [--quick]
     ... bench_upd.py --scan 5 7 9 11 13 15            # the objective per H (25 loads 80-250 N)
@@ -157,7 +158,7 @@ def ti_optimum(sector, cfs, tol=1e-3, periods=150):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/bench_upd")
     ap.add_argument("--quick", action="store_true", help="smoke version (seconds)")
     ap.add_argument("--periods", type=int, default=150, help="TI periods per load")

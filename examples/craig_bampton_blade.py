@@ -1,4 +1,5 @@
 """Bring your own blade: a scikit-fem FE blade, Craig-Bampton reduced, with the UPD-24 damper.
+===========================================================================================
 
 Run:  .venv/bin/python examples/craig_bampton_blade.py [--out out/cb_blade] [--modes 6]
 then: damper upd frf --config out/cb_blade/upd.toml
@@ -19,8 +20,8 @@ Load: F0 = 10 N at the tip (:data:`F0`), the default CF = 120 N.
 
 Harmonics: H = 3 by default. At H = 5 a Newton sweep on a fixed frequency grid stops
 near 530 Hz, most likely at a 5:1 superharmonic resonance of the blade's second bending
-family (free 2.09 kHz, stuck 2.81 kHz); above CF/F0 ~ 20 the curve folds (README):
-``solve.frf`` traces both by arc-length continuation.
+family (free 2.09 kHz, stuck 2.81 kHz); above CF/F0 ~ 20 the curve folds (docs, user
+guide: the bladed disk): ``solve.frf`` traces both by arc-length continuation.
 Prints the CB natural frequencies against the full FE model's, writes ``blade.npz``
 and ``upd.toml`` (the default damper, band around the free and stuck EO resonances)
 and runs the damped forced response with the Python API.
@@ -33,6 +34,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
 import json  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -195,4 +197,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    sys.exit(main())

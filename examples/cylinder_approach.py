@@ -1,4 +1,5 @@
 """Cylinder on a plane: FE approach against the literature formulas (thesis 2.2.2).
+================================================================================
 
 The seed lists Norden (two solutions, eqs 2.3-2.4), Palmgren as cited by Harris
 (2.5), Brandlein (2.6), Roark (2.7), Johnson (2.8) and Kosarev (2.9). They

@@ -1,4 +1,5 @@
 """Closed loop: the damper FMU coupled to a mass-spring oscillator by a fixed-step master.
+=======================================================================================
 
 The oscillator m x'' + c x' + k x + F(x) = P sin(w t) carries a friction contact to
 ground (u = x) whose force F comes from the FMI 2 FMU of a Cattaneo-Mindlin virgin

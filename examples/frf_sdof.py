@@ -1,4 +1,5 @@
 """Forced response of a Jenkins-damped oscillator: HB against the describing function.
+===================================================================================
 
 Run:  .venv/bin/python examples/frf_sdof.py [--out out/frf_sdof]
 

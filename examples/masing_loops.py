@@ -1,4 +1,5 @@
 """Masing loops of a sphere contact: the Iwan element against Mindlin-Deresiewicz.
+===============================================================================
 
 The Cattaneo-Mindlin virgin curve of a steel sphere (R = 10 mm, N = 100 N,
 mu = 0.5; references.md) is tabulated with m segments (uniform in T, flat after
@@ -7,7 +8,7 @@ tangential force of amplitude T* = x mu N (the displacement amplitude is the
 exact inverse of the table's virgin curve) gives the energy per cycle, compared
 with the Mindlin-Deresiewicz closed form. Prints a table (m, x, W, W_MD, error,
 time per loop) and saves ``loops.png`` (loops over the virgin curve) and
-``energy.png`` (W against x, with the small-x law T*^3 / (36 a mu N G*)).
+``energy.png`` (W against x, with the small-x law T*^3 / (36 a mu N G*)). ::
 
     python examples/masing_loops.py                # m = 16 .. 255
     python examples/masing_loops.py --smoke        # tiny (the test runs this)

@@ -1,4 +1,5 @@
 """Normal contact validation: sphere and cylinder on a plane against Hertz.
+========================================================================
 
 Runs the FE models (real half-sphere / half-cylinder on a block), writes one
 JSON file with the results and the Hertz comparison, and plots (pressure map,

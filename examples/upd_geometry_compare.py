@@ -1,4 +1,5 @@
 """UPD-24 with contacts from geometry against the TOML's Jenkins contacts (table; not a test).
+===========================================================================================
 
 Per contact choice ("toml": the default Jenkins points, "geometry": contact_core's laws
 of ``damper.upd_geometry`` at the config's CF):
@@ -88,7 +89,7 @@ def ti_scan(sector, cfs, band, periods: int) -> dict:
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smoke: grid-7 contacts, one load, few periods")
     ap.add_argument("--json", help="write the results here")
     ap.add_argument("--cache-dir", default=None, help="store of the contact results")

@@ -1,10 +1,11 @@
 """Virgin curves of the thesis's contacts: sphere and cylinder, CNF and CND.
+=========================================================================
 
 Prints one line per case (normal force, k_n, k_t, gross-slip displacement,
 points, error against Cattaneo-Mindlin for the sphere) and a hysteresis loop
 computed directly by the contact model against Masing's loop from its virgin
 curve, and the CND cylinder against the thesis's fit (seed eq. 2.14, a
-comparison, not an oracle); saves plots and curve files to ``--out``.
+comparison, not an oracle); saves plots and curve files to ``--out``. ::
 
     python examples/virgin_curves.py                    # half-space BEM, 31 nodes per side
     python examples/virgin_curves.py --model real --grid 21

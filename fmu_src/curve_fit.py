@@ -75,7 +75,7 @@ def check_table(u, T, fit: str = "reject") -> tuple[np.ndarray, np.ndarray]:
     bad = np.flatnonzero(s < 0.0)
     if bad.size:
         i = int(bad[0]) + 1
-        raise IwanInputError(f"curve: point {i}: T = {T[i]!r} falls below T[{i - 1}] = {T[i - 1]!r} "
+        raise IwanInputError(f"curve: point {i}: T = {float(T[i])!r} falls below T[{i - 1}] = {float(T[i - 1])!r} "
                              "(T must not decrease: negative stiffness); fit='concave' flattens it")
     rise = s[1:] - s[:-1] - CONCAVE_RTOL * np.max(np.abs(s))
     bad = np.flatnonzero(rise > 0.0)

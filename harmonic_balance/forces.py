@@ -98,7 +98,7 @@ class ForceElement:
         return np.zeros(self.m)
 
     def stepper(self):
-        """Time-domain law for :mod:`.timeint`: an object with ``force(q) -> f`` (m,).
+        """Time-domain law for :mod:`harmonic_balance.timeint`: an object with ``force(q) -> f`` (m,).
 
         Each call advances the element's history to the local displacement q (m,)
         and returns the rate-independent local force; the linear viscous part

@@ -6,7 +6,7 @@ m = k = 1, c = 0.04, slip force 0.5, forcing 1 and contact stiffness 30 the stuc
 amplitude at omega = 0.5 is 0.033 m, the solution's about 0.9 m, and the residual is
 piecewise smooth (a kink whenever a slip onset moves to another AFT sample), so
 Newton's step from the stuck guess (50 x the guess's size) is no descent direction
-beyond 1e-4 of its length: "line search found no decrease" (issue 10, measured).
+beyond 1e-4 of its length: "line search found no decrease" (measured).
 
 How: the HB residual is affine in the excitation, ``R(x; lam) = N(x) - lam f``
 (f = the excitation's image in the residual: F_ext for the full residual, the
@@ -36,7 +36,7 @@ from .newton import NewtonError, newton
 START_LEVELS = tuple(10.0 ** -k for k in range(1, 9))
 #: Largest scaled step of the homotopy. The scaled x has norm ~sqrt(N) (each unknown
 #: scaled by the RMS), lam runs over [lam0, 1]: 1.0 took 30-40 points on the
-#: issue's sdof at contact stiffness 30 (0.04 took > 400, 0.3 200).
+#: reference sdof at contact stiffness 30 (0.04 took > 400, 0.3 200).
 HOMOTOPY_DS_MAX = 1.0
 
 

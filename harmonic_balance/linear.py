@@ -77,8 +77,11 @@ class LinearModel:
             for name in ("M", "C", "K"):
                 A = getattr(self, name)
                 A = np.zeros((n, n)) if A is None else np.atleast_2d(np.asarray(A, dtype=float))
-                if A.shape != (n, n) or not np.all(np.isfinite(A)):
-                    raise ValueError(f"{name} must be a finite ({n}, {n}) matrix, got shape {A.shape}")
+                if A.shape != (n, n):
+                    raise ValueError(f"{name} must be a ({n}, {n}) matrix, got shape {A.shape}")
+                if not np.all(np.isfinite(A)):
+                    bad = tuple(int(i) for i in np.argwhere(~np.isfinite(A))[0])
+                    raise ValueError(f"{name} must be finite, got {A[bad]} at entry {bad}")
                 if not np.allclose(A, A.T, rtol=0.0, atol=SYMMETRY_TOL * np.abs(A).max()):
                     raise ValueError(f"{name} must be symmetric")
                 setattr(self, name, A)
@@ -91,6 +94,8 @@ class LinearModel:
             r = self.phi.shape[1]
             self.w_r = np.asarray(self.w_r, dtype=float).reshape(r)
             self.c_r = np.zeros(r) if self.c_r is None else np.asarray(self.c_r, dtype=float).reshape(r)
+            if not all(np.all(np.isfinite(a)) for a in (self.phi, self.w_r, self.c_r)):
+                raise ValueError("modal data (phi, frequencies, damping) must be finite")
             if np.any(self.w_r < 0) or np.any(self.c_r < 0):
                 raise ValueError("modal frequencies and damping must be >= 0")
 

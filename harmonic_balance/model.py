@@ -213,15 +213,47 @@ def sdof_model(mass, stiffness, damping, contact_stiffness, slip_force, force) -
 
 
 def load_matrices(path) -> tuple[LinearModel, dict, int]:
-    """Read a ``matrices.npz`` file (format in the module docstring)."""
+    """Read a ``matrices.npz`` file (format in the module docstring).
+
+    Checked here, so a bad file is refused before any solve: M, K, C finite, symmetric
+    and square; M positive definite (a mass matrix; a singular or negative M has no
+    dynamics to solve); modal data finite, frequencies and damping >= 0; ``force``
+    finite with one entry per DOF.
+    """
+    import zipfile
+
     path = Path(path)
     try:
-        data = np.load(path, allow_pickle=False)
-    except (OSError, ValueError) as err:
-        raise ValueError(f"cannot read model file {path}: {err}") from None
-    keys = set(data.files)
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+    except OSError as err:
+        raise ValueError(f"cannot read model file {path}: {err.strerror or err}") from None
+    if magic != b"PK\x03\x04":  # every .npz is a zip archive
+        raise ValueError(f"{path}: not a numpy .npz archive (numpy.savez writes one)")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
+        raise ValueError(f"cannot read model file {path} (a numpy .npz archive): {err}") from None
+    if not arrays:
+        raise ValueError(f"{path}: an empty .npz archive")
+    try:
+        return _matrices_from(arrays, path)
+    except (TypeError, ValueError) as err:
+        msg = str(err)
+        raise ValueError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
+
+
+def _matrices_from(data: dict, path: Path) -> tuple[LinearModel, dict, int]:
+    keys = set(data)
     if {"M", "K"} <= keys:
         lin = LinearModel(M=data["M"], C=data["C"] if "C" in keys else None, K=data["K"])
+        try:
+            np.linalg.cholesky(lin.M)
+        except np.linalg.LinAlgError:
+            low = float(np.linalg.eigvalsh(lin.M).min())
+            raise ValueError(f"M must be positive definite (a mass matrix), but its smallest eigenvalue "
+                             f"is {low:.3g}; give every DOF a positive mass") from None
     elif {"phi", "omega_r"} <= keys:
         w = np.asarray(data["omega_r"], dtype=float)
         z = np.asarray(data["zeta_r"], dtype=float) if "zeta_r" in keys else np.zeros_like(w)
@@ -231,8 +263,14 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
     if "force" not in keys:
         raise ValueError(f"{path}: no 'force' array")
     f = np.atleast_1d(np.asarray(data["force"]))
+    if f.ndim > 2 or f.shape[-1] != lin.n or not np.all(np.isfinite(f)):
+        raise ValueError(f"'force' must be {lin.n} finite values (or rows of {lin.n}, one per harmonic), "
+                         f"got shape {f.shape}" + ("" if np.all(np.isfinite(f)) else " with non-finite entries"))
     forcing = {1: f} if f.ndim == 1 else {h + 1: row for h, row in enumerate(f)}
-    resp = int(data["response_dof"]) if "response_dof" in keys else 0
+    resp = data.get("response_dof")
+    if resp is not None and (np.asarray(resp).size != 1 or not np.issubdtype(np.asarray(resp).dtype, np.integer)):
+        raise ValueError(f"'response_dof' must be one integer, got {np.asarray(resp).tolist()}")
+    resp = int(resp) if resp is not None else 0
     return lin, forcing, resp
 
 
@@ -241,12 +279,31 @@ def load_elements(path) -> list[ForceElement]:
     path = Path(path)
     try:
         spec = tomllib.loads(path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as err:
-        raise ValueError(f"cannot read elements file {path}: {err}") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+        raise ValueError(f"cannot read elements file {path} (TOML): {err}") from None
+    unknown = sorted(set(spec) - {"element"})
+    if unknown:
+        raise ValueError(f"{path}: unknown key(s) {', '.join(map(repr, unknown))}: the file holds "
+                         "[[element]] tables only")
     tables = spec.get("element", [])
-    if not tables:
+    if not isinstance(tables, list) or not tables or not all(isinstance(t, dict) for t in tables):
         raise ValueError(f"{path}: no [[element]] tables")
-    return [_element_link(t, i, path.parent) for i, t in enumerate(tables)]
+    links = []
+    for i, t in enumerate(tables):
+        try:
+            links.append(_element_link(t, i, path.parent))
+        except KeyError as err:
+            raise ValueError(f"{path}: element {i}: missing key {err.args[0]!r}") from None
+        except (TypeError, ValueError) as err:
+            msg = str(err)
+            raise ValueError(f"{path}: {msg if msg.startswith('element') else f'element {i}: {msg}'}") from None
+    return links
+
+
+#: Keys of each [[element]] type (anything else, e.g. a typo, is refused).
+_ELEMENT_KEYS = {"jenkins": {"type", "name", "dofs", "k", "fs"},
+                 "sliders": {"type", "name", "dofs", "k", "fs", "k_res"},
+                 "curve": {"type", "name", "dofs", "path", "fit", "scale"}}
 
 
 def _element_link(t: dict, i: int, base: Path) -> ForceElement:
@@ -255,17 +312,24 @@ def _element_link(t: dict, i: int, base: Path) -> ForceElement:
 
     if t.get("type") == "contact":
         return _contact_element(t, i, base)
-    dofs = t.get("dofs")
-    if not isinstance(dofs, list) or len(dofs) not in (1, 2):
-        raise ValueError(f"element {i}: 'dofs' must be [a] or [a, b]")
     kind = t.get("type", "jenkins")
+    if kind not in _ELEMENT_KEYS:
+        raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve, contact)")
+    unknown = sorted(set(t) - _ELEMENT_KEYS[kind])
+    if unknown:
+        raise ValueError(f"element {i}: unknown key(s) {', '.join(map(repr, unknown))} for type {kind!r} "
+                         f"(known: {', '.join(sorted(_ELEMENT_KEYS[kind]))})")
+    dofs = t.get("dofs")
+    if not isinstance(dofs, list) or len(dofs) not in (1, 2) or not all(
+            isinstance(d, int) and not isinstance(d, bool) for d in dofs):
+        raise ValueError(f"element {i}: 'dofs' must be [a] or [a, b] (integers)")
     name = t.get("name", f"element{i}")
     if kind == "jenkins":
         el = jenkins_element(float(t["k"]), float(t["fs"]))
     elif kind == "sliders":
         el = IwanElement.from_sliders(np.asarray(t["k"], float), np.asarray(t["fs"], float),
                                       k_res=float(t.get("k_res", 0.0)))
-    elif kind == "curve":
+    else:  # "curve"
         from contact_core.curve import read_curve
 
         c = read_curve(base / t["path"])
@@ -273,8 +337,6 @@ def _element_link(t: dict, i: int, base: Path) -> ForceElement:
         # the curve file's own tail (flat at gross slip or last slope), reduced to
         # the element's limit when longer (el.fit_error).
         el = IwanElement.from_virgin_curve(c, fit=t.get("fit", "reject"), scale=float(t.get("scale", 1.0)))
-    else:
-        raise ValueError(f"element {i}: unknown type {kind!r} (jenkins, sliders, curve)")
     b = int(dofs[1]) if len(dofs) == 2 else None
     return FrictionLink(el, int(dofs[0]), b, name)
 
@@ -287,7 +349,8 @@ def _contact_element(t: dict, i: int, base: Path):
     """One [[element]] table of type "contact" -> ContactElement (format in the module docstring)."""
     unknown = set(t) - _CONTACT_KEYS
     if unknown:
-        raise ValueError(f"element {i}: unknown contact keys {sorted(unknown)}")
+        raise ValueError(f"element {i}: unknown key(s) {', '.join(map(repr, sorted(unknown)))} for type "
+                         f"'contact' (known: {', '.join(sorted(_CONTACT_KEYS))})")
     try:
         dofs = [int(d) for d in t["dofs"]]
         normal = np.asarray(t["normal"], dtype=float)

@@ -16,3 +16,34 @@ def load_example():
         spec.loader.exec_module(module)
         return module
     return load
+
+
+# The validation table (docs/validation.md): every refcheck.check of this run, written to
+# $DAMPER_VALIDATION_JSON with the tests that passed and the run's stamp (make validation).
+_PASSED: list[str] = []
+
+
+def pytest_runtest_logreport(report):
+    if report.when == "call" and report.passed:
+        _PASSED.append(report.nodeid)
+
+
+def pytest_sessionfinish(session, exitstatus):
+    import json
+    import os
+    import sys
+
+    import refcheck
+
+    path = os.environ.get("DAMPER_VALIDATION_JSON")
+    if not path:
+        return
+    from damper.bench.common import stamp
+
+    data = {"command": os.environ.get("DAMPER_VALIDATION_COMMAND", " ".join(["pytest", *sys.argv[1:]])),
+            "exit_code": int(exitstatus), "stamp": stamp(), "passed_tests": sorted(_PASSED),
+            "records": refcheck.RECORDS}
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(path + ".tmp")
+    tmp.write_text(json.dumps(data, indent=1) + "\n")
+    tmp.replace(path)

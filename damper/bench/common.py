@@ -104,6 +104,25 @@ def self_peak_mb() -> float:
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
 
 
+#: Paths whose changes do not make a revision "dirty": the recorded documentation data
+#: (a run that writes one data file must not mark the next run's revision as modified).
+NOT_CODE = ("docs/data",)
+
+
+def revision() -> str | None:
+    """Short git revision of the code, with ``-dirty`` when tracked files outside
+    :data:`NOT_CODE` differ from it; None outside a git checkout."""
+    try:
+        rev = subprocess.run(["git", "-C", str(ROOT), "describe", "--always"], capture_output=True,
+                             text=True, timeout=10).stdout.strip() or None
+        changed = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no", "--",
+                                  ".", *(f":(exclude){p}" for p in NOT_CODE)], capture_output=True, text=True,
+                                 timeout=10).stdout.strip()
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return f"{rev}-dirty" if rev and changed else rev
+
+
 def stamp() -> dict:
     """Machine, cores, library versions and code revision of a run."""
     from importlib import metadata
@@ -114,11 +133,7 @@ def stamp() -> dict:
             versions[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:
             versions[pkg] = None
-    try:
-        rev = subprocess.run(["git", "-C", str(ROOT), "describe", "--always", "--dirty"], capture_output=True,
-                             text=True, timeout=10).stdout.strip() or None
-    except (OSError, subprocess.TimeoutExpired):
-        rev = None
+    rev = revision()
     from contact_core import linsolve
 
     mem_total = None

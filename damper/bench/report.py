@@ -110,7 +110,7 @@ def write(out: Path, result: dict) -> tuple[Path, Path]:
 
 
 def markdown(result: dict) -> str:
-    """Markdown tables of every stage (what the README quotes), with the run's stamp."""
+    """Markdown tables of every stage (DIR/bench.md), with the run's stamp."""
     s = result["stamp"]
     out = [f"Run {s['date_utc']}, revision {s['revision']}, {s['cores']} cores, {s['machine']}, "
            f"load average {s['load_average'][0]:.1f}, sparse back ends {', '.join(s['sparse_solvers'])}.", ""]

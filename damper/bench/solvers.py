@@ -1,6 +1,6 @@
 """Sparse back ends on the contact condensation: cold time of the same case per back end.
 
-The goal of issue 13: the 41x41 sphere (normal + tangential condensation, real
+The goal: the 41x41 sphere (normal + tangential condensation, real
 bodies) with the pip-only fast solver within 1.5x of the system's CHOLMOD,
 measured in the same run. Each back end runs ``damper tangential`` cold (no
 cache) in its own child process with ``DAMPER_SOLVER`` set; the error column is

@@ -7,14 +7,18 @@ Each subcommand lives in its own module of this package and exposes
 
 Exit codes: 0 success, 2 bad input (``ValueError``, ``OSError``: a clear
 message on stderr, nothing written), 3 a solver that did not converge
-(``RuntimeError``).
+(``RuntimeError``), 130 interrupted (Ctrl-C: one line saying where).
+Warnings (numpy's overflow, a library's note) print as one line each, once per
+message, however often their cause repeats.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
 import os
+import re
 import sys
+import warnings
 
 # Small dense work (contact compliances, AFT) runs slower with two BLAS threads than
 # with one on the 2-core machines we measure on (bem 41x41 tangential: 3.2 s vs 1.9 s);
@@ -33,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Friction-damper design toolkit: contact stiffness and virgin "
         "curves (FE), the Masing/Iwan friction element, harmonic balance.",
     )
+    parser.add_argument("--version", action="version", version=f"damper {version()}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in SUBCOMMANDS:
@@ -46,18 +51,66 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def version() -> str:
+    """The installed package's version, with the git revision of the code when there is one."""
+    from importlib import metadata
+
+    try:
+        text = metadata.version("damper-toolkit")
+    except metadata.PackageNotFoundError:
+        text = "unknown"
+    from damper.provenance import git_revision
+
+    rev = git_revision()
+    if rev.get("commit"):
+        text += f" (git {rev['commit'][:12]}{', modified' if rev.get('dirty') else ''})"
+    return text
+
+
+def _one_line_warnings(command: str) -> None:
+    """Each distinct warning once, as one line naming the command (no source line, no repeats)."""
+    seen = set()
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        text = " ".join(str(message).split())
+        if (category, text) not in seen:
+            seen.add((category, text))
+            print(f"damper {command}: warning: {text} ({category.__name__})", file=file or sys.stderr)
+
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``damper`` command; return the process exit code."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    command = "damper"
     try:
-        return int(args.func(args) or 0)
-    except (ValueError, OSError) as err:
-        print(f"damper {args.command}: error: {err}", file=sys.stderr)
-        return 2
-    except RuntimeError as err:
-        print(f"damper {args.command}: failed: {err}", file=sys.stderr)
-        return 3
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        command = args.command
+        _one_line_warnings(command)
+        try:
+            return int(args.func(args) or 0)
+        except (ValueError, OSError) as err:
+            print(f"damper {command}: error: {_text(err)}", file=sys.stderr)
+            return 2
+        except RuntimeError as err:
+            print(f"damper {command}: failed: {_text(err)}", file=sys.stderr)
+            return 3
+    except KeyboardInterrupt as err:
+        where = getattr(err, "message", "")
+        print(f"damper {command}: {where or 'interrupted'}", file=sys.stderr)
+        return 130
+
+
+def _text(err: BaseException) -> str:
+    """One line of an error's message (an OSError without its errno prefix)."""
+    if isinstance(err, OSError) and err.strerror and err.filename:
+        text = f"{err.filename}: {err.strerror}"
+    else:
+        text = str(err) or type(err).__name__
+    # a numpy scalar's repr (np.float64(7.0)) reads as the plain number it is
+    text = re.sub(r"np\.(?:float|int|uint|bool_?)\d*\(([^()]*)\)", r"\1", text)
+    return " ".join(text.split())
 
 
 if __name__ == "__main__":  # pragma: no cover

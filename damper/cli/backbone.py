@@ -20,6 +20,7 @@ artificial negative damping), ``damping_ratio`` (xi / (2 omega)), ``amplitude``
 from __future__ import annotations
 
 import argparse
+import math
 
 
 def register(subparsers) -> None:
@@ -40,13 +41,21 @@ def register(subparsers) -> None:
 
 
 def run(args) -> int:
+    from damper import limits
     from harmonic_balance.epmc import EPMCError, compute_backbone
 
-    from .common import atomic_write, dumps, print_json
-    from .frf import build_model
+    from .common import atomic_write, check_out_file, dumps, print_json
+    from .frf import build_model, check_model_arguments, check_samples
 
-    if args.samples < 0:
-        raise ValueError("--samples must be >= 0")
+    check_model_arguments(args)
+    limits.check_harmonics("--harmonics", args.harmonics)
+    check_samples(args.samples)
+    a0, a1 = args.amplitude
+    if not (math.isfinite(a0) and math.isfinite(a1) and a0 > 0 and a1 > 0 and a0 != a1):
+        raise ValueError(f"--amplitude {a0:g} {a1:g}: give two different positive finite amplitudes")
+    if args.mode < 0:
+        raise ValueError(f"--mode must be >= 0 (0 is the first mode), got {args.mode}")
+    check_out_file(args.out, "--out")
     model = build_model(args)
     try:
         bb = compute_backbone(model, args.harmonics, args.amplitude, n_t=args.samples,

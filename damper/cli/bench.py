@@ -1,4 +1,4 @@
-"""``damper bench``: every stage's accuracy against cost in one run, one report (issue 13).
+"""``damper bench``: every stage's accuracy against cost in one run, one report.
 
 Writes DIR/bench.json (``stages``: stage -> rows {case, size, error, time_s,
 memory_mb, cached}, plus the run's stamp) and DIR/bench.html (a plot of error
@@ -37,7 +37,10 @@ def run(args) -> int:
     names = args.stage or [n for n in funcs if n != "solvers" or args.solvers]
     bad = [n for n in names if n not in funcs]
     if bad:
-        raise ValueError(f"unknown stage(s) {bad}: use {', '.join(funcs)}")
+        raise ValueError(f"unknown stage(s) {', '.join(bad)}: use {', '.join(funcs)}")
+    from .common import check_out_dir
+
+    check_out_dir(args.out, "--out")
     result = {"stamp": stamp(), "quick": args.quick, "stages": {}}
     with tempfile.TemporaryDirectory(prefix="damper_bench_") as work:
         for name in names:

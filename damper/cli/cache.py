@@ -7,7 +7,8 @@ Examples::
 
 Location: ``--cache-dir``, else ``$DAMPER_CACHE_DIR``, else ``.damper_cache``; size
 limit ``--cache-max-mb``, else ``$DAMPER_CACHE_MAX_MB``, else 4096 MiB (least recently
-used entries are evicted first).
+used entries are evicted first). The folder holds a ``CACHEDIR.TAG``; ``clear`` removes
+only ``entry-*.damper-cache`` files of a tagged folder and refuses any other folder.
 """
 from __future__ import annotations
 
@@ -23,12 +24,15 @@ def add_cache_options(p) -> None:
 
 def store_from_args(args):
     """The Store the options name."""
+    import math
+
     from damper.cache import Store
 
     limit = getattr(args, "cache_max_mb", None)
-    if limit is not None and not limit > 0:
-        raise ValueError(f"--cache-max-mb must be > 0, got {limit}")
-    return Store(args.cache_dir, None if limit is None else int(limit * 2**20))
+    if limit is not None and not (limit > 0 and math.isfinite(limit)):
+        raise ValueError(f"--cache-max-mb must be a positive finite number of MiB, got {limit:g}")
+    return Store(args.cache_dir, None if limit is None else int(limit * 2**20),
+                 memory=getattr(args, "no_cache", False))
 
 
 def register(subparsers) -> None:
@@ -55,6 +59,8 @@ def run(args) -> int:
     info = store.info()
     if args.json:
         print_json(info)
+    elif not store.owned():
+        print(f"{info['folder']}: not a damper cache (no CACHEDIR.TAG)")
     else:
         print(f"{info['folder']}: {info['entries']} entries, {info['bytes'] / 2**20:.1f} MiB "
               f"of {info['max_bytes'] / 2**20:.0f} MiB"

@@ -1,7 +1,9 @@
-"""Helpers shared by the subcommands: JSON output and all-or-nothing file writes."""
+"""Helpers shared by the subcommands: JSON output, all-or-nothing file writes, output paths
+checked before any work."""
 from __future__ import annotations
 
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -33,3 +35,38 @@ def dumps(obj, indent: int | None = None) -> str:
 def print_json(obj) -> None:
     """Print one JSON object on stdout."""
     sys.stdout.write(dumps(obj) + "\n")
+
+
+def _writable_parent(path: Path, flag: str) -> None:
+    """The nearest existing folder above ``path`` must be a folder this user can write."""
+    probe = path.parent
+    while not probe.exists() and probe != probe.parent:
+        probe = probe.parent
+    if not probe.is_dir():
+        raise ValueError(f"{flag} {path}: {probe} is a file, not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise ValueError(f"{flag} {path}: cannot write in {probe} (permission denied)")
+
+
+def check_out_file(path, flag: str) -> None:
+    """Refuse, before any work, an output file that cannot be written (a folder, no permission)."""
+    if path is None:
+        return
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{flag} {path}: that is a folder; give a file name")
+    _writable_parent(path, flag)
+
+
+def check_out_dir(path, flag: str) -> None:
+    """Refuse, before any work, an output folder that cannot be written (a file, no permission)."""
+    if path is None:
+        return
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{flag} {path}: a file of that name exists; give a folder")
+    if path.is_dir():
+        if not os.access(path, os.W_OK | os.X_OK):
+            raise ValueError(f"{flag} {path}: cannot write in this folder (permission denied)")
+        return
+    _writable_parent(path, flag)

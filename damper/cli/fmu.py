@@ -58,6 +58,11 @@ def run(args) -> int:
     """Read the curve (and the normal law), build and write the FMU; print its path."""
     from contact_core.curve import read_curve
 
+    from .common import check_out_file
+
+    if args.n_ref is not None and not (args.n_ref > 0 and args.n_ref < float("inf")):
+        raise ValueError(f"--n-ref must be a positive finite normal load [N], got {args.n_ref:g}")
+    check_out_file(args.output, "--output")
     source = read_curve(args.curve)
     n_ref = args.n_ref if args.n_ref is not None else source.N
     if n_ref is None:
@@ -77,7 +82,10 @@ def _run_element(args, source, n_ref) -> int:
     from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_build import build_fmu
 
-    curve, error = reduce_virgin_curve(source, fit=args.fit)
+    try:
+        curve, error = reduce_virgin_curve(source, fit=args.fit)
+    except ValueError as err:
+        raise ValueError(f"{args.curve}: {err}") from None
     reduced = (f", reduced from {source.u.size} points, largest force error {error:.3g} N"
                if curve is not source else "")
     description = (f"Masing/Iwan friction element from the virgin curve {args.curve} "
@@ -129,7 +137,10 @@ def _run_point(args, source, n_ref) -> int:
     if args.preload is not None and not (args.preload > 0 and args.preload < float("inf")):
         raise ValueError(f"--preload must be finite and > 0, got {args.preload}")
     p, N, normal_text, law = _normal_law(args, n_ref)
-    curve, error = reduce_virgin_curve(source, fit=args.fit)
+    try:
+        curve, error = reduce_virgin_curve(source, fit=args.fit)
+    except ValueError as err:
+        raise ValueError(f"{args.curve}: {err}") from None
     preload = n_ref if args.preload is None else args.preload
     description = (f"3D contact point: 2D Masing/Iwan element from the virgin curve {args.curve} "
                    f"({curve.u.size} points, N_ref = {n_ref:g} N) and the normal law of the {law}; "

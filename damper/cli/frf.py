@@ -72,15 +72,55 @@ def add_model_arguments(p) -> None:
     p.add_argument("--model", required=True, help="'sdof' or a matrices .npz file")
     p.add_argument("--elements", help="friction elements .toml (with a .npz model)")
     g = p.add_argument_group("sdof model (SI units)")
-    g.add_argument("--mass", type=float, default=1.0, help="mass [kg]")
-    g.add_argument("--stiffness", type=float, default=1.0, help="spring to ground [N/m]")
-    g.add_argument("--damping", type=float, default=0.01, help="dashpot [N s/m]")
-    g.add_argument("--contact-stiffness", type=float, default=1.0, help="Jenkins spring [N/m]")
-    g.add_argument("--slip-force", type=float, default=0.05, help="Jenkins slip force [N]")
-    g.add_argument("--force", type=float, default=0.05, help="excitation amplitude [N]")
-    p.add_argument("--force-scale", type=float, default=1.0,
-                   help="multiply the .npz excitation by this factor")
+    for flag, what in (("--mass", "mass [kg]"), ("--stiffness", "spring to ground [N/m]"),
+                       ("--damping", "dashpot [N s/m]"), ("--contact-stiffness", "Jenkins spring [N/m]"),
+                       ("--slip-force", "Jenkins slip force [N]"), ("--force", "excitation amplitude [N]")):
+        g.add_argument(flag, type=float, default=None, help=f"{what} (default {SDOF[flag]:g})")
+    p.add_argument("--force-scale", type=float, default=None,
+                   help="multiply the .npz excitation by this factor (default 1)")
     p.add_argument("--response-dof", type=int, help="DOF reported (default: the file's, or 0)")
+
+
+#: The sdof model's options and their defaults.
+SDOF = {"--mass": 1.0, "--stiffness": 1.0, "--damping": 0.01, "--contact-stiffness": 1.0,
+        "--slip-force": 0.05, "--force": 0.05}
+
+
+def _dest(flag: str) -> str:
+    return flag[2:].replace("-", "_")
+
+
+def check_model_arguments(args) -> None:
+    """Refuse, before any work, options that do not apply to the model (and fill the sdof defaults)."""
+    from damper import limits
+
+    if args.model == "sdof":
+        for flag in ("--elements", "--force-scale"):
+            if getattr(args, _dest(flag)) is not None:
+                raise ValueError(f"{flag} applies to a .npz model, not to sdof")
+        if args.response_dof not in (None, 0):
+            raise ValueError(f"--response-dof {args.response_dof}: the sdof model has one DOF (0)")
+        for flag, value in SDOF.items():
+            v = getattr(args, _dest(flag))
+            if v is None:
+                setattr(args, _dest(flag), value)
+            elif not math.isfinite(v):
+                raise ValueError(f"{flag} must be finite, got {v:g}")
+            elif abs(v) > limits.MAX_MAGNITUDE:
+                raise ValueError(f"{flag} {v:g} is beyond the limit {limits.MAX_MAGNITUDE:g}: the harmonic "
+                                 "balance squares forces and displacements, which overflows above ~1e154")
+        return
+    given = [flag for flag in SDOF if getattr(args, _dest(flag)) is not None]
+    if given:
+        raise ValueError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to --model sdof only; "
+                         f"the .npz file {args.model} holds the structure and its excitation (--force-scale)")
+    if not args.elements:
+        raise ValueError("a .npz model needs --elements FILE.toml")
+    if args.force_scale is None:
+        args.force_scale = 1.0
+    if not (math.isfinite(args.force_scale) and abs(args.force_scale) <= limits.MAX_MAGNITUDE):
+        raise ValueError(f"--force-scale must be finite and at most {limits.MAX_MAGNITUDE:g} in magnitude, "
+                         f"got {args.force_scale:g}")
 
 
 def build_model(args):
@@ -89,15 +129,10 @@ def build_model(args):
 
     from harmonic_balance.model import Model, load_elements, load_matrices, sdof_model
 
+    check_model_arguments(args)
     if args.model == "sdof":
-        if args.elements:
-            raise ValueError("--elements goes with a .npz model, not sdof")
         return sdof_model(args.mass, args.stiffness, args.damping, args.contact_stiffness,
                           args.slip_force, args.force)
-    if not args.elements:
-        raise ValueError("a .npz model needs --elements FILE.toml")
-    if not math.isfinite(args.force_scale):
-        raise ValueError("--force-scale must be finite")
     lin, forcing, resp = load_matrices(args.model)
     forcing = {h: args.force_scale * np.asarray(f, dtype=complex) for h, f in forcing.items()}
     resp = resp if args.response_dof is None else args.response_dof
@@ -112,12 +147,9 @@ def run(args) -> int:
 
     from .common import atomic_write, dumps, print_json
 
-    if args.model == "sdof" and args.response_dof not in (None, 0):
-        raise ValueError("the sdof model has one DOF (0)")
+    check_run_arguments(args)
     steps = {k: v for k, v in (("ds_max", args.max_step), ("tolerance", args.tolerance))
              if v is not None}
-    if args.max_points < 2 or args.samples < 0:
-        raise ValueError("--max-points must be >= 2 and --samples >= 0")
     model = build_model(args)
     _report_curve_fits(model)
     try:
@@ -138,6 +170,37 @@ def run(args) -> int:
         plot_frf(result, args.plot)
     _emit(args, summary, print_json, atomic_write, dumps)
     return 0
+
+
+def check_samples(samples: int) -> None:
+    """``--samples``: 0 (automatic) or a positive count up to the AFT bound."""
+    from damper import limits
+
+    if samples < 0:
+        raise ValueError(f"--samples must be 0 (automatic) or a positive number of samples, got {samples}")
+    if samples:
+        limits.check_size("--samples", samples, 1, limits.MAX_AFT_SAMPLES,
+                          "the AFT's DFT matrices hold n_t (2H + 1) numbers each (0.2 GB at 65536 x 401)")
+
+
+def check_run_arguments(args) -> None:
+    """Sizes and ranges of ``damper frf``, before any work (each bound names its reason)."""
+    from damper import limits
+    from damper.cli.common import check_out_dir, check_out_file
+
+    check_model_arguments(args)
+    limits.check_harmonics("--harmonics", args.harmonics)
+    check_samples(args.samples)
+    limits.check_omega_range("--omega", *args.omega)
+    if args.max_step is not None and not (math.isfinite(args.max_step) and args.max_step > 0):
+        raise ValueError(f"--max-step must be a positive finite number, got {args.max_step:g}")
+    if args.tolerance is not None and not 1e-6 <= args.tolerance < 1:
+        raise ValueError(f"--tolerance must be in [1e-6, 1) (a relative curve accuracy; finer "
+                         f"steps would resolve the corrector's own accuracy), got {args.tolerance:g}")
+    limits.check_size("--max-points", args.max_points, 2, limits.MAX_CURVE_POINTS,
+                      "each point is a Newton solve (5-50 ms for one DOF, seconds for large models)")
+    check_out_file(args.out, "--out")
+    check_out_dir(args.plot, "--plot")
 
 
 def _report_curve_fits(model) -> None:

@@ -16,7 +16,13 @@ reduced by the min-max optimal fit; the resulting largest force error is printed
 
 Output (JSON with ``--json``): ``energy_per_cycle`` [J], ``force_amplitude`` [N]
 (half the force range), ``displacement_amplitude`` [m], ``u`` [m] and ``F`` [N]
-(the closed loop, n samples), and the element's data.
+(the closed loop, n samples), ``initial_stiffness`` (the stuck stiffness, every
+slider's spring plus k_res) [N/m], ``input_bound`` [m], and the element's data.
+
+Amplitudes are bounded as the element's FMU bounds its input (``input_bound``,
+``fmu_src.fmu_build``): beyond 1e-6 r_min / eps (r_min the smallest slip distance at
+N) the round-off of a slider force exceeds 1e-6 of its strength, so larger
+amplitudes are refused rather than answered with forces above mu N.
 """
 from __future__ import annotations
 
@@ -56,10 +62,28 @@ def _check_args(args) -> None:
         raise ValueError(f"--amplitude must be > 0, got {args.amplitude}")
     if args.force_amplitude is not None and not args.force_amplitude > 0.0:
         raise ValueError(f"--force-amplitude must be > 0, got {args.force_amplitude}")
-    if args.samples < 4:
-        raise ValueError(f"--samples must be >= 4, got {args.samples}")
+    from damper import limits
+
+    from .common import check_out_dir
+
+    limits.check_size("--samples", args.samples, 4, limits.MAX_LOOP_SAMPLES,
+                      "1e6 samples take ~4 s and 0.24 GB (and 40 MB of JSON)")
     if args.N is not None and not args.N > 0.0:
-        raise ValueError(f"--N must be > 0 (N <= 0 is lift-off: no loop), got {args.N}")
+        raise ValueError(f"--N must be > 0 (N <= 0 is lift-off: no loop), got {args.N:g}")
+    if not args.scale > 0.0:
+        raise ValueError(f"--scale must be > 0 (a friction scale), got {args.scale:g}")
+    check_out_dir(args.plot, "--plot")
+
+
+def amplitude_bound(el, N: float) -> float:
+    """Largest displacement amplitude [m] the element resolves at N (its FMU's input bound at N)."""
+    import numpy as np
+
+    from fmu_src.fmu_build import U_BOUND_RTOL
+
+    if el.n_sliders == 0:
+        return float("inf")
+    return U_BOUND_RTOL * float(np.min(el.slip_radii(N))) / float(np.finfo(float).eps)
 
 
 def build_element(curve, fit: str, scale: float):
@@ -98,10 +122,18 @@ def run(args) -> int:
 
     _check_args(args)
     curve = read_curve(args.curve)
-    el, tail = build_element(curve, args.fit, args.scale)
+    try:
+        el, tail = build_element(curve, args.fit, args.scale)
+    except ValueError as err:
+        raise ValueError(f"{args.curve}: {err}") from None
     N = args.N if args.N is not None else el.N_ref
+    bound = amplitude_bound(el, N)
     if args.amplitude is not None:
         a = args.amplitude
+        if a > bound:
+            raise ValueError(f"--amplitude {a:g} m is beyond the element's bound {bound:.4g} m at N = {N:g} N "
+                             f"(its FMU's input bound: beyond it double precision cannot resolve the smallest "
+                             f"slip distance {float(np.min(el.slip_radii(N))):.3g} m); give at most {bound:.4g} m")
     else:
         a = amplitude_for_force(el, args.force_amplitude, N)
     u = a * np.cos(2.0 * np.pi * np.arange(args.samples) / args.samples)
@@ -109,7 +141,8 @@ def run(args) -> int:
     result = {
         "energy_per_cycle": loop.W_cycle, "force_amplitude": 0.5 * float(np.ptp(loop.F)),
         "displacement_amplitude": a, "N": N, "N_ref": el.N_ref, "scale": el.scale,
-        "n_sliders": el.n_sliders, "k_res": el.k_res, "initial_stiffness": float(loop.kt.max()),
+        "n_sliders": el.n_sliders, "k_res": el.k_res, "initial_stiffness": float(np.sum(el.k) + el.k_res),
+        "input_bound": bound if math.isfinite(bound) else None,
         "gross_slip_force": el.gross_slip_force(N), "gross_slip_tail": tail,
         "samples": args.samples, "u": u, "F": loop.F,
         "curve_points": int(curve.u.size), "fit_error": el.fit_error,

@@ -94,9 +94,17 @@ def spec_from_args(args):
 
     radius = _radius(args)
     given = {"radius": radius, "length": args.length, "width": args.width}
-    for name, flag in _GEOMETRY_FLAGS.items():  # the body kind says what it needs
-        if name in bodies.get(args.body).required and given[name] is None:
+    for name, flag in _GEOMETRY_FLAGS.items():  # the body kind says what it needs, and no more
+        needed = name in bodies.get(args.body).required
+        if needed and given[name] is None:
             raise ValueError(f"--body {args.body} needs {flag}")
+        if not needed and given[name] is not None:
+            raise ValueError(f"{flag} does not apply to --body {args.body} (it takes "
+                             f"{', '.join(_GEOMETRY_FLAGS[n] for n in bodies.get(args.body).required)})")
+    if getattr(args, "height", None) is not None and args.body != "flat":
+        raise ValueError(f"--height applies to the flat face only, not to --body {args.body}")
+    if args.p_design is not None and not (0 < args.p_design < float("inf")):
+        raise ValueError(f"--p-design must be a positive finite pressure [Pa], got {args.p_design:g}")
     if args.force is not None and not args.force > 0:
         raise ValueError(f"--force must be positive, got {args.force}")
     if args.approach is not None and not args.approach > 0:
@@ -159,15 +167,17 @@ def run(args) -> int:
     from contact_core import api
     from damper.cache import Store
 
-    # the application's store (same folder and format as contact_core's DiskCache) keeps
-    # the cache under its size limit ($DAMPER_CACHE_MAX_MB)
-    cache = False if args.no_cache else Store(args.cache_dir)
-    if args.stiffness or args.nodes:
+    check_options(args)
+    spec = None if (args.stiffness or args.nodes) else spec_from_args(args)
+    if spec is not None and args.eccentricity is not None:
+        spec.kind.check_eccentricity(spec, args.eccentricity)
+    # the application's store keeps the cache under its size limit ($DAMPER_CACHE_MAX_MB)
+    cache = False if args.no_cache else Store(args.cache_dir).prepare()
+    if spec is None:
         from contact_core import byo
         result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,
                                     args.approach, cache)
     else:
-        spec = spec_from_args(args)
         points = args.curve or (NORMAL_CURVE_POINTS if args.normal_curve else (8 if args.plot else 0))
         result = api.run_normal(spec, force=args.force, approach=args.approach,
                                 eccentricity=args.eccentricity, cache=cache, curve_points=points)
@@ -188,6 +198,40 @@ def run(args) -> int:
     else:
         _print_text(result)
     return 0
+
+
+#: Options that shape a generated body: they do not apply to imported ones (--stiffness).
+_BODY_ONLY = ("radius", "diameter", "length", "width", "height", "E2", "nu2", "p_design", "eccentricity")
+
+
+def check_options(args) -> None:
+    """Options that do not go together, sizes and output paths, refused before any work."""
+    import math
+
+    from damper import limits
+
+    from .common import check_out_dir, check_out_file
+
+    for name in ("force", "approach", "eccentricity", "radius", "diameter", "length", "width", "height",
+                 "E", "nu", "E2", "nu2", "p_design"):
+        v = getattr(args, name, None)
+        if v is not None and not math.isfinite(v):
+            raise ValueError(f"--{name.replace('_', '-')} must be finite, got {v:g}")
+    if bool(args.stiffness) != bool(args.nodes):
+        raise ValueError("--stiffness and --nodes go together (one stiffness file and one node file per body)")
+    if args.stiffness:
+        given = [f"--{n.replace('_', '-')}" for n in _BODY_ONLY if getattr(args, n, None) is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)}: the bodies come from --stiffness and --nodes; "
+                             "these options shape generated bodies only")
+    if args.eccentricity is not None and args.force is None:
+        raise ValueError("--eccentricity places the normal force: it needs --force, not --approach")
+    if args.curve:
+        limits.check_size("--curve", args.curve, 0, limits.MAX_APPROACH_POINTS,
+                          "each point of the F-approach curve is a normal solve")
+    check_out_file(args.out, "--out")
+    check_out_file(getattr(args, "normal_curve", None), "--normal-curve")
+    check_out_dir(args.plot, "--plot")
 
 
 def _print_text(r: dict) -> None:

@@ -11,7 +11,11 @@ scene exits with code 2 naming the key and the file line, and writes nothing. Th
 plan lists every stage with its action (compute, cached, skip) and why; the stages
 then run (a progress bar on a terminal, plain lines otherwise), every result goes to
 the shared content-addressed cache (``damper cache info``) and the output folder
-(``--out``, default ``out/<scene name>``) with its provenance.
+(``--out``, default ``out/<scene name>``) with its provenance. The output folder is
+written once every stage has finished: a run that fails or is interrupted (Ctrl-C: one
+line, exit code 130) writes nothing there, and its finished stages are in the cache.
+``--no-cache`` keeps every result in memory for this run (nothing read from or written
+to the cache folder); a cache folder this user cannot write is read, not written.
 
 ``--json`` prints one object: ``stages`` (list of {name, action, reason}), and after a
 run ``outputs`` (wanted result -> file(s)) and ``times`` (stage -> seconds).
@@ -35,6 +39,8 @@ def register(subparsers) -> None:
     p.add_argument("--dry-run", action="store_true", help="print the plan only")
     p.add_argument("--force", action="append", default=[], metavar="STAGE",
                    help="recompute this stage (name or kind) and what depends on it; repeatable")
+    p.add_argument("--no-cache", action="store_true",
+                   help="neither read nor write the cache folder (results stay in memory for this run)")
     add_cache_options(p)
     p.set_defaults(func=run)
 
@@ -43,11 +49,15 @@ def run(args) -> int:
     from damper.run.runner import run_scene
     from damper.scene import load_scene
 
-    from .common import print_json
+    from .common import check_out_dir, print_json
 
+    if args.no_cache and args.cache_dir is not None:
+        raise ValueError("--no-cache and --cache-dir exclude each other")
     scene = load_scene(args.scene)
-    store = store_from_args(args)
     out = args.out if args.out is not None else Path("out") / Path(args.scene).stem
+    if not args.dry_run:
+        check_out_dir(out, "--out")
+    store = store_from_args(args).prepare()
     echo = (lambda text: print(text, file=sys.stderr)) if args.json else print
     progress = None
     if args.json:

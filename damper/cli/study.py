@@ -35,13 +35,19 @@ def register(subparsers) -> None:
 
 def run(args) -> int:
     """Run one study; print its table or JSON; plot as asked."""
-    if args.workers < 1:
-        raise ValueError("--workers must be >= 1")
+    from damper import limits
+    from damper.cache import Store
+
+    from .common import check_out_dir
+
+    limits.check_workers("--workers", args.workers)
+    check_out_dir(args.plot, "--plot")
+    store = Store(args.cache_dir).prepare()
     if args.name == "eccentric":
         from damper.studies import eccentric as study
     else:
         from damper.studies import cylinders as study
-    result = study.run(quick=args.quick, cache_dir=args.cache_dir, workers=args.workers)
+    result = study.run(quick=args.quick, cache_dir=store, workers=args.workers)
     if args.name == "compression":
         result = {"quick": result["quick"], "grids": result["grids"], "models": result["compression"],
                   "sphere": result["compression_sphere"], "wall_time_s": result["wall_time_s"]}

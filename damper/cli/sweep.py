@@ -15,6 +15,12 @@ shared by the variants run once; every variant then runs as one task on a Dask l
 cluster (one worker per core, ``--workers``), an existing cluster (``--scheduler``),
 or in this process (``--serial``). Writes ``sweep.csv``, ``sweep.json`` and
 ``sweep.png`` into ``--out``; ``--json`` prints the table as one object.
+
+Every variant is validated before any work (a bad value: exit 2, nothing written). A
+variant that fails while it runs (a solver that does not converge) does not stop the
+others: its row has the message in the ``error`` column, the table is written, and the
+command exits with code 3 at the end; ``--fail-fast`` stops at the first failure instead.
+At most 1000 variants (each is one scene run).
 """
 from __future__ import annotations
 
@@ -48,6 +54,9 @@ def register(subparsers) -> None:
     p.add_argument("--workers", type=int, default=None, help="local cluster workers (default: cores)")
     p.add_argument("--serial", action="store_true", help="no Dask: run the tasks in this process")
     p.add_argument("--json", action="store_true", help="print the table as one JSON object")
+    p.add_argument("--fail-fast", action="store_true",
+                   help="stop at the first variant that fails (default: run every variant, report failures "
+                   "in the table's error column and exit with code 3)")
     add_cache_options(p)
     p.set_defaults(func=run, specs=None)
 
@@ -56,9 +65,10 @@ def specs_from(items) -> list[tuple[str, list]]:
     """[(param, values)] from the ordered --param/--values/--range items."""
     import numpy as np
 
+    from damper import limits
     from damper.sweep import parse_value
 
-    out, name = [], None
+    out, name, last = [], None, None
     for kind, v in items or []:
         if kind == "param":
             if name is not None:
@@ -66,40 +76,55 @@ def specs_from(items) -> list[tuple[str, list]]:
             name = v
             continue
         if name is None:
-            raise ValueError(f"--{kind} must follow a --param")
+            text = f"--{kind} {' '.join(v)}"
+            if last is None:
+                raise ValueError(f"{text}: give its --param KEY first")
+            raise ValueError(f"{text} has no --param of its own (--param {last} already has its values): "
+                             "give every --param one --values or --range")
         if kind == "values":
             out.append((name, [parse_value(t) for t in v]))
         else:
             try:
                 a, b, n = float(v[0]), float(v[1]), int(v[2])
             except ValueError:
-                raise ValueError(f"--range needs START STOP NUM (numbers, NUM an integer), got {v}") from None
-            if n < 1:
-                raise ValueError(f"--range NUM must be >= 1, got {n}")
+                raise ValueError(f"--range needs START STOP NUM (numbers, NUM an integer), got "
+                                 f"{' '.join(v)}") from None
+            if not (np.isfinite(a) and np.isfinite(b)):
+                raise ValueError(f"--range {' '.join(v)}: START and STOP must be finite")
+            limits.check_size("--range NUM", n, 1, limits.MAX_SWEEP_VARIANTS,
+                              "each value is one scene run (seconds to minutes)")
             out.append((name, [float(x) for x in np.linspace(a, b, n)]))
-        name = None
+        name, last = None, name
     if name is not None:
         raise ValueError(f"--param {name} has no --values or --range")
     return out
 
 
 def run(args) -> int:
+    from damper import limits
     from damper.sweep import run_sweep
 
-    from .common import print_json
+    from .common import check_out_dir, print_json
 
-    if args.workers is not None and args.workers < 1:
-        raise ValueError(f"--workers must be >= 1, got {args.workers}")
+    if args.workers is not None:
+        limits.check_workers("--workers", args.workers)
     specs = specs_from(args.specs)
-    store = store_from_args(args)
     out = args.out if args.out is not None else Path("out") / f"sweep_{Path(args.scene).stem}"
+    check_out_dir(out, "--out")
+    store = store_from_args(args).prepare()
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     rec = run_sweep(args.scene, specs, store, out, grid=not args.zip, scheduler=args.scheduler,
-                    workers=args.workers, serial=args.serial, echo=echo)
+                    workers=args.workers, serial=args.serial, echo=echo, fail_fast=args.fail_fast)
     if args.json:
         print_json(rec.to_json())
     else:
         for row in rec.rows:
-            print("  ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
+            print("  ".join(f"{k}={v:.6g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()
+                            if v is not None))
         print(f"results in {out}/ (sweep.csv, sweep.json, sweep.png); shared stages: {', '.join(rec.shared) or 'none'}")
+    failed = [r for r in rec.rows if r.get("error")]
+    if failed:
+        print(f"damper sweep: failed: {len(failed)} of {len(rec.rows)} variant(s) failed (the error column of "
+              f"{out / 'sweep.csv'} says why); the others are in the table", file=sys.stderr)
+        return 3
     return 0

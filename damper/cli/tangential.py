@@ -68,14 +68,17 @@ def run(args) -> int:
     from contact_core.curve import write_curve
     from contact_core.tangential_curve import CURVE_TOL
     from damper.cache import Store
-    from damper.cli.common import print_json
+    from damper.cli.common import check_out_dir, check_out_file, print_json
 
     _check_finite(args)
     spec = spec_from_args(args)
+    check_load_options(args, spec)
+    check_out_file(args.out, "--out")
+    check_out_dir(args.plot, "--plot")
     command = "damper " + " ".join(shlex.quote(a) for a in sys.argv[1:])
     result = tangential_run.run(spec, args.mu, force=args.force, approach=args.approach,
                                 eccentricity=args.eccentricity, model=args.model,
-                                cache=False if args.no_cache else Store(args.cache_dir),
+                                cache=False if args.no_cache else Store(args.cache_dir).prepare(),
                                 tol=CURVE_TOL if args.tol is None else args.tol, command=command)
     for warning in result.warnings:
         print(f"damper tangential: warning: {warning}", file=sys.stderr)
@@ -111,10 +114,31 @@ def _check_finite(args) -> None:
         v = getattr(args, name, None)
         if v is not None and not math.isfinite(v):
             raise ValueError(f"--{name.replace('_', '-')} must be finite, got {v}")
-    if args.mu < 0:
-        raise ValueError(f"--mu must be >= 0, got {args.mu}")
-    if args.tol is not None and not 0 < args.tol < 0.5:
-        raise ValueError(f"--tol must lie in (0, 0.5), got {args.tol}")
+    from damper import limits
+
+    if not args.mu > 0:
+        raise ValueError(f"--mu must be > 0 (a friction coefficient), got {args.mu:g}")
+    if args.mu > limits.MAX_MU:
+        raise ValueError(f"--mu {args.mu:g} is above the limit {limits.MAX_MU:g}: dry contacts have mu "
+                         "below a few; a larger value is a typo")
+    if args.tol is not None and not limits.MIN_CURVE_TOL <= args.tol < 0.5:
+        raise ValueError(f"--tol must lie in [{limits.MIN_CURVE_TOL:g}, 0.5), got {args.tol:g}: the curve's "
+                         "points grow as tol^-1/2 (1e-6: ~30 times the default 1e-3's)")
+    if args.loop_amplitude is not None and not args.loop_amplitude > 0:
+        raise ValueError(f"--loop-amplitude must be > 0, got {args.loop_amplitude:g}")
+
+
+def check_load_options(args, spec) -> None:
+    """Load options that do not go together, refused before the FE work."""
+    if args.eccentricity is not None:
+        if args.force is None:
+            raise ValueError("--eccentricity places the normal force: it needs --force (CNF), not --approach")
+        spec.kind.check_eccentricity(spec, args.eccentricity)
+    if args.tangential_force is not None and args.force is not None:
+        limit = args.mu * args.force
+        if abs(args.tangential_force) > limit:
+            raise ValueError(f"--tangential-force {args.tangential_force:g} N exceeds the gross-slip limit mu N = "
+                             f"{limit:g} N: no static solution in force control; give |T| <= {limit:g} N")
 
 
 def summary(result) -> dict:

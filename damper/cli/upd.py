@@ -79,18 +79,34 @@ def run_modes(args) -> int:
     return 0
 
 
-def run_frf(args) -> int:
-    from .common import print_json
+def _check_frf(args) -> None:
+    """Every option of ``upd frf``, before the model (or its contacts) is built."""
+    from damper import limits
 
-    sector = _sector(args)
-    cfg = sector.cfg
-    band = args.band or cfg["load.band_hz"]
-    if not (0 < band[0] < band[1]) or args.points < 3 or args.harmonics < 1:
-        raise ValueError("--band needs 0 < LO < HI, --points >= 3, --harmonics >= 1")
+    from .common import check_out_dir
+
+    if args.band is not None:
+        limits.check_omega_range("--band", *args.band, unit="Hz", scale=2 * np.pi)
+        if not args.band[0] < args.band[1]:
+            raise ValueError(f"--band {args.band[0]:g} {args.band[1]:g}: give LO < HI [Hz]")
+    limits.check_size("--points", args.points, 3, limits.MAX_UPD_POINTS,
+                      "each frequency point is a harmonic-balance solve (~7 ms at H = 7; 10000 points ~1 min)")
+    limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
+                      limits.harmonics_why(limits.MAX_UPD_HARMONICS))
     for name in ("cf", "f0"):
         v = getattr(args, name)
         if v is not None and not (np.isfinite(v) and v > 0):
-            raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v}")
+            raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
+    check_out_dir(args.plot, "--plot")
+
+
+def run_frf(args) -> int:
+    from .common import print_json
+
+    _check_frf(args)
+    sector = _sector(args)
+    cfg = sector.cfg
+    band = args.band or cfg["load.band_hz"]
     omegas = 2 * np.pi * np.linspace(band[0], band[1], args.points)
     if args.damper == "nonlinear":
         out = _frf_nonlinear(sector, args, omegas)
@@ -150,11 +166,31 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     return out
 
 
+def _check_optimize(args) -> None:
+    """Every option of ``upd optimize``, before the model (or its contacts) is built."""
+    from damper import limits
+
+    from .common import check_out_dir
+
+    lo, hi = args.cf_range
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI, both finite [N]")
+    limits.check_size("--points", args.points, 3, limits.MAX_LOAD_POINTS,
+                      "each CF value is a whole forced response (seconds)")
+    limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
+                      limits.harmonics_why(limits.MAX_UPD_HARMONICS))
+    limits.check_size("--grid", args.grid, 3, limits.MAX_UPD_GRID,
+                      "each frequency point is a harmonic-balance solve of the sector")
+    limits.check_workers("--workers", args.workers)
+    check_out_dir(args.plot, "--plot")
+
+
 def run_optimize(args) -> int:
     from harmonic_balance.bladed_disk.optimize import optimal_load
 
     from .common import print_json
 
+    _check_optimize(args)
     out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
                        workers=args.workers)
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}

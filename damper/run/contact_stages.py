@@ -60,7 +60,7 @@ class Condense(Kind):
         return out
 
     def is_cached(self, stage, store):
-        hit = store.get(stage.key) if store.contains(stage.key) else None
+        hit = store.get(stage.key, stage=self.name) if store.contains(stage.key) else None
         return hit is not None and all(store.contains(e) for e in _entries(hit[1]["data"]))
 
     def compute(self, stage, inputs, ctx):
@@ -79,7 +79,7 @@ class Condense(Kind):
                        "solver": meta.get("solver")})
 
     def _entries(self, stage, ctx):
-        hit = ctx.store.get(stage.key)
+        hit = ctx.store.get(stage.key, stage=self.name)
         return _entries(hit[1]["data"]) if hit else []
 
     def lines(self, stage, result):

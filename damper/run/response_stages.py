@@ -2,7 +2,7 @@
 
 One stage per excitation level, so adding a level computes only that curve and a
 changed structural damping recomputes the forced responses and nothing upstream.
-The blade-damper model (issue 15) joins as another structure ``model`` here.
+The blade-damper model joins as another structure ``model`` here.
 """
 from __future__ import annotations
 

@@ -7,7 +7,10 @@ Output folder (``--out``)::
     <stage>/result.json      the stage's data and provenance (scene hash, code version, inputs)
     <stage>/*.png, *.fmu     its plots and products
 
-Every file is written atomically; a scene that fails validation writes nothing.
+Every file is written atomically; a scene that fails validation writes nothing, and
+neither does a run that fails or is interrupted part-way (the output folder is written
+once every stage has finished, so it never shows a partial run as a whole one); the
+stages that finished are in the cache, so running again starts after them.
 """
 from __future__ import annotations
 
@@ -23,6 +26,14 @@ from damper.provenance import code_version, git_revision, record
 from .graph import Plan, Result, build_plan
 from .kinds import KINDS
 from .progress import Progress
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during a run: ``message`` says where, and that finished stages are cached."""
+
+    def __init__(self, message: str):
+        super().__init__(message)
+        self.message = message
 
 
 @dataclass
@@ -81,42 +92,54 @@ def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progres
     rec = RunRecord(scene, plan, out=Path(out) if out is not None else None)
     ctx = Context(store, scene, {s.name for s in plan.stages if s.forced}, progress.step)
     rec.provenance = record(scene=scene.source, scene_hash=scene.hash(), scene_content=scene.raw,
-                            cache=str(store.folder.resolve()))
+                            cache=None if store.memory else str(store.folder.resolve()))
+    current = None
     try:
         for s in plan.stages:
             if s.action == "skip":
                 continue
+            current = s.name
             progress.start(s.name, s.action)
             t0 = time.perf_counter()
             result = _load(s, store) if s.action == "cached" else None
             if result is None:
                 if s.action == "cached":
-                    s.action, s.reason = "compute", s.reason + " (entry vanished: recomputed)"
-                result = _compute(s, rec, ctx)
-                store.put(s.key, *result.encode(_stage_provenance(s, scene)))
+                    s.action, s.reason = "compute", s.reason + " (entry unreadable or gone: recomputed)"
+                result = _compute(s, rec, ctx, _after(rec, out) if out is not None else "")
+                store.put(s.key, *result.encode(_stage_provenance(s, scene)), stage=s.kind.name)
             rec.results[s.name] = result
             rec.times[s.name] = time.perf_counter() - t0
             progress.finish(s.name, rec.times[s.name])
             for line in s.kind.lines(s, result):
                 progress.echo(line)
-    finally:
-        if out is not None:
-            write_outputs(rec)
+    except KeyboardInterrupt:
+        raise Interrupted(f"interrupted in stage {current}{_after(rec, out)}") from None
+    if out is not None:
+        write_outputs(rec)
     return rec
 
 
-def _compute(s, rec: RunRecord, ctx: Context) -> Result:
+def _after(rec: RunRecord, out) -> str:
+    """What a failed or interrupted run leaves: the finished stages (cached), no output folder."""
+    done = list(rec.results)
+    where = "" if out is None else f"; nothing written to {out}/"
+    if not done:
+        return f" (no stage finished{where})"
+    return f" (after {len(done)} finished stage(s), the last {done[-1]}: they are cached{where})"
+
+
+def _compute(s, rec: RunRecord, ctx: Context, after: str = "") -> Result:
     """Run one stage; its errors keep their type (exit 2 bad input, 3 solver) and name the stage."""
     inputs = {d: rec.results[d] for d in s.deps if d in rec.results}
     try:
         return s.kind.compute(s, inputs, ctx)
     except (ValueError, RuntimeError) as err:
         base = ValueError if isinstance(err, ValueError) else RuntimeError
-        raise base(f"stage {s.name}: {err}") from err
+        raise base(f"stage {s.name}: {err}{after}") from err
 
 
 def _load(s, store: Store) -> Result | None:
-    hit = store.get(s.key)
+    hit = store.get(s.key, stage=s.kind.name)
     if hit is None:
         return None
     result, _ = Result.decode(*hit)

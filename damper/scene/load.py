@@ -13,7 +13,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import schema
+from . import checks, schema
 from .lines import key_lines, line_of
 
 
@@ -61,11 +61,18 @@ class Scene:
 def load_scene(path: str | Path, overrides: dict | None = None) -> Scene:
     """Read, override (``{"contact.damper.mu": 0.3}``) and validate the scene file ``path``."""
     path = Path(path)
+    return parse_scene(read_scene_text(path), str(path), overrides, base=path.parent)
+
+
+def read_scene_text(path: str | Path) -> str:
+    """The text of a scene file; SceneError naming the file if it cannot be read as text."""
+    path = Path(path)
     try:
-        text = path.read_text()
+        return path.read_text()
     except OSError as err:
-        raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror}")]) from None
-    return parse_scene(text, str(path), overrides, base=path.parent)
+        raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror or err}")]) from None
+    except UnicodeDecodeError:
+        raise SceneError(str(path), [("", None, "not a text file (a scene is TOML)")]) from None
 
 
 def parse_scene(text: str, source: str = "<scene>", overrides: dict | None = None,
@@ -136,6 +143,11 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         _check_structure(data, problems, base)
         _check_upd(data, problems, base)
         _check_wants(data, problems)
+    if not problems:   # what the stages would refuse only when they run
+        checks.check_contacts(data, problems)
+        checks.check_element(data, problems)
+        checks.check_response(data, problems)
+        checks.check_upd(data, problems)
     return data
 
 

@@ -37,12 +37,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from contact_core.spec import MAX_GRID
+from damper import limits
+
 
 @dataclass(frozen=True)
 class Field:
     """One key: its type ("float", "int", "str", "bool", "list[str]", "list[float]",
-    "list[int]"), whether it is required, its default, allowed values, a lower bound
-    (``gt``: strictly greater) and its documentation."""
+    "list[int]"), whether it is required, its default, allowed values, bounds (``gt``:
+    strictly greater; ``le``: the upper bound of a size, with ``why`` it is bounded) and
+    its documentation."""
 
     type: str
     doc: str
@@ -52,10 +56,12 @@ class Field:
     gt: float | None = None
     ge: float | None = None
     lt: float | None = None
+    le: float | None = None
+    why: str = ""
 
 
 #: Results a scene may want: name -> (producing stage kind, per contact?, doc).
-#: The blade-damper results (issue 15) join here with their stage kinds.
+#: The blade-damper results join here with their stage kinds.
 RESULTS = {
     "k_n": ("normal", True, "normal contact stiffness dN/d(approach), Hertz comparison"),
     "pressure_map": ("normal", True, "contact pressure map and area plots"),
@@ -70,7 +76,7 @@ RESULTS = {
                      "damper's centrifugal load CF and the optimal CF"),
     "report": ("report", False, "one-page HTML report of the run"),
 }
-#: Results named by the issues but not built yet: a scene that wants one is refused
+#: Results planned but not built yet: a scene that wants one is refused
 #: with this reason instead of an "unknown result".
 PLANNED: dict = {}
 
@@ -90,19 +96,23 @@ CONTACT = {
     "E2": Field("float", "Young's modulus of the plane [Pa]", gt=0),
     "nu2": Field("float", "Poisson's ratio of the plane", gt=-1, lt=0.5),
     "model": Field("str", "FE model variant", default="real", choices=("real", "halfspace")),
-    "grid": Field("int", "contact-zone nodes per side", default=21, ge=3),
+    "grid": Field("int", "contact-zone nodes per side", default=21, ge=3, le=MAX_GRID,
+                  why="81 nodes per side is ~0.25 M DOF per body and minutes of condensation; "
+                  "41 already gives a and p0 within 0.2 % of Hertz"),
     "p_design": Field("float", "design peak pressure sizing the contact zone [Pa]", default=2000e6, gt=0),
     "force": Field("float", "normal load [N] (constant normal force)", required=True, gt=0),
     "zone_load": Field("float", "load [N] the potential contact zone is sized to hold besides the design "
                        "pressure (default: force; 0: design pressure only, as the thesis, App. A.1.2)", ge=0),
-    "mu": Field("float", "friction coefficient", gt=0),
+    "mu": Field("float", "friction coefficient", gt=0, le=limits.MAX_MU,
+                why="dry contacts have mu below a few; a larger value is a typo"),
     "want": Field("list[str]", "this contact's results (default: the scene's contact results)"),
 }
 
 ELEMENT = {
     "contact": Field("str", "name of the contact whose virgin curve becomes the element", required=True),
     "loop_force_amplitude": Field("float", "force amplitude of the loop [N]", gt=0),
-    "loop_samples": Field("int", "samples per loop cycle", default=256, ge=4),
+    "loop_samples": Field("int", "samples per loop cycle", default=256, ge=4, le=limits.MAX_LOOP_SAMPLES,
+                          why="1e6 samples take ~4 s and 0.24 GB"),
     "fmi_versions": Field("list[int]", "FMI versions of the FMUs", default=[2, 3], choices=(2, 3)),
 }
 
@@ -126,10 +136,14 @@ EXCITATION = {
                     "force; one forced response each", required=True, gt=0),
 }
 
+_F_MAX = limits.MAX_OMEGA / (2 * math.pi)
+_F_WHY = "far above any structural mode, and omega^2 M must not overflow"
+
 SWEEP = {
-    "f_min": Field("float", "start frequency [Hz]", required=True, gt=0),
-    "f_max": Field("float", "end frequency [Hz]", required=True, gt=0),
-    "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1),
+    "f_min": Field("float", "start frequency [Hz]", required=True, gt=0, le=_F_MAX, why=_F_WHY),
+    "f_max": Field("float", "end frequency [Hz]", required=True, gt=0, le=_F_MAX, why=_F_WHY),
+    "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1, le=limits.MAX_HARMONICS,
+                       why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
                       "sizes the steps below it)", default=0.5, gt=0),
 }
@@ -142,9 +156,11 @@ BACKBONE = {
     "slip_force": Field("float", "jenkins: slip force of the element [N]", gt=0),
     "amplitude": Field("list[float]", "[start, end] mass-normalised modal amplitude [m sqrt(kg)]; "
                        "start small (the start is the stuck linear mode)", required=True, gt=0),
-    "harmonics": Field("int", "harmonics 0..H retained", default=3, ge=1),
+    "harmonics": Field("int", "harmonics 0..H retained", default=3, ge=1, le=limits.MAX_HARMONICS,
+                       why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "mode": Field("int", "mode of the stuck linear system (0-based)", default=0, ge=0),
-    "samples": Field("int", "AFT samples per period (0: automatic)", default=0, ge=0),
+    "samples": Field("int", "AFT samples per period (0: automatic)", default=0, ge=0,
+                     le=limits.MAX_AFT_SAMPLES, why="the AFT's DFT matrices hold n_t (2H + 1) numbers each"),
 }
 #: Keys each backbone element needs.
 BACKBONE_NEEDS = {"contact": (), "jenkins": ("contact_stiffness", "slip_force")}
@@ -154,9 +170,12 @@ UPD = {
                     "scene; default: the bundled UPD-24)"),
     "cf_range": Field("list[float]", "[low, high] centrifugal load CF of the damper [N], log-spaced",
                       default=[30.0, 3000.0], gt=0),
-    "points": Field("int", "number of CF values", default=20, ge=3),
-    "harmonics": Field("int", "highest harmonic", default=7, ge=1),
-    "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3),
+    "points": Field("int", "number of CF values", default=20, ge=3, le=limits.MAX_LOAD_POINTS,
+                    why="each CF value is a whole forced response (seconds)"),
+    "harmonics": Field("int", "highest harmonic", default=7, ge=1, le=limits.MAX_UPD_HARMONICS,
+                       why=limits.harmonics_why(limits.MAX_UPD_HARMONICS)),
+    "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3,
+                  le=limits.MAX_UPD_GRID, why="each point is a harmonic-balance solve of the sector"),
 }
 
 TOP = {
@@ -215,6 +234,8 @@ def _check_scalar(f: Field, scalar: str, v) -> str | None:
         return f"must be >= {f.ge:g}, got {v!r}"
     if f.lt is not None and not v < f.lt:
         return f"must be < {f.lt:g}, got {v!r}"
+    if f.le is not None and not v <= f.le:
+        return f"must be <= {f.le:g}, got {v!r}" + (f": {f.why}" if f.why else "")
     return None
 
 

@@ -1,4 +1,4 @@
-"""The grid of extreme but legal inputs (issue 13), stage by stage.
+"""The grid of extreme but legal inputs, stage by stage.
 
 A case is a ``damper`` command line (or the FMU child) plus what a correct
 outcome is: ``expect="converged"`` for legal inputs the tool must handle, or

@@ -21,7 +21,7 @@ import numpy as np
 
 from damper.bench.common import run_child
 
-from . import checks
+from . import checks, inputs
 from .cases import MU, N0, Case, all_cases
 
 #: Known failures: (stage, case name) -> the entry of /work/wt/notes/stress-findings.md
@@ -108,7 +108,7 @@ def run_case(case: Case, curves: dict[str, Path], work: Path) -> dict:
 def judge(row: dict) -> dict:
     """Set ``ok``, ``advice`` and ``known`` of a row from its outcome, expectation and message.
 
-    A legal input may be refused when the message says what to change (issue 13);
+    A legal input may be refused when the message says what to change;
     an input that must be refused needs only a message.
     """
     message = row["message"].removeprefix("error without advice: ")
@@ -122,11 +122,16 @@ def judge(row: dict) -> dict:
 
 
 def run(quick: bool = False, stages=None, log=print, match=None) -> list[dict]:
-    """Run the grid (``quick``: the marked subset; ``match``: cases whose name contains one of these texts)."""
+    """Run the grid (``quick``: the marked subset; ``match``: cases whose name contains one of these texts).
+
+    The input stage (:mod:`.inputs`, every case in the quick run too) runs first.
+    """
+    rows = inputs.run(log, match) if stages is None or "inputs" in stages else []
     cases = [c for c in all_cases() if (c.quick or not quick) and (stages is None or c.stage in stages)
              and (not match or any(m in c.name for m in match))]
+    if not cases:
+        return rows
     work = Path(tempfile.mkdtemp(prefix="damper_stress_"))
-    rows = []
     try:
         curves = make_curves(work)
         for i, case in enumerate(cases, 1):
@@ -140,7 +145,7 @@ def run(quick: bool = False, stages=None, log=print, match=None) -> list[dict]:
 
 
 def table(rows: list[dict]) -> str:
-    """Markdown table of the rows (what the README shows)."""
+    """Markdown table of the rows (DIR/stress.md)."""
     head = "| stage | case | outcome | expected | worst residual | time [s] | note |\n|---|---|---|---|---|---|---|\n"
     lines = []
     for r in rows:

@@ -208,8 +208,10 @@ def load_config(path=None) -> UPDConfig:
         path = Path(path)
         try:
             user = tomllib.loads(path.read_text())
-        except (OSError, tomllib.TOMLDecodeError) as err:
-            raise ValueError(f"cannot read config {path}: {err}") from None
+        except OSError as err:
+            raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
+        except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
+            raise ValueError(f"cannot read config {path} (TOML): {err}") from None
         for sec, table in user.items():
             if sec not in data or not isinstance(table, dict):
                 raise ValueError(f"config {path}: unknown section [{sec}] "

@@ -6,9 +6,9 @@ refined; after the first load only a narrow band around the predicted peak. The 
 Brent's bounded scalar search in log CF between the neighbours of the smallest grid
 value, each evaluation a refined peak. (casadi is not used: the objective is a
 maximum over frequency of a non-smooth branch, which a bounded scalar search on the
-refined peak handles directly; see the README.)
+refined peak handles directly.)
 
-Measured (README, UPD section): the objective is smooth and path-independent (warm
+Measured (README.md at revision c58d443, UPD section): the objective is smooth and path-independent (warm
 narrow grids equal independent full-band searches to 3e-5; n_t x4: 1e-4), but its
 minimum is flat, so the optimum CF depends on the harmonic truncation (H 5: 150 N,
 7: 131 N, 11-21: 135-141 N, ring time integration 138 N); hence ``optimum_band_cf``.
@@ -29,7 +29,7 @@ from .solve import frf
 #: Relative tolerance of the optimum CF (log-space Brent bracket).
 CF_XTOL = 1e-3
 #: Rise of the peak over the optimum that bounds the reported flat band (1 %): the
-#: optimum CF itself is ill-conditioned (the minimum is flat; README).
+#: optimum CF itself is ill-conditioned (the minimum is flat; README.md at revision c58d443).
 FLAT_BAND = 0.01
 #: Relative half-width of the band around the predicted peak.
 NARROW = 0.03

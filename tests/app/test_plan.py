@@ -1,5 +1,5 @@
 """The plan and the cache: only the stages a scene needs run, and only when their
-inputs or code changed (issue 12's plan tests, on a coarse 7x7 contact grid)."""
+inputs or code changed (on a coarse 7x7 contact grid)."""
 import json
 
 import pytest
@@ -129,12 +129,13 @@ def test_structure_from_a_matrices_file_equals_the_bundled_model(small_run, tmp_
         parse_scene(text, "m.toml", base=tmp_path / "elsewhere")
 
 
-def test_a_failing_stage_is_a_clear_message_naming_it(small_run, tmp_path, capsys):
+def test_a_loop_amplitude_above_mu_n_is_refused_before_any_stage_by_key_and_line(small_run, tmp_path, capsys):
     store, _, _ = small_run
     bad = tmp_path / "bad.toml"
     bad.write_text(TEXT.replace("loop_force_amplitude = 40.0", "loop_force_amplitude = 70.0"))  # mu N = 60 N
+    writes = len(store.entries())
     code = damper(["run", str(bad), "--out", str(tmp_path / "out"), "--cache-dir", str(store.folder)])
     err = capsys.readouterr().err
-    assert code == 2 and "stage loop: force amplitude 70 N is not below the gross-slip force 60 N" in err
-    assert "Traceback" not in err
-    assert (tmp_path / "out" / "tangential_damper" / "curve.json").is_file()   # finished stages kept
+    assert code == 2 and "bad.toml:16: element.loop_force_amplitude: 70 N is not below the gross-slip force" in err
+    assert "Traceback" not in err and err.count("\n") == 1
+    assert not (tmp_path / "out").exists() and len(store.entries()) == writes   # nothing written

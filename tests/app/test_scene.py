@@ -90,8 +90,10 @@ def test_key_lines_of_nested_tables_and_multiline_arrays():
 
 
 def test_overrides_are_checked_like_the_file():
-    s = parse_scene(SMALL, overrides={"contact.damper.mu": 0.3})
-    assert s.data["contact"]["damper"]["mu"] == 0.3
+    s = parse_scene(SMALL, overrides={"contact.damper.mu": 0.4})
+    assert s.data["contact"]["damper"]["mu"] == 0.4
+    with pytest.raises(SceneError, match="element.loop_force_amplitude: 40 N is not below the gross-slip force"):
+        parse_scene(SMALL, overrides={"contact.damper.mu": 0.3})      # mu N = 36 N
     with pytest.raises(SceneError, match="contact.damper.mu: must be a number"):
         parse_scene(SMALL, overrides={"contact.damper.mu": "high"})
     with pytest.raises(SceneError, match="not a scene parameter"):

@@ -1,5 +1,5 @@
 """`damper bench --quick`: every stage gives rows of the documented shape, errors against
-their references are small where the physics says they must be (issue 13)."""
+their references are small where the physics says they must be."""
 import json
 
 import pytest

@@ -1,4 +1,4 @@
-"""Every available sparse back end gives the same condensed compliance (issue 13).
+"""Every available sparse back end gives the same condensed compliance.
 
 The reference is an independent dense computation: the rows and columns of the
 contact DOFs of K^-1 from numpy's dense inverse of a small FE stiffness.

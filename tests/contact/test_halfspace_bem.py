@@ -1,6 +1,7 @@
 """Half-space influence coefficients: closed forms against quadrature and point-force limits."""
 import numpy as np
 import pytest
+from refcheck import check
 from scipy import integrate
 
 from contact_core import halfspace_bem as hb
@@ -51,9 +52,11 @@ def test_far_cells_act_as_boussinesq_and_cerruti_point_forces():
     i, j = 0, grid.x.size - 1  # opposite corners: ~40 cells apart
     X, Y = grid.x[i] - grid.x[j], grid.y[i] - grid.y[j]
     rho = np.hypot(X, Y)
-    assert Czz[i, j] == pytest.approx((1 - NU**2) / (np.pi * E * rho), rel=FAR_RTOL)
+    check("normal influence coefficient [m/N], cells ~40 apart", Czz[i, j], (1 - NU**2) / (np.pi * E * rho),
+          rtol=FAR_RTOL, source="Boussinesq point force (Johnson 1985, ch. 3)")
     cerruti = ((1 - NU) / rho + NU * X**2 / rho**3) / (2 * np.pi * G)
-    assert Cxx[i, j] == pytest.approx(cerruti, rel=FAR_RTOL)
+    check("tangential influence coefficient [m/N], cells ~40 apart", Cxx[i, j], cerruti, rtol=FAR_RTOL,
+          source="Cerruti point force (Johnson 1985, ch. 3)")
 
 
 def test_compliances_are_reciprocal_and_positive_definite():
@@ -76,7 +79,8 @@ def test_uniform_pressure_on_a_square_gives_love_centre_displacement():
     centre = grid.x.size // 2
     w = Czz[centre] @ (p * grid.area)
     love = 4 * np.log(1 + np.sqrt(2)) * 2 * c * p * (1 - NU**2) / (np.pi * E)
-    assert w == pytest.approx(love, rel=1e-12)
+    check("centre displacement [m] of a uniformly loaded square, 15x15 cells", w, love, rtol=1e-12,
+          source="Love 1929")
 
 
 @pytest.mark.parametrize("bad", [dict(radius=-1.0), dict(half_width=0.0), dict(radius=np.nan)])

@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from refcheck import check
 from scipy import optimize
 
 from contact_core import api, assembly, hertz, mesh, normal, report
@@ -15,7 +16,7 @@ from damper.cli import main as damper
 
 F_SPHERE = 200.0
 F_CYL = 350.0
-#: Contact radius and peak pressure against Hertz (issue 2 asked 2 %). Measured
+#: Contact radius and peak pressure against Hertz (the goal was 2 %). Measured
 #: on the 21-node grid: a -0.40 % (real), -0.43 % (half-space), -0.24 %
 #: (dissimilar, 15 nodes); p0 within 0.05 %.
 HERTZ_RTOL = 0.0065
@@ -49,10 +50,14 @@ def test_sphere_matches_hertz(condensed, specs, name):
     sol = normal.solve_force(cc, F_SPHERE)
     out = report.summarize(cc, sol, "sphere")
     ref = hertz.sphere(F_SPHERE, specs[name].radius, specs[name].Estar)
-    assert out["contact_radius"] == pytest.approx(ref["a"], rel=HERTZ_RTOL)
-    assert out["p_max"] == pytest.approx(ref["p0"], rel=HERTZ_RTOL)
-    assert out["approach"] == pytest.approx(ref["approach"], rel=APPROACH_RTOL)
-    assert out["k_n"] == pytest.approx(2 * specs[name].Estar * out["contact_radius"], rel=KN_RTOL)
+    case = f"sphere R = 10 mm, {F_SPHERE:g} N, {name.split('_')[1]} bodies, grid {specs[name].grid}"
+    hz = "Hertz (Johnson 1985, ch. 4)"
+    check(f"contact radius a [m], {case}", out["contact_radius"], ref["a"], rtol=HERTZ_RTOL, source=hz)
+    check(f"peak pressure p0 [Pa], {case}", out["p_max"], ref["p0"], rtol=HERTZ_RTOL, source=hz)
+    check(f"approach [m], {case}", out["approach"], ref["approach"], rtol=APPROACH_RTOL,
+          source="Hertz half-space a^2/R (finite bodies are stiffer)")
+    check(f"k_n [N/m], {case}", out["k_n"], 2 * specs[name].Estar * out["contact_radius"], rtol=KN_RTOL,
+          source="Hertz k_n = 2 E* a")
     assert out["iterations"] >= 1 and not out["zone_edge_in_contact"]
     if name == "sphere_real":  # thesis 2.2.5: the sphere's own compression is < 8 %
         assert 0 < out["body1_share_far"] < 0.08
@@ -99,8 +104,10 @@ def test_cylinder_mid_length_matches_2d_hertz_with_edge_peak(condensed, specs):
     out = report.summarize(cc, normal.solve_force(cc, F_CYL), "cylinder")
     spec = specs["cylinder_real"]
     ref = hertz.cylinder(F_CYL, spec.length, spec.radius, spec.Estar)
-    assert out["contact_halfwidth"] == pytest.approx(ref["b"], rel=CYL_RTOL)
-    assert out["p_mid_max"] == pytest.approx(ref["p0"], rel=CYL_RTOL)
+    case = f"cylinder D = 5 mm, L = 1.2 mm, {F_CYL:g} N, mid-length, grid {spec.grid}"
+    hz = "2D Hertz, plane strain (Johnson 1985, ch. 4)"
+    check(f"contact half-width b [m], {case}", out["contact_halfwidth"], ref["b"], rtol=CYL_RTOL, source=hz)
+    check(f"peak pressure p0 [Pa], {case}", out["p_mid_max"], ref["p0"], rtol=CYL_RTOL, source=hz)
     assert out["p_end_max"] > EDGE_PEAK_RATIO * out["p_mid_max"]
     assert out["contact_halfwidth_end"] >= out["contact_halfwidth_mid_extent"]  # widens (thesis Fig. 5)
     assert 0.2 < out["body1_share"] < 0.8
@@ -161,7 +168,8 @@ def test_tangential_compliance_has_mindlin_stiffness_ratio(contact_cache):
     k_n = m @ np.linalg.solve(cc.Czz[np.ix_(P, P)], np.ones(P.sum()))
     k_t = m @ np.linalg.solve(cc.Cxx[np.ix_(P, P)], np.ones(P.sum()))
     nu = spec.nu1
-    assert k_t / k_n == pytest.approx(2 * (1 - nu) / (2 - nu), rel=KT_KN_RTOL)
+    check("k_t / k_n of a stuck patch, like half-space blocks, grid 9", k_t / k_n, 2 * (1 - nu) / (2 - nu),
+          rtol=KT_KN_RTOL, source="Mindlin 1949: 2(1 - nu)/(2 - nu)")
 
 
 def test_cache_returns_identical_results(contact_cache):

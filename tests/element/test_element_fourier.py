@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from elcases import SEED
+from refcheck import check
 
 from fmu_src.element import IwanElement, IwanInputError
 
@@ -39,8 +40,11 @@ def test_jenkins_describing_function_is_exact():
     th = np.arccos(1 - 2 * fs / (k * a))
     a1, b1 = k * a / np.pi * (th - np.sin(2 * th) / 2), -k * a / np.pi * np.sin(th) ** 2
     assert ne == 2
-    assert Fh[0] == pytest.approx(a1, rel=1e-13) and Fh[1] == pytest.approx(b1, rel=1e-13)
-    assert W == pytest.approx(-np.pi * a * b1, rel=1e-13)
+    df = "Jenkins describing function (references.md)"
+    check("exact-link first harmonic a1 [N], Jenkins, a = 2.7 fs/k", Fh[0], a1, rtol=1e-13, source=df)
+    check("exact-link first harmonic b1 [N], Jenkins, a = 2.7 fs/k", Fh[1], b1, rtol=1e-13, source=df)
+    check("exact-link energy per cycle [J], Jenkins, a = 2.7 fs/k", W, -np.pi * a * b1, rtol=1e-13,
+          source="W = -pi a b1")
     # odd harmonics of a symmetric loop; even ones vanish
     assert abs(Fh[2]) < 1e-12 * abs(a1) and abs(Fh[3]) < 1e-12 * abs(a1)
 

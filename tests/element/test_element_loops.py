@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from elcases import MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy, tanh_table
+from refcheck import check
 
 from fmu_src.element import IwanElement
 
@@ -24,7 +25,8 @@ def test_jenkins_loop_energy_is_4fs_times_slip(a_over_slip):
     a = a_over_slip * fs / k
     loop = IwanElement.jenkins(k, fs).periodic(cosine(a))
     expected = 4.0 * fs * max(a - fs / k, 0.0)
-    assert loop.W_cycle == pytest.approx(expected, rel=ROUNDOFF, abs=ROUNDOFF * fs * a)
+    check(f"Jenkins loop energy per cycle [J], a = {a_over_slip:g} fs/k", loop.W_cycle, expected, rtol=ROUNDOFF,
+          atol=ROUNDOFF * fs * a, source="W = 4 fs (a - fs/k)")
     assert loop.periods == 1
 
 
@@ -40,7 +42,8 @@ def test_masing_energy_of_a_table_is_exact():
     el = IwanElement.from_curve(u_tab, T_tab, N_ref=1.0)
     for a in (1e-7, 1.3e-6, 4.44e-6, 9.9e-6):
         W = el.periodic(cosine(a)).W_cycle
-        assert W == pytest.approx(masing_energy_table(u_tab, T_tab, a), rel=1e-10)
+        check(f"loop energy [J] of a 40-point table, a = {a:g} m", W, masing_energy_table(u_tab, T_tab, a),
+              rtol=1e-10, source="Masing: 8 int_0^a g - 4 a g(a)")
 
 
 def test_masing_energy_of_a_smooth_curve_converges_with_table():
@@ -67,7 +70,8 @@ def test_mindlin_deresiewicz_energy_error_falls_with_refinement(x):
         assert loop.F.max() == pytest.approx(T_amp, rel=ROUNDOFF)
         errors.append(abs(loop.W_cycle / mindlin_deresiewicz_energy(T_amp) - 1.0))
     assert errors[1] < errors[0] / 3.0 and errors[2] < errors[1] / 3.0
-    assert errors[2] < 5e-3
+    check(f"loop energy of a 256-point Mindlin table / Mindlin-Deresiewicz - 1, T* = {x:g} mu N", errors[2], 0.0,
+          atol=5e-3, source="Mindlin-Deresiewicz 1953")
 
 
 def test_branches_after_reversals_are_twice_the_virgin_curve_at_half_distance():

@@ -121,7 +121,7 @@ def test_concave_fit_makes_the_fmu_follow_the_fitted_element(tmp_path):
     F = s.run(hist)[0]
     s.close()
     # same C code and one code path for step and series (two builds of it): the
-    # issue's 1e-12
+    # the required 1e-12
     assert np.max(np.abs(F - ref.F)) <= 1e-12 * np.max(np.abs(ref.F))
 
 

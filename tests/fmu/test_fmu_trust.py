@@ -1,4 +1,4 @@
-"""FMUs every importer can trust (issue 14), through fmpy: locale, state restore, FMI 3
+"""FMUs every importer can trust, through fmpy: locale, state restore, FMI 3
 start values, input bounds, |F| <= mu N, corrupted states, energy balance, step size 0."""
 from __future__ import annotations
 

@@ -7,6 +7,7 @@ by Newton with a homotopy in the forcing level from the stuck linear guess.
 """
 import numpy as np
 import pytest
+from refcheck import check
 
 from fmu_src.element import IwanElement
 from harmonic_balance.contact import ContactElement
@@ -46,7 +47,7 @@ def bouncing_mass(P, m=1.0, kn=1.0, c=0.1, weight=1.0):
 
 
 #: HB (H = 15) against time integration, bouncing mass: measured 8.1e-6 (peak |y|),
-#: 1.9e-5 (first harmonic), 8.2e-6 absolute (mean, static deflection 1); the issue
+#: 1.9e-5 (first harmonic), 8.2e-6 absolute (mean, static deflection 1); the requirement
 #: asks for 0.5 %: tolerances 1.5x measured.
 BOUNCE_PEAK_RTOL = 1.2e-5
 BOUNCE_H1_RTOL = 2.8e-5
@@ -63,8 +64,11 @@ def test_bouncing_mass_with_lift_off_matches_time_integration():
     ti = march(bouncing_mass(P), omega, STEPS)
     assert ti.converged
     c = np.fft.rfft(ti.x_last) / ti.steps_per_period
-    assert abs(b.peak_abs(X[:, 0]) - ti.amplitude) <= BOUNCE_PEAK_RTOL * ti.amplitude
-    assert abs(b.magnitude(X, 1)[0] - 2 * abs(c[1])) <= BOUNCE_H1_RTOL * 2 * abs(c[1])
+    ti_ref = "time integration of the same model (harmonic_balance.timeint)"
+    check("bouncing mass with lift-off, peak |x| [m], H = 15", b.peak_abs(X[:, 0]), ti.amplitude,
+          rtol=BOUNCE_PEAK_RTOL, source=ti_ref)
+    check("bouncing mass with lift-off, first harmonic [m], H = 15", b.magnitude(X, 1)[0], 2 * abs(c[1]),
+          rtol=BOUNCE_H1_RTOL, source=ti_ref)
     assert abs(X[0, 0] - c[0].real) <= BOUNCE_MEAN_ATOL
 
 

@@ -3,12 +3,13 @@ import numpy as np
 import pytest
 from hbcases import sdof
 from jenkins_ref import describing_function
+from refcheck import check
 from scipy.optimize import brentq, minimize_scalar
 
 from harmonic_balance.frf import FRFProblem, compute_frf
 from harmonic_balance.newton import newton
 
-#: Describing-function agreement demanded by the issue (0.1 %); the AFT sampling
+#: Describing-function agreement required (0.1 %); the AFT sampling
 #: error at n_t = 256 is ~0.02 % (fourier.MIN_SAMPLES).
 DF_RTOL = 1e-3
 #: Energy balance against the sampled loops' dissipation: same O(n_t^-2) sampling
@@ -43,14 +44,16 @@ def test_h1_reproduces_the_jenkins_describing_function(h1_curve):
     r = h1_curve
     assert r.status == "complete" and r.omega[0] == 0.9 and r.omega[-1] == 1.3
     err = [df_residual(w, a) / P for w, a in zip(r.omega, r.amplitude_h1)]
-    assert np.max(np.abs(err)) < DF_RTOL
+    check("H = 1 FRF residual |...| / P - 1 of the Jenkins oscillator, every point", err, 0.0, atol=DF_RTOL,
+          source="describing function (references.md)")
     # the sweep goes through resonance: from stuck to well into slip and back
     assert r.amplitude.max() > 3 * FS / KT and r.amplitude[0] < 0.3 * r.amplitude.max()
 
 
 def test_h1_peak_matches_the_describing_function_peak(h1_curve):
     assert h1_curve.peak_interior
-    assert abs(h1_curve.peak_amplitude / df_peak() - 1) < DF_RTOL
+    check("H = 1 peak amplitude [m], Jenkins oscillator m = k = kt = 1, c = 0.01, fs = P = 0.05",
+          h1_curve.peak_amplitude, df_peak(), rtol=DF_RTOL, source="describing-function peak")
     assert abs(h1_curve.peak_amplitude - h1_curve.peak_amplitude_h1) < 1e-12  # H = 1
     assert h1_curve.peak_amplitude >= h1_curve.amplitude.max()
 

@@ -1,4 +1,4 @@
-"""Convergence map (quick) of the single-DOF Jenkins FRF: issue 10's cases that converge.
+"""Convergence map (quick) of the single-DOF Jenkins FRF: the cases that converge.
 
 The full map is examples/bench_hb_robust.py. Here: contact stiffness 1e-3 ... 1e6 k,
 slip force 0.5 of the forcing, sweeps that start below, at and above resonance,
@@ -109,7 +109,7 @@ def test_stiffness_1e6_h7_no_gaps():
 
 
 def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
-    """Issue 10's reproduction: 30 k failed before the first point at H = 15."""
+    """A case that once failed: 30 k stopped before the first point at H = 15."""
     code = main(["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.04",
                  "--contact-stiffness", "30", "--slip-force", "0.5", "--force", "1",
                  "--harmonics", "15", "--omega", "0.5", "2", "--json"])

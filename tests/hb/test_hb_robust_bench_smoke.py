@@ -11,10 +11,10 @@ def test_robustness_benchmark_smoke(capsys, load_example):
 
 
 def test_soft_baseline_benchmark_smoke(capsys, load_example):
-    """examples/bench_hb_soft_baseline.py (the issue-10 cost baseline, runnable against
-    any version of harmonic_balance): one soft row, the issue's 3.1-3.2 evaluations per
-    point (measured on the code of the issue's time; 3.7 with the steps sized by the
-    curve's shape, which takes 76 points instead of 393: at least 1 / frf.LAM_STEP)."""
+    """examples/bench_hb_soft_baseline.py (the soft-contact cost baseline, runnable against
+    any version of harmonic_balance): one soft row, 3.1-3.2 evaluations per point on the
+    older code, 3.7 with the steps sized by the curve's shape, which takes 76 points
+    instead of 393 (at least 1 / frf.LAM_STEP)."""
     from harmonic_balance.frf import LAM_STEP
 
     rows = load_example("bench_hb_soft_baseline").main(["1"])
@@ -25,7 +25,7 @@ def test_soft_baseline_benchmark_smoke(capsys, load_example):
 
 def test_hb_against_den_hartog_table_smoke(load_example):
     """Table 4's function on one small case: 1e3 k, H = 7, at resonance, where the
-    elastic model and the rigid one agree (README: 1.1e-4 at H = 21)."""
+    elastic model and the rigid one agree (README.md at revision c58d443: 1.1e-4 at H = 21)."""
     (kt, H, errs), = load_example("bench_hb_robust").hb_vs_den_hartog((1e3,), (7,), (1.0,))
     assert kt == 1e3 and H == 7 and abs(errs[0]) < 1e-2
 

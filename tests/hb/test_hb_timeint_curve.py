@@ -11,7 +11,7 @@ from hbcases import jenkins, sdof, two_dof
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, march_curve, steady_curve
 
-#: Agreement demanded by the issue between the converged HB and the reference.
+#: Agreement required between the converged HB and the reference.
 TI_RTOL = 5e-3
 #: march and march_curve run the same scheme; they differ by the round-off of an
 #: LU solve against a precomputed inverse, amplified over a few hundred periods.

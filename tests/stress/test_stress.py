@@ -1,4 +1,4 @@
-"""`damper stress --quick`: no crash, hang, NaN, wrong number or unexplained failure (issue 13)."""
+"""`damper stress --quick`: no crash, hang, NaN, wrong number or unexplained failure."""
 import json
 
 import numpy as np
@@ -14,7 +14,8 @@ def test_stress_quick_has_no_unexplained_failure(tmp_path, capsys):
     code = main(["stress", "--quick", "--json", "--out", str(tmp_path)])
     out = json.loads(capsys.readouterr().out)
     rows = out["cases"]
-    assert rows and {r["stage"] for r in rows} == {"normal", "tangential", "loop", "fmu", "frf"}
+    assert rows and {r["stage"] for r in rows} == {"inputs", "normal", "tangential", "loop", "fmu", "frf"}
+    assert sum(r["stage"] == "inputs" for r in rows) >= 150
     for r in rows:
         assert set(r) >= {"stage", "case", "outcome", "message", "worst_residual", "time_s"}
         assert r["outcome"] not in ("crash", "hang", "nan"), r
@@ -23,7 +24,8 @@ def test_stress_quick_has_no_unexplained_failure(tmp_path, capsys):
     refused = [r for r in rows if r["expected"] == "clear_error"]
     assert refused and all(r["outcome"] == "clear_error" and r["message"] for r in refused)
     assert code == 0
-    assert (tmp_path / "stress.md").read_text().startswith("| stage |")
+    md = (tmp_path / "stress.md").read_text()        # the input stage by command, then every row
+    assert md.startswith("| command | cases |") and "\n| stage | case |" in md
 
 
 def test_classify_detects_each_failure_kind():

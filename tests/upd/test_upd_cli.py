@@ -1,4 +1,4 @@
-"""damper upd: JSON keys of the issue's interface, linear limits, optimal-load curve."""
+"""damper upd: JSON keys of the documented interface, linear limits, optimal-load curve."""
 import json
 
 import numpy as np
@@ -36,7 +36,7 @@ def test_frf_linear_limits_and_modes(capsys):
 
 @pytest.mark.slow
 def test_optimize_interior_minimum(capsys):
-    """H = 3 on a coarse grid (fast); the default run is H = 7 (README, benchmark)."""
+    """H = 3 on a coarse grid (fast); the default run is H = 7 (docs: performance)."""
     out = _run(["optimize", "--cf-range", "30", "3000", "--points", "5", "--harmonics", "3",
                 "--grid", "12", "--json"], capsys)
     amp = np.array(out["peak_amplitude"])

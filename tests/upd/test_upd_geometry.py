@@ -128,7 +128,7 @@ def test_cli_frf_end_to_end_geometry_contacts(tmp_path, capsys, monkeypatch):
     cfg = _cfg(tmp_path)
     # CF 300 N (CF/F0 = 10, no lift-off): the sweep converges at every point count tried
     # (10-30); at 120 N it stops near 452 Hz for some counts with these stiff coarse-grid
-    # contacts (the sweep's robustness on a stiff flat with lift-off, README)
+    # contacts (the sweep's robustness on a stiff flat with lift-off, README.md at revision c58d443)
     argv = ["upd", "frf", "--config", str(cfg), "--contacts", "geometry", "--cf", "300",
             "--harmonics", "3", "--points", "12", "--band", "440", "500", "--json"]
     assert main(argv) == 0

@@ -1,10 +1,10 @@
 """The optimal-load objective (refined peak against CF) is smooth and path-independent.
 
-Why the optimum CF differs between H = 5 and H = 7 (issue 15): not noise. The refined
+Why the optimum CF differs between H = 5 and H = 7: not noise. The refined
 peak found by the optimiser's warm-started narrow grids equals an independent
 full-band search at the same load, the AFT sample count does not move it, and the
 curve is convex in log CF around its interior minimum; what moves the optimum is the
-harmonic truncation of a flat minimum (README, UPD section). Cheap version at H = 3.
+harmonic truncation of a flat minimum (README.md at revision c58d443, UPD section). Cheap version at H = 3.
 """
 import numpy as np
 import pytest

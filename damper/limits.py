@@ -1,0 +1,114 @@
+"""Upper bounds of every size a user can type, each with the reason for it.
+
+A size above its bound is refused before any work (exit 2) with a message that names
+the bound and what the size would cost; nothing in the toolkit then runs for hours or
+fills the memory because of one extra digit. The costs quoted were measured with
+``damper`` on the 2-core development machine (``/usr/bin/time``, revision c58d443):
+the sdof forced response (``damper frf --model sdof ... --omega 0.9 1.3``) took 2.9 s
+at H = 11, 6.8 s at H = 31 and 27 s at H = 61 (time ~ H^2); ``damper upd frf`` (200
+points) 1.5 s at H = 7 and 6.6 s at H = 15; ``damper loop`` 3.6 s and 0.24 GB at 1e6
+samples.
+"""
+from __future__ import annotations
+
+import math
+import os
+
+#: Highest harmonic of a forced response or backbone: ~H^2 time, H = 61 takes 27 s for
+#: one DOF, so H = 200 is several minutes (and more per extra nonlinear DOF).
+MAX_HARMONICS = 200
+#: Highest harmonic of the bladed-disk sector (``damper upd``): ~H^2 time, H = 15 takes
+#: 6.6 s for 200 points, H = 50 over a minute.
+MAX_UPD_HARMONICS = 50
+#: AFT samples per period: the DFT matrices hold n_t (2H + 1) numbers each, 0.2 GB at
+#: 65536 x 401.
+MAX_AFT_SAMPLES = 65536
+#: Continuation points of a curve: each is a Newton solve (5-50 ms for one DOF at H <= 7,
+#: seconds for large models), so 20000 points is minutes to hours.
+MAX_CURVE_POINTS = 20000
+#: Samples per cycle of ``damper loop``: 1e6 samples take ~4 s and 0.24 GB (and 40 MB of JSON).
+MAX_LOOP_SAMPLES = 1_000_000
+#: Frequency points of ``damper upd frf``: ~7 ms each at H = 7, 10000 points ~1 min or more.
+MAX_UPD_POINTS = 10000
+#: Load (CF) values of ``damper upd optimize`` / a scene's [upd] points: each is a whole
+#: forced response (seconds), 200 values is minutes.
+MAX_LOAD_POINTS = 200
+#: Frequency points per curve of the load optimisation before its peak refinement.
+MAX_UPD_GRID = 2000
+#: Points of the F-approach curve of ``damper normal --curve``: one normal solve each.
+MAX_APPROACH_POINTS = 1000
+#: Variants of a sweep: each is one scene run (seconds to minutes).
+MAX_SWEEP_VARIANTS = 1000
+#: Forced-response levels of a scene (``excitation.forces``): one curve each.
+MAX_FORCE_LEVELS = 100
+#: Angular frequency [rad/s]: far above any structural mode a blade model holds
+#: (1e9 rad/s is 160 MHz), and omega^2 M must stay far from floating-point overflow.
+MAX_OMEGA = 1e9
+#: Friction coefficient: dry contacts have mu below a few; beyond 100 the input is a typo.
+MAX_MU = 100.0
+#: Largest magnitude of a model parameter typed on the command line (mass, stiffness,
+#: force, ...): the harmonic balance squares forces and displacements (residual norms,
+#: omega^2 M), which overflows double precision above ~1e154.
+MAX_MAGNITUDE = 1e100
+#: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
+#: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
+MIN_CURVE_TOL = 1e-6
+#: Worker processes per core (``--workers``): each worker holds its own copy of the model.
+WORKERS_PER_CORE = 4
+
+
+def max_workers() -> int:
+    """Largest ``--workers``: :data:`WORKERS_PER_CORE` per core of this machine."""
+    return WORKERS_PER_CORE * (os.cpu_count() or 1)
+
+
+def check_size(name: str, value, low: int, high: int, why: str) -> int:
+    """``value`` as an int in [low, high], else ValueError naming ``name``, the bound and ``why``."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"{name} must be an integer, got {value!r}")
+    if value < low:
+        raise ValueError(f"{name} must be >= {low}, got {value}")
+    if value > high:
+        raise ValueError(f"{name} = {value} is above the limit {high}: {why}")
+    return value
+
+
+def check_harmonics(name: str, spec, high: int = MAX_HARMONICS) -> None:
+    """A harmonics option (``H``, ``odd:H``, ``all:H``): H in 1..high, checked before any work."""
+    text = str(spec).strip()
+    kind, _, num = text.partition(":")
+    if not num:
+        kind, num = "all", kind
+    if kind not in ("odd", "all"):
+        raise ValueError(f"{name} {spec!r}: use H, odd:H or all:H (H an integer >= 1)")
+    try:
+        H = int(num)
+    except ValueError:
+        raise ValueError(f"{name} {spec!r}: use H, odd:H or all:H (H an integer >= 1)") from None
+    check_size(name, H, 1, high, harmonics_why(high))
+
+
+def harmonics_why(high: int) -> str:
+    """Why the highest harmonic is bounded (the message of :func:`check_harmonics`)."""
+    if high == MAX_UPD_HARMONICS:
+        return "the sector's harmonic balance grows as H^2 (H = 15: 7 s for 200 points; H = 50: minutes)"
+    return "the harmonic balance grows as H^2 or faster (one DOF: H = 61 takes 27 s; H = 200: minutes)"
+
+
+def check_omega_range(name: str, lo: float, hi: float, unit: str = "rad/s", scale: float = 1.0) -> None:
+    """A frequency range: finite, positive, different, at most MAX_OMEGA (``scale``: to rad/s)."""
+    for v in (lo, hi):
+        if not math.isfinite(v) or v <= 0:
+            raise ValueError(f"{name} {lo:g} {hi:g}: both ends must be positive finite numbers [{unit}]")
+    if lo == hi:
+        raise ValueError(f"{name} {lo:g} {hi:g}: the ends must differ")
+    top = MAX_OMEGA / scale
+    if max(lo, hi) > top:
+        raise ValueError(f"{name} {lo:g} {hi:g}: above the limit {top:.3g} {unit} (1e9 rad/s, 160 MHz: "
+                         "far above any structural mode, and omega^2 M must not overflow)")
+
+
+def check_workers(name: str, n) -> None:
+    """A worker count: 1 .. :func:`max_workers`."""
+    check_size(name, n, 1, max_workers(), f"{WORKERS_PER_CORE} per core of this machine "
+               f"({os.cpu_count()} cores); each worker is a process with its own copy of the model")

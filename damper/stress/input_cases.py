@@ -1,0 +1,330 @@
+"""The input stage's cases: bad inputs over every subcommand and file type, and the cache's duties.
+
+A case is a ``damper`` command line (``{fx}``: the fixtures folder of
+:mod:`.input_fixtures`) run in a folder of its own whose cache is ``.damper_cache``
+there, and the outcome it must have:
+
+* ``clear_error`` (most cases): exit code 2 or 3, no traceback, the last line of
+  standard error the command's one-line message, no warning printed twice, and no
+  file created, changed or removed (in the case's folder, its cache, the fixtures);
+* ``converged``: exit code 0 and the case's ``check`` (e.g. a user's file in the cache
+  folder untouched, exactly one warning for a corrupt entry);
+* ``interrupted``: SIGINT once the text ``interrupt_on`` shows on standard error: exit
+  code 130, one line saying where, no output folder.
+
+``files`` are created in the case's folder first (a user's folder next to the cache),
+``pre`` commands run before (they must succeed) and ``mutate`` then edits the folder
+(truncate or swap cache entries).
+"""
+from __future__ import annotations
+
+import shlex
+from dataclasses import dataclass, field
+
+SDOF = "--model sdof --mass 1 --stiffness 1 --damping 0.01 --contact-stiffness 1 --slip-force 0.05 --force 0.05"
+SPHERE = "--body sphere --radius 0.01"
+NPZ = "--model {fx}/m_good.npz --elements {fx}/el_good.toml"
+KN_SMALL = "normal --body sphere --radius 0.01 --model halfspace --force 100 --grid 5 --json"
+
+
+@dataclass
+class InputCase:
+    """One command and the outcome it must have (module docstring)."""
+
+    group: str
+    name: str
+    argv: list[str]
+    expect: str = "clear_error"
+    files: dict = field(default_factory=dict)
+    pre: list = field(default_factory=list)
+    mutate: str | None = None
+    keep: tuple = ()
+    check: str | None = None
+    interrupt_on: str | None = None
+    timeout: float = 30.0
+
+
+def _case(group: str, name: str, cmd: str, **kw) -> InputCase:
+    return InputCase(group, name, shlex.split(cmd), **kw)
+
+
+def _table(group: str, rows: list[tuple[str, str]], prefix: str = "") -> list[InputCase]:
+    return [_case(group, name, f"{prefix} {cmd}".strip()) for name, cmd in rows]
+
+
+def _cli() -> list[InputCase]:
+    return _table("cli", [
+        ("no subcommand", ""), ("unknown subcommand", "frobnicate"), ("frf without options", "frf"),
+        ("run without a scene", "run"), ("unknown option", "loop --curve {fx}/curve.json --amplitude 1e-6 --wobble"),
+    ]) + [_case("cli", "--version", "--version", expect="converged", check="version")]
+
+
+def _normal() -> list[InputCase]:
+    return _table("normal", [
+        ("force -1", f"{SPHERE} --force -1"), ("force 0", f"{SPHERE} --force 0"),
+        ("force nan", f"{SPHERE} --force nan"), ("force inf", f"{SPHERE} --force inf"),
+        ("approach -1e-6", f"{SPHERE} --approach=-1e-6"), ("force and approach", f"{SPHERE} --force 1 --approach 1e-6"),
+        ("radius 0", "--body sphere --radius 0 --force 100"),
+        ("radius -0.01", "--body sphere --radius=-0.01 --force 1"),
+        ("sphere without radius", "--body sphere --force 100"),
+        ("radius and diameter", "--body sphere --radius 0.01 --diameter 0.02 --force 100"),
+        ("E negative", f"{SPHERE} --force 100 --E=-2e11"), ("nu 0.5", f"{SPHERE} --force 100 --nu 0.5"),
+        ("nu -1.5", f"{SPHERE} --force 100 --nu=-1.5"), ("grid 2", f"{SPHERE} --force 100 --grid 2"),
+        ("grid 100000", f"{SPHERE} --force 100 --grid 100000"),
+        ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
+        ("force 1e12 (Hertz radius > R)", f"{SPHERE} --force 1e12"),
+        ("eccentricity on a sphere", f"{SPHERE} --force 100 --eccentricity 1e-4"),
+        ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
+        ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),
+        ("curve 1e6 points", f"{SPHERE} --force 100 --curve 1000000"), ("curve -1", f"{SPHERE} --force 100 --curve=-1"),
+        ("length on a sphere", f"{SPHERE} --force 100 --length 1e-3"),
+        ("cylinder without length", "--body cylinder --radius 2.5e-3 --force 100"),
+        ("p-design 0", f"{SPHERE} --force 100 --p-design 0"), ("body cube", "--body cube --radius 0.01 --force 1"),
+        ("--out an existing folder", f"{SPHERE} --force 100 --out {{fx}}"),
+        ("--out below a file", f"{SPHERE} --force 100 --out {{fx}}/a_file/r.json"),
+        ("--plot a file", f"{SPHERE} --force 100 --plot {{fx}}/a_file"),
+        ("--normal-curve an existing folder", f"{SPHERE} --force 100 --normal-curve {{fx}}"),
+        ("--cache-dir a file", f"{SPHERE} --force 100 --cache-dir {{fx}}/a_file"),
+        ("stiffness without nodes", "--body sphere --force 100 --stiffness {fx}/m_good.npz {fx}/m_good.npz"),
+        ("stiffness with radius", f"{SPHERE} --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz "
+                                  "--nodes {fx}/m_good.npz {fx}/m_good.npz"),
+        ("stiffness files not matrices", "--body sphere --force 100 --stiffness {fx}/binary.bin {fx}/binary.bin "
+                                         "--nodes {fx}/binary.bin {fx}/binary.bin"),
+    ], "normal") + [_case("normal", "--cache-dir a folder of the user's",
+                          f"normal {SPHERE} --force 100 --model halfspace --grid 5 --cache-dir proj",
+                          files={"proj/matrices.npz": "user data\n"})]
+
+
+def _tangential() -> list[InputCase]:
+    base = f"tangential {SPHERE} --force 200 --model bem --grid 11"
+    return _table("tangential", [
+        ("mu 0", f"{base} --mu 0"), ("mu -0.5", f"{base} --mu=-0.5"), ("mu nan", f"{base} --mu nan"),
+        ("mu 1e300", f"{base} --mu 1e300"), ("mu 101", f"{base} --mu 101"), ("mu missing", base),
+        ("tol 0", f"{base} --mu 0.5 --tol 0"), ("tol 1e-12", f"{base} --mu 0.5 --tol 1e-12"),
+        ("tol 0.6", f"{base} --mu 0.5 --tol 0.6"),
+        ("tangential force above mu N", f"{base} --mu 0.5 --tangential-force 150"),
+        ("loop amplitude -1", f"{base} --mu 0.5 --loop-amplitude=-1"),
+        ("loop amplitude nan", f"{base} --mu 0.5 --loop-amplitude nan"),
+        ("flat, approach, eccentricity", "tangential --body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 "
+                                         "--mu 0.5 --eccentricity 1e-4"),
+        ("eccentricity on a sphere", f"{base} --mu 0.5 --eccentricity 1e-4"),
+        ("--out an existing folder", f"{base} --mu 0.5 --out {{fx}}"),
+        ("--out below a file", f"{base} --mu 0.5 --out {{fx}}/a_file/c.json"),
+        ("--plot a file", f"{base} --mu 0.5 --plot {{fx}}/a_file"), ("model fem", f"{base} --mu 0.5 --model fem"),
+        ("force 0", f"tangential {SPHERE} --force 0 --mu 0.5"),
+        ("grid 100000", f"tangential {SPHERE} --force 200 --mu 0.5 --grid 100000"),
+        ("width on a sphere", f"{base} --mu 0.5 --width 1e-3"),
+    ])
+
+
+def _loop() -> list[InputCase]:
+    a = "--amplitude 2e-6"
+    rows = [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json {a}") for kind in
+            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip")]
+    return _table("loop", rows + [
+        ("curve missing", f"--curve {{fx}}/nowhere.json {a}"), ("curve is a folder", f"--curve {{fx}} {a}"),
+        ("amplitude 1e10", "--curve {fx}/curve.json --amplitude 1e10"),
+        ("amplitude 1e30", "--curve {fx}/curve.json --amplitude 1e30"),
+        ("amplitude 0", "--curve {fx}/curve.json --amplitude 0"),
+        ("amplitude -1", "--curve {fx}/curve.json --amplitude=-1"),
+        ("amplitude nan", "--curve {fx}/curve.json --amplitude nan"),
+        ("amplitude inf", "--curve {fx}/curve.json --amplitude inf"),
+        ("force amplitude = mu N", "--curve {fx}/curve.json --force-amplitude 100"),
+        ("force amplitude 1e9", "--curve {fx}/curve.json --force-amplitude 1e9"),
+        ("amplitude and force amplitude", f"--curve {{fx}}/curve.json {a} --force-amplitude 10"),
+        ("no amplitude", "--curve {fx}/curve.json"),
+        ("samples 1e9", f"--curve {{fx}}/curve.json {a} --samples 1000000000"),
+        ("samples 3", f"--curve {{fx}}/curve.json {a} --samples 3"),
+        ("N 0", f"--curve {{fx}}/curve.json {a} --N 0"), ("N nan", f"--curve {{fx}}/curve.json {a} --N nan"),
+        ("scale 0", f"--curve {{fx}}/curve.json {a} --scale 0"),
+        ("scale -1", f"--curve {{fx}}/curve.json {a} --scale=-1"),
+        ("--plot a file", f"--curve {{fx}}/curve.json {a} --plot {{fx}}/a_file"),
+        ("fit bogus", f"--curve {{fx}}/curve.json {a} --fit bogus"),
+    ], "loop")
+
+
+def _fmu() -> list[InputCase]:
+    return _table("fmu", [
+        ("curve binary", "--curve {fx}/curve_binary.json -o d.fmu"), ("curve missing", "--curve {fx}/no.json -o d.fmu"),
+        ("curve convex", "--curve {fx}/curve_convex.json -o d.fmu"), ("no output", "--curve {fx}/curve.json"),
+        ("-o an existing folder", "--curve {fx}/curve.json -o {fx}"),
+        ("-o below a file", "--curve {fx}/curve.json -o {fx}/a_file/d.fmu"),
+        ("n-ref 0", "--curve {fx}/curve.json -o d.fmu --n-ref 0"),
+        ("n-ref nan", "--curve {fx}/curve.json -o d.fmu --n-ref nan"),
+        ("fmi version 4", "--curve {fx}/curve.json -o d.fmu --fmi-version 4"),
+        ("curve without N", "--curve {fx}/curve_noN.json -o d.fmu"),
+        ("point: k-n 0", "--curve {fx}/curve.json -o d.fmu --k-n 0"),
+        ("point: k-n nan", "--curve {fx}/curve.json -o d.fmu --k-n nan"),
+        ("point: preload -1", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --preload=-1"),
+        ("point: preload without a normal law", "--curve {fx}/curve.json -o d.fmu --preload 100"),
+        ("point: normal curve binary", "--curve {fx}/curve.json -o d.fmu --normal {fx}/binary.bin"),
+        ("point: normal curve missing", "--curve {fx}/curve.json -o d.fmu --normal {fx}/nowhere.json"),
+        ("point: normal curve is a virgin curve", "--curve {fx}/curve.json -o d.fmu --normal {fx}/curve.json"),
+        ("point: k-n and normal", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --normal {fx}/curve.json"),
+    ], "fmu")
+
+
+def _frf() -> list[InputCase]:
+    o = "--omega 0.9 1.3"
+    rows = [
+        ("omega 1 1e300", f"{SDOF} --harmonics 1 --omega 1 1e300"), ("omega 0 1", f"{SDOF} --omega 0 1"),
+        ("omega -1 1", f"{SDOF} --omega -1 1"), ("omega 1 1", f"{SDOF} --omega 1 1"),
+        ("omega nan 1", f"{SDOF} --omega nan 1"), ("harmonics 0", f"{SDOF} {o} --harmonics 0"),
+        ("harmonics 100000", f"{SDOF} {o} --harmonics 100000"), ("harmonics odd:0", f"{SDOF} {o} --harmonics odd:0"),
+        ("harmonics abc", f"{SDOF} {o} --harmonics abc"), ("harmonics even:3", f"{SDOF} {o} --harmonics even:3"),
+        ("samples -1", f"{SDOF} {o} --samples=-1"), ("samples 1e8", f"{SDOF} {o} --samples 100000000"),
+        ("samples 3 at H 7 (aliasing)", f"{SDOF} {o} --harmonics 7 --samples 3"),
+        ("max-step 0", f"{SDOF} {o} --max-step 0"), ("max-step nan", f"{SDOF} {o} --max-step nan"),
+        ("max-points 1", f"{SDOF} {o} --max-points 1"), ("max-points 1e8", f"{SDOF} {o} --max-points 100000000"),
+        ("mass 0", SDOF.replace("--mass 1", "--mass 0") + f" {o}"),
+        ("mass nan", SDOF.replace("--mass 1", "--mass nan") + f" {o}"),
+        ("damping -1", SDOF.replace("--damping 0.01", "--damping=-1") + f" {o}"),
+        ("contact stiffness 0", SDOF.replace("--contact-stiffness 1", "--contact-stiffness 0") + f" {o}"),
+        ("slip force -1", SDOF.replace("--slip-force 0.05", "--slip-force=-1") + f" {o}"),
+        ("force 1e200", SDOF.replace("--force 0.05", "--force 1e200") + f" {o}"),
+        ("stiffness 1e300", SDOF.replace("--stiffness 1", "--stiffness 1e300") + f" {o}"),
+        ("sdof with --elements", f"{SDOF} {o} --elements {{fx}}/el_good.toml"),
+        ("sdof with --force-scale", f"{SDOF} {o} --force-scale 2"),
+        ("sdof response DOF 3", f"{SDOF} {o} --response-dof 3"),
+        ("npz with --mass", f"{NPZ} --mass 5 --omega 100 300"),
+        ("npz without --elements", "--model {fx}/m_good.npz --omega 100 300"),
+        ("npz missing", "--model {fx}/nowhere.npz --elements {fx}/el_good.toml --omega 100 300"),
+        ("npz response DOF 99", f"{NPZ} --response-dof 99 --omega 100 300"),
+        ("npz force-scale inf", f"{NPZ} --force-scale inf --omega 100 300"),
+        ("--out an existing folder", f"{SDOF} {o} --out {{fx}}"),
+        ("--out below a file", f"{SDOF} {o} --out {{fx}}/a_file/f.json"),
+        ("--plot a file", f"{SDOF} {o} --plot {{fx}}/a_file"),
+    ]
+    for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc"):
+        rows.append((f"npz {m}", f"--model {{fx}}/m_{m}.npz --elements {{fx}}/el_good.toml --omega 100 300"))
+    for e in ("wobble", "scael", "top", "badtoml", "binary", "none", "dof9", "nok", "type", "path", "negk",
+              "dofstr", "same", "contact"):
+        rows.append((f"elements {e}", f"--model {{fx}}/m_good.npz --elements {{fx}}/el_{e}.toml --omega 100 300"))
+    return _table("frf", rows, "frf")
+
+
+def _backbone() -> list[InputCase]:
+    a = "--amplitude 1e-3 10"
+    return _table("backbone", [
+        ("amplitude 0 1", f"{SDOF} --amplitude 0 1"), ("amplitude 1 1", f"{SDOF} --amplitude 1 1"),
+        ("amplitude nan", f"{SDOF} --amplitude nan 1"), ("harmonics 100000", f"{SDOF} {a} --harmonics 100000"),
+        ("samples -1", f"{SDOF} {a} --samples=-1"), ("mode -1", f"{SDOF} {a} --mode=-1"),
+        ("mode 5 of one DOF", f"{SDOF} {a} --mode 5"),
+        ("npz M = -I", "--model {fx}/m_negM.npz --elements {fx}/el_good.toml " + a),
+        ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
+        ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),
+    ], "backbone")
+
+
+def _upd() -> list[InputCase]:
+    return _table("upd", [
+        ("frf harmonics 100000", "frf --harmonics 100000"), ("frf points 1e8", "frf --points 100000000"),
+        ("frf harmonics 0", "frf --harmonics 0"), ("frf points 2", "frf --points 2"),
+        ("frf band 0 100", "frf --band 0 100"), ("frf band 500 400", "frf --band 500 400"),
+        ("frf band nan 1", "frf --band nan 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
+        ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
+        ("frf --plot a file", "frf --plot {fx}/a_file"),
+        ("config missing", "modes --config {fx}/nowhere.toml"),
+        ("config binary", "modes --config {fx}/upd_binary.toml"),
+        ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
+        ("config bad TOML", "modes --config {fx}/upd_badtoml.toml"),
+        ("config unknown section", "modes --config {fx}/upd_section.toml"),
+        ("optimize cf-range 0 10", "optimize --cf-range 0 10"), ("optimize cf-range 10 1", "optimize --cf-range 10 1"),
+        ("optimize points 1e6", "optimize --points 1000000"), ("optimize grid 1e6", "optimize --grid 1000000"),
+        ("optimize harmonics 1000", "optimize --harmonics 1000"),
+        ("optimize workers 0", "optimize --workers 0"), ("optimize workers 10000", "optimize --workers 10000"),
+        ("no action", ""),
+    ], "upd")
+
+
+def _run() -> list[InputCase]:
+    rows = [(f"scene {n[2:-5]}", f"{{fx}}/{n}") for n in (
+        "s_loopamp.toml", "s_grid.toml", "s_grid2.toml", "s_forces.toml", "s_forceneg.toml", "s_harm.toml",
+        "s_harm0.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml", "s_fmax.toml",
+        "s_fhuge.toml", "s_zone.toml", "s_hertz.toml", "s_unknown.toml", "s_ckey.toml", "s_want.toml",
+        "s_elcontact.toml", "s_fmi.toml", "s_body.toml", "s_both.toml", "s_nu.toml", "s_type.toml", "s_dofs.toml",
+        "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
+        "s_empty.toml", "s_binary.toml", "s_bbmode.toml", "s_bbamp.toml", "s_updpoints.toml", "s_updharm.toml",
+        "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml")]
+    rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
+             ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
+             ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),
+             ("dry run: grid 100000", "{fx}/s_grid.toml --dry-run"),
+             ("scene missing", "{fx}/nowhere.toml"), ("scene is a folder", "{fx}"),
+             ("--out an existing file", "{fx}/s_ok.toml --out {fx}/a_file"),
+             ("--out below a file", "{fx}/s_ok.toml --out {fx}/a_file/out"),
+             ("--force no such stage", "{fx}/s_ok.toml --force nosuch"),
+             ("--cache-max-mb 0", "{fx}/s_ok.toml --cache-max-mb 0"),
+             ("--cache-max-mb nan", "{fx}/s_ok.toml --cache-max-mb nan"),
+             ("--no-cache with --cache-dir", "{fx}/s_ok.toml --no-cache --cache-dir c"),
+             ("--cache-dir a file", "{fx}/s_ok.toml --cache-dir {fx}/a_file")]
+    cases = _table("run", rows, "run")
+    cases.append(_case("run", "--cache-dir a folder of the user's (eviction)",
+                       "run {fx}/s_kn_small.toml --cache-dir proj --cache-max-mb 1 --out out",
+                       files={"proj/user_data.npz": "user data\n"}))
+    return cases
+
+
+def _sweep() -> list[InputCase]:
+    s = "sweep {fx}/s_ok.toml"
+    p = "--param element.loop_force_amplitude"
+    return _table("sweep", [
+        ("a variant above mu N", f"{s} {p} --values 40 100 --serial"),
+        ("range NUM 1e9", f"{s} --param contact.damper.mu --range 0.3 0.6 1000000000 --serial"),
+        ("range NUM 0", f"{s} --param contact.damper.mu --range 0.3 0.6 0 --serial"),
+        ("range not numbers", f"{s} --param contact.damper.mu --range a b c --serial"),
+        ("range nan", f"{s} --param contact.damper.mu --range nan 1 3 --serial"),
+        ("values without param", f"{s} --values 1 2 --serial"), ("param without values", f"{s} {p} --serial"),
+        ("a second range for one param", f"{s} {p} --values 30 --range 10 20 3 --serial"),
+        ("unknown param", f"{s} --param contact.damper.colour --values 1 --serial"),
+        ("a value of the wrong type", f"{s} {p} --values high --serial"),
+        ("workers 0", f"{s} {p} --values 30 --workers 0"), ("workers 10000", f"{s} {p} --values 30 --workers 10000"),
+        ("zip unequal", f"{s} {p} --values 30 35 --param contact.damper.mu --values 0.5 --zip --serial"),
+        ("grid of 1e12 variants", s + "".join(f" --param {k} --range 1 2 1000" for k in
+                                              ("contact.damper.force", "element.loop_force_amplitude",
+                                               "excitation.forces", "sweep.f_max")) + " --serial"),
+        ("--out an existing file", f"{s} {p} --values 30 --out {{fx}}/a_file --serial"),
+        ("scene binary", "sweep {fx}/s_binary.toml --param contact.damper.mu --values 0.5 --serial"),
+    ])
+
+
+def _cache_and_rest() -> list[InputCase]:
+    cases = _table("cache", [
+        ("info --cache-max-mb -1", "cache info --cache-max-mb=-1"),
+        ("clear a file", "cache clear --cache-dir {fx}/a_file"),
+        ("action bogus", "cache bogus"),
+    ])
+    cases.append(_case("cache", "clear a folder of the user's", "cache clear --cache-dir proj",
+                       files={"proj/matrices.npz": "user data\n", "proj/notes.txt": "keep me\n"}))
+    cases += _table("study", [("workers 0", "study cylinders --quick --workers 0"),
+                              ("workers 10000", "study cylinders --quick --workers 10000"),
+                              ("--plot a file", "study eccentric --quick --plot {fx}/a_file"),
+                              ("unknown study", "study nosuch")])
+    cases += _table("bench", [("--out a file", "bench --quick --stage element --out {fx}/a_file"),
+                              ("unknown stage", "bench --quick --stage nosuch")])
+    cases += _table("stress", [("--out a file", "stress --quick --stage loop --out {fx}/a_file"),
+                               ("unknown stage", "stress --stage nosuch")])
+    return cases
+
+
+def _duties() -> list[InputCase]:
+    """Not bad inputs: what the cache and the runner must do right (converged or interrupted)."""
+    return [
+        _case("cache", "clear keeps a user's file in the cache folder", "cache clear", pre=[shlex.split(KN_SMALL)],
+              mutate="add_user_file", keep=(".damper_cache/notes.txt",), expect="converged", check="no_entries"),
+        _case("cache", "an empty entry is a miss, one warning", KN_SMALL, pre=[shlex.split(KN_SMALL)],
+              mutate="truncate_entries", expect="converged", check="one_warning:is unreadable"),
+        _case("cache", "an entry copied over another key is a miss", KN_SMALL.replace("--grid 5", "--grid 7"),
+              pre=[shlex.split(KN_SMALL), shlex.split(KN_SMALL.replace("--grid 5", "--grid 7"))],
+              mutate="swap_entries", expect="converged", check="one_warning:holds another result"),
+        _case("cache", "run --no-cache writes no cache", "run {fx}/s_kn_small.toml --no-cache --out out",
+              expect="converged", check="no_cache_folder"),
+        _case("run", "Ctrl-C during a cold run", "run {fx}/s_kn.toml --out ok", expect="interrupted",
+              interrupt_on="condense", timeout=120.0),
+    ]
+
+
+def all_cases() -> list[InputCase]:
+    """Every input case, grouped by subcommand."""
+    return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _run()
+            + _sweep() + _cache_and_rest() + _duties())

@@ -1,0 +1,201 @@
+"""Files the input stage's bad inputs point at: curves, scenes, matrices, element and UPD files.
+
+:func:`make` writes them once into a fixtures folder (``{fx}`` in a case's command);
+each good file has broken siblings (binary, truncated, empty, NaN, wrong shape, unknown
+key) so that every file type the toolkit reads is tried with each way it can be bad.
+Nominal values as the stress grid's: a Cattaneo-Mindlin curve of 10 points at N =
+200 N, mu = 0.5; the small scene of the application tests (a 7x7 cylinder contact).
+"""
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+
+N0, MU, U_SLIP = 200.0, 0.5, 2.5e-6
+BINARY = bytes(range(128, 256)) * 4
+
+
+def _curve(n: int = 10) -> dict:
+    u = U_SLIP * np.linspace(0.0, 1.0, n)
+    T = MU * N0 * (1.0 - (1.0 - u / U_SLIP) ** 1.5)
+    T[-1] = MU * N0
+    return {"schema": "damper-virgin-curve/1", "u": u.tolist(), "T": T.tolist(), "N": N0, "mu": MU,
+            "k_t": 1.5 * MU * N0 / U_SLIP, "load_case": "CNF"}
+
+
+def curves() -> dict[str, str | bytes]:
+    good = _curve()
+    text = json.dumps(good)
+    nan = dict(good, T=[float("nan")] + good["T"][1:])
+    convex = dict(good, T=(MU * N0 * np.linspace(0, 1, 10) ** 2).tolist())
+    dip = dict(good, T=good["T"][:4] + [good["T"][2]] + good["T"][5:])
+    return {"curve.json": text, "curve_binary.json": BINARY, "curve_trunc.json": text[: len(text) // 2],
+            "curve_empty.json": "", "curve_list.json": "[1, 2, 3]", "curve_nan.json": json.dumps(nan),
+            "curve_decreasing.json": json.dumps(dict(good, u=good["u"][::-1])),
+            "curve_convex.json": json.dumps(convex), "curve_dip.json": json.dumps(dip),
+            "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
+            "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
+            "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")})}
+
+
+def _npz(**arrays) -> bytes:
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+def matrices() -> dict[str, bytes]:
+    """A 2-DOF model (tip and platform of the 2-DOF blade, SI units) and broken variants."""
+    M = np.diag([0.5, 0.05])
+    K = np.array([[4e7, -4e7], [-4e7, 8e7]])
+    C = 1e-5 * K
+    f = np.array([10.0, 0.0])
+    bad_K = K.copy()
+    bad_K[0, 1] = np.nan
+    asym = K.copy()
+    asym[0, 1] *= 2.0
+    return {"m_good.npz": _npz(M=M, K=K, C=C, force=f), "m_nan.npz": _npz(M=M, K=bad_K, C=C, force=f),
+            "m_negM.npz": _npz(M=-np.eye(2), K=K, C=C, force=f), "m_asym.npz": _npz(M=M, K=asym, C=C, force=f),
+            "m_shape.npz": _npz(M=np.eye(3), K=K, force=f), "m_noforce.npz": _npz(M=M, K=K),
+            "m_forcelen.npz": _npz(M=M, K=K, force=np.ones(5)),
+            "m_cnan.npz": _npz(M=M, K=K, C=np.full((2, 2), np.inf), force=f),
+            "m_text.npz": b"M = [[1, 0], [0, 1]]\n", "m_empty.npz": b"",
+            "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200]}
+
+
+def elements() -> dict[str, str | bytes]:
+    jen = '[[element]]\ndofs = [1]\ntype = "jenkins"\nk = 3.85e7\nfs = 60.0\n'
+    return {"el_good.toml": jen, "el_wobble.toml": jen + "wobble = 3\n",
+            "el_scael.toml": '[[element]]\ndofs = [1]\ntype = "curve"\npath = "curve.json"\nscael = 2.0\n',
+            "el_top.toml": "scale = 2.0\n" + jen, "el_badtoml.toml": "[[element]\ndofs = [1\n",
+            "el_binary.toml": BINARY, "el_none.toml": "# no elements\n",
+            "el_dof9.toml": jen.replace("dofs = [1]", "dofs = [9]"),
+            "el_nok.toml": jen.replace("k = 3.85e7\n", ""), "el_type.toml": jen.replace('"jenkins"', '"magic"'),
+            "el_path.toml": '[[element]]\ndofs = [1]\ntype = "curve"\npath = "missing.json"\n',
+            "el_negk.toml": jen.replace("k = 3.85e7", "k = -1.0"),
+            "el_dofstr.toml": jen.replace("dofs = [1]", 'dofs = ["tip"]'),
+            "el_same.toml": jen.replace("dofs = [1]", "dofs = [1, 1]"),
+            "el_contact.toml": '[[element]]\ntype = "contact"\ndofs = [0, 1]\nnormal = [0.0, 1.0]\nk_n = 1e8\n'
+                               "wobble = 1\n"}
+
+
+#: The application tests' small scene (a 7x7 cylinder contact, loop, one FRF level at H = 3).
+SMALL = """title = "small scene"
+want = ["virgin_curve", "k_t", "loop", "frf"]
+
+[contact.damper]
+body = "cylinder"
+diameter = 5.0e-3
+length = 1.2e-3
+force = 120.0
+mu = 0.5
+grid = 7
+
+[element]
+contact = "damper"
+loop_force_amplitude = 40.0
+fmi_versions = [2]
+
+[structure]
+m_tip = 0.5
+m_platform = 0.05
+k_blade = 4.0e7
+k_disk = 4.0e7
+zeta = 0.002
+
+[excitation]
+forces = [30.0]
+
+[sweep]
+f_min = 880.0
+f_max = 1300.0
+harmonics = 3
+"""
+_TWO_DOF = "m_tip = 0.5\nm_platform = 0.05\nk_blade = 4.0e7\nk_disk = 4.0e7\nzeta = 0.002\n"
+
+
+def _matrices_scene(npz: str, dofs: str = "[1]") -> str:
+    return SMALL.replace(_TWO_DOF, f'model = "matrices"\nmatrices = "{npz}"\nelement_dofs = {dofs}\n')
+
+
+#: Scene variants: file name -> (text replaced, replacement) on SMALL, or a whole text.
+SCENE_EDITS = {
+    "s_ok.toml": ("", ""),
+    "s_loopamp.toml": ("loop_force_amplitude = 40.0", "loop_force_amplitude = 400.0"),
+    "s_grid.toml": ("grid = 7", "grid = 100000"),
+    "s_grid2.toml": ("grid = 7", "grid = 2"),
+    "s_forces.toml": ("forces = [30.0]", "forces = []"),
+    "s_forceneg.toml": ("forces = [30.0]", "forces = [-30.0]"),
+    "s_harm.toml": ("harmonics = 3", "harmonics = 100000"),
+    "s_harm0.toml": ("harmonics = 3", "harmonics = 0"),
+    "s_samples.toml": ("fmi_versions = [2]", "fmi_versions = [2]\nloop_samples = 1000000000"),
+    "s_mu0.toml": ("mu = 0.5", "mu = 0.0"),
+    "s_mubig.toml": ("mu = 0.5", "mu = 1e300"),
+    "s_munan.toml": ("mu = 0.5", "mu = nan"),
+    "s_fmax.toml": ("f_max = 1300.0", "f_max = 800.0"),
+    "s_fhuge.toml": ("f_max = 1300.0", "f_max = 1e300"),
+    "s_zone.toml": ("grid = 7", "grid = 7\nzone_load = -1.0"),
+    "s_hertz.toml": ("force = 120.0", "force = 1.0e9"),
+    "s_unknown.toml": ('title = "small scene"', 'title = "small scene"\nwobble = 3'),
+    "s_ckey.toml": ("grid = 7", "grid = 7\nscael = 2.0"),
+    "s_want.toml": ('want = ["virgin_curve", "k_t", "loop", "frf"]', 'want = ["virgin_curve", "wobble"]'),
+    "s_elcontact.toml": ('contact = "damper"', 'contact = "nosuch"'),
+    "s_fmi.toml": ("fmi_versions = [2]", "fmi_versions = [4]"),
+    "s_body.toml": ('body = "cylinder"', 'body = "cube"'),
+    "s_both.toml": ("diameter = 5.0e-3", "diameter = 5.0e-3\nradius = 2.5e-3"),
+    "s_nu.toml": ("grid = 7", "grid = 7\nnu = 0.5"),
+    "s_type.toml": ("force = 120.0", 'force = "heavy"'),
+    "s_dofs.toml": None, "s_mnan.toml": None, "s_mtext.toml": None, "s_mneg.toml": None,
+    "s_mmissing.toml": None, "s_dofsame.toml": None,
+}
+
+
+def scenes() -> dict[str, str | bytes]:
+    out = {}
+    for name, edit in SCENE_EDITS.items():
+        if edit is not None:
+            assert edit[0] in SMALL, name
+            out[name] = SMALL.replace(*edit) if edit[0] else SMALL
+    out |= {"s_dofs.toml": _matrices_scene("m_good.npz", "[7]"), "s_mnan.toml": _matrices_scene("m_nan.npz"),
+            "s_mtext.toml": _matrices_scene("m_text.npz"), "s_mneg.toml": _matrices_scene("m_negM.npz"),
+            "s_mmissing.toml": _matrices_scene("nowhere.npz"),
+            "s_dofsame.toml": _matrices_scene("m_good.npz", "[1, 1]")}
+    out |= {"s_toml.toml": "want = [\n[contact.damper\n", "s_empty.toml": "", "s_binary.toml": BINARY,
+            "s_bbmode.toml": ('want = ["backbone"]\n[structure]\n' + _TWO_DOF + '[backbone]\nelement = "jenkins"\n'
+                              "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-7, 1e-4]\nmode = 5\n"),
+            "s_bbamp.toml": ('want = ["backbone"]\n[structure]\n' + _TWO_DOF + '[backbone]\nelement = "jenkins"\n'
+                             "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-4, 1e-7]\n"),
+            "s_updpoints.toml": 'want = ["optimal_load"]\n[upd]\npoints = 1000000\n',
+            "s_updharm.toml": 'want = ["optimal_load"]\n[upd]\nharmonics = 100000\n',
+            "s_updcfg.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "missing.toml"\n',
+            "s_updbad.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "upd_unknown.toml"\n',
+            "s_nocontact.toml": 'want = ["virgin_curve"]\n',
+            # the SIGINT and cache cases: a cold condensation that takes a few seconds (kn only)
+            "s_kn.toml": ('want = ["k_n", "report"]\n[contact.damper]\nbody = "cylinder"\ndiameter = 5.0e-3\n'
+                          "length = 1.2e-3\nforce = 120.0\ngrid = 21\n"),
+            "s_kn_small.toml": ('want = ["k_n"]\n[contact.damper]\nbody = "sphere"\nradius = 0.01\n'
+                                'model = "halfspace"\nforce = 100.0\ngrid = 5\n')}
+    return out
+
+
+def upd_files() -> dict[str, str | bytes]:
+    return {"upd_unknown.toml": "[load]\nwobble = 3\n", "upd_binary.toml": BINARY,
+            "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
+
+
+def make(folder: Path) -> Path:
+    """Write every fixture into ``folder``; return it."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for group in (curves(), matrices(), elements(), scenes(), upd_files()):
+        for name, content in group.items():
+            path = folder / name
+            if isinstance(content, bytes):
+                path.write_bytes(content)
+            else:
+                path.write_text(content)
+    (folder / "binary.bin").write_bytes(BINARY)
+    (folder / "a_file").write_text("not a folder\n")
+    return folder

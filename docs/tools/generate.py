@@ -1,0 +1,121 @@
+"""Pages of the documentation that come from the code and from recorded data.
+
+Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
+(git-ignored):
+
+* ``api/<package>.rst``: one ``automodule`` per module of each package, found by
+  walking the package, so a new module appears in the API reference without editing
+  the docs;
+* ``validation.md``: the table of every reference case the tests check, from
+  ``docs/data/validation.json`` (written by ``make validation``: the tests themselves
+  record each check through ``tests/reference.py``);
+* ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
+  ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
+  ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
+
+Every generated page names the command, revision, date and machine of its data.
+"""
+from __future__ import annotations
+
+import json
+import pkgutil
+from pathlib import Path
+
+import tables
+
+#: The packages of the API reference, bottom layer first, with a one-line role each.
+PACKAGES = {
+    "contact_core": "FE contact of two bodies: bodies, condensation, normal and tangential solves, curve file.",
+    "fmu_src": "The Masing/Iwan friction element: C core bindings, curve checks, FMI 2/3 FMU builder.",
+    "harmonic_balance": "Forced response: force elements, AFT, Newton, continuation, stability, EPMC, bladed disk.",
+    "damper": "The application: CLI, scenes, stage graph, cache, provenance, reports, sweeps, studies, bench, stress.",
+}
+
+
+def _write(path: Path, text: str) -> None:
+    """Write only when the text changed (Sphinx then rebuilds only what changed)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
+
+
+def modules(package: str, root: Path) -> list[str]:
+    """Dotted names of every module below ``package`` (the package itself first)."""
+    names = [package]
+    for info in pkgutil.walk_packages([str(root / package.replace(".", "/"))], prefix=package + "."):
+        if info.name.rsplit(".", 1)[-1].startswith("_"):
+            continue  # private modules (the ctypes layer) are documented through their users
+        names.append(info.name)
+    return names
+
+
+def api_pages(docs: Path) -> None:
+    root = docs.parent
+    for pkg, role in PACKAGES.items():
+        lines = [f"``{pkg}``", "=" * (len(pkg) + 4), "", role, ""]   # the theme lists the modules at the side
+        for name in modules(pkg, root):
+            lines += [name, "-" * len(name), "", f".. automodule:: {name}", ""]
+        _write(docs / "_generated" / "api" / f"{pkg}.rst", "\n".join(lines))
+
+
+def cli_page(docs: Path) -> None:
+    """``damper COMMAND --help`` of every subcommand, as one reference page."""
+    import argparse
+
+    from damper.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    lines = ["# Command reference", "",
+             "The `--help` text of every `damper` subcommand, as this version prints it. Every "
+             "subcommand prints one JSON object with `--json`, uses SI units, and exits with 2 on bad "
+             "input (a one-line message, nothing written) and 3 when a solver fails.", "",
+             "```text", parser.format_help().rstrip(), "```", ""]
+    for name, p in sub.choices.items():
+        lines += [f"## damper {name}", "", "```text", p.format_help().rstrip(), "```", ""]
+        nested = [a for a in p._actions if isinstance(a, argparse._SubParsersAction)]
+        for act in nested:
+            for sname, sp in act.choices.items():
+                lines += [f"### damper {name} {sname}", "", "```text", sp.format_help().rstrip(), "```", ""]
+    _write(docs / "_generated" / "cli.md", "\n".join(lines))
+
+
+#: Pages the toctrees of index.md and user/index.md name; any other page found in docs/ or
+#: docs/user/ (added by a part of the project the index does not know yet) is listed
+#: under "More" in the user guide, so the build neither warns nor hides it.
+KNOWN = {
+    "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
+         "changes"},
+    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "scenes", "studies",
+             "bench_stress"},
+}
+
+
+def more_pages(docs: Path) -> None:
+    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages not in KNOWN."""
+    extra = []
+    for sub, known in KNOWN.items():
+        for p in sorted((docs / sub).glob("*.md")):
+            if p.stem not in known:
+                extra.append(p.stem if sub == "user" else f"../{p.stem}")
+    text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
+    _write(docs / "_generated" / "more.md", text)
+
+
+def data_page(docs: Path, name: str, render) -> None:
+    """Render ``docs/data/<name>.json`` with ``render(data) -> markdown``, or say how to make it."""
+    src = docs / "data" / f"{name}.json"
+    if src.exists():
+        text = render(json.loads(src.read_text()))
+    else:
+        text = tables.missing(name)
+    _write(docs / "_generated" / f"{name}.md", text)
+
+
+def all_pages(docs: Path) -> None:
+    api_pages(docs)
+    cli_page(docs)
+    more_pages(docs)
+    data_page(docs, "validation", tables.validation)
+    data_page(docs, "bench", tables.bench)
+    data_page(docs, "stress", tables.stress)

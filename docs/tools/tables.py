@@ -1,0 +1,115 @@
+"""Markdown of the data pages: validation, performance (``damper bench``), stability (``damper stress``).
+
+Each renderer takes the JSON of one data file and returns the page's Markdown,
+starting with where the figures come from (command, revision, date, machine).
+"""
+from __future__ import annotations
+
+#: How each data file is made (shown on a page whose data file is missing, and in the stamp).
+MAKE = {
+    "validation": "make validation",
+    "bench": "make docs-bench",
+    "stress": "make docs-stress",
+}
+
+
+def missing(name: str) -> str:
+    return (f"```{{note}}\nNo recorded data yet (`docs/data/{name}.json`): run `{MAKE[name]}` and build "
+            f"the documentation again.\n```\n")
+
+
+def _g(x, digits: int = 3) -> str:
+    """A number in short form ('-' for none)."""
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int):
+        return str(x)
+    if isinstance(x, float):
+        if x == 0.0:
+            return "0"
+        return f"{x:.{digits}g}" if 1e-3 <= abs(x) < 1e5 else f"{x:.{max(digits - 1, 1)}e}"
+    return str(x)
+
+
+def _cell(x) -> str:
+    return _g(x).replace("|", "/").replace("\n", " ")
+
+
+def stamp_text(data: dict, name: str) -> str:
+    """Where the figures come from: one paragraph."""
+    s = data.get("stamp", {})
+    load = s.get("load_average")
+    load_txt = f", load average {load[0]:.1f}" if load else ""
+    versions = ", ".join(f"{k} {v}" for k, v in (s.get("versions") or {}).items() if v)
+    return (f"Recorded {s.get('date_utc', '?')} at revision `{s.get('revision', '?')}` on "
+            f"{s.get('cores', '?')} cores ({s.get('machine', '?')}, {s.get('system', '?')}, Python "
+            f"{s.get('python', '?')}{load_txt}) by\n\n```\n{data.get('command', '?')}\n```\n\n"
+            f"(exit code {data.get('exit_code', '?')}, {data.get('wall_s', '?')} s wall). Libraries: "
+            f"{versions or '-'}. Regenerate with `{MAKE[name]}`; the machine is shared, so wall times "
+            f"are upper bounds and only ratios within one run compare.\n")
+
+
+def validation(data: dict) -> str:
+    recs = data.get("records", [])
+    out = [stamp_text(data, "validation"), "",
+           f"{len(recs)} reference checks in {len({r['test'] for r in recs})} tests; "
+           f"{sum(r['passed'] for r in recs)} passed, {sum(not r['passed'] for r in recs)} failed.", ""]
+    groups: dict[str, list[dict]] = {}
+    for r in recs:
+        groups.setdefault(r["test"].split("/")[1] if r["test"].count("/") > 1 else "tests", []).append(r)
+    for group in sorted(groups):
+        out += [f"## {group}", "",
+                "| quantity | reference | our value | reference value | tolerance | test |",
+                "|---|---|---|---|---|---|"]
+        for r in sorted(groups[group], key=lambda r: (r["test"], r["quantity"])):
+            mark = "" if r["passed"] else " **(failed)**"
+            out.append(f"| {_cell(r['quantity'])} | {_cell(r['source'])} | {_g(r['value'], 6)} | "
+                       f"{_g(r['reference'], 6)} | {_cell(r['tolerance'])}{mark} | `{r['test']}` |")
+        out.append("")
+    return "\n".join(out) + "\n"
+
+
+def bench(data: dict) -> str:
+    from damper.bench.report import LEGEND
+
+    res = data.get("result", {})
+    out = [stamp_text(data, "bench"), ""]
+    if res.get("quick"):
+        out += ["```{warning}\nThese are the `--quick` sizes (a smoke run), not the full benchmark.\n```", ""]
+    for stage, rows in res.get("stages", {}).items():
+        size, err = LEGEND.get(stage, ("size", "error"))
+        out += [f"## {stage}", "", f"Size: {size}. Error: {err}.", "",
+                "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
+        for r in rows:
+            case = r["case"] + (" (default)" if r.get("default") else "")
+            out.append(f"| {_cell(case)} | {_g(r['size'])} | {_g(r['error'])} | {_g(r['time_s'])} | "
+                       f"{_g(r['memory_mb'], 4)} | {_g(bool(r.get('cached')))} |")
+        out.append("")
+    return "\n".join(out) + "\n"
+
+
+def stress(data: dict) -> str:
+    res = data.get("result", {})
+    summ = res.get("summary", {})
+    counts = ", ".join(f"{n} {k}" for k, n in sorted(summ.get("counts", {}).items()))
+    out = [stamp_text(data, "stress"), "",
+           f"{len(res.get('cases', []))} cases: {counts}; not as expected: {summ.get('unexpected', '?')}; "
+           f"unexplained: {len(summ.get('unexplained', []))}.", ""]
+    if res.get("quick"):
+        out += ["```{warning}\nThese are the `--quick` cases (a smoke run), not the full grid.\n```", ""]
+    stages: dict[str, list[dict]] = {}
+    for r in res.get("cases", []):
+        stages.setdefault(r["stage"], []).append(r)
+    for stage, rows in stages.items():
+        out += [f"## {stage}", "", "| case | outcome | expected | worst residual | time [s] | note |",
+                "|---|---|---|---|---|---|"]
+        for r in rows:
+            note = r.get("known") or ("" if r.get("ok") else "UNEXPECTED: " + r.get("message", ""))
+            if r.get("ok") and r["outcome"] == "clear_error":
+                note = r.get("message", "")
+            out.append(f"| {_cell(r['case'])} | {r['outcome']} | {r['expected']} | {_g(r.get('worst_residual'), 2)} "
+                       f"| {_g(r['time_s'])} | {_cell(note[:160])} |")
+        out.append("")
+    return "\n".join(out) + "\n"
