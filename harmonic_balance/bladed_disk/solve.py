@@ -89,8 +89,8 @@ def start_point(hb: SectorHB, omega: float) -> np.ndarray:
     in the EO force level (the same continuation as the curves', no curve tolerance: it
     only has to arrive) from the first of F0 2^-k (k = 1 .. HOMOTOPY_LEVELS) where Newton
     converges from the stuck guess at that level, with the CF at its full value
-    throughout: R(x; lam) = R(x) + (1 - lam) F_eo. (Halving F0 with Newton at each level,
-    as before, failed at 400 Hz on the geometry contacts at CF 40 N: |R| stalled at 0.14.)
+    throughout: R(x; lam) = R(x) + (1 - lam) F_eo. (Newton at halved levels of F0 instead
+    stalls at |R| = 0.14 at 400 Hz on the geometry contacts at CF 40 N.)
 
     Raises
     ------

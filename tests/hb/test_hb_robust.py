@@ -53,9 +53,9 @@ def test_nearly_undamped_peak_completes_from_any_start(kt, fs, H, start):
 def test_grazing_slip_is_crossed_by_the_exact_aft_or_a_finer_grid(monkeypatch):
     """Slip force = forcing, 10 k, c = 1e-4, H = 3: above 1 rad/s the link's force only
     just exceeds f_s at the turning points, so the slip episodes of a sampled loop span a
-    handful of samples and its corrector stalled (found by the full map: at 1.1066 rad/s
-    on 256-1024 samples with the earlier step control; measured now: gaps near 1.47 rad/s
-    on 64 samples, none on 256). The exact links (the default) have no samples to miss:
+    handful of samples and its corrector stalls (measured: gaps near 1.47 rad/s on 64
+    samples, none on 256; with a fixed largest step of 0.1 it stalled at 1.1066 rad/s on
+    256-1024 samples). The exact links (the default) have no samples to miss:
     complete on the default grid. Sampled from a 64-sample grid, compute_frf traces the
     stalled curve again on doubled grids; with the grid fixed by the caller there is no
     doubling: the gaps stay (and are reported)."""

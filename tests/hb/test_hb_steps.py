@@ -26,9 +26,10 @@ def chain3(force, knl):
 
 def test_a_small_resonance_on_a_flat_curve_is_not_stepped_over():
     """Force 0.5, knl 2000: the links nearly stick, the curve is flat to 1 % but for the
-    third mass's resonance near 1.395 rad/s, 0.6 % high. Swept up in 14 points it was
-    stepped over (peak 0.58 % low, 5 % off in frequency); both directions and a finer
-    tolerance now find the same refined peak."""
+    third mass's resonance near 1.395 rad/s, 0.6 % high: steps of 0.1 scaled arclength
+    with no limit in frequency cross the curve in 14 points and step over it (peak 0.58 %
+    low, 5 % off in frequency). Both directions and a finer tolerance find the same
+    refined peak."""
     peaks = [compute_frf(chain3(0.5, 2000.0), 7, rng, stability=False, **kw)
              for rng, kw in (((0.5, 2.0), {}), ((2.0, 0.5), {}), ((0.5, 2.0), {"tolerance": 1e-3}))]
     assert all(r.peak_interior and r.extra["peak_refined"] for r in peaks)
@@ -40,10 +41,9 @@ def test_a_small_resonance_on_a_flat_curve_is_not_stepped_over():
 def test_a_kink_where_a_second_slip_pair_appears_is_crossed_without_restart():
     """Force 1, knl 20, swept down: at 1.02978 rad/s the second link gains a second pair
     of slip phases per cycle, the branch turns by more than 90 deg in scaled variables
-    and the pseudo-arclength plane misses it; it stalled there (a restart by homotopy and
-    a gap, five finer AFT grids traced for nothing, 121 s). Now crossed in the same
-    curve (the corrector at fixed frequency, the step sized by delta alone past a kink),
-    on the default grid, with the up-sweep's peak."""
+    and the pseudo-arclength plane misses it (without the fixed-frequency corrector and
+    the kink rule: a stall, a restart by homotopy and a gap, whatever the AFT grid). It
+    is crossed in the same curve, on the default grid, with the up-sweep's peak."""
     down = compute_frf(chain3(1.0, 20.0), 7, (2.0, 0.5), stability=False)
     up = compute_frf(chain3(1.0, 20.0), 7, (0.5, 2.0), stability=False)
     for r in (down, up):
