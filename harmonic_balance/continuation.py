@@ -69,6 +69,17 @@ GROW = 2.0
 #: A retry whose tangent angle stays above this share of the longer attempt's angle
 #: found a kink (a smooth branch halves the angle with the step).
 CORNER_SHARE = 0.6
+#: Scaled step below which a step is judged by delta alone: neither the tangent's turn nor
+#: a step back in lam without a change of det(R_x) rejects it. A non-smooth branch can
+#: turn back at a corner without det changing sign (measured: the Jenkins oscillator at
+#: 1e4 k, f_s = P, c = 1e-4, H = 51 near 1.9609 rad/s, where the slip episodes grazing
+#: the turning points come and go: a turn of 143 deg, crossed only in steps this small).
+KINK_STEP = 2e-4
+#: Points accepted in a row below KINK_STEP after which the continuation stops as stalled
+#: (the caller restarts past the kink): a sampled AFT's staircase of kinks (64 samples,
+#: grazing slip) took 2000 such points without getting past 1.471 rad/s; the grazing
+#: corner above needs fewer than 10.
+CREEP_POINTS = 30
 #: Smallest scaled step at which a failed pseudo-arclength corrector is retried at
 #: fixed parameter (below it the fallback only creeps: measured at 1e6 k, 1e-8 rad/s
 #: per point, so the caller's restart is the better way past).
@@ -261,6 +272,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
     orient = 0.0  # sign of det([J; t]): the branch's orientation (set at the first point)
     ctl = _Control(tolerance, lam_step)
+    creep = 0  # points accepted in a row at steps below KINK_STEP
     while len(branch.lam) < max_points:
         tol_now = max(tol, rtol * float(np.linalg.norm(J_phys[:, :-1] @ branch.x[-1])))
         sc = _Scaled(fun, s_x, s_lam, tol_now)
@@ -277,6 +289,10 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
             t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
         branch.tangent[-1] = _unscaled(t, col)
         y_new, it, ds, J_new, f = _step(sc, y, t, min(ds, ds_max), ds_min, branch, ctl, orient)
+        creep = creep + 1 if ds < KINK_STEP else 0
+        if creep > CREEP_POINTS:
+            raise _stop(f"step below minimum (more than {CREEP_POINTS} points in steps below "
+                        f"{KINK_STEP:g}: the corrector creeps along a kink)", branch)
         J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
@@ -360,9 +376,10 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
                     t_new = -t_new
                 alpha = float(np.arccos(np.clip(t_new @ t, -1.0, 1.0)))
                 delta = float(np.linalg.norm(res.x - y_pred))
-                corner = alpha_prev is not None and alpha > CORNER_SHARE * alpha_prev
+                corner = ds < KINK_STEP or (alpha_prev is not None
+                                            and alpha > CORNER_SHARE * alpha_prev)
                 f, f_next = ctl.factor(delta, alpha, res.iterations, corner)
-                if _backwards(res.x[-1] - y[-1], t[-1], t_new[-1]):
+                if ds >= KINK_STEP and _backwards(res.x[-1] - y[-1], t[-1], t_new[-1]):
                     f, reason = max(f, 2.0 * REJECT), "the corrector went back in the parameter"
                 if f <= REJECT:
                     return res.x, res.iterations, ds, res.J[:-1], f_next
