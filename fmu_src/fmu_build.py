@@ -38,8 +38,12 @@ FMI_DIR = Path(__file__).resolve().parent / "fmi"
 CORE_DIR = Path(__file__).resolve().parent / "core"
 HEADER_PATH = FMI_DIR / "damper_vr.h"
 
-#: Model hooks available to the wrapper (model.h): the element, the contact point, a baseline.
-MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c", "point": "model_point.c"}
+#: Model hooks available to the wrapper (model.h): the element, the contact point, a
+#: baseline, a linear blade (fmu_src.blade_fmu) and an underplatform damper (fmu_src.upd_fmu).
+MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c", "point": "model_point.c",
+          "blade": "model_blade.c", "upd": "model_upd.c"}
+#: Models that read the curve / normal-law resources (model_table.c).
+USES_TABLE = ("iwan", "passthrough", "point")
 #: Binary folder of each FMI version on 64-bit Linux.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 #: How a curve table that is not concave is handled (iwan.h iwan_fit).
@@ -48,7 +52,7 @@ _FMI_HEADERS = {
     2: ("fmi2Functions.h", "fmi2FunctionTypes.h", "fmi2TypesPlatform.h"),
     3: ("fmi3Functions.h", "fmi3FunctionTypes.h", "fmi3PlatformTypes.h"),
 }
-_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h")
+_WRAPPER_HEADERS = ("fmu_instance.h", "fmu_internal.h", "model.h", "model_table.h")
 #: Input bound of the Iwan model (model_iwan.c U_BOUND_RTOL): the force error of a
 #: slider, about k eps |u|, stays below this fraction of its slip strength.
 U_BOUND_RTOL = 1e-6
@@ -64,6 +68,8 @@ def core_files(model: str) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """(C sources, headers) of fmu_src/core compiled into the FMU of ``model``."""
     if model == "point":
         return CORE_SOURCES + POINT_SOURCES, CORE_HEADERS + POINT_HEADERS
+    if model == "blade":
+        return (), ()
     return CORE_SOURCES, CORE_HEADERS
 #: The one compile-flag list shared with CMake and the pip extension (one flag a line).
 CFLAGS_FILE = CORE_DIR / "cflags.txt"
@@ -84,7 +90,8 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model],
+    table = ("model_table.c",) if model in USES_TABLE else ()
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *table,
             *core_files(model)[0]]
 
 
@@ -146,16 +153,21 @@ def curve_resource_text(u, T, n_ref: float, fit: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
+def _copy_sources(dest: Path, fmi_version: int, model: str,
+                  iface: fmu_xml.Interface | None = None) -> list[str]:
     """Copy the C sources and headers flat into ``dest`` (with the model's variable
-    table and the fmu_vars.h that picks it); return the .c names."""
+    table and the fmu_vars.h that picks it); return the .c names. ``iface`` (default:
+    the model's committed one) is written from its table when it has no committed header."""
     dest.mkdir(parents=True)
     names = c_sources(fmi_version, model)
     sources, headers = core_files(model)
-    iface = fmu_xml.INTERFACES[model]
-    for name in names + list(_WRAPPER_HEADERS + headers) + [iface.header]:
+    iface = fmu_xml.INTERFACES[model] if iface is None else iface
+    committed = iface in HEADERS.values()
+    for name in names + list(_WRAPPER_HEADERS + headers) + ([iface.header] if committed else []):
         src = CORE_DIR if name in sources + headers else FMI_DIR
         shutil.copy(src / name, dest / name)
+    if not committed:
+        (dest / iface.header).write_text(fmu_xml.render_vr_header(iface))
     (dest / "fmu_vars.h").write_text(fmu_xml.render_fmu_vars(iface))
     for name in _FMI_HEADERS[fmi_version] + ("LICENSE.txt",):
         shutil.copy(FMI_DIR / "headers" / name,
@@ -164,8 +176,9 @@ def _copy_sources(dest: Path, fmi_version: int, model: str) -> list[str]:
 
 
 def compile_binary(source_dir: Path, names: list[str], out: Path,
-                   compiler: str | None = None) -> None:
-    """Compile ``names`` from ``source_dir`` into the shared library ``out``.
+                   compiler: str | None = None, extra_flags: tuple = ()) -> None:
+    """Compile ``names`` from ``source_dir`` into the shared library ``out``
+    (``extra_flags``: e.g. ``-Werror`` in CI).
 
     Raises
     ------
@@ -174,7 +187,7 @@ def compile_binary(source_dir: Path, names: list[str], out: Path,
     """
     cc = compiler or os.environ.get("CC", "cc")
     out.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [cc, *CFLAGS, f"-I{source_dir}", *[str(source_dir / n) for n in names],
+    cmd = [cc, *CFLAGS, *extra_flags, f"-I{source_dir}", *[str(source_dir / n) for n in names],
            "-o", str(out), "-lm"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
@@ -225,6 +238,53 @@ def _zip_dir(root: Path) -> bytes:
             if path.is_file():
                 zf.write(path, path.relative_to(root).as_posix())
     return buf.getvalue()
+
+
+def package_fmu(out: str | os.PathLike, fmi_version: int, model: str,
+                iface: fmu_xml.Interface, resources: dict, description: str = "",
+                documentation: str = "", bounds: dict | None = None,
+                compiler: str | None = None) -> Path:
+    """Write a co-simulation FMU of ``model`` behind the FMI layer (atomically), for a
+    model whose start values are in its table (rules none / zero / one / value).
+
+    Parameters
+    ----------
+    out : path                 the ``.fmu`` file
+    fmi_version : {2, 3}
+    model : str                a key of :data:`MODELS`
+    iface : fmu_xml.Interface  its variable table (its header is generated into sources/)
+    resources : dict           file name -> text, written under ``resources/``
+    description, documentation : str
+        Model description text; ``documentation/index.html``.
+    bounds : dict              input bounds by name (min/max in the model description)
+    compiler : str, optional   C compiler (default ``$CC`` or ``cc``)
+
+    Raises
+    ------
+    RuntimeError
+        The compiler failed.
+    """
+    _check_version(fmi_version)
+    with tempfile.TemporaryDirectory(prefix="damper_fmu_") as tmp:
+        root = Path(tmp) / "fmu"
+        names = _copy_sources(root / "sources", fmi_version, model, iface)
+        (root / "resources").mkdir()
+        for name, text in resources.items():
+            (root / "resources" / name).write_text(text)
+        if documentation:
+            (root / "documentation").mkdir()
+            (root / "documentation" / "index.html").write_text(documentation)
+        text = fmu_xml.render_model_description(fmi_version, 0.0, names, description,
+                                                iface=iface, bounds=bounds or {})
+        (root / "modelDescription.xml").write_text(text)
+        if fmi_version == 3:
+            (root / "sources" / "buildDescription.xml").write_text(
+                fmu_xml.render_build_description(names, iface))
+        binary = root / "binaries" / PLATFORM[fmi_version] / f"{iface.model_identifier}.so"
+        compile_binary(root / "sources", names, binary, compiler)
+        path = atomic_write(out, _zip_dir(root))
+    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
+    return path
 
 
 def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,

@@ -8,7 +8,11 @@ element :data:`DAMPER`, ``point_vr.h`` for the contact point :data:`POINT`). The
 headers are committed; a test checks that they equal :func:`render_vr_header`
 (regenerate with ``python -m fmu_src.fmu_build --write-header``). Nothing is kept in
 sync by hand. Every header defines the same C names, so the FMI layer compiles
-against whichever one ``fmu_vars.h`` includes.
+against whichever one ``fmu_vars.h`` includes. Models whose variables depend on their
+data (a blade's named DOFs, a damper's contacts: :mod:`fmu_src.blade_fmu`,
+:mod:`fmu_src.upd_fmu`) get their header generated into the FMU's ``sources/`` at build
+time, with their start values in it (rule ``value``) and their capabilities (direct
+feedthrough, directional derivatives, FMI 2 input derivatives) as flags.
 
 Symbols: u relative tangential displacement [m], N normal load [N], F friction
 force [N], kt tangent stiffness dF/du [N/m], W dissipated energy [J], slip slip
@@ -19,14 +23,17 @@ from __future__ import annotations
 
 import hashlib
 import uuid
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from xml.sax.saxutils import escape, quoteattr
 
 #: Model identifier of the 1D element: the binary is ``binaries/<platform>/damper.so``.
 MODEL_IDENTIFIER = "damper"
 
-#: Start rules shared by XML and C: where a variable's start value comes from.
+#: Start rules shared by XML and C: where a variable's start value comes from. The first
+#: three are the FMI layer's own; any other is the model's (``model_start`` in C).
 START_RULES = ("none", "zero", "one", "curve_n")
+#: The start rules of tables that carry their start values (rule ``value``).
+VALUE_START_RULES = ("none", "zero", "one", "value")
 
 #: FMI log categories the FMU declares (and accepts in SetDebugLogging).
 LOG_CATEGORIES = (
@@ -44,8 +51,11 @@ class Variable:
     causality: str      # independent | input | output | parameter
     variability: str    # continuous | fixed
     unit: str
-    start: str          # one of START_RULES
+    start: str          # one of the interface's start rules
     description: str
+    # the start value of rule "value" (out of the repr: the tables without that rule
+    # keep their tokens)
+    value: float = field(default=0.0, repr=False)
 
 
 #: The FMU's variables, in ModelVariables order (value reference = position).
@@ -82,6 +92,9 @@ UNITS = {
     "1": {},
     "m/s": {"m": 1, "s": -1},
     "N.s/m": {"kg": 1, "s": -1},
+    "N/s": {"kg": 1, "m": 1, "s": -3},
+    "Hz": {"s": -1},
+    "rad": {},
 }
 
 #: The 1D element's start rules (the C enum of its header, part of its token).
@@ -156,7 +169,11 @@ class Interface:
     model_name : str         ``modelName`` of the model description
     variables : tuple of Variable (value reference = position)
     start_rules : tuple of str (C enum START_<RULE>; part of the token)
-    header : str             the generated C header (in fmu_src/fmi)
+    header : str             the generated C header (committed in fmu_src/fmi, or
+                             written into an FMU's sources)
+    feedthrough : bool       outputs depend on the current inputs (ModelStructure)
+    directional : bool       provides directional derivatives
+    interpolates : bool      accepts FMI 2 input derivatives (order 1)
     """
 
     model_identifier: str
@@ -164,6 +181,13 @@ class Interface:
     variables: tuple
     start_rules: tuple
     header: str
+    feedthrough: bool = True
+    directional: bool = True
+    interpolates: bool = True
+
+    def fmi2_variables(self) -> tuple:
+        """The FMI 2 ModelVariables (:func:`fmi2_variables`)."""
+        return fmi2_variables(self)
 
     def by_causality(self, causality: str) -> list[Variable]:
         """Variables of one causality, in table order."""
@@ -206,6 +230,9 @@ def instantiation_token(iface: Interface = DAMPER) -> str:
     table refuses to load.
     """
     text = repr((iface.model_identifier, iface.variables, iface.start_rules))
+    values = [v.value for v in iface.variables if v.start == "value"]
+    if values or not (iface.feedthrough and iface.directional and iface.interpolates):
+        text += repr((values, iface.feedthrough, iface.directional, iface.interpolates))
     digest = hashlib.sha256(text.encode()).digest()[:16]
     return "{" + str(uuid.UUID(bytes=digest)) + "}"
 
@@ -213,7 +240,8 @@ def instantiation_token(iface: Interface = DAMPER) -> str:
 def start_value(var: Variable, curve_n: float, starts: dict | None = None) -> float | None:
     """Numeric start value of ``var`` for an FMU whose curve was computed at ``curve_n``;
     ``starts`` gives the values of the model's own rules (e.g. ``normal_p``)."""
-    rules = {"none": None, "zero": 0.0, "one": 1.0, "curve_n": float(curve_n), **(starts or {})}
+    rules = {"none": None, "zero": 0.0, "one": 1.0, "curve_n": float(curve_n),
+             "value": var.value, **(starts or {})}
     return rules[var.start]
 
 
@@ -279,13 +307,14 @@ def _fmi3_variables(iface: Interface, curve_n: float, bounds: dict, starts: dict
 
 
 def _structure(fmi_version: int, iface: Interface = DAMPER) -> str:
-    """ModelStructure: every output depends directly on every input (feedthrough).
+    """ModelStructure: with direct feedthrough every output depends on every input,
+    without it on none (the outputs are the state at the communication point).
 
     During initialization the outputs also depend on the parameters (knowns with
     initial="exact"). FMI 2 dependencies are 1-based indices into the FMI 2 ModelVariables;
     FMI 3 dependencies are value references.
     """
-    inputs = iface.by_causality("input")
+    inputs = iface.by_causality("input") if iface.feedthrough else []
     knowns = inputs + iface.by_causality("parameter")
     outputs = iface.by_causality("output")
     if fmi_version == 2:
@@ -304,6 +333,10 @@ def _structure(fmi_version: int, iface: Interface = DAMPER) -> str:
     rows += [f'    <InitialUnknown valueReference="{v.vr}" dependencies="{init_deps}"/>'
              for v in outputs]
     return "  <ModelStructure>\n" + "\n".join(rows) + "\n  </ModelStructure>"
+
+
+def _flag(v: bool) -> str:
+    return "true" if v else "false"
 
 
 def render_model_description(fmi_version: int, curve_n: float, source_files: list[str],
@@ -342,9 +375,11 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
         head = (f'<fmiModelDescription fmiVersion="2.0" {common} guid="{token}" '
                 f'numberOfEventIndicators="0">\n'
                 f'  <CoSimulation modelIdentifier="{mid}" '
-                'canHandleVariableCommunicationStepSize="true" canInterpolateInputs="true" '
+                'canHandleVariableCommunicationStepSize="true" '
+                f'canInterpolateInputs="{_flag(iface.interpolates)}" '
                 'maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true" '
-                'canSerializeFMUstate="true" providesDirectionalDerivative="true" '
+                'canSerializeFMUstate="true" '
+                f'providesDirectionalDerivative="{_flag(iface.directional)}" '
                 'canNotUseMemoryManagementFunctions="true" '
                 'canBeInstantiatedOnlyOncePerProcess="false">\n'
                 f'    <SourceFiles>{files}\n    </SourceFiles>\n  </CoSimulation>')
@@ -354,7 +389,8 @@ def render_model_description(fmi_version: int, curve_n: float, source_files: lis
                 f'instantiationToken="{token}">\n'
                 f'  <CoSimulation modelIdentifier="{mid}" '
                 'canHandleVariableCommunicationStepSize="true" canGetAndSetFMUState="true" '
-                'canSerializeFMUState="true" providesDirectionalDerivatives="true" '
+                'canSerializeFMUState="true" '
+                f'providesDirectionalDerivatives="{_flag(iface.directional)}" '
                 'providesAdjointDerivatives="false" hasEventMode="false" '
                 'canBeInstantiatedOnlyOncePerProcess="false"/>')
         variables = _fmi3_variables(iface, curve_n, bounds, starts or {})
@@ -382,9 +418,14 @@ def render_fmu_vars(iface: Interface) -> str:
             f"fmu_src.fmu_build). */\n#include \"{iface.header}\"\n")
 
 
+def c_name(name: str) -> str:
+    """A variable name as a C macro suffix (letters, digits, underscores, upper case)."""
+    return "".join(c if c.isalnum() else "_" for c in name).upper()
+
+
 def render_vr_header(iface: Interface = DAMPER) -> str:
     """Text of the model's C header (``fmu_src/fmi/<iface.header>``): the C view of its table."""
-    guard = iface.header.upper().replace(".", "_")
+    guard = c_name(iface.header)
     variables = iface.variables
     lines = [
         f"/* {iface.header} -- GENERATED by `python -m fmu_src.fmu_build --write-header`",
@@ -393,10 +434,16 @@ def render_vr_header(iface: Interface = DAMPER) -> str:
         f"#ifndef {guard}", f"#define {guard}", "",
         f'#define DAMPER_MODEL_IDENTIFIER "{iface.model_identifier}"',
         f'#define DAMPER_TOKEN "{instantiation_token(iface)}"',
-        f"#define DAMPER_N_VARIABLES {len(variables)}", "",
+        f"#define DAMPER_N_VARIABLES {len(variables)}",
+        f"#define DAMPER_FEEDTHROUGH {int(iface.feedthrough)}"
+        "  /* outputs depend on the current inputs */",
+        f"#define DAMPER_DIRECTIONAL {int(iface.directional)}"
+        "  /* directional derivatives provided */",
+        f"#define DAMPER_INTERPOLATES {int(iface.interpolates)}"
+        "  /* FMI 2 input derivatives accepted */", "",
         "/* value references */",
     ]
-    lines += [f"#define VR_{v.name.upper()} {v.vr}" for v in variables]
+    lines += [f"#define VR_{c_name(v.name)} {v.vr}" for v in variables]
     lines += ["", "typedef enum { CAUS_INDEPENDENT, CAUS_INPUT, CAUS_OUTPUT, CAUS_PARAMETER }"
               " damper_causality;",
               "typedef enum { " + ", ".join(f"START_{r.upper()}" for r in iface.start_rules)
@@ -408,6 +455,10 @@ def render_vr_header(iface: Interface = DAMPER) -> str:
     lines += [f"    START_{v.start.upper()},  /* {v.name} */" for v in variables]
     lines += ["};", "static const char *const damper_name_of[DAMPER_N_VARIABLES] = {"]
     lines += [f'    "{escape(v.name)}",' for v in variables]
+    lines += ["};", "/* start values of rule value (0 for the others) */",
+              "static const double damper_start_value[DAMPER_N_VARIABLES] = {"]
+    lines += [f"    {_fmt(v.value if v.start == 'value' else 0.0)},  /* {v.name} */"
+              for v in variables]
     lines += ["};", "static const char *const damper_unit_of[DAMPER_N_VARIABLES] = {"]
     lines += [f'    "{escape(v.unit)}",' for v in variables]
     lines += ["};", "", "/* value references of the inputs and of the outputs */"]

@@ -26,7 +26,8 @@ import warnings
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 #: Subcommand modules, in the order ``damper --help`` lists them.
-SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "frf", "backbone", "upd", "study",
+SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "frf", "backbone", "upd", "system",
+               "cosim", "study",
                "bench", "stress")
 
 

@@ -7,6 +7,9 @@
 #define DAMPER_MODEL_IDENTIFIER "damper"
 #define DAMPER_TOKEN "{49b29d45-df0f-e744-1400-81cd7648a4e5}"
 #define DAMPER_N_VARIABLES 10
+#define DAMPER_FEEDTHROUGH 1  /* outputs depend on the current inputs */
+#define DAMPER_DIRECTIONAL 1  /* directional derivatives provided */
+#define DAMPER_INTERPOLATES 1  /* FMI 2 input derivatives accepted */
 
 /* value references */
 #define VR_TIME 0
@@ -59,6 +62,19 @@ static const char *const damper_name_of[DAMPER_N_VARIABLES] = {
     "scale",
     "N_ref",
     "stored_energy",
+};
+/* start values of rule value (0 for the others) */
+static const double damper_start_value[DAMPER_N_VARIABLES] = {
+    0.0,  /* time */
+    0.0,  /* u */
+    0.0,  /* N */
+    0.0,  /* F */
+    0.0,  /* kt */
+    0.0,  /* W */
+    0.0,  /* slip */
+    0.0,  /* scale */
+    0.0,  /* N_ref */
+    0.0,  /* stored_energy */
 };
 static const char *const damper_unit_of[DAMPER_N_VARIABLES] = {
     "s",

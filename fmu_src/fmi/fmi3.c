@@ -222,7 +222,8 @@ fmi3Status fmi3SetClock(fmi3Instance instance, const fmi3ValueReference valueRef
     UNSUPPORTED("fmi3SetClock");
 }
 
-/* Every output depends on every input (direct feedthrough), as in ModelStructure. */
+/* With direct feedthrough every output depends on every input, without it on none
+ * (as in ModelStructure). */
 fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
                                                fmi3ValueReference valueReference,
                                                size_t *nDependencies)
@@ -230,7 +231,8 @@ fmi3Status fmi3GetNumberOfVariableDependencies(fmi3Instance instance,
     WRAPPER(instance);
     if (valueReference >= DAMPER_N_VARIABLES || !nDependencies)
         RET(fmu_log(w->inst, FMU_ERROR, "unknown value reference %u", valueReference));
-    *nDependencies = damper_causality_of[valueReference] == CAUS_OUTPUT ? DAMPER_N_INPUTS : 0;
+    *nDependencies = damper_causality_of[valueReference] == CAUS_OUTPUT && DAMPER_FEEDTHROUGH
+                     ? DAMPER_N_INPUTS : 0;
     return fmi3OK;
 }
 
@@ -241,14 +243,15 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
                                        fmi3DependencyKind dependencyKinds[],
                                        size_t nDependencies)
 {
+    const size_t n = DAMPER_FEEDTHROUGH ? DAMPER_N_INPUTS : 0;
     size_t i;
     WRAPPER(instance);
     if (dependent >= DAMPER_N_VARIABLES || damper_causality_of[dependent] != CAUS_OUTPUT
-        || nDependencies != DAMPER_N_INPUTS || !elementIndicesOfDependent || !independents
-        || !elementIndicesOfIndependents || !dependencyKinds)
+        || nDependencies != n || (n && (!elementIndicesOfDependent || !independents
+        || !elementIndicesOfIndependents || !dependencyKinds)))
         RET(fmu_log(w->inst, FMU_ERROR, "fmi3GetVariableDependencies: only outputs have "
-                    "dependencies (%d: every input)", DAMPER_N_INPUTS));
-    for (i = 0; i < DAMPER_N_INPUTS; i++) {
+                    "dependencies (all inputs with direct feedthrough, else none)"));
+    for (i = 0; i < n; i++) {
         elementIndicesOfDependent[i] = 0;
         independents[i] = damper_inputs[i];
         elementIndicesOfIndependents[i] = 0;

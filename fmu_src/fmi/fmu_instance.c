@@ -46,79 +46,86 @@ fmu_status fmu_check_mode(fmu_instance *inst, int allowed, const char *function)
                    mode_name(inst->h.mode));
 }
 
-/* Read the curve table written by fmu_src/fmu_build.py, in the C locale:
- *   damper-curve 1 / n_ref <N> / fit <0|1> / points <m> / m lines "u T". */
-static int scan_curve(fmu_instance *inst, FILE *f, const char *path)
+/* The model's resources, read in the C locale whatever setlocale the importer did. */
+static int load_resources(fmu_instance *inst, const char *resource_dir)
 {
-    int version = 0, fit = 0;
-    long m = 0, i;
-    model_table *t = &inst->table;
-    if (fscanf(f, " damper-curve %d n_ref %lf fit %d points %ld", &version, &t->n_ref, &fit,
-               &m) != 4 || version != 1 || m < 2 || m > FMU_MAX_CURVE_POINTS)
-        return fmu_log(inst, FMU_ERROR, "'%s' is not a damper-curve 1 file with 2..%d points",
-                       path, FMU_MAX_CURVE_POINTS), 0;
-    t->u = (double *)malloc((size_t)m * sizeof(double));
-    t->T = (double *)malloc((size_t)m * sizeof(double));
-    if (!t->u || !t->T) return fmu_log(inst, FMU_ERROR, "out of memory reading the curve"), 0;
-    for (i = 0; i < m; i++)
-        if (fscanf(f, "%lf %lf", &t->u[i], &t->T[i]) != 2)
-            return fmu_log(inst, FMU_ERROR, "'%s': point %ld of %ld unreadable", path, i, m), 0;
-    t->n = (size_t)m;
-    t->fit = fit;
-    return 1;
+    char why[512];
+    const char *err;
+    locale_t old = uselocale(inst->c_locale);
+    err = model_load(&inst->res, resource_dir, why, sizeof why);
+    uselocale(old);
+    if (err) fmu_log(inst, FMU_ERROR, "cannot read the resources in '%s': %s", resource_dir, err);
+    return err == NULL;
 }
 
-/* Read the normal law written by fmu_src/fmu_point.py, in the C locale:
- *   damper-normal 1 / p_start <p> / points <m> / m lines "p N". */
-static int scan_normal(fmu_instance *inst, FILE *f, const char *path)
+fmu_instance *fmu_new(const char *name, const char *token, const char *resource_dir,
+                      fmu_logger log, void *log_ctx)
 {
-    int version = 0;
-    long m = 0, i;
-    model_table *t = &inst->table;
-    if (fscanf(f, " damper-normal %d p_start %lf points %ld", &version, &t->p_start, &m) != 3
-        || version != 1 || m < 2 || m > FMU_MAX_CURVE_POINTS)
-        return fmu_log(inst, FMU_ERROR, "'%s' is not a damper-normal 1 file with 2..%d points",
-                       path, FMU_MAX_CURVE_POINTS), 0;
-    t->p = (double *)malloc((size_t)m * sizeof(double));
-    t->N = (double *)malloc((size_t)m * sizeof(double));
-    if (!t->p || !t->N) return fmu_log(inst, FMU_ERROR, "out of memory reading the normal law"), 0;
-    for (i = 0; i < m; i++)
-        if (fscanf(f, "%lf %lf", &t->p[i], &t->N[i]) != 2)
-            return fmu_log(inst, FMU_ERROR, "'%s': point %ld of %ld unreadable", path, i, m), 0;
-    t->n_normal = (size_t)m;
-    return 1;
-}
-
-/* Read resources/<name> with `scan` (in the C locale). A missing optional file is no
- * error (returns 1 with nothing read). */
-static int load_resource(fmu_instance *inst, const char *resource_dir, const char *name,
-                         int (*scan)(fmu_instance *, FILE *, const char *), int optional)
-{
-    size_t len = strlen(resource_dir), nlen = strlen(name);
-    char *path = (char *)malloc(len + nlen + 2);
-    FILE *f;
-    int ok = optional;
-    if (!path) return 0;
-    memcpy(path, resource_dir, len);
-    if (len == 0 || path[len - 1] != '/') path[len++] = '/';
-    memcpy(path + len, name, nlen + 1);
-    f = fopen(path, "r");
-    if (!f) {
-        if (!optional) fmu_log(inst, FMU_ERROR, "cannot open the resource file '%s'", path);
-    } else {
-        locale_t old = uselocale(inst->c_locale);  /* whatever setlocale the importer did */
-        ok = scan(inst, f, path);
-        uselocale(old);
-        fclose(f);
+    fmu_instance *inst = (fmu_instance *)calloc(1, sizeof(fmu_instance));
+    if (!inst) return NULL;
+    inst->log = log;
+    inst->log_ctx = log_ctx;
+    inst->c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);
+    strncpy(inst->name, name ? name : "", sizeof inst->name - 1);
+    if (!inst->c_locale) {
+        fmu_log(inst, FMU_ERROR, "out of memory creating the instance");
+        fmu_free(inst);
+        return NULL;
     }
-    free(path);
-    return ok;
+    if (!token || strcmp(token, DAMPER_TOKEN) != 0) {
+        fmu_log(inst, FMU_ERROR, "instantiation token '%s' does not match this binary (%s)",
+                token ? token : "(null)", DAMPER_TOKEN);
+        fmu_free(inst);
+        return NULL;
+    }
+    if (!resource_dir || !load_resources(inst, resource_dir)) {
+        if (!resource_dir) fmu_log(inst, FMU_ERROR, "no resource location given");
+        fmu_free(inst);
+        return NULL;
+    }
+    inst->history_size = model_history_size(inst->res);
+    inst->history = (unsigned char *)calloc(1, inst->history_size);
+    inst->trial = (unsigned char *)calloc(1, inst->history_size);
+    inst->model = calloc(1, model_size(inst->res));
+    if (!inst->history || !inst->trial || !inst->model) {
+        fmu_log(inst, FMU_ERROR, "out of memory creating the instance");
+        fmu_free(inst);
+        return NULL;
+    }
+    fmu_reset(inst);
+    return inst;
 }
 
-static int load_curve(fmu_instance *inst, const char *resource_dir)
+void fmu_free(fmu_instance *inst)
 {
-    return load_resource(inst, resource_dir, FMU_CURVE_FILE, scan_curve, 0)
-           && load_resource(inst, resource_dir, FMU_NORMAL_FILE, scan_normal, 1);
+    if (!inst) return;
+    fmu_free_states(inst);  /* states the importer did not free */
+    model_unload(inst->res);
+    free(inst->history);
+    free(inst->trial);
+    free(inst->model);
+    if (inst->c_locale) freelocale(inst->c_locale);
+    free(inst);
+}
+
+void fmu_reset(fmu_instance *inst)
+{
+    int vr;
+    memset(&inst->h, 0, sizeof inst->h);  /* also zeroes padding: states compare bytewise */
+    memset(inst->history, 0, inst->history_size);
+    inst->h.magic = FMU_STATE_MAGIC;
+    inst->h.version = FMU_STATE_VERSION;
+    inst->h.size = fmu_state_bytes(inst);
+    for (vr = 0; vr < DAMPER_N_VARIABLES; vr++) {
+        switch (damper_start_of[vr]) {
+        case START_ONE: inst->h.value[vr] = 1.0; break;
+        case START_NONE: case START_ZERO: inst->h.value[vr] = 0.0; break;
+        default: inst->h.value[vr] = model_start(inst->res, (unsigned int)vr); break;
+        }
+    }
+    inst->h.mode = MODE_INSTANTIATED;
+    inst->model_ready = 0;
+    inst->out_valid = 0;
 }
 
 /* "name = value unit, ..." of the variables of one causality (C locale), for messages. */
@@ -141,85 +148,19 @@ static const char *describe(const fmu_instance *inst, int causality, const doubl
     return buf;
 }
 
-fmu_instance *fmu_new(const char *name, const char *token, const char *resource_dir,
-                      fmu_logger log, void *log_ctx)
-{
-    fmu_instance *inst = (fmu_instance *)calloc(1, sizeof(fmu_instance));
-    if (!inst) return NULL;
-    inst->log = log;
-    inst->log_ctx = log_ctx;
-    inst->c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);
-    strncpy(inst->name, name ? name : "", sizeof inst->name - 1);
-    inst->history = (unsigned char *)calloc(1, model_history_size());
-    inst->trial = (unsigned char *)calloc(1, model_history_size());
-    inst->model = calloc(1, model_size());
-    if (!inst->c_locale || !inst->history || !inst->trial || !inst->model) {
-        fmu_log(inst, FMU_ERROR, "out of memory creating the instance");
-        fmu_free(inst);
-        return NULL;
-    }
-    if (!token || strcmp(token, DAMPER_TOKEN) != 0) {
-        fmu_log(inst, FMU_ERROR, "instantiation token '%s' does not match this binary (%s)",
-                token ? token : "(null)", DAMPER_TOKEN);
-        fmu_free(inst);
-        return NULL;
-    }
-    if (!resource_dir || !load_curve(inst, resource_dir)) {
-        if (!resource_dir) fmu_log(inst, FMU_ERROR, "no resource location given");
-        fmu_free(inst);
-        return NULL;
-    }
-    fmu_reset(inst);
-    return inst;
-}
-
-void fmu_free(fmu_instance *inst)
-{
-    if (!inst) return;
-    fmu_free_states(inst);  /* states the importer did not free */
-    free(inst->table.u);
-    free(inst->table.T);
-    free(inst->table.p);
-    free(inst->table.N);
-    free(inst->history);
-    free(inst->trial);
-    free(inst->model);
-    if (inst->c_locale) freelocale(inst->c_locale);
-    free(inst);
-}
-
-void fmu_reset(fmu_instance *inst)
-{
-    int vr;
-    memset(&inst->h, 0, sizeof inst->h);  /* also zeroes padding: states compare bytewise */
-    memset(inst->history, 0, model_history_size());
-    inst->h.magic = FMU_STATE_MAGIC;
-    inst->h.version = FMU_STATE_VERSION;
-    inst->h.size = fmu_state_bytes();
-    for (vr = 0; vr < DAMPER_N_VARIABLES; vr++) {
-        switch (damper_start_of[vr]) {
-        case START_ONE: inst->h.value[vr] = 1.0; break;
-        case START_CURVE_N: inst->h.value[vr] = inst->table.n_ref; break;
-        case START_NONE: case START_ZERO: inst->h.value[vr] = 0.0; break;
-        default: inst->h.value[vr] = model_start_value(&inst->table, (unsigned int)vr); break;
-        }
-    }
-    inst->h.mode = MODE_INSTANTIATED;
-    inst->model_ready = 0;
-    inst->out_valid = 0;
-}
-
 fmu_status fmu_ensure_model(fmu_instance *inst)
 {
     const char *why;
-    char text[256];
     int i;
     if (inst->model_ready) return FMU_OK;
-    why = model_build(inst->model, &inst->table, inst->h.value);
+    memset(inst->model, 0, model_size(inst->res));
+    why = model_build(inst->model, inst->res, inst->h.value);
     if (!why && !inst->h.has_history) why = model_reset(inst->model, inst->history, inst->h.value);
-    if (why)
+    if (why) {
+        char params[256];
         return fmu_log(inst, FMU_ERROR, "cannot build the model (%s): %s",
-                       describe(inst, CAUS_PARAMETER, inst->h.value, text, sizeof text), why);
+                       describe(inst, CAUS_PARAMETER, inst->h.value, params, sizeof params), why);
+    }
     for (i = 0; i < DAMPER_N_INPUTS; i++)
         inst->bound[damper_inputs[i]] = model_input_bound(inst->model, damper_inputs[i]);
     inst->model_ready = 1;
@@ -235,8 +176,7 @@ static fmu_status check_bounds(fmu_instance *inst, const double *value, const ch
         const unsigned int vr = damper_inputs[i];
         if (fabs(value[vr]) > inst->bound[vr])
             return fmu_log(inst, FMU_ERROR, "%s: input %s = %g is beyond the bound |%s| <= %.17g "
-                           "of this FMU (see its documentation: beyond it double precision "
-                           "cannot represent the element's slip distances)", what,
+                           "of this FMU (see its documentation)", what,
                            damper_name_of[vr], value[vr], damper_name_of[vr], inst->bound[vr]);
     }
     return FMU_OK;
@@ -254,15 +194,16 @@ static int outputs_finite(const double *out)
 static fmu_status ensure_outputs(fmu_instance *inst)
 {
     const char *why;
-    char text[256];
     if (inst->out_valid) return FMU_OK;  /* implies model_ready */
     if (fmu_ensure_model(inst) != FMU_OK) return FMU_ERROR;
     if (check_bounds(inst, inst->h.value, "evaluating the outputs") != FMU_OK) return FMU_ERROR;
     why = model_eval(inst->model, inst->history, inst->h.value, inst->out);
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
-    if (why)
+    if (why) {
+        char in[256];
         return fmu_log(inst, FMU_ERROR, "evaluating the model at %s: %s",
-                       describe(inst, CAUS_INPUT, inst->h.value, text, sizeof text), why);
+                       describe(inst, CAUS_INPUT, inst->h.value, in, sizeof in), why);
+    }
     inst->out_valid = 1;
     return FMU_OK;
 }
@@ -311,7 +252,7 @@ static const char *set_refusal(const fmu_instance *inst, unsigned int vr, double
     case CAUS_PARAMETER:
         if (!(inst->h.mode & (MODE_INSTANTIATED | MODE_INIT)))
             return "fixed parameters can only be set before initialization ends";
-        return model_check_parameter(vr, v);
+        return model_check_parameter(inst->res, vr, v);
     default:
         return "only inputs and parameters can be set";
     }
@@ -337,8 +278,7 @@ fmu_status fmu_set(fmu_instance *inst, const unsigned int *vr, size_t n, const d
             double bound = inst->bound[vr[i]];
             if (fabs(v[i]) > bound)
                 return fmu_log(inst, FMU_ERROR, "cannot set %s to %g: beyond the bound |%s| <= "
-                               "%.17g of this FMU (stated in its documentation: double precision "
-                               "cannot represent the element's slip distances there)",
+                               "%.17g of this FMU (stated in its documentation)",
                                damper_name_of[vr[i]], v[i], damper_name_of[vr[i]], bound);
         }
     }
@@ -356,6 +296,9 @@ fmu_status fmu_set_derivative(fmu_instance *inst, const unsigned int *vr, size_t
     size_t i;
     if (fmu_check_mode(inst, MODE_INIT | MODE_STEP, "SetRealInputDerivatives")) return FMU_ERROR;
     if (n > 0 && (!vr || !v || !order)) return fmu_log(inst, FMU_ERROR, "null array");
+    if (n > 0 && !DAMPER_INTERPOLATES)
+        return fmu_log(inst, FMU_ERROR, "this FMU does not interpolate inputs "
+                       "(canInterpolateInputs = false)");
     for (i = 0; i < n; i++) {
         if (vr[i] >= DAMPER_N_VARIABLES || damper_causality_of[vr[i]] != CAUS_INPUT)
             return fmu_log(inst, FMU_ERROR, "value reference %u is not an input", vr[i]);
@@ -380,7 +323,7 @@ fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double 
         if (damper_causality_of[vr[i]] == CAUS_OUTPUT) {
             if (ensure_outputs(inst) != FMU_OK) return FMU_ERROR;
             v[i] = inst->out[vr[i]];
-        } else if (vr[i] == VR_TIME) {
+        } else if (damper_causality_of[vr[i]] == CAUS_INDEPENDENT) {
             v[i] = inst->h.time;
         } else {
             v[i] = inst->h.value[vr[i]];
@@ -389,14 +332,12 @@ fmu_status fmu_get(fmu_instance *inst, const unsigned int *vr, size_t n, double 
     return FMU_OK;
 }
 
-/* Commit the history to the current inputs, then along their straight lines to
- * time + h (FMI 2 input derivatives, then reset: a master that sets none holds
- * its inputs). All or nothing: the update runs on a copy that replaces the
- * history only when it succeeded. */
+/* Hand the model the inputs at time and at time + h (FMI 2 input derivatives, then
+ * reset: a master that sets none holds its inputs). All or nothing: the update runs on
+ * a copy that replaces the history only when it succeeded. */
 fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
 {
     double end[DAMPER_N_VARIABLES];
-    char text[256];
     const char *why = NULL;
     unsigned char *swap;
     int i, moves = 0;
@@ -408,9 +349,9 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
         return fmu_log(inst, FMU_ERROR, "DoStep at t = %.17g, but the FMU is at t = %.17g",
                        t, inst->h.time);
     if (fmu_ensure_model(inst) != FMU_OK) return FMU_ERROR;
+    memcpy(end, inst->h.value, sizeof end);
     for (i = 0; i < DAMPER_N_INPUTS; i++) moves |= inst->h.deriv[damper_inputs[i]] != 0.0;
     if (moves) {  /* FMI 2 input derivatives: the inputs' values at t + h */
-        memcpy(end, inst->h.value, sizeof end);
         for (i = 0; i < DAMPER_N_INPUTS; i++) {
             const unsigned int vr = damper_inputs[i];
             end[vr] += inst->h.deriv[vr] * h;
@@ -423,14 +364,13 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
         || (moves && check_bounds(inst, end, "DoStep (extrapolated input)") != FMU_OK))
         return FMU_ERROR;
     model_copy_history(inst->model, inst->trial, inst->history);
-    why = model_commit(inst->model, inst->trial, inst->h.value, inst->out);
-    if (!why && moves) why = model_commit(inst->model, inst->trial, end, inst->out);
+    why = model_step(inst->model, inst->trial, inst->h.value, end, t, h, inst->out);
     if (!why && !outputs_finite(inst->out)) why = "outputs overflow (inputs too large)";
     if (why) {
+        char in[256];
         inst->out_valid = 0;
-        return fmu_log(inst, FMU_ERROR, "DoStep to %s refused: %s",
-                       describe(inst, CAUS_INPUT, moves ? end : inst->h.value, text, sizeof text),
-                       why);
+        return fmu_log(inst, FMU_ERROR, "DoStep from t = %g over h = %g with %s refused: %s",
+                       t, h, describe(inst, CAUS_INPUT, end, in, sizeof in), why);
     }
     swap = inst->history;
     inst->history = inst->trial;
@@ -451,6 +391,8 @@ fmu_status fmu_directional_derivative(fmu_instance *inst, const unsigned int *un
 {
     size_t i, k;
     if (fmu_check_mode(inst, MODE_INIT | MODE_STEP, "GetDirectionalDerivative")) return FMU_ERROR;
+    if (!DAMPER_DIRECTIONAL)
+        return fmu_log(inst, FMU_ERROR, "this FMU provides no directional derivatives");
     if ((n_unknowns && (!unknowns || !sensitivity)) || (n_knowns && (!knowns || !seed)))
         return fmu_log(inst, FMU_ERROR, "GetDirectionalDerivative: null array");
     for (k = 0; k < n_knowns; k++) {

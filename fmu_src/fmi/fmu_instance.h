@@ -3,24 +3,25 @@
  *
  * Written once and shared by fmi2.c and fmi3.c (Reference-FMUs shape): the
  * instance, its mode (state machine), variable values by value reference
- * (damper_vr.h), the resource table, logging, doStep, FMU states and directional
+ * (fmu_vars.h), the model's resources, logging, doStep, FMU states and directional
  * derivatives. It knows nothing of the physics: that is behind the hooks of
  * model.h (model_iwan.c: the Masing/Iwan element; model_point.c: the 3D contact
- * point; model_passthrough.c: F = u), and nothing of the variables but what the
- * model's generated table (fmu_vars.h) lists.
+ * point; model_passthrough.c: F = u; model_blade.c: a linear blade; model_upd.c: an
+ * underplatform damper), and nothing of the variables but what the model's generated
+ * table (fmu_vars.h) lists.
  *
- * Co-simulation semantics (rate-independent element, see issue 5):
- * - the committed history changes only in doStep; getters evaluate a trial update
- *   from the committed history to the current inputs (direct feedthrough), so a master
- *   may set/get any number of times without corrupting the history;
+ * Co-simulation semantics:
+ * - the committed history changes only in doStep; getters evaluate the outputs from
+ *   the committed history (a direct-feedthrough model: a trial update to the current
+ *   inputs), so a master may set/get any number of times without corrupting the history;
  * - an input is a straight line in time, x(t) = x + dx (t - time): SetReal sets x,
  *   FMI 2 SetRealInputDerivatives sets dx for the next step (dx is reset to 0 after
- *   each doStep). doStep(h), h > 0, commits the path to the current inputs, then along
- *   the straight line to time + h;
+ *   each doStep; models that do not interpolate inputs refuse it). doStep(h), h > 0,
+ *   hands the model the inputs at time and at time + h (model_step);
  * - inputs beyond the model's bound (model_input_bound; stated in the FMU's
  *   documentation) are refused with a logged message.
  *
- * FMU state (issue 14): one flat block, fmu_header followed by the model's history
+ * FMU state: one flat block, fmu_header followed by the model's history
  * (model_history_size() bytes), no pointers; the serialized state is these bytes.
  * It carries the mode, time, values, input derivatives, whether a history has been
  * committed (after Exit Initialization Mode), and a 64-bit FNV-1a checksum of
@@ -46,10 +47,7 @@
 #include "model.h"
 
 #define FMU_STATE_MAGIC 0x46504d44u  /* "DMPF": marks a state of this FMU */
-#define FMU_STATE_VERSION 2          /* bump when fmu_header or a history changes layout */
-#define FMU_MAX_CURVE_POINTS 4096    /* largest curve table read from the resources */
-#define FMU_CURVE_FILE "curve.txt"
-#define FMU_NORMAL_FILE "normal.txt"   /* optional: the normal law of a contact point */
+#define FMU_STATE_VERSION 3          /* bump when fmu_header or a history changes layout */
 
 typedef enum { FMU_OK = 0, FMU_WARNING = 1, FMU_ERROR = 2 } fmu_status;
 
@@ -81,7 +79,7 @@ typedef struct {
 
 typedef struct fmu_instance fmu_instance;
 
-/* Create an instance: check the token, read the resource table from `resource_dir`
+/* Create an instance: check the token, read the model's resources from `resource_dir`
  * (a native directory path). Returns NULL (after logging why) on failure. */
 fmu_instance *fmu_new(const char *name, const char *token, const char *resource_dir,
                       fmu_logger log, void *log_ctx);

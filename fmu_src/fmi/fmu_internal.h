@@ -13,15 +13,16 @@
 
 struct fmu_instance {
     fmu_header h;               /* saved part: mode, time, values, input derivatives */
-    unsigned char *history;     /* committed history (model_history_size() bytes, saved) */
+    unsigned char *history;     /* committed history (history_size bytes, saved) */
     unsigned char *trial;       /* scratch history of the doStep in progress */
-    void *model;                /* built model (model_size() bytes) */
+    void *model;                /* built model (model_size(res) bytes) */
+    void *res;                  /* the model's resources (model_load) */
+    size_t history_size;        /* model_history_size(res) */
     int model_ready;            /* model (and, before a history exists, the virgin
                                    history) match the parameters */
     int out_valid;              /* `out` holds the outputs at the current inputs */
     double out[DAMPER_N_VARIABLES];
     double bound[DAMPER_N_VARIABLES];  /* model_input_bound of each input (model_ready) */
-    model_table table;          /* resources/curve.txt */
     void **states;              /* FMU states this instance handed out */
     size_t n_states, cap_states;
     char name[128];
@@ -31,7 +32,7 @@ struct fmu_instance {
 };
 
 /* Bytes of a whole state: header + history. */
-size_t fmu_state_bytes(void);
+size_t fmu_state_bytes(const fmu_instance *inst);
 
 /* Build the model for the current parameters if needed (and the virgin history
  * while none has been committed). */

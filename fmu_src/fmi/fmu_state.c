@@ -7,9 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-size_t fmu_state_bytes(void)
+size_t fmu_state_bytes(const fmu_instance *inst)
 {
-    return sizeof(fmu_header) + model_history_size();
+    return sizeof(fmu_header) + inst->history_size;
 }
 
 /* 64-bit FNV-1a of every byte after the checksum field: a flipped or changed byte
@@ -46,7 +46,7 @@ static unsigned char *own_state(fmu_instance *inst, void **state)
         inst->states = grown;
         inst->cap_states = cap;
     }
-    s = (unsigned char *)malloc(fmu_state_bytes());
+    s = (unsigned char *)malloc(fmu_state_bytes(inst));
     if (s) inst->states[inst->n_states++] = s;
     return s;
 }
@@ -59,9 +59,9 @@ fmu_status fmu_state_get(fmu_instance *inst, void **state)
     s = own_state(inst, state);
     if (!s) return fmu_log(inst, FMU_ERROR, "GetFMUState: out of memory");
     h = inst->h;
-    h.size = fmu_state_bytes();
+    h.size = fmu_state_bytes(inst);
     memcpy(s, &h, sizeof h);
-    memcpy(s + sizeof h, inst->history, model_history_size());
+    memcpy(s + sizeof h, inst->history, inst->history_size);
     h.checksum = state_checksum(s, h.size);
     memcpy(s, &h, sizeof h);
     *state = s;
@@ -79,7 +79,7 @@ fmu_status fmu_state_set(fmu_instance *inst, const void *state)
     memcpy(&h, state, sizeof h);
     inst->h = h;
     if (mode == MODE_INIT) inst->h.mode = MODE_INIT;
-    memcpy(inst->history, (const unsigned char *)state + sizeof h, model_history_size());
+    memcpy(inst->history, (const unsigned char *)state + sizeof h, inst->history_size);
     inst->model_ready = 0;  /* the state's parameters; a history is kept (has_history) */
     inst->out_valid = 0;
     if (fmu_ensure_model(inst) != FMU_OK)
@@ -114,23 +114,24 @@ fmu_status fmu_state_size(fmu_instance *inst, const void *state, size_t *size)
 {
     if (find_state(inst, state) == (size_t)-1 || !size)
         return fmu_log(inst, FMU_ERROR, "SerializedFMUStateSize: not a state of this instance");
-    *size = fmu_state_bytes();
+    *size = fmu_state_bytes(inst);
     return FMU_OK;
 }
 
 fmu_status fmu_state_serialize(fmu_instance *inst, const void *state, void *bytes,
                                size_t size)
 {
-    if (find_state(inst, state) == (size_t)-1 || !bytes || size != fmu_state_bytes())
+    if (find_state(inst, state) == (size_t)-1 || !bytes || size != fmu_state_bytes(inst))
         return fmu_log(inst, FMU_ERROR, "SerializeFMUState: not a state of this instance, "
                        "or %lu bytes instead of %lu", (unsigned long)size,
-                       (unsigned long)fmu_state_bytes());
+                       (unsigned long)fmu_state_bytes(inst));
     memcpy(bytes, state, size);
     return FMU_OK;
 }
 
 /* Reason a header cannot be a state of this FMU, or NULL. */
-static const char *header_refusal(const fmu_header *h, const unsigned char *bytes, size_t size)
+static const char *header_refusal(const fmu_instance *inst, const fmu_header *h,
+                                  const unsigned char *bytes, size_t size)
 {
     int vr;
     if (h->magic != FMU_STATE_MAGIC) return "not a state of this FMU (magic)";
@@ -149,7 +150,7 @@ static const char *header_refusal(const fmu_header *h, const unsigned char *byte
         if (damper_causality_of[vr] != CAUS_INPUT && h->deriv[vr] != 0.0)
             return "derivative of a non-input";
         if (damper_causality_of[vr] == CAUS_PARAMETER
-            && model_check_parameter((unsigned int)vr, h->value[vr]))
+            && model_check_parameter(inst->res, (unsigned int)vr, h->value[vr]))
             return "parameter out of range";
     }
     return NULL;
@@ -161,9 +162,9 @@ static const char *model_refusal(fmu_instance *inst, const fmu_header *h,
 {
     const char *why;
     int vr;
-    void *model = calloc(1, model_size());
+    void *model = calloc(1, model_size(inst->res));
     if (!model) return "out of memory";
-    why = model_build(model, &inst->table, h->value);
+    why = model_build(model, inst->res, h->value);
     for (vr = 0; !why && vr < DAMPER_N_VARIABLES; vr++)
         if (damper_causality_of[vr] == CAUS_INPUT
             && fabs(h->value[vr]) > model_input_bound(model, (unsigned int)vr))
@@ -179,11 +180,11 @@ fmu_status fmu_state_from_bytes(fmu_instance *inst, const void *bytes, size_t si
     fmu_header h;
     const char *why;
     unsigned char *s;
-    if (!bytes || !state || size != fmu_state_bytes())
+    if (!bytes || !state || size != fmu_state_bytes(inst))
         return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: expected %lu bytes, got %lu",
-                       (unsigned long)fmu_state_bytes(), (unsigned long)size);
+                       (unsigned long)fmu_state_bytes(inst), (unsigned long)size);
     memcpy(&h, bytes, sizeof h);
-    why = header_refusal(&h, (const unsigned char *)bytes, size);
+    why = header_refusal(inst, &h, (const unsigned char *)bytes, size);
     if (!why) why = model_refusal(inst, &h, (const unsigned char *)bytes + sizeof h);
     if (why) return fmu_log(inst, FMU_ERROR, "DeSerializeFMUState: state refused: %s", why);
     s = own_state(inst, state);

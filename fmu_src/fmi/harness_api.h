@@ -1,7 +1,7 @@
 /*
  * harness_api.h -- the FMI 2 / FMI 3 driver of the C test harnesses (test_harness.c
- * for the 1D element, test_point_harness.c for the contact point; fmu_vars.h gives the
- * variable table each is compiled with):
+ * for the 1D element, test_point_harness.c for the contact point, test_model_harness.c
+ * for the blade and the damper; fmu_vars.h gives the variable table each is compiled with):
  * one `api` per dlopen'ed binary, one `inst` per instance, and calls that return
  * the FMI status as int for both versions (OK = 0, Error = 3 in both).
  */

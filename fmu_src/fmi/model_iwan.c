@@ -12,6 +12,7 @@
 #include "fmu_vars.h"
 #include "iwan.h"
 #include "model.h"
+#include "model_table.h"
 
 /* Input bound: the force error of a slider, about k_j * eps * |u|, stays below this
  * fraction of its slip strength k_j r_j: |u| <= U_BOUND_RTOL * min_j r_j / eps, with
@@ -28,8 +29,30 @@ typedef struct {
     double T_top;     /* largest force of the table [N]: |F| <= T_top f(N) when k_res = 0 */
 } iwan_fmu_model;
 
-size_t model_size(void) { return sizeof(iwan_fmu_model); }
-size_t model_history_size(void) { return sizeof(iwan_state); }
+void model_unload(void *res) { model_table_free((model_table *)res); }
+
+const char *model_load(void **res, const char *dir, char *why, size_t why_size)
+{
+    return model_table_load((model_table **)res, dir, why, why_size);
+}
+
+size_t model_size(const void *res) { (void)res; return sizeof(iwan_fmu_model); }
+size_t model_history_size(const void *res) { (void)res; return sizeof(iwan_state); }
+
+/* N and N_ref start at the curve's normal load. */
+double model_start(const void *res, unsigned int vr)
+{
+    (void)vr;
+    return ((const model_table *)res)->n_ref;
+}
+
+const char *model_check_parameter(const void *res, unsigned int vr, double v)
+{
+    (void)res;
+    if (vr == VR_SCALE && !(v >= 0.0)) return "scale must be >= 0";
+    if (vr == VR_N_REF && !(v > 0.0)) return "N_ref must be > 0";
+    return NULL;
+}
 
 /* Header, the n sliders in use and dir: the rest of z stays zero in every history. */
 void model_copy_history(const void *model, void *dst, const void *src)
@@ -41,8 +64,9 @@ void model_copy_history(const void *model, void *dst, const void *src)
     d->dir = s->dir;
 }
 
-const char *model_build(void *model, const model_table *t, const double *value)
+const char *model_build(void *model, const void *res, const double *value)
 {
+    const model_table *t = (const model_table *)res;
     iwan_fmu_model *md = (iwan_fmu_model *)model;
     double rmin = HUGE_VAL;
     size_t i;
@@ -92,14 +116,27 @@ const char *model_eval(const void *model, const void *history, const double *val
     return NULL;
 }
 
-const char *model_commit(const void *model, void *history, const double *value, double *out)
+static const char *commit(const iwan_fmu_model *md, void *history, const double *value,
+                          double *out)
 {
-    const iwan_fmu_model *md = (const iwan_fmu_model *)model;
     iwan_output o;
     iwan_status st = iwan_step(&md->m, (iwan_state *)history, value[VR_U], value[VR_N], &o);
     if (st != IWAN_OK) return iwan_status_text(st);
     store(md, &o, value[VR_N], out);
     return NULL;
+}
+
+/* The path to the inputs at t, then along their straight lines to t + h: the core is
+ * exact along straight (u, N) paths, so h itself does not enter (rate independence). */
+const char *model_step(const void *model, void *history, const double *start,
+                       const double *end, double t, double h, double *out)
+{
+    const iwan_fmu_model *md = (const iwan_fmu_model *)model;
+    const char *why = commit(md, history, start, out);
+    (void)t; (void)h;
+    if (!why && (end[VR_U] != start[VR_U] || end[VR_N] != start[VR_N]))
+        why = commit(md, history, end, out);
+    return why;
 }
 
 /* dF = kt du + dF/dN dN; kt, slip are piecewise constant in (u, N) (zero derivative);
@@ -156,17 +193,4 @@ const char *model_check_history(const void *model, const void *history)
 double model_input_bound(const void *model, unsigned int vr)
 {
     return vr == VR_U ? ((const iwan_fmu_model *)model)->u_bound : HUGE_VAL;
-}
-
-const char *model_check_parameter(unsigned int vr, double v)
-{
-    if (vr == VR_SCALE && !(v >= 0.0)) return "scale must be >= 0";
-    if (vr == VR_N_REF && !(v > 0.0)) return "N_ref must be > 0";
-    return NULL;
-}
-
-double model_start_value(const model_table *table, unsigned int vr)
-{
-    (void)table; (void)vr;
-    return 0.0;  /* every start rule of this model is the layer's own */
 }

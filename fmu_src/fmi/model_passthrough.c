@@ -7,13 +7,32 @@
 
 #include "fmu_vars.h"
 #include "model.h"
+#include "model_table.h"
 
 typedef struct {
     double u;   /* last committed displacement [m] */
 } passthrough_history;
 
-size_t model_size(void) { return 1; }
-size_t model_history_size(void) { return sizeof(passthrough_history); }
+/* The curve is read as by the element (the same start values), not used. */
+const char *model_load(void **res, const char *dir, char *why, size_t why_size)
+{
+    return model_table_load((model_table **)res, dir, why, why_size);
+}
+
+void model_unload(void *res) { model_table_free((model_table *)res); }
+size_t model_size(const void *res) { (void)res; return 1; }
+size_t model_history_size(const void *res) { (void)res; return sizeof(passthrough_history); }
+double model_start(const void *res, unsigned int vr)
+{
+    (void)vr;
+    return ((const model_table *)res)->n_ref;
+}
+
+const char *model_check_parameter(const void *res, unsigned int vr, double v)
+{
+    (void)res; (void)vr; (void)v;
+    return NULL;
+}
 
 void model_copy_history(const void *model, void *dst, const void *src)
 {
@@ -21,9 +40,9 @@ void model_copy_history(const void *model, void *dst, const void *src)
     memcpy(dst, src, sizeof(passthrough_history));
 }
 
-const char *model_build(void *model, const model_table *table, const double *value)
+const char *model_build(void *model, const void *res, const double *value)
 {
-    (void)model; (void)table; (void)value;
+    (void)model; (void)res; (void)value;
     return NULL;
 }
 
@@ -43,10 +62,12 @@ const char *model_eval(const void *model, const void *history, const double *val
     return NULL;
 }
 
-const char *model_commit(const void *model, void *history, const double *value, double *out)
+const char *model_step(const void *model, void *history, const double *start,
+                       const double *end, double t, double h, double *out)
 {
-    ((passthrough_history *)history)->u = value[VR_U];
-    return model_eval(model, history, value, out);
+    (void)start; (void)t; (void)h;
+    ((passthrough_history *)history)->u = end[VR_U];
+    return model_eval(model, history, end, out);
 }
 
 const char *model_partial(const void *model, const void *history, const double *value,
@@ -67,16 +88,4 @@ double model_input_bound(const void *model, unsigned int vr)
 {
     (void)model; (void)vr;
     return HUGE_VAL;
-}
-
-const char *model_check_parameter(unsigned int vr, double v)
-{
-    (void)vr; (void)v;
-    return NULL;
-}
-
-double model_start_value(const model_table *table, unsigned int vr)
-{
-    (void)table; (void)vr;
-    return 0.0;
 }

@@ -15,6 +15,7 @@
 #include "contact_point.h"
 #include "fmu_vars.h"
 #include "model.h"
+#include "model_table.h"
 
 /* Input bound of the slip (as model_iwan.c): a slider force's round-off k eps |u| stays
  * below this fraction of its strength at N_ref; fmu_point.py documents the same number. */
@@ -35,8 +36,15 @@ static const unsigned int VR_Q[3] = {VR_U_X, VR_U_Y, VR_P};
 static const unsigned int VR_V[3] = {VR_V_X, VR_V_Y, VR_V_N};
 static const unsigned int VR_FORCE[3] = {VR_F_X, VR_F_Y, VR_N};
 
-size_t model_size(void) { return sizeof(point_fmu_model); }
-size_t model_history_size(void) { return sizeof(cpoint_state); }
+/* The virgin curve and the normal law (model_table.h). */
+const char *model_load(void **res, const char *dir, char *why, size_t why_size)
+{
+    return model_table_load((model_table **)res, dir, why, why_size);
+}
+
+void model_unload(void *res) { model_table_free((model_table *)res); }
+size_t model_size(const void *res) { (void)res; return sizeof(point_fmu_model); }
+size_t model_history_size(const void *res) { (void)res; return sizeof(cpoint_state); }
 
 /* Header and the sliders in use (the rest of z stays zero in every history). */
 void model_copy_history(const void *model, void *dst, const void *src)
@@ -46,8 +54,9 @@ void model_copy_history(const void *model, void *dst, const void *src)
                          + 2 * (size_t)n * sizeof(double));
 }
 
-const char *model_build(void *model, const model_table *t, const double *value)
+const char *model_build(void *model, const void *res, const double *value)
 {
+    const model_table *t = (const model_table *)res;
     point_fmu_model *md = (point_fmu_model *)model;
     iwan_model tm;
     double rmin = HUGE_VAL;
@@ -107,7 +116,7 @@ const char *model_eval(const void *model, const void *history, const double *val
     return NULL;
 }
 
-const char *model_commit(const void *model, void *history, const double *value, double *out)
+static const char *commit(const void *model, void *history, const double *value, double *out)
 {
     double q[3], v[3];
     cpoint_output o;
@@ -117,6 +126,19 @@ const char *model_commit(const void *model, void *history, const double *value, 
     if (st != IWAN_OK) return iwan_status_text(st);
     store(&o, out);
     return NULL;
+}
+
+/* The path to the inputs at t, then along their straight lines to t + h (the core is
+ * exact along straight paths: h itself does not enter). */
+const char *model_step(const void *model, void *history, const double *start,
+                       const double *end, double t, double h, double *out)
+{
+    const char *why = commit(model, history, start, out);
+    int i, moves = 0;
+    (void)t; (void)h;
+    for (i = 0; i < DAMPER_N_INPUTS; i++) moves |= end[damper_inputs[i]] != start[damper_inputs[i]];
+    if (!why && moves) why = commit(model, history, end, out);
+    return why;
 }
 
 /* d f / d q = K and d f / d v = diag(C) (the core's exact tangent of the step to the
@@ -186,16 +208,19 @@ double model_input_bound(const void *model, unsigned int vr)
     return (vr == VR_U_X || vr == VR_U_Y) ? ((const point_fmu_model *)model)->u_bound : HUGE_VAL;
 }
 
-const char *model_check_parameter(unsigned int vr, double v)
+const char *model_check_parameter(const void *res, unsigned int vr, double v)
 {
+    (void)res;
     if (vr == VR_SCALE && !(v >= 0.0)) return "scale must be >= 0";
     if (vr == VR_N_REF && !(v > 0.0)) return "N_ref must be > 0";
     if ((vr == VR_C_T || vr == VR_C_N) && !(v >= 0.0)) return "dashpots must be >= 0";
     return NULL;
 }
 
-/* The start penetration (rule normal_p) comes with the normal law (normal.txt). */
-double model_start_value(const model_table *table, unsigned int vr)
+/* The start penetration (rule normal_p) comes with the normal law (normal.txt); N_ref
+ * (rule curve_n) is the curve's load. */
+double model_start(const void *res, unsigned int vr)
 {
-    return vr == VR_P ? table->p_start : 0.0;
+    const model_table *t = (const model_table *)res;
+    return vr == VR_P ? t->p_start : t->n_ref;
 }

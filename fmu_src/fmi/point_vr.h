@@ -7,6 +7,9 @@
 #define DAMPER_MODEL_IDENTIFIER "contact_point"
 #define DAMPER_TOKEN "{fa8ab667-cfbe-1834-8119-1059da365573}"
 #define DAMPER_N_VARIABLES 27
+#define DAMPER_FEEDTHROUGH 1  /* outputs depend on the current inputs */
+#define DAMPER_DIRECTIONAL 1  /* directional derivatives provided */
+#define DAMPER_INTERPOLATES 1  /* FMI 2 input derivatives accepted */
 
 /* value references */
 #define VR_TIME 0
@@ -127,6 +130,36 @@ static const char *const damper_name_of[DAMPER_N_VARIABLES] = {
     "N_ref",
     "c_t",
     "c_n",
+};
+/* start values of rule value (0 for the others) */
+static const double damper_start_value[DAMPER_N_VARIABLES] = {
+    0.0,  /* time */
+    0.0,  /* u_x */
+    0.0,  /* u_y */
+    0.0,  /* p */
+    0.0,  /* v_x */
+    0.0,  /* v_y */
+    0.0,  /* v_n */
+    0.0,  /* F_x */
+    0.0,  /* F_y */
+    0.0,  /* N */
+    0.0,  /* W */
+    0.0,  /* stored_energy */
+    0.0,  /* state */
+    0.0,  /* slip */
+    0.0,  /* K_xx */
+    0.0,  /* K_xy */
+    0.0,  /* K_xp */
+    0.0,  /* K_yx */
+    0.0,  /* K_yy */
+    0.0,  /* K_yp */
+    0.0,  /* K_px */
+    0.0,  /* K_py */
+    0.0,  /* K_pp */
+    0.0,  /* scale */
+    0.0,  /* N_ref */
+    0.0,  /* c_t */
+    0.0,  /* c_n */
 };
 static const char *const damper_unit_of[DAMPER_N_VARIABLES] = {
     "s",
