@@ -18,11 +18,10 @@ the airfoil tip (the EO force and the response); plus ``--modes`` fixed-interfac
 The blade sits on a rigid disk (no K_next); damping C = beta K of the config.
 Load: F0 = 10 N at the tip (:data:`F0`), the default CF = 120 N.
 
-Harmonics: H = 3 by default. At H = 5 the fixed-grid Newton sweep of ``solve.frf``
-stops near 530 Hz ("harmonic balance failed near ..."), most likely at a 5:1
-superharmonic resonance of the blade's second bending family (free 2.09 kHz, stuck
-2.81 kHz); above CF/F0 ~ 20 the curve folds (docs, user guide: the bladed disk): such curves need arc-length
-continuation.
+Harmonics: H = 3 by default. At H = 5 a Newton sweep on a fixed frequency grid stops
+near 530 Hz, most likely at a 5:1 superharmonic resonance of the blade's second bending
+family (free 2.09 kHz, stuck 2.81 kHz); above CF/F0 ~ 20 the curve folds (docs, user
+guide: the bladed disk): ``solve.frf`` traces both by arc-length continuation.
 Prints the CB natural frequencies against the full FE model's, writes ``blade.npz``
 and ``upd.toml`` (the default damper, band around the free and stuck EO resonances)
 and runs the damped forced response with the Python API.

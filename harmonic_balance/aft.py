@@ -18,9 +18,9 @@ Exact links
 A link with ``exact=True`` skips the sampling: the C core locates the extrema of u(theta)
 (a trigonometric polynomial), runs the loop between them as piecewise-linear branches
 and integrates F(theta) in closed form (``IwanElement.periodic_fourier``): no sampling
-error and no kinks where a stick episode starts or ends between samples. Used for links
-more than 1e4 times stiffer than the structure (``frf.exact_links``) and to retry a
-sampled curve that stalled (``frf.compute_frf``).
+error and no kinks where a stick episode starts or ends between samples. The default of
+forced-response curves for every Iwan link (``frf.exact_links``); the sampled AFT stays
+for elements without the exact path and on request (``compute_frf(aft="sampled")``).
 
 Zeroth-harmonic convention for a fully stuck element
 ----------------------------------------------------
@@ -63,8 +63,8 @@ class FrictionLink(ForceElement):
         Label used in messages.
     exact : bool
         True: the force harmonics are the exact Fourier coefficients of the loop (the C
-        core's ``periodic_fourier``: no AFT sampling, :func:`aft_link`), for contacts
-        so stiff that the sampled loop needs thousands of samples (``frf.exact_links``).
+        core's ``periodic_fourier``: no AFT sampling, :func:`aft_link`; the default of
+        ``frf.compute_frf``, :func:`frf.exact_links`).
     """
 
     element: object

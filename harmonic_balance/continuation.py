@@ -3,51 +3,83 @@
 Knows nothing about mechanics: ``fun(x, lam) -> (R (N,), dR/dx (N, N), dR/dlam (N,))``.
 
 Scaling: the arclength is measured in scaled variables ``x / s_x`` and
-``lam / s_lam``, with ``s_lam`` the length of the parameter range and ``s_x`` the RMS
-of x at the current point, floored at :data:`S_X_FLOOR` of the largest met so far
-(a steep flank is climbed and descended in relative steps, so a resonance peak is
-resolved by more points and the step never lets lam run away: with a fixed scale a
-50-DOF case wandered to negative frequency, performance.md; with the largest RMS met
-as the scale the two flanks of a peak 1e4 high came within 1e-3 of each other in
-scaled units and the corrector jumped between them).
+``lam / s_lam``, with ``s_lam`` the length of the parameter range and ``s_x`` the
+largest RMS of x met so far on the branch (at least ``x_scale``): the curve's accuracy
+and its steps are relative to the size of the response, so a stretch of small amplitude
+next to a resonance (an antiresonance, the tail of a flank) is crossed in a few steps.
+(With the current point's RMS as the scale, every decade of amplitude and every phase
+turn of a small response cost as much as the resonance itself: 2-4 times the points on
+the friction chains of ``examples/bench_hb_speed.py``.) The two flanks of a sharp peak
+then lie close together in scaled units near their feet; the orientation (below) and
+the step control keep the corrector on its own flank.
 
 Orientation: the branch keeps the sign of det([R_x R_lam; t^T]) (Allgower & Georg,
-sec. 2.1), so a corrected point where it flips (the step jumped over a peak or a fold
-narrower than itself) is rejected, above :data:`FLIP_STEP`.
+sec. 2.1), whatever the scaling, through turning points and peaks; so the forward
+tangent at a new point is the one of the branch's orientation, not the one closest to
+the last tangent (which goes backwards after a turn of more than 90 deg in scaled
+variables: a kink, or a peak narrower than the step).
 
 Step (Allgower & Georg, Numerical Continuation Methods, ch. 6): tangent t from
 ``[R_x R_lam; t_prev^T] t = [0; 1]``; predictor ``y + ds t``; corrector Newton on R = 0
-and ``t . (y - y_pred) = 0`` (the pseudo-arclength plane), which passes turning points.
-Step control: the step grows or shrinks with the corrector's iteration count
-(target :data:`TARGET_ITER`), is halved on failure or when the tangent turns by more
-than :data:`MAX_TURN` (so a sharp peak is not jumped over).
+and ``t . (y - y_pred) = 0`` (the pseudo-arclength plane), which passes turning points;
+where it fails, Newton at the predictor's parameter (:meth:`_Scaled.correct_fixed`).
+
+Step size by the curve's shape (Allgower & Georg sec. 6.1, steplength adaptation by
+the asymptotic error model): after a corrector the step is judged by the distance
+delta from predictor to corrected point (delta ~ kappa ds^2 / 2 on a branch of
+curvature kappa; the chord between two points then deviates from the branch by
+~delta / 4) and the angle alpha between the tangents:
+``f = max(sqrt(delta / (4 tolerance)), alpha / TURN)``; the step is rejected and
+retried at ds / f when f > REJECT, else the next one is ds / f (at most GROW times
+longer, at most ds_max, and at most ``lam_step`` of the range in lam). So a straight
+stretch is crossed in long steps and a curved one (a peak, a fold) in short ones, to
+``tolerance`` in scaled variables (the relative accuracy of the polyline). A kink of the
+branch (a friction link starting or stopping to slip: the residual is only piecewise
+smooth) turns the tangent by the same angle at any step; when a shorter retry leaves
+alpha above CORNER_SHARE of the last one, the angle is not held against the step (only
+delta, which falls like ds past a corner, is), so a kink is crossed in a few points
+instead of shrinking the step to nothing. Without a tolerance (homotopies, which only
+need to arrive) the corrector's iterations size the steps (target TARGET_ITER).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.linalg import lu_factor, lu_solve
-from scipy.optimize import minimize_scalar
 
 from .newton import NewtonError, newton
 
-#: Floor of the x scale relative to the largest RMS met on the branch (the scale
-#: is the current point's RMS above it).
-S_X_FLOOR = 1e-4
+#: Largest step in lam of a forced-response curve (frf, bladed_disk.solve), as a fraction
+#: of the range: a resonance of 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force
+#: 0.5, ~7 % of the range wide) was stepped over by the shape control alone; at least
+#: ~1 / LAM_STEP points per curve.
+LAM_STEP = 0.03
 #: Corrector iterations the step control aims at.
 TARGET_ITER = 4
-#: Largest angle between successive tangents in scaled variables [rad].
-MAX_TURN = 0.35
-#: Scaled step below which a large tangent turn is accepted as a kink of the branch.
+#: Default curve accuracy: the polyline of the points deviates from the branch by
+#: about this much in scaled variables (x relative to the largest RMS met, lam to the
+#: range).
+CURVE_TOL = 1e-2
+#: Nominal angle between successive tangents in scaled variables [rad].
+TURN = 0.5
+#: A step whose shape factor f (module docstring) exceeds this is retried at ds / f.
+REJECT = 2.0
+#: Largest growth of the step from one point to the next.
+GROW = 2.0
+#: A retry whose tangent angle stays above this share of the longer attempt's angle
+#: found a kink (a smooth branch halves the angle with the step).
+CORNER_SHARE = 0.6
+#: Scaled step below which a step is judged by delta alone: neither the tangent's turn nor
+#: a step back in lam without a change of det(R_x) rejects it. A non-smooth branch can
+#: turn back at a corner without det changing sign (measured: the Jenkins oscillator at
+#: 1e4 k, f_s = P, c = 1e-4, H = 51 near 1.9609 rad/s, where the slip episodes grazing
+#: the turning points come and go: a turn of 143 deg, crossed only in steps this small).
 KINK_STEP = 2e-4
-#: Scaled step below which a reversed orientation (det([J; t]) changing sign) is
-#: accepted as a kink turning the branch by more than 90 deg; above it, the corrector
-#: jumped to the other flank of a peak: measured on the Jenkins FRF with c = 1e-4
-#: (resonance 3e-5 of the range wide), which without this test circled the peak
-#: (left flank up, jump to the right flank, up it backwards, over the top, down the
-#: left flank ...) until the point limit.
-FLIP_STEP = 1e-5
+#: Points accepted in a row below KINK_STEP after which the continuation stops as stalled
+#: (the caller restarts past the kink): a sampled AFT's staircase of kinks (64 samples,
+#: grazing slip) took 2000 such points without getting past 1.471 rad/s; the grazing
+#: corner above needs fewer than 10.
+CREEP_POINTS = 30
 #: Smallest scaled step at which a failed pseudo-arclength corrector is retried at
 #: fixed parameter (below it the fallback only creeps: measured at 1e6 k, 1e-8 rad/s
 #: per point, so the caller's restart is the better way past).
@@ -80,18 +112,28 @@ class Branch:
     x : list of (N,) arrays
     lam : list of float
     iterations : list of int   corrector iterations per point
+    det_sign : list of float   sign of det(dR/dx) per point (+1, -1; 0: not known), free
+        by-product of the tangent (:meth:`_Scaled.tangent`): it changes where a real Floquet
+        multiplier crosses +1 (folds, branch points), so Hill's stability is only needed
+        where it changes (:func:`stability.along_branch`)
+    tangent : list of (N + 1,) arrays or None   forward unit tangent (dx, dlam) per point
+        in unscaled variables (None: not known), for interpolation between points
     status : str               'complete', or why it stopped
     """
 
     x: list = field(default_factory=list)
     lam: list = field(default_factory=list)
     iterations: list = field(default_factory=list)
+    det_sign: list = field(default_factory=list)
+    tangent: list = field(default_factory=list)
     status: str = "running"
 
-    def append(self, x, lam, it):
+    def append(self, x, lam, it, det_sign=0.0, tangent=None):
         self.x.append(np.array(x))
         self.lam.append(float(lam))
         self.iterations.append(int(it))
+        self.det_sign.append(float(det_sign))
+        self.tangent.append(tangent)
 
 
 class _Scaled:
@@ -105,12 +147,17 @@ class _Scaled:
         return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
 
     def tangent(self, J, t_prev):
-        """Unit tangent t (N+1,) with t . t_prev > 0, and the sign of det([J; t^T]).
+        """Unit tangent t (N+1,) with t . t_prev > 0, the sign of det([J; t^T]) and the
+        sign of det(J_x) (J without its last column).
 
-        The sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays the
-        same along a regular branch, through turning points and peaks, whatever the
-        scaling (positive column scales change det([J; t]) by a positive factor).
+        The first sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays
+        the same along a regular branch, through turning points and peaks, whatever the
+        scaling (positive column scales change det([J; t]) by a positive factor). The
+        second is free: by Cramer's rule the last component of the solution of
+        [J; t_prev] t = e_(N+1) is det(J_x) / det([J; t_prev]).
         """
+        from scipy.linalg import lu_factor, lu_solve  # after the first point: start-up
+
         A = np.vstack([J, t_prev])
         rhs = np.zeros(A.shape[0])
         rhs[-1] = 1.0
@@ -124,7 +171,7 @@ class _Scaled:
         # which the LU gives.
         perm = np.count_nonzero(piv != np.arange(len(piv))) % 2
         sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
-        return t / n, float(sign)
+        return t / n, float(sign), float(np.sign(t[-1]) * sign)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
         """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
@@ -171,8 +218,9 @@ class _Scaled:
 
 
 def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0.01,
-                 ds_min: float = 1e-6, ds_max: float = 0.02, max_points: int = 2000,
-                 x_scale: float = 0.0, max_turn: float = MAX_TURN, on_point=None) -> Branch:
+                 ds_min: float = 1e-6, ds_max: float = 0.5, max_points: int = 2000,
+                 x_scale: float = 0.0, tolerance: float | None = CURVE_TOL,
+                 on_point=None, rtol: float = 0.0, lam_step: float | None = None) -> Branch:
     """Trace the branch through (x0, lam0) until lam reaches lam_end.
 
     Parameters
@@ -187,10 +235,17 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     x_scale : float, smallest scale of x (default 0: the RMS of the first point); a
         homotopy from a tiny level passes the final level's size so that the first
         steps are not 1 % of a tiny x
-    max_turn : float, tangent turn limit [rad] (np.pi disables it: a homotopy only
-        needs to arrive, not to resolve the path)
+    tolerance : float or None, curve accuracy in scaled variables (module docstring);
+        None: steps by the corrector's iterations alone (a homotopy only needs to
+        arrive, not to resolve its path)
     on_point : callable (lam) -> None, optional
         Called after every accepted point (progress display); None: no call.
+    lam_step : float or None, largest step in lam as a fraction of the range (None: no
+        limit): a feature narrower than the steps the shape allows on a flat stretch
+        (a bump of 0.6 % on a flat curve) is still sampled
+    rtol : float, relative tolerance of the correctors: |R| <= max(tol, rtol |R_x x|)
+        at the last point (the size of the terms that balance in R: a resonance's
+        internal forces, a slipping response many times the stuck one that sized tol)
 
     Returns
     -------
@@ -200,6 +255,8 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     ------
     ContinuationError (a RuntimeError) with the parameter reached and ``.branch``.
     """
+    if tolerance is not None and not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"curve tolerance must be a positive number, got {tolerance}")
     branch = Branch()
     first = _solve_fixed(fun, x0, lam0, tol, branch)
     branch.append(first.x, lam0, first.iterations)
@@ -214,20 +271,28 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     _, Jx, Jl = fun(first.x, lam0)
     J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
     orient = 0.0  # sign of det([J; t]): the branch's orientation (set at the first point)
+    ctl = _Control(tolerance, lam_step)
+    creep = 0  # points accepted in a row at steps below KINK_STEP
     while len(branch.lam) < max_points:
-        sc = _Scaled(fun, s_x, s_lam, tol)
+        tol_now = max(tol, rtol * float(np.linalg.norm(J_phys[:, :-1] @ branch.x[-1])))
+        sc = _Scaled(fun, s_x, s_lam, tol_now)
         y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
         col = np.append(np.full(len(x0), s_x), s_lam)
         J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
         try:
-            t, d = sc.tangent(J, t_prev)
+            t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
         except (np.linalg.LinAlgError, ValueError):
             raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
         if not orient:
             orient = d  # t points towards lam_end here
         elif d != orient:
-            t = -t  # a kink accepted at a tiny step turned the branch by more than 90 deg
-        y_new, it, ds, J_new = _step(sc, y, t, ds, ds_min, branch, max_turn, sign, orient)
+            t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
+        branch.tangent[-1] = _unscaled(t, col)
+        y_new, it, ds, J_new, f = _step(sc, y, t, min(ds, ds_max), ds_min, branch, ctl, orient)
+        creep = creep + 1 if ds < KINK_STEP else 0
+        if creep > CREEP_POINTS:
+            raise _stop(f"step below minimum (more than {CREEP_POINTS} points in steps below "
+                        f"{KINK_STEP:g}: the corrector creeps along a kink)", branch)
         J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
@@ -240,7 +305,7 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
                 # interpolated guess stalled at |R| = 3e-4 while Newton from the last
                 # point (lam = -0.005) converged in 24 iterations.
                 res = _solve_fixed(fun, branch.x[-1], lam_end, tol, branch)
-            branch.append(res.x, lam_end, res.iterations)
+            branch.append(res.x, lam_end, res.iterations, *_end_tangent(fun, res.x, lam_end, sign))
             if on_point is not None:
                 on_point(lam_end)
             branch.status = "complete"
@@ -251,62 +316,107 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         branch.append(y_new[:-1] * s_x, lam_new, it)
         if on_point is not None:
             on_point(lam_new)
-        s_now = _rms(branch.x[-1])
-        s_max = max(s_max, s_now)
-        s_x = max(s_now, S_X_FLOOR * s_max, x_scale, 1e-300)
+        s_max = max(s_max, _rms(branch.x[-1]))
+        s_x = max(s_max, x_scale, 1e-300)
         # Tangent expressed in the (possibly updated) scaling, for the next orientation.
         t_prev = t * np.append(np.full(len(x0), sc.s_x / s_x), 1.0)
         t_prev /= np.linalg.norm(t_prev)
-        ds = min(ds_max, ds * np.clip(TARGET_ITER / max(it, 1), 0.5, 2.0))
+        ds = min(ds_max, ds / max(f, 1.0 / GROW))
     raise _stop(f"point limit {max_points} reached", branch)
 
 
-def _step(sc, y, t, ds, ds_min, branch, max_turn=MAX_TURN, sign=0.0, orient=0.0):
-    """One accepted predictor-corrector step; shrinks ds until it succeeds.
+class _Control:
+    """The shape factor f of a corrected step (module docstring): > REJECT rejects it,
+    else the next step is ds / f; and the largest scaled step in lam."""
 
-    A corrected point is rejected (step halved) when the tangent there turned by more
-    than max_turn (above KINK_STEP) or when it has the opposite orientation
-    (:meth:`_Scaled.tangent`, above FLIP_STEP): the corrector then landed on the
-    other flank of a peak narrower than the step, or on another branch.
+    def __init__(self, tolerance, lam_step):
+        self.delta_ok = None if tolerance is None else 4.0 * tolerance
+        self.lam_step = np.inf if lam_step is None else float(lam_step)
+
+    def factor(self, delta, alpha, it, corner=False):
+        """(shape factor: rejects above REJECT, factor for the next step). Without a
+        tolerance the corrector's iterations size the next step (target TARGET_ITER, at
+        most halving it); with one, the shape alone does (delta and alpha already grow
+        where Newton struggles, and the iterations count the tolerance's digits too)."""
+        if self.delta_ok is None:
+            return 0.0, min(it / TARGET_ITER, 2.0)
+        shape = max(np.sqrt(delta / self.delta_ok), 0.0 if corner else alpha / TURN)
+        return shape, shape
+
+
+def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
+    """One accepted predictor-corrector step: (y_new, iterations, ds, J, shape factor).
+
+    Corrector: the pseudo-arclength plane, else Newton at the predictor's parameter
+    (where the plane misses the branch: past a kink that turns it by more than 90 deg
+    in scaled variables, or Newton's direction fails at the kink). The forward tangent
+    at the corrected point is the branch's orientation's; the step is retried shorter
+    while its shape factor exceeds REJECT, and halved when no corrector converges.
     """
+    alpha_prev, reason = None, ""
+    if abs(t[-1]) * ds > ctl.lam_step:
+        ds = ctl.lam_step / abs(t[-1])
     while True:
+        y_pred = y + ds * t
+        res = None
         try:
-            res = sc.correct(y + ds * t, t)
-            reason = _rejected(sc, res, t, ds, max_turn, orient)
-            if reason is None:
-                return res.x, res.iterations, ds, res.J[:-1]
+            res = sc.correct(y_pred, t)
         except NewtonError as err:
             reason = err.reason
-            # natural-parameter step of the same scaled length from the last point,
-            # towards the end of the range
-            step = np.zeros(len(t))
-            step[-1] = sign or np.sign(t[-1])
-            res = sc.correct_fixed(y + ds * step) if ds >= FIXED_MIN_STEP else None
-            if res is not None and _rejected(sc, res, t, ds, max_turn, orient) is None:
-                return res.x, res.iterations, ds, res.J[:-1]
-        ds *= 0.5
+            if ds >= FIXED_MIN_STEP:
+                res = sc.correct_fixed(y_pred)
+        f = None
+        if res is not None:
+            try:
+                t_new, d_new, _ = sc.tangent(res.J[:-1], t)
+            except (np.linalg.LinAlgError, ValueError):
+                t_new, reason = None, "singular extended Jacobian at the corrected point"
+            if t_new is not None:
+                if orient and d_new != orient:
+                    t_new = -t_new
+                alpha = float(np.arccos(np.clip(t_new @ t, -1.0, 1.0)))
+                delta = float(np.linalg.norm(res.x - y_pred))
+                corner = ds < KINK_STEP or (alpha_prev is not None
+                                            and alpha > CORNER_SHARE * alpha_prev)
+                f, f_next = ctl.factor(delta, alpha, res.iterations, corner)
+                if ds >= KINK_STEP and _backwards(res.x[-1] - y[-1], t[-1], t_new[-1]):
+                    f, reason = max(f, 2.0 * REJECT), "the corrector went back in the parameter"
+                if f <= REJECT:
+                    return res.x, res.iterations, ds, res.J[:-1], f_next
+                alpha_prev = alpha
+                if not reason.startswith("the corrector went back"):
+                    reason = "the branch bends more than the tolerance allows"
+        ds *= 0.5 if f is None else max(1.0 / f, 0.25)
         if ds < ds_min:
             raise _stop(f"step below minimum ({reason})", branch)
 
 
-def _rejected(sc, res, t, ds, max_turn, orient):
-    """Why the corrected point ``res`` is not accepted after a step ds along t, or None.
+def _unscaled(t, col):
+    """Unit tangent in unscaled variables from one in scaled ones (column scales col)."""
+    u = t * col
+    return u / np.linalg.norm(u)
 
-    A kink of the branch (stick-slip onset: the describing function is only C0 in the
-    Jacobian) keeps its turn at any step, so the turn limit only applies to steps
-    above KINK_STEP and the orientation test to steps above FLIP_STEP.
-    """
-    if max_turn >= np.pi and not orient:
-        return None
+
+def _end_tangent(fun, x, lam, sign):
+    """(sign of det(R_x), unit tangent (dx, dlam) pointing along ``sign`` in lam) at the
+    last point of a branch, from one more evaluation there (None where R_x is singular)."""
+    _, Jx, Jl = fun(x, lam)
+    det = float(np.linalg.slogdet(Jx)[0])
     try:
-        t_new, d_new = sc.tangent(res.J[:-1], t)
-    except (np.linalg.LinAlgError, ValueError):
-        return "singular extended Jacobian at the corrected point"
-    if ds > KINK_STEP and max_turn < np.pi and abs(t_new @ t) < np.cos(max_turn):
-        return "tangent turned too much"
-    if ds > FLIP_STEP and orient and d_new != orient:
-        return "orientation of the branch reversed (a peak or fold jumped over)"
-    return None
+        dx = -np.linalg.solve(Jx, Jl)
+    except np.linalg.LinAlgError:
+        return det, None
+    u = sign * np.append(dx, 1.0)
+    return det, u / np.linalg.norm(u) if np.all(np.isfinite(u)) else None
+
+
+def _backwards(dlam, t_lam, t_new_lam) -> bool:
+    """True when a step moved lam against the branch's direction at both its ends: no
+    fold lies between them (t's lam component has one sign), so the corrector landed on
+    an earlier part of the branch (the other flank of a sharp resonance, whose feet lie
+    close together in scaled variables: measured on x'' + 1e-4 x' + x = cos(lam t), which
+    circled its peak without this test)."""
+    return bool(dlam * t_lam < 0.0 and dlam * t_new_lam < 0.0)
 
 
 def _solve_fixed(fun, x, lam, tol, branch):
@@ -336,12 +446,14 @@ def _rms(x):
 def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: float):
     """Locate the local maximum of ``amplitude(x, lam)`` on the branch near point i.
 
-    The branch between points i-1 and i+1 is parameterised by tau in [0, 2]: a
-    point on the chord of segment k = floor(tau), corrected onto the branch in the
-    plane normal to that chord (so it works through turning points). Brent's
-    bounded search maximises the amplitude in tau until the bracket is below the
-    tau equivalent of ``tol_lam`` (parameter tolerance); the amplitude error is then
-    second order, ~ A'' tol_lam^2 / 2.
+    The branch between points i-1 and i+1 is parameterised by tau in [-1, 1] (0 at
+    point i): a point on the chord of the segment tau lies on, corrected onto the
+    branch in the plane normal to that chord (so it works through turning points), or,
+    where that corrector fails (a kink of a friction branch), at the chord point's
+    parameter (:meth:`_Scaled.correct_fixed`); a point neither corrector reaches counts
+    as no maximum. Brent's search (:func:`brent_min`) maximises the amplitude in tau
+    until the bracket is below the tau equivalent of ``tol_lam`` (parameter
+    tolerance); the amplitude error is then second order, ~ A'' tol_lam^2 / 2.
 
     Parameters
     ----------
@@ -354,7 +466,8 @@ def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: floa
 
     Returns
     -------
-    x : (N,) array, lam : float, amp : float, evaluations : int
+    x : (N,) array, lam : float, amp : float, evaluations : int (of the amplitude);
+    point i itself when no corrected point is higher.
     """
     if not 0 < i < len(branch.lam) - 1:
         raise ValueError("refinement needs a point with neighbours on both sides")
@@ -362,25 +475,86 @@ def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: floa
     scale = np.append(np.full(len(branch.x[i]), max(_rms(branch.x[i]), 1e-300)),
                       max(abs(branch.lam[i + 1] - branch.lam[i - 1]), 1e-300))
     pts = [p / scale for p in pts]
-    cache = {}
+    sc = _Scaled(fun, scale[:-1], scale[-1], tol)
+    cache = {0.0: pts[1] * scale}
 
     def point(tau):
-        k = min(int(tau), 1)
-        a, b = pts[k], pts[k + 1]
+        if tau == 0.0:
+            return -amplitude(branch.x[i], branch.lam[i])
+        a, b = (pts[0], pts[1]) if tau < 0 else (pts[1], pts[2])
         chord = (b - a) / np.linalg.norm(b - a)
-        y_pred = a + (tau - k) * (b - a)
-        sc = _Scaled(fun, scale[:-1], scale[-1], tol)
-        res = sc.correct(y_pred, chord, max_iter=30)
+        y_pred = a + (tau + 1.0 if tau < 0 else tau) * (b - a)
+        try:
+            res = sc.correct(y_pred, chord, max_iter=30)
+        except NewtonError:
+            res = sc.correct_fixed(y_pred, max_iter=30)
+            if res is None:
+                return np.inf
         y = res.x * scale
         cache[tau] = y
         return -amplitude(y[:-1], y[-1])
 
     dlam = max(abs(branch.lam[i] - branch.lam[i - 1]), abs(branch.lam[i + 1] - branch.lam[i]))
-    xatol = max(tol_lam / max(dlam, 1e-300), 1e-12)
-    opt = minimize_scalar(point, bounds=(0.0, 2.0), method="bounded",
-                          options={"xatol": xatol, "maxiter": 200})
-    y = cache.get(opt.x)
-    if y is None:
-        point(opt.x)
-        y = cache[opt.x]
-    return y[:-1], float(y[-1]), float(-opt.fun), int(opt.nfev)
+    xtol = max(tol_lam / max(dlam, 1e-300), 1e-12)
+    tau, f, n = brent_min(point, -1.0, 1.0, xtol, start=0.0)
+    y = cache[tau]
+    return y[:-1], float(y[-1]), float(-f), n
+
+
+#: Golden-section share of Brent's minimiser.
+_GOLDEN = 0.5 * (3.0 - np.sqrt(5.0))
+
+
+def brent_min(f, a: float, b: float, xtol: float, start: float | None = None,
+              max_eval: int = 200) -> tuple[float, float, int]:
+    """Minimum of f on [a, b] to an absolute tolerance xtol in x (Brent, Algorithms for
+    Minimization without Derivatives, 1973, ch. 5: golden-section steps, parabolic steps
+    through the three best points where they are safe). ``start``: the first point
+    (default the golden-section point). f may return inf (a point to avoid).
+
+    Returns
+    -------
+    x, f(x), evaluations
+    """
+    x = w = v = a + _GOLDEN * (b - a) if start is None else float(start)
+    fx = fw = fv = f(x)
+    d = e = 0.0
+    n = 1
+    while n < max_eval:
+        m = 0.5 * (a + b)
+        if abs(x - m) <= 2.0 * xtol - 0.5 * (b - a):
+            break
+        p = q = r = 0.0
+        if abs(e) > xtol and np.isfinite(fx) and np.isfinite(fw) and np.isfinite(fv):
+            r = (x - w) * (fx - fv)
+            q = (x - v) * (fx - fw)
+            p = (x - v) * q - (x - w) * r
+            q = 2.0 * (q - r)
+            p, q = (-p, q) if q > 0.0 else (p, -q)
+            r, e = e, d
+        if q != 0.0 and abs(p) < abs(0.5 * q * r) and q * (a - x) < p < q * (b - x):
+            d = p / q  # parabolic step
+            if (x + d) - a < 2.0 * xtol or b - (x + d) < 2.0 * xtol:
+                d = xtol if x < m else -xtol
+        else:
+            e = (b - x) if x < m else (a - x)  # golden-section step into the larger part
+            d = _GOLDEN * e
+        u = x + (d if abs(d) >= xtol else np.copysign(xtol, d))
+        fu = f(u)
+        n += 1
+        if fu <= fx:
+            if u < x:
+                b = x
+            else:
+                a = x
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v in (x, w):
+                v, fv = u, fu
+    return x, fx, n

@@ -135,9 +135,10 @@ def harmonic_work(U: np.ndarray, F: np.ndarray, basis: FourierBasis) -> float:
     return float(w)
 
 
-def _damping_terms(C: np.ndarray, U: np.ndarray, basis: FourierBasis, omega: float):
-    """Viscous force harmonics omega (D_theta (x) C) U, its Jacobian and d/domega."""
-    op = np.kron(basis.dtheta, C)
+def _damping_terms(C: np.ndarray, U: np.ndarray, basis: FourierBasis, omega: float, op=None):
+    """Viscous force harmonics omega (D_theta (x) C) U, its Jacobian and d/domega
+    (``op``: D_theta (x) C when the caller keeps it)."""
+    op = np.kron(basis.dtheta, C) if op is None else op
     dw = op @ U.ravel()
     return omega * dw, omega * op, dw
 
@@ -167,15 +168,24 @@ class LinearElement(ForceElement):
     def evaluate(self, U, basis, omega, jac=True) -> LocalForce:
         U = np.asarray(U, dtype=float).reshape(basis.nb, self.m)
         F = U @ self.K.T
-        dF = np.kron(np.eye(basis.nb), self.K) if jac else None
+        dF = self._operators(basis)[0] if jac else None
         dw, W = None, 0.0
         if self.C is not None:
-            Fc, dFc, dw = _damping_terms(self.C, U, basis, omega)
+            Fc, dFc, dw = _damping_terms(self.C, U, basis, omega, self._operators(basis)[1])
             F = F + Fc.reshape(basis.nb, self.m)
             if jac:
                 dF = dF + dFc
             W = viscous_work(self.C, U, basis, omega)
         return LocalForce(F, dF, dw, W, W)
+
+    def _operators(self, basis):
+        """(I (x) K, D_theta (x) C or None), (n_b m, n_b m) each, kept per basis and
+        matrices (the same numbers as built at every call)."""
+        key = (basis.harmonics, self.K.tobytes(), None if self.C is None else self.C.tobytes())
+        if getattr(self, "_ops", (None,))[0] != key:
+            self._ops = (key, (np.kron(np.eye(basis.nb), self.K),
+                               None if self.C is None else np.kron(basis.dtheta, self.C)))
+        return self._ops[1]
 
     def stuck_stiffness(self) -> np.ndarray:
         return self.K

@@ -3,18 +3,20 @@
 ``compute_frf(model, harmonics, (omega_start, omega_end))`` traces the branch with
 :func:`continuation.continuation`, reports for the response DOF the peak absolute
 displacement over the period (``amplitude``) and the first-harmonic magnitude
-(``amplitude_h1``), and refines every resonance peak of ``amplitude`` (prominence
-above :data:`PEAK_PROMINENCE`) to :data:`PEAK_TOL_REL` in frequency
-(:func:`continuation.refine_max`); the highest is ``peak_omega``/``peak_amplitude``.
+(``amplitude_h1``), and refines the resonance peaks of ``amplitude``
+(:func:`peaks.refine_peaks`); the highest is ``peak_omega``/``peak_amplitude``. The
+points are as many as the curve's shape needs at the curve ``tolerance``
+(:mod:`continuation`), at least ~1 / LAM_STEP.
 
 Accuracy of the peak: the refinement locates the maximum of the *discrete* HB
-curve (given H and n_t) to PEAK_TOL_REL in frequency, hence its amplitude to
-~1e-12. The discrete curve differs from the exact one by the truncation in H and
-by the AFT sampling error, O(n_t^-2) (2e-4 relative at n_t = 256 on the Jenkins
-describing function). The sampling also puts ripples of that order on the curve
-(the reversal point moves between samples as omega changes), so on a very flat
-peak two neighbouring ripple maxima can compete: measured 4e-5 in amplitude and
-3e-4 in frequency between two runs of the same model.
+curve (given H) to peaks.PEAK_TOL_REL in frequency, hence its amplitude to ~1e-12. The
+discrete curve differs from the exact one by the truncation in H only when the friction
+links are exact (the default, :func:`exact_links`); a sampled AFT (``aft="sampled"``,
+and contacts whose normal load varies) adds an O(n_t^-2) error (2e-4 relative at
+n_t = 256 on the Jenkins describing function) and ripples of that order on the curve
+(the reversal point moves between samples as omega changes), so on a very flat peak two
+neighbouring ripple maxima can compete: measured 4e-5 in amplitude and 3e-4 in
+frequency between two runs of the same model.
 """
 from __future__ import annotations
 
@@ -22,26 +24,21 @@ import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.signal import find_peaks
 
 from .aft import FrictionLink
-from .continuation import Branch, ContinuationError, continuation, refine_max
+from .contact import ContactElement
+from .continuation import CURVE_TOL, LAM_STEP, Branch, ContinuationError, continuation
 from .fourier import FourierBasis, default_samples, parse_harmonics
 from .homotopy import HomotopyError
 from .model import Model
 from .parameter import ParameterProblem
-from .residual import FullResidual, energy_per_cycle, make_residual
+from .peaks import peak_indices, refine_peaks
+from .residual import CondensedResidual, FullResidual, energy_per_cycle, make_residual
 from .start import _stiffness_ratio, homotopy_start
 
 #: Newton tolerance relative to the residual's reference size (|F_ext| for the
 #: full residual, |X| of the stuck linear response for the condensed one).
 TOL_REL = 1e-10
-#: Peak frequency located to this relative tolerance (the amplitude error is second
-#: order in it, ~1e-12 relative).
-PEAK_TOL_REL = 1e-6
-#: A local maximum is a resonance peak (refined, listed in ``peaks``) when its
-#: prominence exceeds this fraction of the curve's maximum; AFT ripples are ~1e-4.
-PEAK_PROMINENCE = 0.01
 
 
 #: Aliasing indicator (FourierBasis.alias_ratio at the peak) above which the
@@ -100,6 +97,8 @@ class FRFResult:
             "harmonics": list(self.harmonics), "n_t": self.n_t, "alias_ratio": self.alias_ratio,
             "aft": self.extra.get("aft"),
             "status": self.status, "stable": self.stable,
+            "stability_checks": self.extra.get("stability_checks", 0),
+            "peak_refined": self.extra.get("peak_refined"),
         }
         return {k: _finite(v) for k, v in out.items()}
 
@@ -164,51 +163,67 @@ class FRFProblem:
         return out
 
 
+#: Smallest curve tolerance: finer steps would resolve the corrector's own accuracy
+#: (TOL_REL of the residual, ~1e-8 of the response near a resonance).
+MIN_TOLERANCE = 1e-6
+#: Default largest continuation step (scaled arclength, :mod:`continuation`): the
+#: curve tolerance sizes the steps; this only bounds them on straight stretches.
+DS_MAX = 0.5
+
+
 #: Largest number of full-residual unknowns for which ``stability="auto"`` runs
 #: Hill's method at every point (a (2N)^2 eigenproblem: ~5 ms at N = 200).
 STABILITY_AUTO_MAX = 200
 
 
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
-                ds_max: float = 0.1, max_points: int = 2000, refine: bool = True,
-                stability="auto", progress=None) -> FRFResult:
+                ds_max: float = DS_MAX, max_points: int = 2000, refine: bool = True,
+                stability="auto", progress=None, aft: str = "exact",
+                tolerance: float = CURVE_TOL) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
     end of a homotopy in the excitation level (:mod:`homotopy`), so the curve does
-    not depend on where the sweep starts. ``stability`` (True, False or "auto": when
-    the model has matrices and at most STABILITY_AUTO_MAX full unknowns) adds Hill's
-    stability of every point (``result.stable``). ``progress(done, total, label)``, if
+    not depend on where the sweep starts. ``stability`` adds Hill's stability of every
+    point (``result.stable``): "auto" (default) when the model has matrices and at most
+    STABILITY_AUTO_MAX full unknowns, True at any size, both by Hill checks only where
+    it can change (:func:`stability.along_branch`: the sign changes of det(dR/dx), the
+    local maxima of the amplitude, the ends, every CHECK_SPACING points, bisection
+    between checks that disagree), "all" by Hill's method at every point, False or
+    "off" not at all. ``progress(done, total, label)``, if
     given, is called after every continuation point with the share of the frequency
     range covered, in percent (``total`` = 100), as ``contact_core``'s long stages do.
+    ``aft``: "exact" (default) evaluates every Iwan friction link by its exact periodic
+    loop (:func:`exact_links`), "sampled" by the sampled AFT on ``n_t`` samples (the
+    reference of the sampling error); contacts with a normal load varying in time and
+    elements without the exact path are sampled either way. ``tolerance``: the curve's
+    accuracy, which sizes the continuation's steps (:mod:`continuation`, at least
+    MIN_TOLERANCE); ``ds_max`` bounds them (scaled arclength). A peak refinement that
+    fails keeps the curve's highest point (``extra["peak_refined"]`` False, a warning in
+    the status; :mod:`peaks`).
 
     Raises
     ------
-    ValueError for bad input; FRFError (a RuntimeError) when the continuation or the
-    peak refinement fails, carrying the points computed so far and the frequency reached.
+    ValueError for bad input; FRFError (a RuntimeError) when the continuation fails,
+    carrying the points computed so far and the frequency reached.
     """
     w0, w1 = (float(w) for w in omega_range)
     if not (np.isfinite(w0) and np.isfinite(w1)) or w0 <= 0 or w1 <= 0 or w0 == w1:
         raise ValueError(f"omega range must be two different positive numbers, got {omega_range}")
+    if aft not in ("exact", "sampled"):
+        raise ValueError(f"aft must be 'exact' or 'sampled', got {aft!r}")
+    if not (MIN_TOLERANCE <= tolerance < 1 and np.isfinite(ds_max) and ds_max > 0):
+        raise ValueError(f"the curve tolerance must be in [{MIN_TOLERANCE:g}, 1) and the largest "
+                         f"step a finite number > 0, got {tolerance}, {ds_max}")
     t0 = time.perf_counter()
-    model = exact_links(model)
+    model = exact_links(model, aft == "exact")
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
     tries = 1 if n_t else 1 + min(GRID_DOUBLINGS, max(0, int(np.log2(GRID_MAX / n_base))))
-    spent, exact_retry = 0, False
+    spent = 0
     for k in range(tries):
         prob = FRFProblem(model, harmonics, n_base * 2**k, condensed)
-        branch, gaps, error, start, tol = _trace(prob, w0, w1, ds_max, max_points, progress)
-        if k == 0 and not n_t and (error is not None or gaps) and _has_sampled_links(model):
-            # First remedy of a stalled sampled curve: the same grid with exact links
-            # (no sampling kinks); measured on the H = 51 map at 1e4 k with f_s = P (the
-            # grazing-slip class): 5 of 75 curves failed sampled, all completed exact.
-            spent += prob.evaluations
-            ex = FRFProblem(exact_links(model, every=True), harmonics, n_base, condensed)
-            ex_trace = _trace(ex, w0, w1, ds_max, max_points, progress)
-            if ex_trace[2] is None and not ex_trace[1]:
-                prob, (branch, gaps, error, start, tol), exact_retry = ex, ex_trace, True
-                break
-            spent += ex.evaluations
+        branch, gaps, error, start, tol = _trace(prob, w0, w1, (ds_max, tolerance), max_points,
+                                                 progress)
         if not _grid_limited(error, gaps) or k == tries - 1:
             break
         spent += prob.evaluations
@@ -218,24 +233,28 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
         result.status = branch.status = error
         result.extra["gaps"] = gaps
         result.extra["grid_doublings"] = k
-        result.stable = _stability(prob, branch, stability) if branch.lam else None
+        result.stable = _stability(prob, branch, stability)[0] if branch.lam else None
         raise FRFError(error, result)
     result = _collect(prob, branch, t0)
     result.extra["start"] = start
     result.extra["gaps"] = gaps
     result.extra["grid_doublings"] = k
-    result.extra["exact_retry"] = exact_retry
     # how the friction links were evaluated: "exact" (no AFT sampling, n_t only scans
-    # for the extrema), "sampled", or "mixed"
-    kinds = {link.exact for link in prob.model.links if isinstance(link, FrictionLink)}
+    # for the extrema), "sampled", or "mixed" (e.g. exact links and sampled contacts)
+    kinds = {link.exact if isinstance(link, FrictionLink) else False for link in prob.model.links
+             if isinstance(link, (FrictionLink, ContactElement))}
     result.extra["aft"] = {frozenset({True}): "exact", frozenset({False}): "sampled"}.get(
         frozenset(kinds), "mixed" if kinds else None)
     if gaps:
         result.status = (f"complete; {len(gaps)} restart(s) by homotopy after a stalled corrector, "
                          "no points in omega " + ", ".join(f"{a:.6g}-{b:.6g}" for a, b in gaps))
-    result.stable = _stability(prob, branch, stability)
+    result.stable, result.extra["stability_checks"] = _stability(
+        prob, branch, stability, peak_indices(result.amplitude, 0.0))
     if refine:
-        _refine_peak(prob, branch, result, tol)
+        exact = None if all(getattr(el, "exact", True) for el in prob.model.links) else (
+            lambda: FRFProblem(exact_links(prob.model), prob.basis.harmonics, prob.basis.n_t,
+                               isinstance(prob.residual, CondensedResidual)))
+        refine_peaks(prob, branch, result, tol, exact)
     result.alias_ratio = prob.alias_ratio(result.peak_solution)
     if result.alias_ratio > ALIAS_WARN:
         result.status += (f"; warning: AFT grid of {prob.basis.n_t} samples leaves "
@@ -253,34 +272,25 @@ STIFF_SAMPLES_RATIO = 1e4
 STIFF_SAMPLES_BASE = 512
 
 
-def _has_sampled_links(model: Model) -> bool:
-    from fmu_src.element import IwanElement
+def exact_links(model: Model, exact: bool = True) -> Model:
+    """``model`` with every Iwan friction link's ``exact`` flag set to ``exact`` (links of
+    other elements and other force elements as they are).
 
-    return any(isinstance(link, FrictionLink) and isinstance(link.element, IwanElement)
-               and not link.exact for link in model.links)
-
-
-def exact_links(model: Model, every: bool = False) -> Model:
-    """``model`` with its Iwan friction links made ``exact`` (:func:`aft.aft_link`: the
-    loop's Fourier coefficients without sampling) when they are more than
-    STIFF_SAMPLES_RATIO times stiffer than the structure, else ``model`` itself.
-
-    Why there: a sampled loop needs a grid growing like sqrt(k_t / k) (below) and its
-    kinks, where a stick episode shorter than a sample starts or ends between samples,
-    cost the corrector evaluations. Measured on the Jenkins FRF (H = 15, 0.5 -> 2
-    rad/s, no refinement): 1e6 k sampled on 8192 samples 474 points, 5.4 evaluations
-    per point, 1.8 s; exact (512-sample scan) 401 points, 3.6 per point, ~1 s;
-    1e5 k 2048 samples 5.9 per point, exact 3.8. Below the ratio the sampled loop is
-    as good and the results of earlier rounds stay as they were; ``every``: all Iwan
-    links (compute_frf's retry of a stalled sampled curve).
+    Exact (:func:`aft.aft_link`): the loop's Fourier coefficients from the C core, the
+    extrema of u located exactly and the loop between them integrated in closed form: no
+    sampling error and no kinks where a stick episode starts or ends between samples, at
+    the cost of a sampled evaluation (measured per link evaluation, H = 7, 256 samples:
+    30 us sampled, 50 us exact; H = 15, 512: 90 us both). The sampled loop carries an
+    O(n_t^-2) error that grows with the link's stiffness (a stick episode spans fewer
+    samples): first-harmonic force of a Jenkins link at H = 7, 256 samples, k_t = 20:
+    7e-4 relative, 2000: 1.2e-2; a stiff sampled curve needs thousands of samples
+    (:func:`stiff_samples`) and stalls at its kinks.
     """
     from fmu_src.element import IwanElement
 
-    ratio = _stiffness_ratio(model)
-    if not every and (ratio is None or ratio <= STIFF_SAMPLES_RATIO):
-        return model
-    links = [replace(link, exact=True) if isinstance(link, FrictionLink)
-             and isinstance(link.element, IwanElement) else link for link in model.links]
+    links = [replace(link, exact=exact) if isinstance(link, FrictionLink)
+             and isinstance(link.element, IwanElement) and link.exact != exact else link
+             for link in model.links]
     return replace(model, links=links)
 
 
@@ -332,7 +342,7 @@ def _grid_limited(error, gaps) -> bool:
     return error is not None and ("step below minimum" in error or "before the first point" in error)
 
 
-def _trace(prob, w0, w1, ds_max, max_points, progress):
+def _trace(prob, w0, w1, steps, max_points, progress):
     """First point and continuation on one grid: (branch, gaps, error or None, start, tol)."""
     tol = TOL_REL * max(prob.reference(w0), 1e-300)
     try:
@@ -344,7 +354,7 @@ def _trace(prob, w0, w1, ds_max, max_points, progress):
     if progress is not None:
         def on_point(w):
             progress(min(100, round(100 * abs(w - w0) / abs(w1 - w0))), 100, "continuation")
-    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point)
+    branch, gaps, error = _sweep(prob, x0, w0, w1, tol, steps, max_points, on_point)
     return branch, gaps, error, start, tol
 
 
@@ -355,7 +365,7 @@ MAX_RESTARTS = 100
 RESTART_JUMPS = (1e-3, 4e-3, 1.6e-2)
 
 
-def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
+def _sweep(prob, x0, w0, w1, tol, steps, max_points, on_point=None):
     """Continuation from (x0, w0) to w1 with restarts: (Branch, gaps, error or None).
 
     When the corrector stalls ("step below minimum": on a stiff contact the residual
@@ -369,8 +379,9 @@ def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
     sign = 1.0 if w1 > w0 else -1.0
     for _ in range(MAX_RESTARTS + 1):
         try:
-            br = continuation(prob, x0, w0, w1, tol, ds_max=ds_max,
-                              max_points=max_points - len(merged.lam), on_point=on_point)
+            br = continuation(prob, x0, w0, w1, tol, ds_max=steps[0], tolerance=steps[1],
+                              max_points=max_points - len(merged.lam), on_point=on_point,
+                              rtol=TOL_REL, lam_step=LAM_STEP)
             error = None
         except ContinuationError as err:
             br, error = err.branch, str(err)
@@ -402,8 +413,10 @@ def _sweep(prob, x0, w0, w1, tol, ds_max, max_points, on_point=None):
 
 
 def _extend(merged, br):
-    for x, w, it in zip(br.x, br.lam, br.iterations):
-        merged.append(x, w, it)
+    n = len(br.x)
+    for x, w, it, d, t in zip(br.x, br.lam, br.iterations, br.det_sign or [0.0] * n,
+                              br.tangent or [None] * n):
+        merged.append(x, w, it, d, t)
 
 
 def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
@@ -422,59 +435,34 @@ def _collect(prob: FRFProblem, branch, t0) -> FRFResult:
                      status=branch.status)
 
 
-def _refine_peak(prob, branch, result, tol):
-    """Refine every resonance peak (interior maxima with prominence above
-    :data:`PEAK_PROMINENCE` of the highest amplitude, so AFT ripples are skipped);
-    the highest refined one becomes the result's peak. Updates ``result`` in place."""
-    amp = result.amplitude
-    idx, _ = find_peaks(amp, prominence=PEAK_PROMINENCE * amp.max())
-    # a peak next to a restart gap has no continuous neighbours to refine between
-    edges = {w for gap in result.extra.get("gaps", ()) for w in gap}
-    idx = [i for i in idx if not edges & {result.omega[i - 1], result.omega[i], result.omega[i + 1]}]
-    peaks, nfev = [], 0
-    for i in idx:
-        try:
-            x, w, a, n = refine_max(prob, branch, int(i), prob.amplitude, tol,
-                                    PEAK_TOL_REL * abs(result.omega[i]))
-        except RuntimeError as err:
-            raise FRFError(f"peak refinement near omega = {result.omega[i]:.6g} rad/s failed: "
-                           f"{err}", result) from None
-        peaks.append((a, w, x))
-        nfev += n
-    result.extra["peak_refinement_evaluations"] = nfev
-    result.peaks = [{"omega": w, "amplitude": a} for a, w, _ in sorted(peaks, key=lambda p: p[1])]
-    if not peaks or max(peaks, key=lambda p: p[0])[0] < amp.max():
-        return  # the maximum is at an end of the range: no interior peak to refine
-    a, w, x = max(peaks, key=lambda p: p[0])
-    r = prob.response(x, w)
-    result.peak_omega, result.peak_amplitude, result.peak_solution = w, a, x
-    result.peak_amplitude_h1 = (float(prob.basis.magnitude(r, 1)) if 1 in prob.basis.harmonics
-                                else float("nan"))
-    result.peak_interior = True
-
-
-def _stability(prob: FRFProblem, branch, mode):
-    """Hill stability per branch point (list of bool), or None when not computed."""
+def _stability(prob: FRFProblem, branch, mode, anchors=()):
+    """Hill stability per branch point (list of bool) and the number of Hill checks, or
+    (None, 0) when not computed (``mode`` as :func:`compute_frf`'s ``stability``)."""
     from .residual import FullResidual
-    from .stability import is_stable
+    from .stability import along_branch, is_stable
 
     lin = prob.model.linear
-    if mode is False or lin.M is None or lin.K is None:
-        return None
+    if mode in (False, None, "off") or lin.M is None or lin.K is None:
+        return None, 0
     full = prob.residual if isinstance(prob.residual, FullResidual) else None
     size = prob.basis.nb * prob.model.n
     if mode == "auto" and size > STABILITY_AUTO_MAX:
-        return None
+        return None, 0
     if full is None:
         full = FullResidual(prob.model, prob.basis)
     V = full.viscous_operator()
     V = V if np.any(V) else None
-    out = []
-    for x, w in zip(branch.x, branch.lam):
+
+    def check(i):
+        x, w = branch.x[i], branch.lam[i]
         X = prob.residual.displacements(x, w).ravel() if full is not prob.residual else x
         _, J, _ = full(X, w)
-        out.append(is_stable(J, lin, prob.basis, w, V)[0])
-    return out
+        return is_stable(J, lin, prob.basis, w, V)[0]
+    n = len(branch.lam)
+    if mode == "all":
+        return [check(i) for i in range(n)], n
+    det = branch.det_sign if len(branch.det_sign) == n else [0.0] * n
+    return along_branch(n, det, check, anchors)
 
 
 @dataclass
@@ -491,7 +479,7 @@ class ParameterCurve:
 
 
 def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
-                    condensed=None, affine: bool = False, ds_max: float = 0.1,
+                    condensed=None, affine: bool = False, ds_max: float = DS_MAX,
                     max_points: int = 2000, stability: bool = True) -> ParameterCurve:
     """Continuation in lam over ``lam_range = (start, end)`` at fixed ``omega`` [rad/s].
 
@@ -510,6 +498,10 @@ def parameter_curve(model_at, harmonics, lam_range, omega: float, n_t: int = 0,
     if not (np.isfinite(l0) and np.isfinite(l1)) or l0 == l1:
         raise ValueError(f"parameter range must be two different finite numbers, got {lam_range}")
     t0 = time.perf_counter()
+    given = model_at
+
+    def model_at(lam):  # exact friction links, as compute_frf's
+        return exact_links(given(lam))
     pp = ParameterProblem(model_at, harmonics, omega, n_t, condensed, affine)
     start = FRFProblem(model_at(l0), harmonics, n_t, condensed)
     tol = TOL_REL * max(float(np.linalg.norm(start.residual.linear_guess(omega))), 1e-300)

@@ -87,7 +87,7 @@ def solve_with_homotopy(fun, x_stuck, f, tol, max_points=400):
     lam0, first = _first_level(fun_lam, x_stuck, tol)
     try:
         br = continuation(fun_lam, first, lam0, 1.0, tol, ds=0.1, ds_max=HOMOTOPY_DS_MAX,
-                          max_points=max_points, x_scale=_rms(x_stuck), max_turn=np.pi)
+                          max_points=max_points, x_scale=_rms(x_stuck), tolerance=None)
     except ContinuationError as err:
         raise HomotopyError(f"homotopy in the excitation level failed: {err}") from None
     info = {"start_level": lam0, "points": len(br.lam), "iterations": int(sum(br.iterations))}

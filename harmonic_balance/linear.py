@@ -25,13 +25,26 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 #: Relative size of the off-diagonal part of phi^T C phi below which C counts as
 #: modal (proportional) damping; round-off of eigh is ~1e-14.
 MODAL_DAMPING_TOL = 1e-9
 #: Relative asymmetry tolerated in M, C, K (round-off of an assembly).
 SYMMETRY_TOL = 1e-10
+
+
+def _eigh_general(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues (n,) ascending and M-orthonormal vectors (n, n) of K phi = lam M phi.
+
+    The reduction LAPACK's sygvd makes (M = L L^T, L^-1 K L^-T v = lam v, phi = L^-T v),
+    in numpy: the same numbers to round-off without loading scipy.linalg (a third of a
+    second of every ``damper frf``'s start-up on a busy machine). LinAlgError when M is
+    not positive definite.
+    """
+    L = np.linalg.cholesky(M)
+    A = np.linalg.solve(L, np.linalg.solve(L, K).T)
+    lam, v = np.linalg.eigh(0.5 * (A + A.T))
+    return lam, np.linalg.solve(L.T, v)
 
 
 @dataclass
@@ -97,7 +110,7 @@ class LinearModel:
     def _try_modal(self):
         """Use modes when M is SPD and C is diagonal in them (proportional damping)."""
         try:
-            lam, phi = sla.eigh(self.K, self.M)
+            lam, phi = _eigh_general(self.K, self.M)
         except (np.linalg.LinAlgError, ValueError):
             return  # M singular or not SPD: direct solves only
         Cm = phi.T @ self.C @ phi

@@ -22,7 +22,6 @@ sliders' mean position, counts as stable).
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 #: Largest real part of a Floquet exponent, relative to omega, still counted as
 #: stable: round-off of the eigensolver on the (2N)^2 companion matrix is ~1e-12;
@@ -62,7 +61,7 @@ def floquet_exponents(J, d1, d2, n: int, omega: float) -> np.ndarray:
     A[:N, N:] = np.eye(N)
     A[N:, :N] = -np.linalg.solve(d2, J)
     A[N:, N:] = -np.linalg.solve(d2, d1)
-    lam = sla.eigvals(A)
+    lam = np.linalg.eigvals(A)  # LAPACK geev, as scipy's, without its import
     order = np.argsort(np.abs(lam.imag))
     return lam[order[:2 * n]]
 
@@ -73,3 +72,50 @@ def is_stable(J, linear, basis, omega: float, V=None) -> tuple[bool, float]:
     lam = floquet_exponents(J, d1, d2, linear.n, omega)
     worst = float(lam.real.max())
     return bool(worst <= STABLE_TOL * omega), worst
+
+
+#: Largest number of points between two Hill checks in the reduced mode of
+#: :func:`along_branch`: a guard against a change that leaves det(dR/dx) alone (a
+#: complex pair or a multiplier -1 leaving the unit circle) between checks that agree.
+CHECK_SPACING = 25
+
+
+def along_branch(n: int, det_sign, check, anchors=(), spacing: int = CHECK_SPACING):
+    """Stability of the n points of a branch from Hill checks where it can change.
+
+    Hill's method (``check(i) -> bool``) runs at the first and last point, on both sides
+    of every sign change of det(dR/dx) (``det_sign`` (n,): a real Floquet multiplier
+    crosses +1 there: a fold or a branch point; 0 = unknown counts as its own sign), at
+    the ``anchors`` (e.g. the peaks) and at least every ``spacing`` points. Between two
+    checks that agree every point gets their answer; where they differ (a change det
+    does not see: a complex pair, a multiplier at -1) the stretch is bisected down to
+    neighbouring points, so the change is located exactly.
+
+    Returns
+    -------
+    stable : list of bool (n,), checks : int (Hill eigenproblems solved)
+    """
+    known = {}
+
+    def at(i):
+        if i not in known:
+            known[i] = bool(check(i))
+        return known[i]
+
+    marks = {0, n - 1} | {int(i) for i in anchors if 0 <= i < n} | set(range(0, n, max(1, spacing)))
+    marks |= {j for i in range(1, n) if det_sign[i] != det_sign[i - 1] for j in (i - 1, i)}
+    marks = sorted(marks)
+    out = [False] * n
+    stack = list(zip(marks, marks[1:]))
+    for i in marks:
+        at(i)
+    while stack:
+        a, b = stack.pop()
+        if at(a) == at(b):
+            out[a:b + 1] = [known[a]] * (b - a + 1)
+        elif b - a > 1:
+            m = (a + b) // 2
+            stack += [(a, m), (m, b)]
+    for i, v in known.items():
+        out[i] = v
+    return out, len(known)

@@ -67,8 +67,9 @@ class ChildResult:
 
 
 def run_child(argv: list[str], timeout: float, env: dict | None = None, python_code: str = _CLI,
-              cwd: str | Path | None = None) -> ChildResult:
-    """Run ``damper ARGV`` (or ``python -c python_code ARGV``) in a child; wall time and peak RSS.
+              cwd: str | Path | None = None, command: list[str] | None = None) -> ChildResult:
+    """Run ``damper ARGV`` (or ``python -c python_code ARGV``, or any ``command``) in a child;
+    wall time and peak RSS.
 
     The peak resident memory is read from ``ru_maxrss`` of a wrapper process
     that runs nothing else, so it is the child's own.
@@ -79,7 +80,8 @@ def run_child(argv: list[str], timeout: float, env: dict | None = None, python_c
                "sys.exit(p.returncode)\n")
     full_env = dict(os.environ, OPENBLAS_NUM_THREADS=os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     full_env.update(env or {})
-    cmd = [sys.executable, "-c", wrapper, sys.executable, "-c", python_code, *map(str, argv)]
+    inner = command if command is not None else [sys.executable, "-c", python_code, *map(str, argv)]
+    cmd = [sys.executable, "-c", wrapper, *map(str, inner)]
     t0 = time.perf_counter()
     # own session: on a timeout the whole group (wrapper and command) is killed, no orphan left running
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=full_env, cwd=cwd,

@@ -19,7 +19,9 @@ LEGEND = {
     "tangential": ("grid (nodes per side)", "max |T - T_Mindlin| / mu N"),
     "element": ("sliders", "|loop energy / Masing energy of the exact Mindlin curve - 1|"),
     "fmu": ("communication steps per cycle", "|energy per cycle / exact Masing energy - 1|"),
-    "hb": ("H or AFT samples", "|amplitude / time-integration amplitude - 1| at 1.1 rad/s"),
+    "hb": ("H or AFT samples; model rows: HB unknowns n (2 H + 1)",
+           "|amplitude / time-integration amplitude - 1| at 1.1 rad/s; model rows: "
+           "|first-harmonic peak / dense reference - 1|"),
     "solvers": ("contact nodes (grid^2)", "largest relative difference of k_n, k_t against the first solver"),
 }
 
@@ -33,16 +35,20 @@ def _plot(stage: str, rows: list[dict]) -> str:
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     floor = 1e-16  # an exact result (error 0) is drawn at round-off
-    for case in dict.fromkeys(r["case"] for r in rows):
+    # model rows (a "tool" key) are one series per tool, marks only, labelled by model
+    for case in dict.fromkeys(r.get("tool", r["case"]) for r in rows):
         for cached in (False, True):
-            pts = [r for r in rows if r["case"] == case and r["cached"] == cached and r["error"] is not None]
+            pts = [r for r in rows if r.get("tool", r["case"]) == case and r["cached"] == cached
+                   and r["error"] is not None and r["time_s"]]
             if not pts:
                 continue
             x = [max(r["error"], floor) for r in pts]
             y = [r["time_s"] for r in pts]
-            ax.plot(x, y, "s--" if cached else "o-", label=f"{case}{' (cached)' if cached else ''}")
+            style = ("s" if cached else "o") if "tool" in pts[0] else ("s--" if cached else "o-")
+            ax.plot(x, y, style, label=f"{case}{' (cached)' if cached else ''}")
             for r, xi, yi in zip(pts, x, y):
-                ax.annotate(f"{r['size']:g}", (xi, yi), fontsize=7, xytext=(3, 3), textcoords="offset points")
+                ax.annotate(r.get("model") or f"{r['size']:g}", (xi, yi), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
                 if r.get("default"):
                     ax.plot(xi, yi, "*", ms=16, mfc="none", mec="k")
     ax.set_xscale("log")
@@ -68,13 +74,24 @@ def _fmt(v) -> str:
     return html.escape(str(v))
 
 
+def _split(rows: list[dict]) -> tuple[list[dict], list[dict]]:
+    """(the stage's own rows, the model-class rows of damper.bench.hb_classes)."""
+    return [r for r in rows if "tool" not in r], [r for r in rows if "tool" in r]
+
+
 def table_text(stage: str, rows: list[dict]) -> str:
-    """Plain-text table of one stage (case, size, error, time, memory, cached)."""
+    """Plain-text table of one stage (case, size, error, time, memory, cached), then its
+    model-class rows (hb_classes.table)."""
+    own, models = _split(rows)
     lines = [f"== {stage}", f"{'case':26s} {'size':>8s} {'error':>10s} {'time_s':>8s} {'memory_mb':>9s} cached"]
-    for r in rows:
+    for r in own:
         err = "-" if r["error"] is None else f"{r['error']:.2e}"
         lines.append(f"{r['case']:26s} {r['size']:8g} {err:>10s} {r['time_s']:8.2f} {r['memory_mb']:9.0f} "
                      f"{'yes' if r['cached'] else 'no'}{'  (default)' if r.get('default') else ''}")
+    if models:
+        from .hb_classes import table
+
+        lines += ["model classes (peak error against dense references):", table(models)]
     return "\n".join(lines)
 
 
@@ -118,10 +135,16 @@ def markdown(result: dict) -> str:
         size_label, err_label = LEGEND.get(stage, ("size", "error"))
         out += [f"**{stage}** (size: {size_label}; error: {err_label})", "",
                 "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
-        for r in rows:
+        own, models = _split(rows)
+        for r in own:
             err = "-" if r["error"] is None else f"{r['error']:.2e}"
             star = " (default)" if r.get("default") else ""
             out.append(f"| {r['case']}{star} | {r['size']:g} | {err} | {r['time_s']:.2f} | {r['memory_mb']:.0f} | "
                        f"{'yes' if r['cached'] else 'no'} |")
         out.append("")
+        if models:
+            from .hb_classes import markdown as model_markdown
+
+            out += [f"**{stage}: model classes** (error: |first-harmonic peak / dense reference - 1|)", "",
+                    *model_markdown(models), ""]
     return "\n".join(out)

@@ -12,7 +12,10 @@ error of each row is against an independent reference:
   the energy the FMU dissipates per cycle at P communication steps a cycle;
 * hb: time integration (``harmonic_balance.timeint.march``, 1024 steps a period,
   tol 1e-10) of the single-DOF Jenkins model at one frequency near resonance,
-  against the harmonic-balance amplitude there, over H and over AFT samples.
+  against the harmonic-balance amplitude there, over H and over AFT samples; then
+  whole curves of the model classes (:mod:`.hb_classes`: single-DOF soft and stiff,
+  3- and 5-mass friction chains, UPD-24, with pyHarm and NLvib when given), their
+  first-harmonic peak against a dense reference (:mod:`.hb_reference`).
 
 ``time_s`` is the command's wall time, interpreter start and imports included
 (hb: the solver's own time, which the CLI reports). Rows carry ``default: True``
@@ -179,8 +182,19 @@ def _ti_reference(log) -> float:
     return float(amp)
 
 
-def hb(quick: bool, work: Path, log=print) -> list[Row]:
-    """Harmonic balance: harmonics and AFT samples against the error vs time integration (default H 1, auto)."""
+def hb(quick: bool, work: Path, log=print, models=None) -> list[Row]:
+    """Harmonic balance: harmonics and AFT samples against the error vs time integration (default H 1, auto),
+    then the model classes with their peers (:mod:`.hb_classes`; ``models``: its ModelOptions)."""
+    from . import hb_classes
+
+    rows = _hb_settings(quick, log)
+    log("  hb model classes (peak error against dense references):")
+    log("  " + hb_classes.HEAD)
+    return rows + hb_classes.run(quick, work, lambda s: log("  " + s), models)
+
+
+def _hb_settings(quick: bool, log) -> list[Row]:
+    """The H and AFT-sample rows against time integration on the single-DOF model."""
     ref = _ti_reference(log)
     band = ["--omega", f"{W_REF * 0.999:g}", f"{W_REF * 1.001:g}"]
     rows = []

@@ -4,7 +4,12 @@ Writes DIR/bench.json (``stages``: stage -> rows {case, size, error, time_s,
 memory_mb, cached}, plus the run's stamp) and DIR/bench.html (a plot of error
 against time per stage, the tool's defaults starred). ``--quick`` is a small
 version (about a minute) that the tests run; ``--solvers`` adds the sparse
-back ends on the 21x21 and 41x41 sphere (minutes).
+back ends on the 21x21 and 41x41 sphere (minutes). The hb stage ends with whole
+curves of the model classes (single-DOF soft and stiff, 3- and 5-mass friction
+chains, UPD-24), and of the peers pyHarm (``--pyharm PYTHON``) and NLvib
+(``--nlvib DIR``, GNU Octave) on the same cases when given::
+
+    damper bench --stage hb --pyharm /opt/pyharm/bin/python --nlvib /opt/NLvib --out out/bench
 """
 from __future__ import annotations
 
@@ -24,15 +29,28 @@ def register(sub) -> None:
                    "element, fmu, hb, solvers")
     p.add_argument("--solvers", action="store_true", help="also time every sparse back end (slow)")
     p.add_argument("--json", action="store_true", help="print one JSON object with `stages`")
+    g = p.add_argument_group("hb stage: model classes and peers (damper.bench.hb_classes)")
+    g.add_argument("--full", action="store_true", help="all 18 curves of the 3-mass chain (default: 4)")
+    g.add_argument("--case", action="append", default=[], metavar="TEXT",
+                   help="only the model cases whose name contains TEXT (repeatable), e.g. 'chain5', 'sdof soft'")
+    g.add_argument("--pyharm", metavar="PYTHON", help="a Python interpreter with pyHarm (pip install pyharm-os)")
+    g.add_argument("--nlvib", metavar="DIR", help="an NLvib folder (github.com/maltekrack/NLvib), run by Octave")
+    g.add_argument("--octave", metavar="EXE", help="GNU Octave for NLvib (default: octave on PATH)")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from damper.bench import report, solvers, stages
     from damper.bench.common import stamp
+    from damper.bench.hb_classes import ModelOptions, case_names
 
     log = (lambda s: print(s, file=sys.stderr, flush=True)) if args.json else (lambda s: print(s, flush=True))
+    models = ModelOptions(args.full, tuple(args.case), args.pyharm, args.nlvib, args.octave)
+    if args.case and not case_names(args.quick, models):
+        raise ValueError(f"--case {args.case} matches no model case; names: "
+                         f"{', '.join(case_names(False, ModelOptions(full=True)))}")
     funcs = dict(stages.STAGES)
+    funcs["hb"] = lambda quick, work, log: stages.hb(quick, work, log, models)
     funcs["solvers"] = lambda quick, work, log: solvers.run(grids=(5,) if quick else (21, 41), log=log)
     names = args.stage or [n for n in funcs if n != "solvers" or args.solvers]
     bad = [n for n in names if n not in funcs]

@@ -17,11 +17,14 @@ JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of 
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
 ``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``aft``
-("sampled", or "exact": the links' Fourier coefficients without sampling, used above
-1e4 k and to retry a stalled curve; n_t then only scans for extrema), ``points``,
+("exact": the links' Fourier coefficients without sampling, the default, n_t then only
+scans for extrema; "sampled" with ``--aft sampled``; "mixed" with contacts), ``points``,
 ``newton_iterations`` (corrector iterations), ``time_s``, ``status`` and ``stable``
-(per point, Hill's method; null for models above 200 full unknowns or modal-only
-ones; unstable stretches are dashed in frf.png). The first point does not depend
+(per point, Hill's method, solved where stability can change: sign changes of the
+Jacobian's determinant, peaks, ends, every 25 points, bisection where two checks
+disagree; ``stability_checks`` counts them; ``--stability all`` solves it at every
+point; null for models above 200 full unknowns with ``auto``, modal-only ones, or
+``--stability off``; unstable stretches are dashed in frf.png). The first point does not depend
 on where the sweep starts: Newton from the stuck linear guess, else a homotopy in
 the excitation level or in the contact stiffness (harmonic_balance.start). A run
 that fails part-way prints the points computed so far (``status`` says where and
@@ -40,12 +43,24 @@ def register(subparsers) -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_model_arguments(p)
     p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
-    p.add_argument("--samples", type=int, default=0, help="AFT samples per period (0: auto)")
+    p.add_argument("--samples", type=int, default=0,
+                   help="AFT samples per period (0: auto); exact links only scan them for the extrema")
+    p.add_argument("--aft", choices=("exact", "sampled"), default="exact",
+                   help="friction links: exact periodic loop (default) or sampled AFT on --samples "
+                   "(contacts with a varying normal load are sampled either way)")
     p.add_argument("--omega", type=float, nargs=2, required=True, metavar=("START", "END"),
                    help="frequency range [rad/s]")
-    p.add_argument("--max-step", type=float, default=0.1,
-                   help="largest continuation step (scaled arclength, default 0.1: ~200 points on a 2-DOF curve)")
+    p.add_argument("--tolerance", type=float,
+                   help="curve accuracy: the points' polyline deviates from the curve by about this "
+                   "much, relative to the response and the range (default 0.01, "
+                   "harmonic_balance.continuation.CURVE_TOL); peaks are refined whatever it is")
+    p.add_argument("--max-step", type=float,
+                   help="largest continuation step (scaled arclength; default 0.5, "
+                   "harmonic_balance.frf.DS_MAX)")
     p.add_argument("--max-points", type=int, default=2000)
+    p.add_argument("--stability", choices=("auto", "all", "off"), default="auto",
+                   help="Hill stability per point: auto (checked where it can change, models up "
+                   "to 200 full unknowns), all (Hill at every point, any size), off")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", help="also write the JSON to this file")
     p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
@@ -133,18 +148,21 @@ def run(args) -> int:
     from .common import atomic_write, dumps, print_json
 
     check_run_arguments(args)
+    steps = {k: v for k, v in (("ds_max", args.max_step), ("tolerance", args.tolerance))
+             if v is not None}
     model = build_model(args)
     _report_curve_fits(model)
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
-                             ds_max=args.max_step, max_points=args.max_points)
+                             max_points=args.max_points, aft=args.aft, **steps,
+                             stability=args.stability)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
         raise RuntimeError(f"{err} ({err.result.points} points kept); try fewer --harmonics, "
-                           "a narrower --omega range or a smaller --max-step") from None
+                           "a narrower --omega range or a smaller --tolerance") from None
     summary = result.summary()
     if args.plot:
         from harmonic_balance.plots import plot_frf
@@ -174,8 +192,11 @@ def check_run_arguments(args) -> None:
     limits.check_harmonics("--harmonics", args.harmonics)
     check_samples(args.samples)
     limits.check_omega_range("--omega", *args.omega)
-    if not (math.isfinite(args.max_step) and args.max_step > 0):
+    if args.max_step is not None and not (math.isfinite(args.max_step) and args.max_step > 0):
         raise ValueError(f"--max-step must be a positive finite number, got {args.max_step:g}")
+    if args.tolerance is not None and not 1e-6 <= args.tolerance < 1:
+        raise ValueError(f"--tolerance must be in [1e-6, 1) (a relative curve accuracy; finer "
+                         f"steps would resolve the corrector's own accuracy), got {args.tolerance:g}")
     limits.check_size("--max-points", args.max_points, 2, limits.MAX_CURVE_POINTS,
                       "each point is a Newton solve (5-50 ms for one DOF, seconds for large models)")
     check_out_file(args.out, "--out")

@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import argparse
 
-from contact_core.bodies import MIN_NODES_ACROSS
-
 from .common import atomic_write, dumps, print_json
 
 
@@ -247,6 +245,8 @@ def _print_text(r: dict) -> None:
         errs = {k: v for k, v in r["hertz"].items() if k.startswith("error")}
         print("vs Hertz: " + ", ".join(f"{k[6:]} {100 * v:+.2f} %" for k, v in errs.items()))
     if r.get("under_resolved"):
+        from contact_core.bodies import MIN_NODES_ACROSS
+
         print(f"warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid spacings "
               "(radius or half-width), so its size and peak pressure are rough; lower --p-design "
               "(the potential zone is sized for that peak pressure) or refine --grid")

@@ -207,6 +207,8 @@ def run_frf(args) -> int:
     else:
         print(f"peak {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
               f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
+        if "warning" in out:
+            print(f"warning: {out['warning']}")
     return 0
 
 
@@ -235,7 +237,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
     c = frf(hb, omegas)
     summ = hb.contact_summary(c.peak_x)
-    return {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
+    out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
@@ -244,7 +246,11 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
             "static_normal_load": hb.static["N"].tolist(),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
-            "method": c.extra.get("method", ""), "evaluations": c.evaluations, "time_s": c.time_s}
+            "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
+            "evaluations": c.evaluations, "time_s": c.time_s}
+    if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
+        out["warning"] = c.extra["warning"]
+    return out
 
 
 def _check_optimize(args) -> None:

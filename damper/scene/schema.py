@@ -146,7 +146,8 @@ SWEEP = {
     "f_max": Field("float", "end frequency [Hz]", required=True, gt=0, le=_F_MAX, why=_F_WHY),
     "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1, le=limits.MAX_HARMONICS,
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
-    "max_step": Field("float", "largest continuation step (scaled arclength)", default=0.1, gt=0),
+    "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
+                      "sizes the steps below it)", default=0.5, gt=0),
 }
 
 BACKBONE = {

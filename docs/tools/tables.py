@@ -82,11 +82,17 @@ def bench(data: dict) -> str:
         size, err = LEGEND.get(stage, ("size", "error"))
         out += [f"## {stage}", "", f"Size: {size}. Error: {err}.", "",
                 "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
-        for r in rows:
+        for r in (r for r in rows if "tool" not in r):
             case = r["case"] + (" (default)" if r.get("default") else "")
             out.append(f"| {_cell(case)} | {_g(r['size'])} | {_g(r['error'])} | {_g(r['time_s'])} | "
                        f"{_g(r['memory_mb'], 4)} | {_g(bool(r.get('cached')))} |")
         out.append("")
+        models = [r for r in rows if "tool" in r]   # whole curves of the model classes, with peers
+        if models:
+            from damper.bench.hb_classes import markdown
+
+            out += ["Model classes (error: |first-harmonic peak / dense reference - 1|):", "",
+                    *markdown(models), ""]
     return "\n".join(out) + "\n"
 
 

@@ -44,7 +44,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import scipy.linalg as sla
 
 #: Matrix keys of a blade file, required first.
 MATRICES = ("M", "K", "C", "K_next", "C_next")
@@ -367,5 +366,7 @@ def craig_bampton(M, K, boundary, modes: int):
 
 def generalized_eigenfrequencies(M, K, count: int) -> np.ndarray:
     """Lowest ``count`` natural frequencies [Hz] of dense (M, K)."""
+    import scipy.linalg as sla  # here: the forced response never loads it
+
     w2 = sla.eigh(np.asarray(K), np.asarray(M), eigvals_only=True, subset_by_index=[0, count - 1])
     return np.sqrt(np.clip(w2, 0.0, None)) / (2 * np.pi)

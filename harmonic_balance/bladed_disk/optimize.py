@@ -1,7 +1,8 @@
 """Damper design: the refined resonance peak against the centrifugal load (optimal-load curve).
 
-For each CF of a log-spaced list the peak of the first-harmonic |u_a| is found on a
-coarse frequency grid and refined (:func:`solve.frf`). The optimum is then located by
+For each CF of a log-spaced list the curve of the first-harmonic |u_a| is traced over
+the band (:func:`solve.frf`: continuation with at least ``grid`` points) and its peak
+refined; after the first load only a narrow band around the predicted peak. The optimum is then located by
 Brent's bounded scalar search in log CF between the neighbours of the smallest grid
 value, each evaluation a refined peak. (casadi is not used: the objective is a
 maximum over frequency of a non-smooth branch, which a bounded scalar search on the
@@ -30,9 +31,10 @@ CF_XTOL = 1e-3
 #: Rise of the peak over the optimum that bounds the reported flat band (1 %): the
 #: optimum CF itself is ill-conditioned (the minimum is flat; README.md at revision c58d443).
 FLAT_BAND = 0.01
-#: Relative half-width of the frequency grid around the predicted peak.
+#: Relative half-width of the band around the predicted peak.
 NARROW = 0.03
-#: Points of that grid (3 % / 8 = 0.4 % of the peak frequency apart).
+#: Frequency points of that band: its curve has steps of at most 1 / (NARROW_POINTS - 1)
+#: of the band (0.4 % of the peak frequency).
 NARROW_POINTS = 17
 #: The CF list is dealt into this many interleaved chunks (chunk k takes loads k,
 #: k + CHUNKS, ...), each swept upwards by its own :class:`_Peaks` (full band at its

@@ -32,7 +32,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from .config import UPDConfig
 
@@ -159,6 +158,8 @@ def natural_frequencies(sector: Sector, nd: int, damper: str) -> np.ndarray:
 
     The complex Hermitian eigenproblem K(phi) v = w^2 M v with phi = 2 pi nd / N_b.
     """
+    import scipy.linalg as sla  # here: the forced response never loads it
+
     M, K, _ = sector.matrices(2.0 * np.pi * nd / sector.cfg.blades, damper)
     w2 = sla.eigh(K, M, eigvals_only=True)
     return np.sqrt(np.clip(w2, 0.0, None)) / (2.0 * np.pi)
@@ -196,7 +197,7 @@ def modal_response(sector: Sector, omegas, damper: str, f0: float | None = None)
     Z = np.zeros_like(M, dtype=complex)
     A = np.block([[C, M], [M, Z]])
     B = np.block([[-K, Z], [Z, M]])
-    lam, V = sla.eig(np.linalg.solve(A, B))
+    lam, V = np.linalg.eig(np.linalg.solve(A, B))  # LAPACK geev, without scipy's import
     F = np.concatenate([sector.forcing(f0, damper), np.zeros(n)])
     g = np.linalg.solve(V, np.linalg.solve(A, F))
     return np.array([(V @ (g / (1j * w - lam)))[:n] for w in np.atleast_1d(omegas)])

@@ -32,9 +32,12 @@ def test_bench_quick_report(tmp_path, capsys):
     # (4 or 64 a cycle) dissipates the exact Masing energy (measured 2e-15); 6 a cycle misses them
     fmu = {r["size"]: r["error"] for r in stages["fmu"]}
     assert fmu[4] < 1e-12 and fmu[64] < 1e-12 and fmu[6] > 1e-2
-    # harmonic balance converges to time integration with H (measured 1.5e-2, 1.2e-3, 2e-5)
+    # harmonic balance converges to time integration with H (measured with exact friction
+    # links 1.5e-2, 1.1e-3, 1.2e-4: H = 7's truncation; H = 21 is within 7e-6 of the 1024-
+    # step time integration, which 4096 steps move by 5e-6. The sampled AFT's 2e-5 at H = 7
+    # was its sampling error cancelling the truncation)
     hb = {r["size"]: r["error"] for r in stages["hb"] if r["case"] == "harmonics"}
-    assert hb[1] > hb[3] > hb[7] and hb[7] < 1e-4
+    assert hb[1] > hb[3] > hb[7] and hb[7] < 2e-4
     assert any(r.get("default") for r in stages["hb"])
     assert out["stamp"]["cores"] >= 1 and "numpy" in out["stamp"]["versions"]
     html = (tmp_path / "bench.html").read_text()

@@ -30,11 +30,26 @@ def test_sdof_json_has_the_interface_fields(capsys):
 
 
 @pytest.mark.parametrize("bad", [["--mass", "-1"], ["--omega", "1", "1"], ["--harmonics", "odd:0"],
-                                 ["--slip-force", "nan"]])
+                                 ["--slip-force", "nan"], ["--tolerance", "0"],
+                                 ["--tolerance", "nan", "--json"], ["--tolerance", "1"],
+                                 ["--tolerance", "1e-9"], ["--max-step", "inf"],
+                                 ["--max-step", "-1", "--json"]])
 def test_bad_input_exits_2(capsys, bad):
     argv = SDOF + ["--omega", "0.9", "1.3"] + bad
     assert main(argv) == 2
-    assert "error" in capsys.readouterr().err
+    cap = capsys.readouterr()
+    assert "error" in cap.err and cap.out == ""
+
+
+def test_a_finer_tolerance_gives_more_points_and_the_same_peak(capsys):
+    """--tolerance sizes the steps (more points when finer); the peak is refined either
+    way (the same to the refinement's tolerance, 1e-6 in frequency)."""
+    base = SDOF + ["--harmonics", "3", "--omega", "0.9", "1.3", "--json"]
+    _, coarse = run_json(capsys, base)
+    _, fine = run_json(capsys, base + ["--tolerance", "1e-4"])
+    assert fine["points"] > coarse["points"]
+    assert abs(fine["peak_amplitude"] / coarse["peak_amplitude"] - 1) < 1e-9
+    assert fine["peak_refined"] and coarse["peak_refined"]
 
 
 def test_unfinished_curve_exits_3_and_keeps_the_points(capsys):
@@ -104,3 +119,15 @@ def test_long_curve_is_reduced_and_the_fit_error_printed(tmp_path, capsys):
     cap = capsys.readouterr()
     assert code == 0 and json.loads(cap.out)["status"] == "complete"
     assert "reduced" in cap.err and "fit" in cap.err
+
+
+def test_stability_modes(capsys):
+    """--stability all solves Hill at every point, auto where stability can change (the
+    same flags here: a stable friction curve), off not at all."""
+    base = SDOF + ["--harmonics", "3", "--omega", "0.9", "1.3", "--json"]
+    _, auto = run_json(capsys, base)
+    _, every = run_json(capsys, base + ["--stability", "all"])
+    _, off = run_json(capsys, base + ["--stability", "off"])
+    assert every["stability_checks"] == every["points"] == auto["points"]
+    assert 2 <= auto["stability_checks"] < auto["points"] and auto["stable"] == every["stable"]
+    assert off["stable"] is None and off["stability_checks"] == 0

@@ -13,8 +13,12 @@ def s_curve(x, lam):
     return np.array([x[0] ** 3 - 3 * x[0] - lam]), np.array([[3 * x[0] ** 2 - 3]]), np.array([-1.0])
 
 
+#: Curve accuracy of the turning-point test: the folds are sampled to ~1e-3 of the range.
+FOLD_TOL = 1e-3
+
+
 def test_continuation_passes_two_turning_points():
-    br = continuation(s_curve, np.array([-2.2]), -4.0, 4.0, TOL)
+    br = continuation(s_curve, np.array([-2.2]), -4.0, 4.0, TOL, tolerance=FOLD_TOL)
     x, lam = np.array(br.x)[:, 0], np.array(br.lam)
     assert br.status == "complete" and lam[-1] == 4.0
     np.testing.assert_allclose(x**3 - 3 * x, lam, atol=1e-10)
@@ -28,7 +32,7 @@ def test_continuation_failure_keeps_the_points_and_names_the_parameter():
         return np.array([x[0] ** 2 - lam]), np.array([[2 * x[0]]]), np.array([-1.0])
 
     with pytest.raises(ContinuationError, match="parameter") as info:
-        continuation(fold, np.array([1.0]), 1.0, -1.0, TOL)
+        continuation(fold, np.array([1.0]), 1.0, -1.0, TOL, tolerance=FOLD_TOL)
     br = info.value.branch
     assert len(br.lam) > 5 and min(br.lam) < 0.01
     assert isinstance(info.value, RuntimeError)
@@ -100,3 +104,22 @@ def test_newton_stops_at_the_round_off_floor():
         return R, np.array([[1e6]])
     res = newton(fun, np.array([1.0]), 1e-12)
     assert abs(res.x[0] - 3.0) < 1e-14 * 3 + 2e-15 and res.iterations <= 4
+
+
+#: brent_min's tolerance in x in these tests.
+BRENT_XTOL = 1e-10
+
+
+def test_brent_min_finds_the_minimum_to_an_absolute_tolerance():
+    """A smooth minimum (x = 0.3 of (x - 0.3)^2 + 0.1 (x - 0.3)^4) next to the start, one at
+    a bound, and an interval where f is inf (points to avoid) on one side."""
+    from harmonic_balance.continuation import brent_min
+
+    x, f, n = brent_min(lambda x: (x - 0.3) ** 2 + 0.1 * (x - 0.3) ** 4, -1.0, 1.0, BRENT_XTOL,
+                        start=0.0)
+    assert abs(x - 0.3) < 2 * BRENT_XTOL and f < 1e-18 and n < 40
+    x, _, _ = brent_min(lambda x: x, -1.0, 1.0, BRENT_XTOL)
+    assert x < -1.0 + 3 * BRENT_XTOL
+    x, _, _ = brent_min(lambda x: np.inf if x > 0.5 else (x - 0.45) ** 2, -1.0, 1.0, BRENT_XTOL,
+                        start=0.0)
+    assert abs(x - 0.45) < 2 * BRENT_XTOL

@@ -61,7 +61,7 @@ def test_h1_peak_matches_the_describing_function_peak(h1_curve):
 def test_energy_balances_at_every_solution_point():
     model = sdof(M, K, C, KT, FS, P)
     r = compute_frf(model, "odd:5", (0.9, 1.3), refine=False)
-    prob = FRFProblem(model, "odd:5")
+    prob = r.problem  # the links as the curve evaluated them (exact)
     for x, w in zip(r.solutions, r.omega):
         e = prob.energy(x, w)
         assert e["W_ext"] > 0
@@ -100,10 +100,25 @@ def test_scaling_force_and_slip_strength_scales_the_response():
 
 
 def test_a_coarse_time_grid_is_flagged_as_aliased():
-    fine = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2))
-    coarse = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2), n_t=16)
+    fine = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2), aft="sampled")
+    coarse = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2), n_t=16, aft="sampled")
     assert fine.status == "complete" and fine.alias_ratio < 1e-3
     assert "warning" in coarse.status and coarse.alias_ratio > 1e-2
+
+
+#: Peak of the exact links on a 16-point scan against the default 256: the scan only
+#: brackets the extrema of u (refined by Newton), so only round-off differs.
+SCAN_RTOL = 1e-9
+
+
+def test_exact_links_do_not_depend_on_the_scan_grid():
+    """Exact links (the default) have no sampling: a 16-point scan of u' gives the
+    256-point scan's peak, no aliasing warning (alias ratio 0)."""
+    fine = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2))
+    coarse = compute_frf(sdof(M, K, C, KT, FS, P), 1, (1.0, 1.2), n_t=16)
+    assert coarse.status == "complete" and coarse.alias_ratio == 0.0
+    assert abs(coarse.peak_amplitude / fine.peak_amplitude - 1) < SCAN_RTOL
+    assert abs(coarse.peak_omega / fine.peak_omega - 1) < SCAN_RTOL
 
 
 def test_tiny_force_refines_the_stuck_linear_peak():
@@ -113,3 +128,24 @@ def test_tiny_force_refines_the_stuck_linear_peak():
     lin = 1e-4 / (C * w_n)  # |P / Z| at w_n; the damped maximum differs by O(zeta^2) ~ 1e-5
     assert r.peak_interior and abs(r.peak_omega / w_n - 1) < 1e-4
     assert abs(r.peak_amplitude / lin - 1) < 1e-4
+
+
+#: Random curves compared with scipy's peak finder (the definition peak_indices follows).
+PEAK_FINDER_TRIALS = 2000
+
+
+def test_peak_indices_agree_with_scipy_find_peaks():
+    """Same peaks and prominence rule as scipy.signal.find_peaks (plateaus, ties, edges)
+    on random curves, integer-valued ones included (plateaus and equal bases)."""
+    from scipy.signal import find_peaks
+
+    from harmonic_balance.peaks import peak_indices
+
+    rng = np.random.default_rng(20261122)
+    for trial in range(PEAK_FINDER_TRIALS):
+        n = int(rng.integers(3, 60))
+        a = rng.integers(0, 6, n).astype(float) if trial % 2 else rng.normal(size=n)
+        p = float(rng.uniform(0.0, 2.0))
+        idx, props = find_peaks(a, prominence=0.0)
+        want = [int(i) for i, q in zip(idx, props["prominences"]) if q > p]
+        assert peak_indices(a, p) == want, (a, p)

@@ -52,27 +52,25 @@ def test_nearly_undamped_peak_completes_from_any_start(kt, fs, H, start):
 
 def test_grazing_slip_is_crossed_by_the_exact_aft_or_a_finer_grid(monkeypatch):
     """Slip force = forcing, 10 k, c = 1e-4, H = 3: above 1 rad/s the link's force only
-    just exceeds f_s at the turning points, so the slip episodes span a handful of
-    samples and the corrector stalled at 1.1066 rad/s (a gap) on 256-1024 samples
-    (found by the full map). compute_frf traces a stalled curve again with exact links
-    (no sampling: measured complete on the same 256-sample grid); without that retry
-    (a link the C core cannot integrate exactly) on doubled grids: measured complete at
-    2048 samples (3 doublings), ~2 s."""
+    just exceeds f_s at the turning points, so the slip episodes of a sampled loop span a
+    handful of samples and its corrector stalls (measured: gaps near 1.47 rad/s on 64
+    samples, none on 256; with a fixed largest step of 0.1 it stalled at 1.1066 rad/s on
+    256-1024 samples). The exact links (the default) have no samples to miss:
+    complete on the default grid. Sampled from a 64-sample grid, compute_frf traces the
+    stalled curve again on doubled grids; with the grid fixed by the caller there is no
+    doubling: the gaps stay (and are reported)."""
     import harmonic_balance.frf as frf
 
-    r = compute_frf(sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0), 3, (0.5, 2.0), refine=False,
-                    stability=False)
+    model = sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0)
+    r = compute_frf(model, 3, (0.5, 2.0), refine=False, stability=False)
     assert r.status.startswith("complete") and r.extra["gaps"] == [] and r.omega[-1] == 2.0
-    assert r.extra["exact_retry"] and r.n_t == 256 and r.problem.model.links[0].exact
-    monkeypatch.setattr(frf, "_has_sampled_links", lambda model: False)
-    r = compute_frf(sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0), 3, (0.5, 2.0), refine=False,
-                    stability=False)
-    assert r.status.startswith("complete") and r.extra["gaps"] == [] and not r.extra["exact_retry"]
-    assert r.extra["grid_doublings"] >= 1 and r.n_t == 256 * 2 ** r.extra["grid_doublings"]
-    # with the grid fixed by the caller there is neither retry nor doubling: a gap
-    r0 = compute_frf(sdof_model(1, 1, 1e-4, 10.0, 1.0, 1.0), 3, (0.5, 2.0), n_t=256,
-                     refine=False, stability=False)
-    assert r0.extra["gaps"] and r0.extra["grid_doublings"] == 0 and not r0.extra["exact_retry"]
+    assert r.extra["aft"] == "exact" and r.n_t == 256 and r.extra["grid_doublings"] == 0
+    monkeypatch.setattr(frf, "default_samples", lambda H: 64)
+    r = compute_frf(model, 3, (0.5, 2.0), refine=False, stability=False, aft="sampled")
+    assert r.status.startswith("complete") and r.extra["gaps"] == [] and r.extra["aft"] == "sampled"
+    assert r.extra["grid_doublings"] >= 1 and r.n_t == 64 * 2 ** r.extra["grid_doublings"]
+    r0 = compute_frf(model, 3, (0.5, 2.0), n_t=64, refine=False, stability=False, aft="sampled")
+    assert r0.extra["gaps"] and r0.extra["grid_doublings"] == 0 and "restart" in r0.status
 
 
 @pytest.mark.slow
@@ -149,14 +147,14 @@ def test_stiff_start_on_a_coarse_grid_is_the_fine_grids_solution(monkeypatch):
 
 
 @pytest.mark.slow
-def test_grazing_slip_at_h51_completes_by_the_exact_retry():
+def test_grazing_slip_at_h51_completes_with_exact_links():
     """The H = 51 map's only failures with the sampled AFT (1e4 k, f_s = P, starts at
     1 rad/s: 'no solution at fixed parameter 2', Newton's 30 iterations on the grazing
-    kinks): the exact retry completes them (measured ~9 s, 96 points)."""
+    kinks): complete with the exact links, the default (measured ~9 s, 96 points)."""
     r = compute_frf(sdof_model(1, 1, 1e-4, 1e4, 1.0, 1.0), 51, (1.0, 2.0), refine=False,
                     stability=False)
     assert r.status.startswith("complete") and r.extra["gaps"] == [] and r.omega[-1] == 2.0
-    assert r.extra["exact_retry"]
+    assert r.extra["aft"] == "exact"
 
 
 @pytest.mark.slow

@@ -12,7 +12,7 @@ from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.ring import RingHB
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.solve import frf, start_point
+from harmonic_balance.bladed_disk.solve import start_point, sweep
 from harmonic_balance.bladed_disk.timeint import march_ring
 
 #: HB solutions of the same equations (Newton to round-off), relative.
@@ -46,8 +46,12 @@ def test_without_axial_motion_the_sector_is_upd24(tmp_path, builtin):
     band = 2 * np.pi * np.linspace(430, 460, 6)
     hb = SectorHB(sector, 3)
     assert all(el.m == 3 for el in hb.points)
-    a, b = frf(hb, band), frf(SectorHB(builtin, 3), band)
-    assert a.amplitude == pytest.approx(b.amplitude, rel=SAME_RTOL)
+    # Newton solutions at the grid points (frf's grid values are interpolated on each
+    # model's own branch: equal only to the interpolation's accuracy)
+    ref = SectorHB(builtin, 3)
+    a = [hb.amplitude_h1(x) for x in sweep(hb, band)]
+    b = [ref.amplitude_h1(x) for x in sweep(ref, band)]
+    assert a == pytest.approx(b, rel=SAME_RTOL)
 
 
 def test_axial_forcing_slips_across_and_the_sector_is_the_ring(tmp_path, builtin):
