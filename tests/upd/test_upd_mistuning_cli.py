@@ -1,4 +1,4 @@
-"""damper upd mistuning: the issue's JSON keys, refused input (exit 2, nothing written),
+"""damper upd mistuning: the documented JSON keys, refused input (exit 2, nothing written),
 resumption from the cache, a failing sample in the table, Dask against serial, the scene."""
 import json
 
