@@ -72,6 +72,7 @@ def test_folded_curve_of_the_craig_bampton_blade_is_followed(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert "the branch folds" in out["method"]
     f, a = np.array(out["frequency_hz"]), np.array(out["amplitude"])
+    assert out["branch_points"] == f.size   # a folded curve is reported at its own points
     # a fold: the branch crosses 424 Hz three times, on a low and a high amplitude
     cross = np.nonzero(np.diff(np.sign(f - 424.0)))[0]
     assert len(cross) >= 3
