@@ -15,7 +15,7 @@
 
 /* Round-off of sums over a few dozen sliders and samples, relative. */
 #define ROUNDOFF 1e-12
-/* The bound for the circle at 4000 steps a cycle (the polygon's own ~2e-7). */
+/* The required accuracy of the circle at 4000 steps a cycle (the polygon's own ~2e-7). */
 #define CIRCLE_RTOL 1e-4
 /* Central differences at 1e-7 of the slip radius (truncation ~1e-14, round-off ~1e-9). */
 #define FD_RTOL 1e-6
