@@ -34,7 +34,7 @@ ground; :func:`modal_chain` -- n masses with 8 Jenkins links at seeded random DO
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -150,18 +150,13 @@ def modal_chain(n_modes: int, n_links: int = 8, harmonics: int = 7) -> BenchCase
     links = tuple(Jenkins(int(dofs[2 * e]), int(dofs[2 * e + 1]), 0.3, 0.005) if e < half
                   else Jenkins(int(dofs[(n_links + e - half) % dofs.size]), None, 0.3, 0.005)
                   for e in range(n_links))
-    K_stuck = K.copy()
-    for j in links:
-        w = np.zeros(n)
-        w[j.dof_a] = 1.0
-        if j.dof_b is not None:
-            w[j.dof_b] = -1.0
-        K_stuck += j.k * np.outer(w, w)
-    w_free, w_stuck = (np.sqrt(sla.eigh(k, M, eigvals_only=True)[0]) for k in (K, K_stuck))
     f = np.zeros(n)
     f[0] = 0.02
-    return BenchCase(f"chain {n} modes, {n_links} el.", M, K, 0.02 * M + 0.001 * K, f, links, 0,
-                     harmonics, (0.9 * w_free, 1.1 * w_stuck))
+    case = BenchCase(f"chain {n} modes, {n_links} el.", M, K, 0.02 * M + 0.001 * K, f, links, 0,
+                     harmonics, ())
+    K_stuck = case.model().stuck_stiffness()
+    w_free, w_stuck = (np.sqrt(sla.eigh(k, M, eigvals_only=True)[0]) for k in (K, K_stuck))
+    return replace(case, band=(0.9 * w_free, 1.1 * w_stuck))
 
 
 def chain3(force: float = 1.0, knl: float = 20.0, down: bool = False) -> BenchCase:
