@@ -38,8 +38,6 @@ ARGS: dict[str, list[str]] = {
     "bench_fmu.py": ["--sliders", "3,50", "--steps", "20000", "--py-steps", "2000", "--repeats", "1"],
     "bench_hb.py": ["--smoke"],                                      # full: with solve_ivp, minutes
     "bench_hb_robust.py": ["--smoke"],                               # full map: hours
-    "bench_hb_soft_baseline.py": ["1"],                              # one stiffness ratio
-    "bench_hb_speed.py": ["sdof", "--no-ref"],                       # full: ~1 min + references
     "bench_tangential.py": ["--smoke"],                              # full: BEM 61, FE 21
     "bench_upd.py": ["--quick", "--out", "{out}"],                   # full: ~1 h of TI
     "upd_cosim.py": ["--quick", "--out", "{out}"],                   # full: ~15 min of co-simulation

@@ -21,7 +21,7 @@ from fmu_src.fmu_point import build_point_fmu, contact_point
 
 #: Same C core, same flags: agreement to round-off.
 EXACT_TOL = 1e-12
-#: Issue's bound for the circle at 4000 steps a cycle (the polygon's own effect ~2e-7).
+#: The required accuracy of the circle at 4000 steps a cycle (the polygon's own effect ~2e-7).
 CIRCLE_RTOL = 1e-4
 #: Central differences at 1e-6 of the slip distance, away from slider switches.
 FD_RTOL = 1e-6
