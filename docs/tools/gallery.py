@@ -44,6 +44,25 @@ ARGS: dict[str, list[str]] = {
 }
 
 
+def prune_stale(docs: Path) -> list[str]:
+    """Remove the gallery's generated files of examples that no longer exist.
+
+    sphinx-gallery writes ``docs/auto_examples/<name>.*`` (and images) per script but never
+    deletes them; a removed example would leave a page outside every toctree, which the
+    build (warnings as errors) refuses. Returns the names removed.
+    """
+    gen = docs / "auto_examples"
+    if not gen.is_dir():
+        return []
+    sources = {p.stem for p in (docs.parent / "examples").glob("*.py")}
+    stale = sorted({p.name.split(".", 1)[0] for p in gen.glob("*.rst")} - sources - {"index"})
+    for name in stale:
+        for f in [*gen.glob(f"{name}.*"), *gen.glob(f"images/sphx_glr_{name}_*"),
+                  *gen.glob(f"images/thumb/sphx_glr_{name}_*")]:
+            f.unlink()
+    return stale
+
+
 def _out(script_vars) -> Path:
     return OUT / Path(script_vars["src_file"]).stem
 
