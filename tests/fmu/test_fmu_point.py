@@ -260,6 +260,17 @@ def test_cli_builds_point_fmus(curve_file, tmp_path, capsys):
     assert math.isclose(fmu.get(["N"])[0], 150.0, rel_tol=1e-12)
 
 
+def test_cli_json_describes_the_fmu_written(curve_file, tmp_path, capsys):
+    """``--json``: one object on stdout whose path, model and preload are those of the file."""
+    out = tmp_path / "j.fmu"
+    assert damper_main(["fmu", "--curve", str(curve_file), "--k-n", "2e8", "--preload", "150",
+                        "-o", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["fmu"] == str(out) and info["model"] == "contact_point" and info["preload_N"] == 150.0
+    assert read_model_description(out).coSimulation.modelIdentifier == info["model"]
+    assert info["points"] <= info["curve_points"] == 21
+
+
 @pytest.mark.parametrize("args, N, load, message", [
     ([], N_TAB[[0, 1, 2, 3, 2, 5, 6]], None, "increase strictly"),           # not monotone
     ([], N_TAB, 0.5 * N_CURVE, "--preload"),                                  # other load
