@@ -29,7 +29,7 @@ hand-made table works too. Unknown keys are kept in ``extra`` and written back
 unchanged.
 
 Version 1 files (``"damper-virgin-curve/1"`` or no ``schema`` key) carry no tail:
-it is decided once, here, by the rule every reader used to guess (:func:`_v1_tail`):
+it is decided once, here, by one rule (:func:`_v1_tail`):
 flat when mu and N are declared and T[-1] = mu N to ``V1_GROSS_SLIP_RTOL``, else
 slope. Version 2 files state it, written by the producer that knows it
 (``contact_core.tangential_curve.to_virgin_curve``: flat, the curve ends at gross slip).
@@ -168,7 +168,7 @@ class VirginCurve:
 
 
 def _v1_tail(curve: VirginCurve) -> str:
-    """Tail of a version 1 curve (the only place the old guess survives): "flat" when
+    """Tail of a version 1 curve (the only place it is inferred): "flat" when
     mu and N are declared and T[-1] = mu N to ``V1_GROSS_SLIP_RTOL``, else "slope"."""
     mu, N = curve.mu, curve.N
     if mu is None or N is None or not mu > 0.0:

@@ -29,6 +29,7 @@ from pathlib import Path
 from damper.cache import Store
 from damper.cli.common import atomic_write, dumps
 from damper.limits import MAX_SWEEP_VARIANTS
+from damper.run.graph import closure
 from damper.tasks import executor
 
 
@@ -73,21 +74,11 @@ def _restricted_plan(text, source, overrides, store, only):
     scene = parse_scene(text, source, overrides, base=Path(source).parent)
     plan = plan_scene(scene, store)
     if only is not None:
-        keep = _closure(plan, set(only))
+        keep = closure(set(only), plan)
         for s in plan.stages:
             if s.name not in keep and s.action != "skip":
                 s.action, s.reason = "skip", "not in this sweep task"
     return scene, plan
-
-
-def _closure(plan, names):
-    out, todo = set(), list(names)
-    while todo:
-        n = todo.pop()
-        if n not in out:
-            out.add(n)
-            todo.extend(plan[n].deps)
-    return out
 
 
 def run_task(text: str, source: str, overrides: dict, folder: str, max_bytes: int,
@@ -177,7 +168,7 @@ def run_sweep(scene_path, specs, store: Store, out: Path | None = None, grid: bo
 
 def _failed_dep(plan, name: str, failed: dict) -> bool:
     """Whether a stage depends (directly or not) on a failed shared stage."""
-    return any(plan[n].key in failed for n in _closure(plan, {name}) if n != name)
+    return any(plan[n].key in failed for n in closure({name}, plan) if n != name)
 
 
 def _failed_in(plan, failed: dict) -> str | None:

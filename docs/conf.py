@@ -7,8 +7,8 @@ the API module lists (every module of the three libraries and the application),
 the validation table (``docs/data/validation.json``), the performance page
 (``docs/data/bench.json``) and the stability page (``docs/data/stress.json``), into
 ``docs/_generated/`` (git-ignored). The gallery runs every script in ``examples/``
-(``docs/tools/gallery.py`` gives the quick mode of the slow ones) and the build fails when one
-fails.
+(``docs/tools/gallery.py`` gives the quick mode of the slow ones, and removes the pages of
+examples that no longer exist) and the build fails when one fails.
 """
 from __future__ import annotations
 
@@ -30,6 +30,7 @@ import gallery  # noqa: E402  (docs/tools/gallery.py)
 import generate  # noqa: E402  (docs/tools/generate.py)
 
 generate.all_pages(HERE)
+gallery.prune_stale(HERE)   # pages of removed examples (sphinx-gallery keeps them)
 
 project = "damper-toolkit"
 author = "the damper-toolkit authors"

@@ -4,9 +4,9 @@
 Run:  .venv/bin/python examples/bench_hb_robust.py [--smoke | --full] [--harmonics 1,3]
           [--log map.csv] [--no-cost | --cost-only] [--den-hartog | --den-hartog-hb]
 
-Model: single-DOF Jenkins oscillator m = k = 1, forcing P = 1 cos(omega t), sweep
-0.5 -> 2 rad/s (start below resonance), 1 -> 2 (start at resonance) and 2 -> 0.5
-(start above, sweeping down), no tuning (library defaults).
+Model: single-DOF Jenkins oscillator m = k = 1 (``harmonic_balance.bench_models.sdof``),
+forcing P = 1 cos(omega t), sweep 0.5 -> 2 rad/s (start below resonance), 1 -> 2 (start
+at resonance) and 2 -> 0.5 (start above, sweeping down), no tuning (library defaults).
 
 Table 1 (convergence map): contact stiffness ratio kt/k, slip force fs/P, damping c,
 harmonics H and the three starts; per (H, kt/k) the number of curves converged over
@@ -17,9 +17,12 @@ c in {1e-4, 0.04, 0.5}, H in {1, 7, 21}; ``--full`` the whole grid (kt/k
 many hours; ``--harmonics`` picks a subset of H, ``--log`` keeps one CSV line per
 curve).
 
-Table 2 (cost vs stiffness): the reference case (c = 0.04, fs = 0.5, H = 15,
-0.5 -> 2 rad/s): points, Newton iterations and residual evaluations per point, and
-time per point against kt/k (goal: no worse than 2x the soft-contact cost at 1e6).
+Table 2 (cost vs stiffness): the reference case (``harmonic_balance.bench_models.sdof``,
+c = 0.04, fs = 0.5, H = 15, 0.5 -> 2 rad/s, no peak refinement; ``damper bench --stage
+hb`` runs it at 1, 1e4 and 1e6 k with the command's defaults): points, Newton iterations
+and residual evaluations per point, the cost of one residual evaluation and time per
+point against kt/k (goal: no worse than 2x the soft-contact cost at 1e6). To compare
+revisions, run this table (``--cost-only``) from a worktree of each, back to back.
 
 Table 3 (``--den-hartog``): HB (H = 21) and time integration of the same elastic
 model against Den Hartog's rigid-Coulomb steady state at 1e3 and 1e5 k, 0.5-2 rad/s.
@@ -41,9 +44,9 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from harmonic_balance import bench_models as bm  # noqa: E402
 from harmonic_balance.denhartog import den_hartog  # noqa: E402
 from harmonic_balance.frf import TOL_REL, FRFError, FRFProblem, compute_frf, exact_links, stiff_samples  # noqa: E402
-from harmonic_balance.model import sdof_model  # noqa: E402
 from harmonic_balance.start import homotopy_start  # noqa: E402
 from harmonic_balance.timeint import steady_curve  # noqa: E402
 
@@ -64,7 +67,8 @@ def one_curve(kt, fs, c, H, start, details=False, eval_point=False):
     complete with no gap."""
     t0 = time.perf_counter()
     try:
-        r = compute_frf(sdof_model(1.0, 1.0, c, kt, fs, 1.0), H, STARTS[start], refine=False,
+        case = bm.sdof(kt, damping=c, slip_force=fs, harmonics=H, band=STARTS[start])
+        r = compute_frf(case.model(), case.harmonics, case.band, refine=False,
                         stability=False, max_points=MAX_POINTS)
         # a curve with restart gaps has stretches without points: not converged over the
         # whole range
@@ -126,7 +130,7 @@ def convergence_map(grid, log=None):
 
 
 def cost_table(kts, H=15):
-    print(f"\nTable 2: issue case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
+    print(f"\nTable 2: reference case (c = 0.04, fs = 0.5, H = {H}, 0.5 -> 2 rad/s) vs stiffness")
     curves = [one_curve(kt, 0.5, 0.04, H, "below", True, True) for kt in kts]
     ms = _eval_ms([cv[-1] for cv in curves])
     print("(ms/eval: one residual evaluation, best of 7 x 30 interleaved over the rows; "
@@ -174,7 +178,7 @@ def den_hartog_table(kts=(1e3, 1e5), omegas=(0.5, 0.75, 1.0, 1.5, 2.0), H=21):
           f"{'TI/DH-1':>9} {'TI_step':>8}")
     out = []
     for kt in kts:
-        m = exact_links(sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0))   # as compute_frf
+        m = exact_links(bm.sdof(kt).model())   # as compute_frf
         prob = FRFProblem(m, H, stiff_samples(m, H))
         ti, _, err, _ = steady_curve(m, np.array(omegas), 512)
         for w, a_ti, e in zip(omegas, ti, err):
@@ -193,7 +197,7 @@ def hb_vs_den_hartog(kts=(1e5, 1e6), Hs=(21, 51), omegas=(0.5, 0.75, 1.0, 1.5, 2
     print(f"{'kt/k':>8} {'H':>3} {'n_t':>5} " + " ".join(f"{w:>9.2f}" for w in omegas))
     out = []
     for kt in kts:
-        m = exact_links(sdof_model(1.0, 1.0, 0.04, kt, 0.5, 1.0))   # as compute_frf
+        m = exact_links(bm.sdof(kt).model())   # as compute_frf
         for H in Hs:
             prob = FRFProblem(m, H, stiff_samples(m, H))
             errs = []

@@ -26,10 +26,15 @@ Cases
   mass 4-mass 5: 200, 2), H = 7, 0.3 <-> 2.2 rad/s (all five modes of the free chain,
   2 sin(j pi / 12) = 0.52 ... 1.93 rad/s; the first two resonances lie between the
   free and the stuck chain's, where the links stick and slip).
+
+Cases of the example benchmarks only (``examples/bench_hb.py``, ``bench_hb_robust.py``;
+not in :func:`all_cases`): :func:`sdof` with other damping, slip force, force, H and
+band; :func:`two_dof` -- the 2-DOF test model, links between the masses and to the
+ground; :func:`modal_chain` -- n masses with 8 Jenkins links at seeded random DOFs.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -102,12 +107,56 @@ def spring_chain(n: int, k: float = 1.0) -> np.ndarray:
     return k * (2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
 
 
-def sdof(kt: float = 1.0) -> BenchCase:
-    """Single-DOF Jenkins oscillator: m = k = 1, c = 0.04, f_s = 0.5, F = 1, H = 15, 0.5 -> 2
-    (named "sdof soft" at k_t = k, else "sdof stiff 1e4" etc.)."""
-    name = "sdof soft" if kt == 1.0 else f"sdof stiff {kt:.0e}".replace("e+0", "e")
-    return BenchCase(name, np.eye(1), np.eye(1), 0.04 * np.eye(1), np.ones(1),
-                     (Jenkins(0, None, kt, 0.5),), 0, 15, (0.5, 2.0))
+def sdof(kt: float = 1.0, damping: float = 0.04, slip_force: float = 0.5, force: float = 1.0,
+         harmonics: int = 15, band: tuple = (0.5, 2.0), name: str | None = None) -> BenchCase:
+    """Single-DOF Jenkins oscillator m = k = 1, link to the ground: by default c = 0.04,
+    f_s = 0.5, F = 1, H = 15, 0.5 -> 2 (named "sdof soft" at k_t = k, else "sdof stiff 1e4"
+    etc.; ``name`` overrides)."""
+    if name is None:
+        name = "sdof soft" if kt == 1.0 else f"sdof stiff {kt:.0e}".replace("e+0", "e")
+    return BenchCase(name, np.eye(1), np.eye(1), damping * np.eye(1), np.array([float(force)]),
+                     (Jenkins(0, None, kt, slip_force),), 0, harmonics, tuple(band))
+
+
+def two_dof() -> BenchCase:
+    """The 2-DOF test model (``tests/hb/hbcases.two_dof``): M = diag(1, 0.5), a link between
+    the masses (k 0.8, f_s 0.04) and one from mass 2 to the ground (0.5, 0.08),
+    C = 0.01 M + 0.005 K, force 0.05 on mass 1 (the response), H = 7, 0.6 -> 1.6 rad/s."""
+    M = np.diag([1.0, 0.5])
+    K = np.array([[2.0, -1.0], [-1.0, 1.5]])
+    return BenchCase("2-DOF", M, K, 0.01 * M + 0.005 * K, np.array([0.05, 0.0]),
+                     (Jenkins(0, 1, 0.8, 0.04), Jenkins(1, None, 0.5, 0.08)), 0, 7, (0.6, 1.6))
+
+
+#: Seed of :func:`modal_chain`'s link placement.
+CHAIN_SEED = 20261122
+
+
+def modal_chain(n_modes: int, n_links: int = 8, harmonics: int = 7) -> BenchCase:
+    """Chain of n masses (M = diag(1 ... 0.5), unit springs, C = 0.02 M + 0.001 K), force
+    0.02 on DOF 0 (the response), ``n_links`` Jenkins links (k 0.3, f_s 0.005): half between
+    pairs of DOFs, half to the ground, at distinct DOFs drawn with :data:`CHAIN_SEED`
+    (12 for 8 links when the chain is long enough). Band: 0.9 x the free to 1.1 x the
+    stuck first natural frequency (the first resonance with the links slipping and
+    stuck)."""
+    import scipy.linalg as sla
+
+    n = n_modes
+    M = np.diag(np.linspace(1.0, 0.5, n))
+    K = 2 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1)
+    rng = np.random.default_rng(CHAIN_SEED)
+    dofs = rng.choice(np.arange(1, n), size=min(n - 1, 3 * n_links // 2), replace=False)
+    half = n_links // 2
+    links = tuple(Jenkins(int(dofs[2 * e]), int(dofs[2 * e + 1]), 0.3, 0.005) if e < half
+                  else Jenkins(int(dofs[(n_links + e - half) % dofs.size]), None, 0.3, 0.005)
+                  for e in range(n_links))
+    f = np.zeros(n)
+    f[0] = 0.02
+    case = BenchCase(f"chain {n} modes, {n_links} el.", M, K, 0.02 * M + 0.001 * K, f, links, 0,
+                     harmonics, ())
+    K_stuck = case.model().stuck_stiffness()
+    w_free, w_stuck = (np.sqrt(sla.eigh(k, M, eigvals_only=True)[0]) for k in (K, K_stuck))
+    return replace(case, band=(0.9 * w_free, 1.1 * w_stuck))
 
 
 def chain3(force: float = 1.0, knl: float = 20.0, down: bool = False) -> BenchCase:

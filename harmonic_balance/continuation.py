@@ -8,8 +8,8 @@ largest RMS of x met so far on the branch (at least ``x_scale``): the curve's ac
 and its steps are relative to the size of the response, so a stretch of small amplitude
 next to a resonance (an antiresonance, the tail of a flank) is crossed in a few steps.
 (With the current point's RMS as the scale, every decade of amplitude and every phase
-turn of a small response cost as much as the resonance itself: 2-4 times the points on
-the friction chains of ``examples/bench_hb_speed.py``.) The two flanks of a sharp peak
+turn of a small response would cost as much as the resonance itself: 2-4 times the points
+on the friction chains of :mod:`harmonic_balance.bench_models`.) The two flanks of a sharp peak
 then lie close together in scaled units near their feet; the orientation (below) and
 the step control keep the corrector on its own flank.
 

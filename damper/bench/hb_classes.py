@@ -160,9 +160,9 @@ def _upd_numbers(j: dict) -> dict:
     """Row numbers of a ``damper upd frf --json`` result."""
     f = np.asarray(j["frequency_hz"], float)
     pa, pw, _ = curve_peak(2 * np.pi * f, j["amplitude"])
-    # the solved points: the curve's own count where the command reports one (a continuation
-    # interpolated on the output grid), else the grid's
-    points = j.get("branch_points") or j.get("points") or int(f.size)
+    # the solved points: the continuation's own (the curve is reported interpolated on the
+    # output grid); a linear curve (no continuation) is solved at each grid point
+    points = j.get("branch_points") or int(f.size)
     return {"points": points, "evaluations": j.get("evaluations"), "time_s": j.get("time_s"),
             "status": j.get("method", ""), "complete": True, "gaps": False, "dofs": j.get("dofs"),
             "harmonics": j.get("harmonics", 7), "peak_amplitude": j["peak_amplitude"],

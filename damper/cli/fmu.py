@@ -49,6 +49,8 @@ def register(subparsers) -> None:
                      "--normal-curve) as its normal law")
     law.add_argument("--k-n", type=float, default=None,
                      help="3D contact point with a penalty normal law N = k_n p [N/m]")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (the FMU's path, model, points, fit error) on stdout")
     p.add_argument("--preload", type=float, default=None,
                    help="contact point: normal load at the start [N] (default: the curve's N)")
     p.set_defaults(func=run)
@@ -76,7 +78,6 @@ def run(args) -> int:
 
 def _run_element(args, source, n_ref) -> int:
     """The 1D friction element FMU (inputs u, N)."""
-    import sys
     from pathlib import Path
 
     from fmu_src.curve_fit import reduce_virgin_curve
@@ -95,11 +96,7 @@ def _run_element(args, source, n_ref) -> int:
     path = build_fmu(curve.u, curve.T, n_ref, args.output, fmi_version=args.fmi_version,
                      fit=args.fit, description=description, tail=curve.tail,
                      curve_json=Path(args.curve).read_text())
-    if reduced:
-        print(f"note: the curve's {source.u.size} points were reduced to {curve.u.size}; "
-              f"largest force error of the fit {error:.3g} N", file=sys.stderr)
-    print(path)
-    return 0
+    return _report(args, path, "element", source, curve, error, n_ref, None)
 
 
 #: A normal curve and a virgin curve computed at loads closer than this (relative)
@@ -128,7 +125,6 @@ def _normal_law(args, n_ref: float):
 
 def _run_point(args, source, n_ref) -> int:
     """The 3D contact point FMU (inputs u_x, u_y, p)."""
-    import sys
     from pathlib import Path
 
     from fmu_src.curve_fit import reduce_virgin_curve
@@ -151,7 +147,23 @@ def _run_point(args, source, n_ref) -> int:
     path = build_point_fmu(curve.u, curve.T, n_ref, p, N, args.output, fmi_version=args.fmi_version,
                            N_start=preload, fit=args.fit, tail=curve.tail, description=description,
                            resources=resources)
-    if curve is not source:
+    return _report(args, path, "contact_point", source, curve, error, n_ref, preload)
+
+
+def _report(args, path, model, source, curve, error, n_ref, preload) -> int:
+    """Print the FMU's path (and a note on a reduced curve), or one JSON object."""
+    import sys
+
+    from .common import print_json
+
+    reduced = curve is not source
+    if args.json:
+        print_json({"fmu": str(path), "model": model, "fmi_version": args.fmi_version,
+                    "points": int(curve.u.size), "curve_points": int(source.u.size),
+                    "fit_error_N": float(error) if reduced else 0.0, "n_ref_N": n_ref,
+                    "preload_N": preload})
+        return 0
+    if reduced:
         print(f"note: the curve's {source.u.size} points were reduced to {curve.u.size}; "
               f"largest force error of the fit {error:.3g} N", file=sys.stderr)
     print(path)

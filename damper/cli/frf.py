@@ -161,8 +161,11 @@ def run(args) -> int:
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
-        raise RuntimeError(f"{err} ({err.result.points} points kept); try fewer --harmonics, "
-                           "a narrower --omega range or a smaller --tolerance") from None
+        if "point limit" in str(err):
+            hint = "raise --max-points, or a larger --tolerance takes fewer points"
+        else:
+            hint = "try fewer --harmonics, a narrower --omega range or a smaller --tolerance"
+        raise RuntimeError(f"{err} ({err.result.points} points kept); {hint}") from None
     summary = result.summary()
     if args.plot:
         from harmonic_balance.plots import plot_frf

@@ -247,7 +247,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "static_normal_load": hb.static["N"].tolist(),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
-            "evaluations": c.evaluations, "time_s": c.time_s}
+            "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
+            "time_s": c.time_s}
     if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
         out["warning"] = c.extra["warning"]
     return out

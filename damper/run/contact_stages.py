@@ -89,7 +89,10 @@ class Condense(Kind):
                "built" if not any(hits.values()) else
                "built " + ", ".join(k for k, v in hits.items() if not v) + "; loaded "
                + ", ".join(k for k, v in hits.items() if v) + " from the cache")
-        return [f"condensed bodies {how} ({', '.join(f'{k} {v:.2f} s' for k, v in d['timings'].items())})"]
+        times = ", ".join(f"{k} {v:.2f} s" for k, v in d["timings"].items())
+        if stage.action == "cached":   # the stage itself came from the cache: its timings are the build's
+            return [f"condensed bodies loaded from the cache (built with {times})"]
+        return [f"condensed bodies {how} ({times})"]
 
 
 def _entries(data: dict) -> list:

@@ -171,7 +171,7 @@ def build_plan(data: dict, kinds, store: Store, force=(), previous: dict | None 
         if f not in names and not any(s.kind.name == f for s in stages):
             raise ValueError(f"--force {f}: no such stage in this scene (stages: {', '.join(by_name)})")
     wanted = _wanted(data, stages)
-    needed = _closure(wanted, by_name)
+    needed = closure(wanted, by_name)
     order = _toposort([s for s in stages if s.name in needed], by_name)
     forced = set()
     for s in order:  # keys and compute/cached in dependency order
@@ -216,13 +216,15 @@ def _wanted(data: dict, stages) -> dict:
     return out
 
 
-def _closure(wanted, by_name) -> set:
-    todo, seen = list(wanted), set()
+def closure(names, stages) -> set:
+    """``names`` and, transitively, every stage they depend on; ``stages`` maps a stage's
+    name to the stage (its ``deps``: the names it depends on)."""
+    todo, seen = list(names), set()
     while todo:
         n = todo.pop()
         if n not in seen:
             seen.add(n)
-            todo.extend(by_name[n].deps)
+            todo.extend(stages[n].deps)
     return seen
 
 

@@ -9,6 +9,8 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
 * ``validation.md``: the table of every reference case the tests check, from
   ``docs/data/validation.json`` (written by ``make validation``: the tests themselves
   record each check through ``tests/reference.py``);
+* ``limits.md``: the table of the bounds every size a user types is checked against,
+  from the constants of ``damper/limits.py`` and their ``#:`` comments;
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -68,8 +70,9 @@ def cli_page(docs: Path) -> None:
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     lines = ["# Command reference", "",
              "The `--help` text of every `damper` subcommand, as this version prints it. Every "
-             "subcommand prints one JSON object with `--json`, uses SI units, and exits with 2 on bad "
-             "input (a one-line message, nothing written) and 3 when a solver fails.", "",
+             "subcommand prints one JSON object with `--json`, uses SI units, and exits with 0 when done, 2 on "
+             "bad input (a one-line message, nothing written), 3 when a solver fails and 130 when "
+             "interrupted (Ctrl-C).", "",
              "```text", parser.format_help().rstrip(), "```", ""]
     for name, p in sub.choices.items():
         lines += [f"## damper {name}", "", "```text", p.format_help().rstrip(), "```", ""]
@@ -86,8 +89,8 @@ def cli_page(docs: Path) -> None:
 KNOWN = {
     "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
          "changes"},
-    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "scenes", "studies",
-             "bench_stress"},
+    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "system", "scenes",
+             "limits", "studies", "bench_stress"},
 }
 
 
@@ -100,6 +103,28 @@ def more_pages(docs: Path) -> None:
                 extra.append(p.stem if sub == "user" else f"../{p.stem}")
     text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
     _write(docs / "_generated" / "more.md", text)
+
+
+def limits_page(docs: Path) -> None:
+    """``_generated/limits.md``: every constant of ``damper/limits.py`` with its ``#:`` reason."""
+    import ast
+
+    src = (docs.parent / "damper" / "limits.py").read_text()
+    lines = src.splitlines()
+    rows = []
+    for node in ast.parse(src).body:
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1
+                and isinstance(node.targets[0], ast.Name) and node.targets[0].id.isupper()):
+            continue
+        k, why = node.lineno - 2, []
+        while k >= 0 and lines[k].lstrip().startswith("#:"):
+            why.insert(0, lines[k].lstrip()[2:].strip())
+            k -= 1
+        value = ast.literal_eval(node.value)
+        shown = f"{value:g}" if isinstance(value, float) else f"{value:,}".replace(",", " ")
+        rows.append(f"| `{node.targets[0].id}` | {shown} | {' '.join(why)} |")
+    text = "| constant | bound | what it bounds, and why |\n|---|---|---|\n" + "\n".join(rows) + "\n"
+    _write(docs / "_generated" / "limits.md", text)
 
 
 def data_page(docs: Path, name: str, render) -> None:
@@ -115,6 +140,7 @@ def data_page(docs: Path, name: str, render) -> None:
 def all_pages(docs: Path) -> None:
     api_pages(docs)
     cli_page(docs)
+    limits_page(docs)
     more_pages(docs)
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)

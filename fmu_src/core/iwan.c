@@ -13,7 +13,7 @@
  * Masing's branches F_r + 2 f((x - x_r)/2) (thesis eqs. 2.15-2.16; Iwan 1966)
  * exactly, with the memory of nested loops.
  *
- * Exact straight-path update (issue 3, iwan.h): between two committed points
+ * Exact straight-path update (iwan.h): between two committed points
  * (u0, N0) -> (u1, N1) both u and r_j are linear in the path parameter s, so the
  * trial stretch e0 + s du and the limits +-r_j(s) are linear too. A slider that
  * ends outside its limit crossed it once, at s* = (r0 - e0) / (du - dr) (upper

@@ -6,6 +6,7 @@
  */
 #include "iwan.h"
 #include "iwan_internal.h"   /* the straight-path update, to check the fast path against */
+#include "test_check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -14,23 +15,6 @@
 /* Round-off of sums over a few hundred sliders and samples, relative. */
 #define ROUNDOFF 1e-11
 #define PI 3.14159265358979323846
-
-static int failures = 0;
-
-#define CHECK(cond, ...)                                                   \
-    do {                                                                   \
-        if (!(cond)) {                                                     \
-            ++failures;                                                    \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                   \
-            printf(__VA_ARGS__);                                           \
-            printf("\n");                                                  \
-        }                                                                  \
-    } while (0)
-
-static int close_to(double a, double b, double rtol, double atol)
-{
-    return fabs(a - b) <= atol + rtol * fabs(b);
-}
 
 /* Concave table: g(u) = 10 (1 - (1 - u/us)^1.5) on [0, us], 24 segments, flat tail. */
 #define M_TAB 26

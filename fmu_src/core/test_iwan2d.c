@@ -8,6 +8,7 @@
  */
 #include "iwan.h"
 #include "iwan2d.h"
+#include "test_check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -15,23 +16,11 @@
 
 /* Round-off of sums over a few dozen sliders and samples, relative. */
 #define ROUNDOFF 1e-12
-/* The bound for the circle at 4000 steps a cycle (the polygon's own ~2e-7). */
+/* The required accuracy of the circle at 4000 steps a cycle (the polygon's own ~2e-7). */
 #define CIRCLE_RTOL 1e-4
 /* Central differences at 1e-7 of the slip radius (truncation ~1e-14, round-off ~1e-9). */
 #define FD_RTOL 1e-6
 #define PI 3.14159265358979323846
-
-static int failures = 0;
-
-#define CHECK(cond, ...)                                                   \
-    do {                                                                   \
-        if (!(cond)) {                                                     \
-            ++failures;                                                    \
-            printf("FAIL %s:%d: ", __FILE__, __LINE__);                   \
-            printf(__VA_ARGS__);                                           \
-            printf("\n");                                                  \
-        }                                                                  \
-    } while (0)
 
 /* Deterministic pseudo-random numbers in [-1, 1] (LCG, reproducible everywhere). */
 static double rnd(unsigned long *seed)

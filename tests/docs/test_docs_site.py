@@ -176,7 +176,8 @@ def test_every_code_reference_in_the_pages_exists():
 
 #: Project text speaks of the project as it is; history goes to CHANGES.md.
 #: (written in pieces, so that this file itself does not match the pattern it checks)
-HISTORY = re.compile(r"issue [0-9]+|" + "this" + r" round|" + "last" + r" round")
+HISTORY = re.compile(r"issue #?[0-9]+|" + "issue" + r"'s|" + r"(this|last|previous) " + "round|"
+                     + "previous" + r" release", re.IGNORECASE)
 
 
 def test_project_text_names_no_issue_numbers_or_rounds():
@@ -185,7 +186,7 @@ def test_project_text_names_no_issue_numbers_or_rounds():
     for folder, dirs, files in os.walk(ROOT):
         dirs[:] = [d for d in dirs if d not in skip]
         for name in files:
-            if not name.endswith((".md", ".py")) or name == "CHANGES.md":
+            if not name.endswith((".md", ".py", ".c", ".h")) or name == "CHANGES.md":
                 continue
             path = Path(folder) / name
             for i, line in enumerate(path.read_text(errors="replace").splitlines(), 1):

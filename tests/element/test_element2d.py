@@ -18,7 +18,7 @@ ROUNDOFF = 1e-12
 #: The reference integrates with quad/brentq to QUAD_RTOL; positions and work of a
 #: history of tens of steps agree to this relative tolerance.
 REF_RTOL = 1e-10
-#: Issue's target for the circle at 4000 steps per cycle (the polygon's own error ~1e-7).
+#: The required accuracy of the circle at 4000 steps per cycle (the polygon's own error ~1e-7).
 CIRCLE_RTOL = 1e-4
 #: Central differences at 1e-7 of the slip radius: truncation O(h^2) ~ 1e-14 of the
 #: curvature scale, round-off ~1e-16 / 1e-7 = 1e-9 of the force scale.

@@ -21,7 +21,7 @@ from fmu_src.fmu_point import build_point_fmu, contact_point
 
 #: Same C core, same flags: agreement to round-off.
 EXACT_TOL = 1e-12
-#: Issue's bound for the circle at 4000 steps a cycle (the polygon's own effect ~2e-7).
+#: The required accuracy of the circle at 4000 steps a cycle (the polygon's own effect ~2e-7).
 CIRCLE_RTOL = 1e-4
 #: Central differences at 1e-6 of the slip distance, away from slider switches.
 FD_RTOL = 1e-6
@@ -258,6 +258,17 @@ def test_cli_builds_point_fmus(curve_file, tmp_path, capsys):
                         "-o", str(out2), "--fmi-version", "3"]) == 0
     fmu = PointSlave(out2, 3)
     assert math.isclose(fmu.get(["N"])[0], 150.0, rel_tol=1e-12)
+
+
+def test_cli_json_describes_the_fmu_written(curve_file, tmp_path, capsys):
+    """``--json``: one object on stdout whose path, model and preload are those of the file."""
+    out = tmp_path / "j.fmu"
+    assert damper_main(["fmu", "--curve", str(curve_file), "--k-n", "2e8", "--preload", "150",
+                        "-o", str(out), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["fmu"] == str(out) and info["model"] == "contact_point" and info["preload_N"] == 150.0
+    assert read_model_description(out).coSimulation.modelIdentifier == info["model"]
+    assert info["points"] <= info["curve_points"] == 21
 
 
 @pytest.mark.parametrize("args, N, load, message", [

@@ -20,7 +20,7 @@ NEWTON_TOL = 1e-11
 SOLVE_RTOL = 1e-8
 #: Central differences at 1e-7 of the coefficient scale (kinks away), relative.
 FD_STEP, FD_RTOL = 1e-7, 1e-6
-#: The issue's bound for HB against time integration (measured: see the test).
+#: The required accuracy of HB against time integration (measured: see the test).
 TI_RTOL = 5e-3
 STEPS = 512
 H = 7

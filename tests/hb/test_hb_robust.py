@@ -88,10 +88,10 @@ def test_first_point_at_1e6_k_inside_the_slipping_resonance():
 
 
 @pytest.mark.slow
-def test_issue_case_stiffness_1e4_no_gaps():
-    """Issue case at 1e4 k (H = 15): the stick-slip band near 0.5 rad/s used to be skipped
-    in 41 gaps (the pseudo-arclength corrector cycled on AFT kinks); the fixed-parameter
-    corrector fallback solves it (measured: 292 points, 0 gaps, ~6 s alone)."""
+def test_reference_case_stiffness_1e4_no_gaps():
+    """The reference case at 1e4 k (H = 15): in the stick-slip band near 0.5 rad/s the
+    pseudo-arclength corrector cycles on AFT kinks (41 gaps without a fallback); the
+    fixed-parameter corrector fallback solves it (measured: 292 points, 0 gaps, ~6 s alone)."""
     r = compute_frf(sdof_model(1, 1, 0.04, 1e4, 0.5, 1.0), 15, (0.5, 2.0), refine=False,
                     stability=False)
     assert r.status == "complete" and r.extra["gaps"] == [] and r.omega[-1] == 2.0
@@ -99,17 +99,18 @@ def test_issue_case_stiffness_1e4_no_gaps():
 
 @pytest.mark.slow
 def test_stiffness_1e6_h7_no_gaps():
-    """1e6 k, H = 7, from 0.5 rad/s: gaps in the stick-slip band before frf.stiff_samples
-    (measured after: 190 points, 0 gaps, ~9 s); since the exact AFT (frf.exact_links) the
-    link is exact and H's default 256 samples only scan u' for its extrema."""
+    """1e6 k, H = 7, from 0.5 rad/s: the stick-slip band is traced without gaps (measured:
+    190 points, ~9 s); the link is evaluated exactly (frf.exact_links), so H's default 256
+    samples only scan u' for its extrema."""
     r = compute_frf(sdof_model(1, 1, 0.04, 1e6, 0.5, 1.0), 7, (0.5, 2.0), refine=False,
                     stability=False)
     assert r.status == "complete" and r.extra["gaps"] == [] and r.n_t == 256
     assert r.problem.model.links[0].exact
 
 
-def test_issue_case_contact_stiffness_30_no_longer_fails(capsys):
-    """A case that once failed: 30 k stopped before the first point at H = 15."""
+def test_contact_stiffness_30_h15_completes_from_its_first_point(capsys):
+    """30 k, H = 15, through the CLI: the first point is found and the curve completes,
+    with its stability."""
     code = main(["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.04",
                  "--contact-stiffness", "30", "--slip-force", "0.5", "--force", "1",
                  "--harmonics", "15", "--omega", "0.5", "2", "--json"])

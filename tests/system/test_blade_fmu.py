@@ -6,7 +6,7 @@ from slaves import Slave
 
 from fmu_src.blade_fmu import BladeSpec, build_blade_fmu, check_spec, modal_data
 
-#: Steady-state first harmonic against the direct solve: the issue's bound.
+#: Steady-state first harmonic against the direct solve: the required accuracy.
 FRF_RTOL = 1e-6
 #: Two step sizes on the same input path: only round-off differs (exact integration).
 STEP_RTOL = 1e-11

@@ -5,9 +5,7 @@ import numpy as np
 import pytest
 
 from harmonic_balance.bladed_disk import solve
-from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
-from harmonic_balance.bladed_disk.sector import Sector
 
 #: Interpolated grid values against Newton at the grid points: measured 1.7e-4 at H = 7
 #: over 400-500 Hz (solve.UPD_TOL); the AFT sampling error of the contacts is as large.
@@ -15,11 +13,6 @@ GRID_RTOL = 5e-4
 #: Two refinements of the same discrete curve's peak: to the frequency tolerance
 #: (PEAK_XTOL = 1e-6), so in amplitude to its square and the correctors' 1e-10.
 PEAK_RTOL = 1e-8
-
-
-@pytest.fixture(scope="module")
-def sector():
-    return Sector(load_config())
 
 
 def test_grid_values_agree_with_newton_at_the_grid_points(sector):
@@ -72,6 +65,7 @@ def test_folded_curve_of_the_craig_bampton_blade_is_followed(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert "the branch folds" in out["method"]
     f, a = np.array(out["frequency_hz"]), np.array(out["amplitude"])
+    assert out["branch_points"] == f.size   # a folded curve is reported at its own points
     # a fold: the branch crosses 424 Hz three times, on a low and a high amplitude
     cross = np.nonzero(np.diff(np.sign(f - 424.0)))[0]
     assert len(cross) >= 3

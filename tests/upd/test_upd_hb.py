@@ -3,9 +3,8 @@ import numpy as np
 import pytest
 from refcheck import check
 
-from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
-from harmonic_balance.bladed_disk.sector import Sector, linear_response, peak_of
+from harmonic_balance.bladed_disk.sector import linear_response, peak_of
 from harmonic_balance.bladed_disk.solve import energy_balance, frf, start_point, sweep
 
 #: Closed-form statics vs the linear solve (round-off; measured 2e-16).
@@ -16,11 +15,6 @@ ENERGY_RTOL = 1e-6
 HOMOG_RTOL = 1e-8
 #: Linear limits, peaks to 0.1 % (the required bound).
 LIMIT_RTOL = 1e-3
-
-
-@pytest.fixture(scope="module")
-def sector():
-    return Sector(load_config())
 
 
 def test_frictionless_statics_closed_form(sector):

@@ -3,9 +3,7 @@ import numpy as np
 import pytest
 from refcheck import check
 
-from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.sector import (
-    Sector,
     linear_response,
     modal_response,
     modes_table,
@@ -18,11 +16,6 @@ MODAL_RTOL = 1e-6
 #: Peak frequency vs undamped natural frequency: shift ~ zeta^2 ~ 4e-6 (0.2 % damping),
 #: measured 3e-6; the required 0.1 % is the bound.
 PEAK_RTOL = 1e-3
-
-
-@pytest.fixture(scope="module")
-def sector():
-    return Sector(load_config())
 
 
 @pytest.mark.parametrize("damper", ["free", "stuck", "sliding"])
