@@ -121,6 +121,8 @@ def limits_page(docs: Path) -> None:
             why.insert(0, lines[k].lstrip()[2:].strip())
             k -= 1
         value = ast.literal_eval(node.value)
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            continue   # a message text (e.g. RING_BLADES_WHY), not a bound
         shown = f"{value:g}" if isinstance(value, float) else f"{value:,}".replace(",", " ")
         rows.append(f"| `{node.targets[0].id}` | {shown} | {' '.join(why)} |")
     text = "| constant | bound | what it bounds, and why |\n|---|---|---|\n" + "\n".join(rows) + "\n"
