@@ -183,7 +183,10 @@ def test_ctrl_c_during_a_run_is_one_line_and_exit_130(tmp_path):
     scene = tmp_path / "kn.toml"
     scene.write_text('want = ["k_n", "report"]\n[contact.damper]\nbody = "cylinder"\ndiameter = 5.0e-3\n'
                      "length = 1.2e-3\nforce = 120.0\ngrid = 21\n")
-    code = "import sys; from damper.cli import main; sys.exit(main(sys.argv[1:]))"
+    # Python leaves SIGINT ignored when its parent ignored it (pytest under `nohup ... &`):
+    # the child restores the interactive default, as in a terminal.
+    code = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+            "from damper.cli import main; sys.exit(main(sys.argv[1:]))")
     env = dict(os.environ, DAMPER_CACHE_DIR=str(tmp_path / "cache"))
     p = subprocess.Popen([sys.executable, "-c", code, "run", str(scene), "--out", str(tmp_path / "ok")],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
