@@ -38,6 +38,10 @@ def executor(scheduler, workers, serial):
         client = Client(cluster)
 
     def close():
+        # After Ctrl-C Dask's gather task ends with an exception nobody retrieves; asyncio
+        # and distributed would log it with a traceback after our one-line message.
+        for name in ("asyncio", "distributed"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
         client.close()
         if cluster is not None:
             cluster.close()
