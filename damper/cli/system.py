@@ -34,8 +34,9 @@ def run(args) -> int:
     from damper.upd_geometry import apply_to_args
     from harmonic_balance.bladed_disk.config import load_config
 
-    from .common import print_json
+    from .common import check_out_file, print_json
 
+    check_out_file(args.output, "-o")   # before building the FMUs (seconds)
     cfg = load_config(args.config)
     cf = cfg.cf if args.cf is None else args.cf
     f0 = cfg.f0 if args.f0 is None else args.f0

@@ -234,7 +234,29 @@ def _upd() -> list[InputCase]:
         ("optimize harmonics 1000", "optimize --harmonics 1000"),
         ("optimize workers 0", "optimize --workers 0"), ("optimize workers 10000", "optimize --workers 10000"),
         ("no action", ""),
+        ("mistuning std -0.01", "mistuning --std=-0.01"), ("mistuning std nan", "mistuning --std nan"),
+        ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
+        ("mistuning samples 0", "mistuning --samples 0"), ("mistuning samples 1e5", "mistuning --samples 100000"),
+        ("mistuning blades 1e5", "mistuning --blades 100000"),
+        ("mistuning factor -1", "mistuning --blades 4 --engine-order 1 --factors 1 -1 1 1"),
+        ("mistuning factor nan", "mistuning --blades 4 --engine-order 1 --factors 1 nan 1 1"),
+        ("mistuning 3 factors for 4 blades", "mistuning --blades 4 --engine-order 1 --factors 1 1 1"),
+        ("mistuning unreachable scheduler", "mistuning --scheduler tcp://127.0.0.1:9 --samples 2"),
+        ("mistuning workers and serial", "mistuning --workers 2 --serial"),
+        ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
     ], "upd")
+
+
+def _system() -> list[InputCase]:
+    return _table("system", [
+        ("system cf -1", "system --cf=-1 -o r.ssp"), ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
+        ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
+        ("system frequency -1", "system --frequency-hz=-1 -o r.ssp"),
+        ("cosim archive missing", "cosim {fx}/nowhere.ssp --frequency-hz 400"),
+        ("cosim archive binary", "cosim {fx}/binary.bin --frequency-hz 400"),
+        ("cosim a text file", "cosim {fx}/a_file --frequency-hz 400"),
+    ])
 
 
 def _run() -> list[InputCase]:
@@ -326,5 +348,5 @@ def _duties() -> list[InputCase]:
 
 def all_cases() -> list[InputCase]:
     """Every input case, grouped by subcommand."""
-    return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _run()
+    return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _system() + _run()
             + _sweep() + _cache_and_rest() + _duties())
