@@ -107,7 +107,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
             x = x + dx  # the last (tiny) step, so a smooth residual keeps quadratic accuracy
             R, J = fun(x)
             return NewtonResult(x, R, J, it + 1)
-        step = _line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha)
+        step = line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha)
         if step is None and _at_noise_floor(fun, x, R, J, nr, tol, x_norm):
             return NewtonResult(x, R, J, it)
         if step is None:
@@ -146,8 +146,12 @@ def _at_noise_floor(fun, x, R, J, nr, tol, x_norm=0.0) -> bool:
     return bool(np.linalg.norm(R2 - R) >= 0.5 * nr and np.linalg.norm(J @ d) <= 0.1 * nr)
 
 
-def _line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA):
-    """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < min_alpha."""
+def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA):
+    """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < min_alpha.
+
+    Also the sparse ring solver's (:mod:`.bladed_disk.ring_solve`): ``J`` is whatever
+    ``fun`` returns, dense or sparse.
+    """
     alpha = 1.0
     while alpha >= min_alpha:
         xt = x + alpha * dx

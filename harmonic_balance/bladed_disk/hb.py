@@ -134,6 +134,18 @@ def sector_model(sector: Sector, cf: float, f0: float, mu: float) -> Model:
                  {0: f_static, 1: f_eo}, sector.response)
 
 
+def loads(cfg, cf=None, f0=None, mu=None) -> tuple[float, float, float]:
+    """(CF [N], F0 [N], mu) given or from the config, checked: CF, F0 > 0 and mu >= 0, finite."""
+    cf = cfg.cf if cf is None else float(cf)
+    f0 = cfg.f0 if f0 is None else float(f0)
+    mu = cfg.mu if mu is None else float(mu)
+    if not (np.isfinite(cf) and cf > 0 and np.isfinite(f0) and f0 > 0):
+        raise ValueError(f"CF and F0 must be finite and > 0, got CF={cf}, F0={f0}")
+    if not (np.isfinite(mu) and mu >= 0):
+        raise ValueError(f"mu must be finite and >= 0, got {mu}")
+    return cf, f0, mu
+
+
 class SectorHB:
     """HB residual of the UPD sector with its exact Jacobian, and its outputs.
 
@@ -149,15 +161,8 @@ class SectorHB:
     blades = 1
 
     def __init__(self, sector: Sector, H: int = 7, cf=None, f0=None, mu=None, n_t: int = 0):
-        cfg = sector.cfg
         self.sector, self.H = sector, int(H)
-        self.cf = cfg.cf if cf is None else float(cf)
-        self.f0 = cfg.f0 if f0 is None else float(f0)
-        self.mu = cfg.mu if mu is None else float(mu)
-        if not (np.isfinite(self.cf) and self.cf > 0 and np.isfinite(self.f0) and self.f0 > 0):
-            raise ValueError(f"CF and F0 must be finite and > 0, got CF={self.cf}, F0={self.f0}")
-        if not (np.isfinite(self.mu) and self.mu >= 0):
-            raise ValueError(f"mu must be finite and >= 0, got {self.mu}")
+        self.cf, self.f0, self.mu = loads(sector.cfg, cf, f0, mu)
         self.basis = sector_basis(sector, self.H, n_t)
         self.model = self._build_model()
         self.x_static, _ = frictionless_statics(self.model, apply=True)

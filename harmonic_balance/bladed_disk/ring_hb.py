@@ -33,7 +33,7 @@ from ..contact import frictionless_statics
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
-from .hb import contact_elements, neighbour_map, sector_basis
+from .hb import contact_elements, loads, neighbour_map, sector_basis
 from .mistuning import LinearRing, blade_stiffness, check_factors, ring_forcing, ring_structure
 from .sector import Sector
 
@@ -62,13 +62,7 @@ class MistunedRingHB:
                  n_t: int = 0):
         cfg = sector.cfg
         self.sector, self.H = sector, int(H)
-        self.cf = cfg.cf if cf is None else float(cf)
-        self.f0 = cfg.f0 if f0 is None else float(f0)
-        self.mu = cfg.mu if mu is None else float(mu)
-        if not (np.isfinite(self.cf) and self.cf > 0 and np.isfinite(self.f0) and self.f0 > 0):
-            raise ValueError(f"CF and F0 must be finite and > 0, got CF={self.cf}, F0={self.f0}")
-        if not (np.isfinite(self.mu) and self.mu >= 0):
-            raise ValueError(f"mu must be finite and >= 0, got {self.mu}")
+        self.cf, self.f0, self.mu = loads(cfg, cf, f0, mu)
         self.kappa = check_factors(kappa, cfg.blades)
         self.blades = nbl = cfg.blades
         self.basis = sector_basis(sector, self.H, n_t)

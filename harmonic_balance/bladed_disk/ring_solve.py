@@ -32,7 +32,7 @@ import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
 from scipy.sparse.linalg import splu
 
-from ..newton import ARMIJO, LM_ACCEPT, LM_MU_MAX, LM_TRIALS, MIN_ALPHA, STEP_RTOL, NewtonError
+from ..newton import LM_ACCEPT, LM_MU_MAX, LM_TRIALS, STEP_RTOL, NewtonError, line_search
 from .hb import SectorHB
 from .ring_hb import MistunedRingHB
 from .solve import PEAK_XTOL, TOL_REL, SolverError, StartError, start_point
@@ -106,26 +106,13 @@ def newton_sparse(fun, x0: np.ndarray, tol: float, max_iter: int = 40, lm: bool 
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         if np.linalg.norm(dx) <= STEP_RTOL * np.linalg.norm(x):
             return x + dx, it + 1
-        step = _line_search(fun, x, dx, nr) or (lm and damped.step(fun, x, R, J, nr))
+        step = line_search(fun, x, dx, nr) or (lm and damped.step(fun, x, R, J, nr))
         if not step:
             raise NewtonError("no decrease, neither along Newton's direction nor by "
                               "Levenberg-Marquardt steps" if lm else "no decrease along "
                               "Newton's direction", x, it, nr)
         x, R, J, nr = step
     raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
-
-
-def _line_search(fun, x, dx, nr):
-    """Armijo backtracking along dx; (x, R, J, |R|) or None below MIN_ALPHA."""
-    alpha = 1.0
-    while alpha >= MIN_ALPHA:
-        xt = x + alpha * dx
-        Rt, Jt = fun(xt)
-        nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
-        if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
-            return xt, Rt, Jt, nt
-        alpha *= 0.5
-    return None
 
 
 class _LM:
