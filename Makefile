@@ -13,7 +13,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale docs validation docs-bench docs-stress
+.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale docs validation docs-bench docs-bench-peers docs-stress
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -94,6 +94,12 @@ validation: $(STAMP) cbuild
 	  OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q -p no:cacheprovider $$(grep -rl --include='test_*.py' 'from refcheck import' tests)
 docs-bench: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/bench.json -- $(VENV)/bin/damper bench --json --out out/bench
+# docs-bench-peers: the hb stage against pyHarm and NLvib (PYHARM = a Python with pyharm-os,
+# NLVIB = a checkout of maltekrack/NLvib, GNU Octave on the PATH; about 45 minutes).
+docs-bench-peers: $(STAMP) cbuild
+	@test -n "$(PYHARM)" -a -n "$(NLVIB)" || { echo "give PYHARM=python-with-pyharm NLVIB=nlvib-folder"; exit 2; }
+	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/bench_peers.json -- \
+	  $(VENV)/bin/damper bench --stage hb --pyharm $(PYHARM) --nlvib $(NLVIB) --json --out out/bench_peers
 docs-stress: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/stress.json -- $(VENV)/bin/damper stress --json --out out/stress
 

@@ -146,4 +146,5 @@ def all_pages(docs: Path) -> None:
     more_pages(docs)
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)
+    data_page(docs, "bench_peers", tables.bench)
     data_page(docs, "stress", tables.stress)

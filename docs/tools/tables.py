@@ -9,6 +9,7 @@ from __future__ import annotations
 MAKE = {
     "validation": "make validation",
     "bench": "make docs-bench",
+    "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
     "stress": "make docs-stress",
 }
 
