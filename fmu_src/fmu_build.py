@@ -42,8 +42,6 @@ HEADER_PATH = FMI_DIR / "damper_vr.h"
 #: baseline, a linear blade (fmu_src.blade_fmu) and an underplatform damper (fmu_src.upd_fmu).
 MODELS = {"iwan": "model_iwan.c", "passthrough": "model_passthrough.c", "point": "model_point.c",
           "blade": "model_blade.c", "upd": "model_upd.c"}
-#: Models that read the curve / normal-law resources (model_table.c).
-USES_TABLE = ("iwan", "passthrough", "point")
 #: Binary folder of each FMI version on 64-bit Linux.
 PLATFORM = {2: "linux64", 3: "x86_64-linux"}
 #: How a curve table that is not concave is handled (iwan.h iwan_fit).
@@ -90,8 +88,8 @@ def c_sources(fmi_version: int, model: str = "iwan") -> list[str]:
     _check_version(fmi_version)
     if model not in MODELS:
         raise ValueError(f"model must be one of {sorted(MODELS)}, not {model!r}")
-    table = ("model_table.c",) if model in USES_TABLE else ()
-    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], *table,
+    # model_table.c: the resource files' reader and opener, which every model uses
+    return [f"fmi{fmi_version}.c", "fmu_instance.c", "fmu_state.c", MODELS[model], "model_table.c",
             *core_files(model)[0]]
 
 

@@ -35,6 +35,7 @@
 
 #include "fmu_vars.h"
 #include "model.h"
+#include "model_table.h"
 
 #define BLADE_FILE "blade.txt"
 #define DD_SERIES_SPREAD 1.0  /* largest |x_i - x_j| summed by the series */
@@ -206,26 +207,14 @@ static const char *read_blade(blade_res *r, FILE *f, char *why, size_t nw)
 
 const char *model_load(void **res, const char *dir, char *why, size_t why_size)
 {
-    size_t len = strlen(dir);
-    char *path = (char *)malloc(len + sizeof(BLADE_FILE) + 2);
     blade_res *r = (blade_res *)calloc(1, sizeof(blade_res));
-    const char *err = NULL;
-    FILE *f = NULL;
+    const char *err;
+    FILE *f;
     *res = NULL;
-    if (!path || !r) err = "out of memory reading the blade";
-    if (!err) {
-        memcpy(path, dir, len);
-        if (len == 0 || path[len - 1] != '/') path[len++] = '/';
-        memcpy(path + len, BLADE_FILE, sizeof(BLADE_FILE));
-        f = fopen(path, "r");
-        if (!f) {
-            snprintf(why, why_size, "cannot open the blade file '%s'", path);
-            err = why;
-        }
-    }
-    if (!err) err = read_blade(r, f, why, why_size);
+    if (!r) return "out of memory reading the blade";
+    f = model_open_resource(dir, BLADE_FILE, "blade", why, why_size);
+    err = f ? read_blade(r, f, why, why_size) : why;
     if (f) fclose(f);
-    free(path);
     if (err) {
         model_unload(r);
         return err;

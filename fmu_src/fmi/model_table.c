@@ -89,6 +89,21 @@ static const char *read_file(model_table *t, const char *dir, const char *name, 
     return err;
 }
 
+FILE *model_open_resource(const char *dir, const char *name, const char *what, char *why,
+                          size_t why_size)
+{
+    char *path = join(dir, name);
+    FILE *f;
+    if (!path) {
+        snprintf(why, why_size, "out of memory reading the %s", what);
+        return NULL;
+    }
+    f = fopen(path, "r");
+    if (!f) snprintf(why, why_size, "cannot open the %s file '%s'", what, path);
+    free(path);
+    return f;
+}
+
 void model_table_free(model_table *t)
 {
     if (!t) return;

@@ -38,6 +38,7 @@
 #include "fmu_vars.h"
 #include "iwan.h"
 #include "model.h"
+#include "model_table.h"
 
 #define UPD_FILE "upd.txt"
 #define MAX_CONTACTS 8
@@ -140,26 +141,14 @@ void model_unload(void *res) { free(res); }
 
 const char *model_load(void **res, const char *dir, char *why, size_t why_size)
 {
-    size_t len = strlen(dir);
-    char *path = (char *)malloc(len + sizeof(UPD_FILE) + 2);
     upd_res *r = (upd_res *)calloc(1, sizeof(upd_res));
-    const char *err = NULL;
-    FILE *f = NULL;
+    const char *err;
+    FILE *f;
     *res = NULL;
-    if (!path || !r) err = "out of memory reading the damper";
-    if (!err) {
-        memcpy(path, dir, len);
-        if (len == 0 || path[len - 1] != '/') path[len++] = '/';
-        memcpy(path + len, UPD_FILE, sizeof(UPD_FILE));
-        f = fopen(path, "r");
-        if (!f) {
-            snprintf(why, why_size, "cannot open the damper file '%s'", path);
-            err = why;
-        }
-    }
-    if (!err) err = read_upd(r, f, why, why_size);
+    if (!r) return "out of memory reading the damper";
+    f = model_open_resource(dir, UPD_FILE, "damper", why, why_size);
+    err = f ? read_upd(r, f, why, why_size) : why;
     if (f) fclose(f);
-    free(path);
     if (err) {
         free(r);
         return err;
