@@ -116,6 +116,23 @@ void *instantiate(const api *a, const char *name, const char *token, const char 
                  logger3, NULL);
 }
 
+void check_instantiation_errors(const api *a, const char *token, const char *missing)
+{
+    int logs = g_log_count;
+    void *c = instantiate(a, "bad", "{00000000-0000-0000-0000-000000000000}", a->resources);
+    CHECK(c == NULL && g_log_count > logs, "FMI %d: wrong token accepted or not logged", a->v);
+    logs = g_log_count;
+    c = instantiate(a, "bad", token, missing);
+    CHECK(c == NULL && g_log_count > logs, "FMI %d: missing resources accepted", a->v);
+    c = instantiate(a, "bad", token, NULL);
+    CHECK(c == NULL, "FMI %d: NULL resource location accepted", a->v);
+    if (a->v == 2)
+        c = a->i2("me", fmi2ModelExchange, token, a->resources, &callbacks2, 0, 1);
+    else
+        c = a->ime3("me", token, a->resources, fmi3False, fmi3True, NULL, logger3);
+    CHECK(c == NULL, "FMI %d: Model Exchange instantiation accepted", a->v);
+}
+
 void release(inst *x)
 {
     if (x->a->v == 2) x->a->free2(x->c);

@@ -66,6 +66,9 @@ void logger3(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category
 /* dlopen `path`, check every required fmi2* (co-simulation) or fmi3* symbol. */
 int load(api *a, int v, const char *path, const char *dir);
 void *instantiate(const api *a, const char *name, const char *token, const char *res);
+/* Instantiation that must fail: a wrong token (logged), the resource location `missing`
+ * (no such folder; logged), a NULL location, Model Exchange. */
+void check_instantiation_errors(const api *a, const char *token, const char *missing);
 void release(inst *x);
 int enter_init(inst *x);
 int exit_init(inst *x);

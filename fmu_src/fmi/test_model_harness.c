@@ -453,23 +453,12 @@ static void test_broken_resources(const api *a, const char *res, const char *scr
     CHECK(files > 0, "no resource file in %s", res);
 }
 
+/* The shared instantiation checks, with a missing folder below the scratch folder. */
 static void test_instantiation_errors(const api *a, const char *scratch)
 {
     char missing[1200];
-    int logs = g_log_count;
-    void *c = instantiate(a, "bad", "{00000000-0000-0000-0000-000000000000}", a->resources);
-    CHECK(c == NULL && g_log_count > logs, "FMI %d: wrong token accepted or not logged", a->v);
-    snprintf(missing, sizeof missing, "%s/missing", scratch);
-    logs = g_log_count;
-    c = instantiate_from(a, missing);
-    CHECK(c == NULL && g_log_count > logs, "FMI %d: missing resources accepted", a->v);
-    c = instantiate(a, "bad", DAMPER_TOKEN, NULL);
-    CHECK(c == NULL, "FMI %d: NULL resource location accepted", a->v);
-    if (a->v == 2)
-        c = a->i2("me", fmi2ModelExchange, DAMPER_TOKEN, a->resources, &callbacks2, 0, 1);
-    else
-        c = a->ime3("me", DAMPER_TOKEN, a->resources, fmi3False, fmi3True, NULL, logger3);
-    CHECK(c == NULL, "FMI %d: Model Exchange instantiation accepted", a->v);
+    snprintf(missing, sizeof missing, a->v == 2 ? "file://%s/missing" : "%s/missing/", scratch);
+    check_instantiation_errors(a, DAMPER_TOKEN, missing);
 }
 
 /* ------------------------------------------------------------------ main */
