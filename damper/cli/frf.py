@@ -161,7 +161,7 @@ def run(args) -> int:
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
-        if "point limit" in str(err):
+        if err.result.points >= args.max_points:   # stopped by the point limit
             hint = "raise --max-points, or a larger --tolerance takes fewer points"
         else:
             hint = "try fewer --harmonics, a narrower --omega range or a smaller --tolerance"

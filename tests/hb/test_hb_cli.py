@@ -56,6 +56,7 @@ def test_unfinished_curve_exits_3_and_keeps_the_points(capsys):
     code = main(SDOF + ["--omega", "0.9", "1.3", "--max-points", "5", "--json"])
     cap = capsys.readouterr()
     assert code == 3 and "stopped at parameter" in cap.err
+    assert "raise --max-points" in cap.err      # the hint names what lifts the limit
     out = json.loads(cap.out)
     assert out["points"] == 5 and out["status"].startswith("continuation stopped")
 
