@@ -36,9 +36,9 @@ def main(argv: list[str] | None = None) -> int:
     if not command:
         print("record.py: error: no command after --", file=sys.stderr)
         return 2
-    from damper.bench.common import stamp
+    from damper.bench.common import revision, stamp
 
-    start = stamp()   # the code that runs: a commit made during a long run must not be named
+    started_at = revision()   # the code that runs: a commit made during a long run must not be named
     t0 = time.perf_counter()
     proc = subprocess.run(command, stdout=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
               f"nothing written", file=sys.stderr)
         return 3
     data = {"command": shlex.join(command), "exit_code": proc.returncode, "wall_s": round(wall, 1),
-            "stamp": {**stamp(), "revision": start["revision"]}, "result": result}
+            "stamp": {**stamp(), "revision": started_at}, "result": result}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     tmp = args.out.with_suffix(args.out.suffix + ".tmp")
     tmp.write_text(json.dumps(data, indent=1) + "\n")
