@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_core.fileio import atomic_write
+from contact_core.fileio import atomic_write, read_text_bounded
 
 #: Schema tag written to every normal-curve file.
 SCHEMA = "damper-normal-curve/1"
@@ -135,7 +135,7 @@ def read_normal_curve(path: str | Path) -> NormalCurve:
     """Read and validate a normal-curve JSON file (ValueError with the path on bad content)."""
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(read_text_bounded(path, what="normal-curve file"))
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not JSON ({err})") from None
     except UnicodeDecodeError:

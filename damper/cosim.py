@@ -37,6 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core.fileio import MAX_SSP_BYTES, check_regular_input, check_zip_members
+
 #: Harmonics fitted to one period's samples (0..FIT_HARMONICS).
 FIT_HARMONICS = 9
 #: Default settling tolerance (relative change of the first harmonic, extrapolated).
@@ -60,12 +62,14 @@ class EngineMissing(ValueError):
 def read_info(ssp) -> dict:
     """The archive's ``resources/system.json`` (ValueError if it is not a ring archive)."""
     path = Path(ssp)
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"{path}: no such SSP archive")
+    check_regular_input(path, MAX_SSP_BYTES, "SSP archive")
     try:
         with zipfile.ZipFile(path) as zf:
+            check_zip_members(zf, MAX_SSP_BYTES, f"SSP archive {path}")
             info = json.loads(zf.read("resources/system.json"))
-    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError):
+    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError):
         raise ValueError(f"{path} is not a ring archive of `damper system` (no "
                          "resources/system.json): build one with damper system -o ring.ssp") from None
     if info.get("kind") != "damper-ring":
@@ -94,6 +98,7 @@ def _unpack(ssp, step_ns: int, directory: Path) -> Path:
     SSD's fixed-step annotation (libcosim truncates the step to whole ns: written as
     step_ns + 1/2 ns)."""
     with zipfile.ZipFile(ssp) as zf:
+        check_zip_members(zf, MAX_SSP_BYTES, f"SSP archive {ssp}")   # again: it may have changed
         zf.extractall(directory)
     ssd = directory / "SystemStructure.ssd"
     text, n = re.subn(r'<osp:FixedStepAlgorithm[^>]*/>',
@@ -148,8 +153,20 @@ class _Ring:
     """The loaded execution with the variables the runner reads."""
 
     def __init__(self, ssp, info, plan, frequency_hz):
-        CosimExecution, CosimObserver, vt = _engine()
+        _engine()   # EngineMissing before any temporary folder
         self._tmp = tempfile.TemporaryDirectory(prefix="damper_cosim_")
+        try:
+            self._load(ssp, info, plan, frequency_hz)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Remove the unpacked archive (also after an error, Ctrl-C or SIGTERM)."""
+        self._tmp.cleanup()
+
+    def _load(self, ssp, info, plan, frequency_hz) -> None:
+        CosimExecution, CosimObserver, vt = _engine()
         root = _unpack(ssp, plan["step_ns"], Path(self._tmp.name))
         self.ex = CosimExecution.from_ssp_file(str(root))
         self.info, self.n = info, plan["steps_per_period"]
@@ -248,12 +265,20 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
     if not (np.isfinite(tol) and tol >= 0):
         raise ValueError(f"--tol must be finite and >= 0, got {tol}")
     plan = plan_step(info, frequency_hz, step, force)
-    omega = 2 * np.pi * frequency_hz
     t0 = time.perf_counter()
     try:
         ring = _Ring(ssp, info, plan, frequency_hz)
     except AssertionError as err:  # libcosimpy reports failures with assert
         raise RuntimeError(f"libcosim could not load {ssp}: {err}") from None
+    try:
+        return _steady(ring, info, plan, frequency_hz, periods, tol, keep_last, t0)
+    finally:
+        ring.close()
+
+
+def _steady(ring, info, plan, frequency_hz, periods, tol, keep_last, t0) -> dict:
+    """Step ``ring`` period by period until settled (:func:`run`)."""
+    omega = 2 * np.pi * frequency_hz
     e_prev, h1_prev, deltas = ring.energies(), None, []
     settled, est = False, float("inf")
     for k in range(1, periods + 1):

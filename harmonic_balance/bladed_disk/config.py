@@ -25,6 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core.fileio import read_text_bounded
+
 from .blade import MATRICES, Blade, load_blade
 
 #: The bundled default model.
@@ -207,7 +209,7 @@ def load_config(path=None) -> UPDConfig:
     if path is not None:
         path = Path(path)
         try:
-            user = tomllib.loads(path.read_text())
+            user = tomllib.loads(read_text_bounded(path, what="config"))
         except OSError as err:
             raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
         except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
