@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -186,10 +187,37 @@ def upd_files() -> dict[str, str | bytes]:
             "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
 
 
+def _forged_sizes(blob: bytes, size: int) -> bytes:
+    """A zip archive whose members declare ``size`` bytes unpacked (local and central headers)."""
+    out = bytearray(blob)
+    for sig, offset in ((b"PK\x03\x04", 22), (b"PK\x01\x02", 24)):
+        at = out.find(sig)
+        while at >= 0:
+            out[at + offset:at + offset + 4] = size.to_bytes(4, "little")
+            at = out.find(sig, at + 4)
+    return bytes(out)
+
+
+def archives() -> dict[str, bytes]:
+    """Forged archives: members declaring 4 GiB (an SSP, a model .npz), an SSP of 5000
+    members, and a blade Matrix Market header declaring a 1e8 x 1e8 matrix."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("resources/system.json", '{"kind": "damper-ring"}')
+    many = io.BytesIO()
+    with zipfile.ZipFile(many, "w") as zf:
+        for i in range(5000):
+            zf.writestr(f"m{i}", b"")
+    mtx = b"%%MatrixMarket matrix coordinate real general\n100000000 100000000 1\n1 1 1.0\n"
+    return {"bomb.ssp": _forged_sizes(buf.getvalue(), 2**32 - 16), "many.ssp": many.getvalue(),
+            "m_bomb.npz": _forged_sizes(matrices()["m_good.npz"], 2**32 - 16), "big_M.mtx": mtx, "big_K.mtx": mtx,
+            "upd_bigmtx.toml": b'[blade]\nM = "big_M.mtx"\nK = "big_K.mtx"\n'}
+
+
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
-    for group in (curves(), matrices(), elements(), scenes(), upd_files()):
+    for group in (curves(), matrices(), elements(), scenes(), upd_files(), archives()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):

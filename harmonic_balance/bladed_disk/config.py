@@ -211,7 +211,7 @@ def load_config(path=None) -> UPDConfig:
         try:
             user = tomllib.loads(read_text_bounded(path, what="config"))
         except OSError as err:
-            raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
+            raise ValueError(f"cannot read config {path}: {err.strerror}" if err.strerror else str(err)) from None
         except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise ValueError(f"cannot read config {path} (TOML): {err}") from None
         for sec, table in user.items():
