@@ -27,7 +27,7 @@ from pathlib import Path
 
 #: Bytes of a text input (curve and normal-curve JSON, scene and configuration TOML,
 #: element tables): a virgin curve of 20000 points is ~1 MB of JSON and a scene a few
-#: kB; parsing 16 MiB of JSON numbers already takes ~0.3 GB of Python objects.
+#: kB; parsing 16 MiB of JSON numbers already makes ~80 MB of Python objects.
 MAX_TEXT_FILE_BYTES = 16 * 2**20
 #: Bytes of array data in an input file (.npz members uncompressed, a Matrix Market
 #: file, and the arrays its header declares): three dense matrices of 9000 DOFs take
@@ -37,8 +37,8 @@ MAX_ARRAY_FILE_BYTES = 2 * 2**30
 #: Members of an input archive (.npz, .ssp): a model holds a few arrays and a ring SSP
 #: a few FMUs; tens of thousands of members is a forged archive.
 MAX_ARCHIVE_MEMBERS = 4096
-#: Bytes of a co-simulation archive (.ssp) unpacked: the UPD-24 ring's eight FMUs with
-#: their sources take ~2 MB unpacked; 1 GiB is a forged archive (a zip bomb).
+#: Bytes of a co-simulation archive (.ssp) unpacked: the UPD-24 ring's (``damper system``,
+#: 4 members) unpacks to 0.2 MB; 1 GiB is a forged archive (a zip bomb).
 MAX_SSP_BYTES = 2**30
 
 _UMASK_LOCK = threading.Lock()
