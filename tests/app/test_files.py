@@ -248,3 +248,18 @@ def test_sigterm_exits_143_in_one_line_and_removes_temporary_folders(tmp_path, m
     assert made and not os.path.exists(made[0])
     assert capsys.readouterr().err == "damper fmu: terminated (SIGTERM)\n"
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_dask_workers_temporary_files_are_removed_by_close(tmp_path, monkeypatch):
+    """A worker stopped in the middle of a task never cleans up: its TMPDIR is ours to remove."""
+    from damper.tasks import executor
+
+    monkeypatch.setenv("TMPDIR", str(tmp_path))
+    monkeypatch.setattr(tempfile, "tempdir", None)            # this process re-reads TMPDIR
+    submit, gather, close = executor(None, 1, serial=False)
+    try:
+        left = gather([submit(tempfile.mkdtemp)])[0]           # a worker's folder, never removed by it
+        assert os.path.isdir(left) and Path(left).parent.name.startswith("damper_workers_")
+    finally:
+        close()
+    assert not os.path.exists(left) and not list(tmp_path.iterdir())
