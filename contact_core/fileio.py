@@ -147,13 +147,14 @@ def check_writable_target(path: str | os.PathLike) -> None:
                                   "give another output name")
 
 
-def read_bounded(path: str | os.PathLike, cap: int, what: str = "input file") -> bytes:
+def read_bounded(path: str | os.PathLike, cap: int, what: str = "input file", protect: bool = True) -> bytes:
     """The bytes of the regular file ``path``, at most ``cap`` of them.
 
     The file's size is checked before reading (stat of the open file), then at most
     ``cap + 1`` bytes are read, so a file that grows meanwhile is caught too. A device,
-    FIFO or socket is refused without blocking (opened with O_NONBLOCK). The file is
-    then protected from being overwritten by this process's outputs (:func:`protect`).
+    FIFO or socket is refused without blocking (opened with O_NONBLOCK). With
+    ``protect`` the file is then protected from being overwritten by this process's
+    outputs (:func:`protect`; not for a command's own earlier output that it rewrites).
 
     Raises
     ------
@@ -183,7 +184,8 @@ def read_bounded(path: str | os.PathLike, cap: int, what: str = "input file") ->
             raise ValueError(f"{what} {path} grew above the limit of {_size_text(cap)} while read")
     finally:
         os.close(fd)
-    _remember(st, path)
+    if protect:
+        _remember(st, path)
     return b"".join(chunks)
 
 
