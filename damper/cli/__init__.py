@@ -135,8 +135,9 @@ def _main(argv: list[str] | None) -> int:
             return 3
     except KeyboardInterrupt as err:
         where = getattr(err, "message", "")
-        if isinstance(err, Terminated):
-            print(f"damper {command}: terminated (SIGTERM)", file=sys.stderr)
+        if isinstance(err, Terminated) or isinstance(err.__context__, Terminated):  # (re-raised with a where)
+            text = where.replace("interrupted", "terminated (SIGTERM)", 1) if where else "terminated (SIGTERM)"
+            print(f"damper {command}: {text}", file=sys.stderr)
             return 143
         print(f"damper {command}: {where or 'interrupted'}", file=sys.stderr)
         return 130
