@@ -72,6 +72,11 @@ def _bounded() -> list[InputCase]:
         _case("files", "frf an .npz whose member unpacks to 4 GiB",
               "frf --model {fx}/m_bomb.npz --elements {fx}/el_good.toml --omega 100 300"),
         _case("files", "upd modes: blade Matrix Market 1e8 x 1e8", "upd modes --config {fx}/upd_bigmtx.toml"),
+        _case("files", "normal: stiffness Matrix Market of 1e12 entries",
+              "normal --body sphere --force 100 --stiffness {fx}/big_nnz.mtx {fx}/big_nnz.mtx "
+              "--nodes {fx}/m_good.npz {fx}/m_good.npz"),
+        _case("files", "run: the scene's matrices a 3 GiB file", "run s.toml",
+              files={"s.toml": fx._matrices_scene("big.npz")}, mutate=f"sparse:big.npz:{BIG}"),
     ]
 
 

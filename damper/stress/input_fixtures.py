@@ -200,7 +200,7 @@ def _forged_sizes(blob: bytes, size: int) -> bytes:
 
 def archives() -> dict[str, bytes]:
     """Forged archives: members declaring 4 GiB (an SSP, a model .npz), an SSP of 5000
-    members, and a blade Matrix Market header declaring a 1e8 x 1e8 matrix."""
+    members, Matrix Market headers declaring a 1e8 x 1e8 matrix and 1e12 entries."""
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
         zf.writestr("resources/system.json", '{"kind": "damper-ring"}')
@@ -211,7 +211,8 @@ def archives() -> dict[str, bytes]:
     mtx = b"%%MatrixMarket matrix coordinate real general\n100000000 100000000 1\n1 1 1.0\n"
     return {"bomb.ssp": _forged_sizes(buf.getvalue(), 2**32 - 16), "many.ssp": many.getvalue(),
             "m_bomb.npz": _forged_sizes(matrices()["m_good.npz"], 2**32 - 16), "big_M.mtx": mtx, "big_K.mtx": mtx,
-            "upd_bigmtx.toml": b'[blade]\nM = "big_M.mtx"\nK = "big_K.mtx"\n'}
+            "upd_bigmtx.toml": b'[blade]\nM = "big_M.mtx"\nK = "big_K.mtx"\n',
+            "big_nnz.mtx": b"%%MatrixMarket matrix coordinate real general\n1000 1000 1000000000000\n1 1 1.0\n"}
 
 
 def make(folder: Path) -> Path:
