@@ -30,7 +30,7 @@ from pathlib import Path
 #: kB; parsing 16 MiB of JSON numbers already makes ~80 MB of Python objects.
 MAX_TEXT_FILE_BYTES = 16 * 2**20
 #: Bytes of array data in an input file (.npz members uncompressed, a Matrix Market
-#: file, and the arrays its header declares): three dense matrices of 9000 DOFs take
+#: file, and the arrays its header declares): three dense matrices of 9500 DOFs take
 #: 2 GiB, far above a reduced blade or damper model, and the harmonic balance holds
 #: several matrices of that size again.
 MAX_ARRAY_FILE_BYTES = 2 * 2**30
@@ -147,6 +147,18 @@ def check_writable_target(path: str | os.PathLike) -> None:
                                   "give another output name")
 
 
+def _checked_stat(fd: int, path, cap: int, what: str) -> os.stat_result:
+    """Stat of the open ``fd``: a regular file of at most ``cap`` bytes, else the error naming ``path``."""
+    st = os.fstat(fd)
+    if stat.S_ISDIR(st.st_mode):
+        raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(path))
+    if not stat.S_ISREG(st.st_mode):
+        raise NotRegularFileError(f"{what} {path} is {_kind(st.st_mode)}, not a regular file: give a file")
+    if st.st_size > cap:
+        raise ValueError(f"{what} {path} is {_size_text(st.st_size)}, above the limit of {_size_text(cap)}")
+    return st
+
+
 def read_bounded(path: str | os.PathLike, cap: int, what: str = "input file", protect: bool = True) -> bytes:
     """The bytes of the regular file ``path``, at most ``cap`` of them.
 
@@ -166,13 +178,7 @@ def read_bounded(path: str | os.PathLike, cap: int, what: str = "input file", pr
     """
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     try:
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(path))
-        if not stat.S_ISREG(st.st_mode):
-            raise NotRegularFileError(f"{what} {path} is {_kind(st.st_mode)}, not a regular file: give a file")
-        if st.st_size > cap:
-            raise ValueError(f"{what} {path} is {_size_text(st.st_size)}, above the limit of {_size_text(cap)}")
+        st = _checked_stat(fd, path, cap, what)
         chunks, total = [], 0
         while total <= cap:
             chunk = os.read(fd, min(cap + 1 - total, 1 << 20))
@@ -201,15 +207,9 @@ def check_regular_input(path: str | os.PathLike, cap: int, what: str = "input fi
     """
     fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     try:
-        st = os.fstat(fd)
+        st = _checked_stat(fd, path, cap, what)
     finally:
         os.close(fd)
-    if stat.S_ISDIR(st.st_mode):
-        raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(path))
-    if not stat.S_ISREG(st.st_mode):
-        raise NotRegularFileError(f"{what} {path} is {_kind(st.st_mode)}, not a regular file: give a file")
-    if st.st_size > cap:
-        raise ValueError(f"{what} {path} is {_size_text(st.st_size)}, above the limit of {_size_text(cap)}")
     _remember(st, path)
     return st
 
