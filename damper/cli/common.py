@@ -31,6 +31,8 @@ from contact_core.fileio import (
 #: Option destinations that name outputs: dest -> (flag, "file" or "folder").
 OUTPUTS = {"output": ("-o", "file"), "out": ("--out", "file"), "normal_curve": ("--normal-curve", "file"),
            "plot": ("--plot", "figures")}
+#: Positional arguments that name input files (named as they are in messages, without --).
+POSITIONAL = ("scene", "ssp")
 
 
 def to_jsonable(obj):
@@ -101,7 +103,7 @@ def _inputs(args) -> list[tuple[str, Path]]:
             continue
         for v in value if isinstance(value, (list, tuple)) else [value]:
             if isinstance(v, (str, os.PathLike)) and str(v) and os.path.isfile(v):
-                found.append(("--" + dest.replace("_", "-") if dest != "scene" and dest != "ssp" else dest, Path(v)))
+                found.append((dest if dest in POSITIONAL else "--" + dest.replace("_", "-"), Path(v)))
     return found
 
 
