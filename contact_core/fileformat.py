@@ -94,7 +94,13 @@ def describe(model: type[BaseModel], error: dict) -> str:
     if kind == "finite_number":
         text = "must be a finite number"
     if kind == "model_type" or kind == "dict_type":
-        text = "must be a table (JSON object)"
+        text = "must be a table (a JSON object)"
+    if kind in ("too_long", "too_short"):
+        ctx = error.get("ctx", {})
+        bound = ctx.get("max_length") if kind == "too_long" else ctx.get("min_length")
+        word = "string of" if isinstance(value, str) else "list of"
+        return (f"must be a {word} at {'most' if kind == 'too_long' else 'least'} {bound} "
+                f"item{'s' if bound != 1 else ''}, got {ctx.get('actual_length', len(value))}")
     return f"{text}, got {shown(value)}"
 
 

@@ -18,7 +18,7 @@ def test_override_and_unknown_key(tmp_path):
     f.write_text("[load]\ncf = 60.0\n")
     assert load_config(f).cf == 60.0
     f.write_text("[load]\ncff = 60.0\n")
-    with pytest.raises(ValueError, match="unknown key load.cff"):
+    with pytest.raises(ValueError, match="load.cff: unknown key"):
         load_config(f)
     f.write_text("[damper]\nmu = -1\n")
     with pytest.raises(ValueError, match="damper.mu"):
