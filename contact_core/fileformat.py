@@ -61,11 +61,23 @@ def message(model: type[BaseModel], err: ValidationError, source: str) -> str:
     """The one-line message of ``err``: its first error with the key's path."""
     errors = err.errors(include_url=False)
     first = errors[0]
-    loc = first.get("loc", ())
-    text = f"{source}: " + (f"{key_path(loc)}: " if loc else "") + describe(model, first)
+    loc = tuple(first.get("loc", ()))
+    cut = next((i for i, part in enumerate(loc) if _is_union_label(part)), None)
+    what = describe(model, first)
+    if cut is not None:   # a value of several allowed forms (a number or a list...) that fits none
+        loc, what = loc[:cut], f"no allowed form fits ({what})"
+        errors = [e for e in errors if tuple(e["loc"][:cut]) != loc]
+        errors.insert(0, first)
+    text = f"{source}: " + (f"{key_path(loc)}: " if loc else "") + what
     if len(errors) > 1:
         text += f" (and {len(errors) - 1} more problem{'s' if len(errors) > 2 else ''})"
     return " ".join(text.split())   # one line whatever the input held
+
+
+def _is_union_label(part) -> bool:
+    """pydantic names the member of a union a value was tried against in the error's
+    location ('constrained-float', 'list[...]'); no key of a file model looks like that."""
+    return isinstance(part, str) and ("-" in part or "[" in part or part in ("float", "int", "str", "list"))
 
 
 def key_path(loc) -> str:
@@ -89,6 +101,9 @@ def describe(model: type[BaseModel], error: dict) -> str:
         return "unknown key" + (f" (known here: {', '.join(known)})" if known else "")
     if kind in ("value_error", "assertion_error"):
         return str(error["ctx"]["error"]) if "ctx" in error else error["msg"]
+    if kind == "union_tag_invalid":   # a tagged table (e.g. an element's type) of an unknown kind
+        ctx = error.get("ctx", {})
+        return f"{ctx.get('discriminator', 'type')}: unknown {ctx.get('tag')!r} (one of {ctx.get('expected_tags')})"
     text = error["msg"]
     text = text.replace("Input should be", "must be").replace("Input", "the value")
     if kind == "finite_number":

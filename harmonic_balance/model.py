@@ -275,16 +275,17 @@ def _matrices_from(data: dict, path: Path) -> tuple[LinearModel, dict, int]:
 
 
 def load_elements(path) -> list[ForceElement]:
-    """Read an ``elements.toml`` file into force elements (format in the module docstring)."""
+    """Read an ``elements.toml`` file into force elements (format in the module docstring;
+    keys and types: :class:`harmonic_balance.elements_model.ElementsFile`)."""
+    from contact_core.fileformat import parse
+    from harmonic_balance.elements_model import ElementsFile
+
     path = Path(path)
     try:
         spec = tomllib.loads(path.read_text())
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
         raise ValueError(f"cannot read elements file {path} (TOML): {err}") from None
-    unknown = sorted(set(spec) - {"element"})
-    if unknown:
-        raise ValueError(f"{path}: unknown key(s) {', '.join(map(repr, unknown))}: the file holds "
-                         "[[element]] tables only")
+    parse(ElementsFile, spec, str(path))   # tables, keys, types, ranges (elements_model)
     tables = spec.get("element", [])
     if not isinstance(tables, list) or not tables or not all(isinstance(t, dict) for t in tables):
         raise ValueError(f"{path}: no [[element]] tables")
