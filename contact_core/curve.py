@@ -188,8 +188,11 @@ class CurveFile(FileModel):
 
     schema_: Literal["damper-virgin-curve/2", "damper-virgin-curve/1"] = Field(
         SCHEMA_V1, alias="schema", description="format tag; version 1 (or none) has no tail")
-    u: list[_Displacement] = Field(description="tangential displacement [m], strictly increasing from 0")
-    T: list[_Force] = Field(description="tangential force [N] from 0, non-negative, at most mu N")
+    u: list[_Displacement] = Field(description="tangential displacement [m], strictly increasing from 0",
+                                   json_schema_extra={"why": "a contact slips within micrometres: metres "
+                                                      "are a unit error"})
+    T: list[_Force] = Field(description="tangential force [N] from 0, non-negative, at most mu N",
+                            json_schema_extra={"why": "1 GN is far above any contact of a machine"})
     tail: Literal["flat", "slope"] | None = Field(
         None, description="beyond the last point: flat (gross slip) or the last slope (version 2: required)")
     N: Annotated[float, Field(gt=0.0, le=MAX_FORCE)] | None = Field(None, description="normal load [N]")

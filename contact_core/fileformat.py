@@ -106,6 +106,10 @@ def describe(model: type[BaseModel], error: dict) -> str:
         return f"{ctx.get('discriminator', 'type')}: unknown {ctx.get('tag')!r} (one of {ctx.get('expected_tags')})"
     text = error["msg"]
     text = text.replace("Input should be", "must be").replace("Input", "the value")
+    if kind in ("less_than", "less_than_equal", "greater_than", "greater_than_equal"):
+        why = reason(model, error["loc"])
+        if why:
+            return f"{text}, got {shown(value)}: {why}"
     if kind == "finite_number":
         text = "must be a finite number"
     if kind == "model_type" or kind == "dict_type":
@@ -130,6 +134,21 @@ def shown(value) -> str:
     if len(text) > MAX_SHOWN:
         text = text[:MAX_SHOWN] + "..."
     return kind if value is None else f"{kind} {text}"
+
+
+def reason(model, loc) -> str:
+    """The ``why`` of the innermost field on ``loc`` (``Field(json_schema_extra={"why": ...})``:
+    why a bound is where it is), or ""."""
+    node, why = model, ""
+    for part in loc:
+        m = _model_of(node)
+        if m is not None and isinstance(part, str) and part in m.model_fields:
+            extra = m.model_fields[part].json_schema_extra
+            why = extra.get("why", why) if isinstance(extra, dict) else why
+        node = _step(node, part)
+        if node is None:
+            break
+    return why
 
 
 def known_keys(model, loc) -> list[str]:

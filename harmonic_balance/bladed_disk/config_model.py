@@ -20,6 +20,8 @@ from contact_core.spec import MAX_GRID
 #: statics ((7 N_b)^2 numbers per matrix: 190 MB for three at 400 blades) and its FMU
 #: archive holds one blade and one damper per ring blade; real disks hold below ~150.
 MAX_BLADES = 400
+BLADES_WHY = ("the ring's statics are dense ((7 N_b)^2 numbers per matrix) and its archive holds a blade "
+              "and a damper FMU per ring blade")
 #: Largest magnitude of a model parameter [SI]: the harmonic balance squares forces and
 #: displacements (residual norms, omega^2 M), which overflows double precision near 1e154.
 MAX_PARAMETER = 1e100
@@ -34,7 +36,8 @@ DofName = Annotated[str, Field(min_length=1, max_length=200)]
 
 
 class Disk(FileModel):
-    blades: Annotated[int, Field(ge=2, le=MAX_BLADES)] = Field(description="N_b, blades of the disk")
+    blades: Annotated[int, Field(ge=2, le=MAX_BLADES)] = Field(
+        description="N_b, blades of the disk", json_schema_extra={"why": BLADES_WHY})
     engine_order: Annotated[int, Field(ge=0, le=MAX_BLADES // 2)] = Field(description="EO, 0..N_b/2")
 
 
