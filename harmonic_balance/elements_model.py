@@ -28,7 +28,8 @@ Vector = Annotated[list[Real], Field(min_length=1, max_length=3)]   # k = 1, 2 o
 
 
 class Jenkins(FileModel):
-    type: Literal["jenkins"] = Field(description="spring k in series with a slider of strength fs")
+    type: Literal["jenkins"] = Field("jenkins", description="spring k in series with a slider of strength fs "
+                                     "(the type of a table without one)")
     name: str | None = Field(None, description="label in the output")
     dofs: Link = Field(description="[a] (to the ground) or [a, b]: u = x_a - x_b")
     k: Positive = Field(description="stiffness [N/m]")
@@ -37,8 +38,8 @@ class Jenkins(FileModel):
 
 class Sliders(FileModel):
     type: Literal["sliders"] = Field(description="Iwan parallel sliders at the reference normal load")
-    name: str | None = None
-    dofs: Link
+    name: str | None = Field(None, description="label in the output")
+    dofs: Link = Field(description="[a] (to the ground) or [a, b]: u = x_a - x_b")
     k: Annotated[list[Positive], Field(min_length=1, max_length=100_000)] = Field(description="[N/m] each")
     fs: Annotated[list[Positive], Field(min_length=1, max_length=100_000)] = Field(description="[N] each")
     k_res: NonNegative = Field(0.0, description="residual stiffness [N/m]")
@@ -52,8 +53,8 @@ class Sliders(FileModel):
 
 class Curve(FileModel):
     type: Literal["curve"] = Field(description="a virgin curve file (contact_core.curve)")
-    name: str | None = None
-    dofs: Link
+    name: str | None = Field(None, description="label in the output")
+    dofs: Link = Field(description="[a] (to the ground) or [a, b]: u = x_a - x_b")
     path: Annotated[str, Field(min_length=1)] = Field(description="curve JSON, relative to the .toml file")
     fit: Literal["reject", "concave"] = Field("reject", description="a non-concave curve: refused or its "
                                               "least concave majorant")
@@ -62,7 +63,7 @@ class Curve(FileModel):
 
 class Contact(FileModel):
     type: Literal["contact"] = Field(description="penalty normal with lift-off + friction following N")
-    name: str | None = None
+    name: str | None = Field(None, description="label in the output")
     dofs: Annotated[list[Dof], Field(min_length=1, max_length=6)] = Field(
         description="DOFs of the contact point's relative displacement")
     normal: Vector = Field(description="unit normal from body 2 into body 1")
@@ -75,8 +76,8 @@ class Contact(FileModel):
     k_t: Positive | None = Field(None, description="Jenkins friction stiffness [N/m] (with mu)")
     mu: Annotated[float, Field(ge=0.0, le=100.0)] | None = Field(None, description="friction coefficient")
     curve: Annotated[str, Field(min_length=1)] | None = Field(None, description="curve JSON instead of k_t, mu")
-    fit: Literal["reject", "concave"] | None = None
-    scale: Positive | None = None
+    fit: Literal["reject", "concave"] | None = Field(None, description="with curve: as a curve element's")
+    scale: Positive | None = Field(None, description="with curve: friction scale on every slip strength")
     preload: Real = Field(0.0, description="static penetration at x = 0 [m]")
     slip_ref: Real | Annotated[list[Real], Field(min_length=1, max_length=2)] = Field(
         0.0, description="prestress slip where the sliders are virgin [m]")

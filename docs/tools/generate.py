@@ -158,7 +158,13 @@ def _schema_keys(node: dict, root: dict, prefix: str = ""):
     for key, sub in _resolve(node, root).get("properties", {}).items():
         sub = _resolve(sub, root)
         inner = sub.get("additionalProperties") if isinstance(sub.get("additionalProperties"), dict) else None
-        if "properties" in sub and not prefix:
+        kinds = sub.get("items", {}).get("oneOf", []) if sub.get("type") == "array" else []
+        if kinds and not prefix:   # an array of tagged tables ([[element]] of each type)
+            for ref in kinds:
+                table = _resolve(ref, root)
+                tag = table["properties"].get("type", {})
+                yield from _schema_keys(table, root, f"{key}[type={tag.get('const', tag.get('default'))}].")
+        elif "properties" in sub and not prefix:
             yield from _schema_keys(sub, root, f"{key}.")
         elif inner and "properties" in inner and not prefix:
             yield from _schema_keys(inner, root, f"{key}.NAME.")
