@@ -10,6 +10,7 @@ import json
 import math
 import re
 import tempfile
+import tomllib
 import zipfile
 from pathlib import Path
 
@@ -225,6 +226,25 @@ def test_mutated_upd_model_loads_or_is_refused_with_its_name(text):
 @given(_toml_mutations(_ELEMENTS))
 def test_mutated_elements_file_loads_or_is_refused_with_its_name(text):
     _check(_load_elements, text, "el.toml")
+
+
+def _upd_data() -> dict:
+    return tomllib.loads((ROOT / "harmonic_balance" / "bladed_disk" / "upd24.toml").read_text())
+
+
+def _load_upd_data(data):
+    from harmonic_balance.bladed_disk.config import UPDConfig
+
+    cfg = UPDConfig(data, source="u.toml")
+    cfg.validate()
+    return cfg
+
+
+@FUZZ
+@given(_mutations(_upd_data()))
+def test_upd_model_with_any_value_anywhere_loads_or_is_refused_with_its_name(data):
+    """Deeper than TOML text edits: any JSON value (tables, nested lists) at any key."""
+    _check(_load_upd_data, data, "u.toml")
 
 
 def test_refusals_name_the_key():
