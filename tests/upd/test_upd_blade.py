@@ -161,8 +161,8 @@ def test_bad_blade_file_is_refused(case, tmp_path, builtin, capsys):
     ({"file": "b.npz", "K": "K.mtx"}, "either file"),
     ({"forced": "nope"}, "unknown DOF 'nope'"),
     ({"left": ["u_p"]}, "left must name 2"),
-    ({"file": 3}, "file = 3 must be a string"),
-    ({"left": "u_p"}, "must be a list of DOF names"),
+    ({"file": 3}, "blade.file: must be a valid string, got an integer 3"),
+    ({"left": "u_p"}, "blade.left: must be a valid list, got a string 'u_p'"),
 ])
 def test_bad_blade_section_is_refused(keys, match, tmp_path, capsys):
     cfg = _toml(tmp_path, keys)
