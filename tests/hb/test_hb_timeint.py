@@ -6,8 +6,10 @@ from refcheck import check
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, steady_amplitude
 
-#: Agreement required between the converged HB and the reference.
-TI_RTOL = 5e-3
+#: Converged HB against the time integration: H truncation and the march's time-step
+#: error, both deterministic. Measured 1.1e-4 (Jenkins oscillator, H = 7) and 3.6e-5
+#: (2-DOF, H = 5) (revision a12e5f1); 1e-3, 9x the larger.
+TI_RTOL = 1e-3
 #: Steady-state tolerance of the march (extrapolated change per period).
 SS_TOL = 1e-8
 

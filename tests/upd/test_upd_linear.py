@@ -13,9 +13,11 @@ from harmonic_balance.bladed_disk.sector import (
 
 #: Direct solve vs complex modal superposition; measured 2e-8 (free), 4e-7 (stuck).
 MODAL_RTOL = 1e-6
-#: Peak frequency vs undamped natural frequency: shift ~ zeta^2 ~ 4e-6 (0.2 % damping),
-#: measured 3e-6; the required 0.1 % is the bound.
-PEAK_RTOL = 1e-3
+#: Peak frequency vs undamped natural frequency: the displacement peak lies below the
+#: natural frequency by ~zeta^2 = 4e-6 (0.2 % damping). Measured 4.0e-6 (free), 5.0e-6
+#: (stuck) (revision a12e5f1); 2e-5, 4x the larger: deterministic, a shift of the
+#: modes or of the peak search by 2e-5 fails.
+PEAK_RTOL = 2e-5
 
 
 @pytest.mark.parametrize("damper", ["free", "stuck", "sliding"])
