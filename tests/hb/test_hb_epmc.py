@@ -41,7 +41,7 @@ def test_two_dof_forced_peaks_lie_on_the_backbone():
         r = compute_frf(two_dof(True, P=P), "odd:3", (0.5, 1.3))
         w_bb = np.interp(r.peak_amplitude, bb.amplitude, bb.omega)
         check(f"forced peak frequency [rad/s], 2-DOF Jenkins model, P = {P:g}", r.peak_omega, w_bb, rtol=PEAK_RTOL,
-              source="EPMC backbone at the peak's amplitude (phase resonance)")
+              kind="self-consistency", source="EPMC backbone at the peak's amplitude (phase resonance)")
 
 
 def test_backbone_cli_json(capsys):

@@ -34,7 +34,7 @@ def test_converged_hb_peak_agrees_with_time_integration(peaks):
     amp, _, step_err, ss = steady_amplitude(model, r[7].peak_omega, 256, tol=SS_TOL)
     assert ss.converged and step_err < 1e-3  # the reference itself is converged in dt
     check("HB peak amplitude [m], Jenkins oscillator, H = odd:7", r[7].peak_amplitude, amp, rtol=TI_RTOL,
-          source="time integration to steady state (harmonic_balance.timeint)")
+          kind="self-consistency", source="time integration to steady state (harmonic_balance.timeint)")
 
 
 @pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
@@ -45,4 +45,4 @@ def test_two_dof_hb_agrees_with_time_integration_at_the_peak():
     s = march(model, r.peak_omega, 256, tol=SS_TOL)
     assert s.converged
     check("HB peak amplitude [m], 2-DOF Jenkins model, H = odd:5", r.peak_amplitude, s.amplitude, rtol=TI_RTOL,
-          source="time integration to steady state (harmonic_balance.timeint)")
+          kind="self-consistency", source="time integration to steady state (harmonic_balance.timeint)")

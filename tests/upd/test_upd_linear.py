@@ -34,7 +34,7 @@ def test_peak_at_natural_frequency(sector, damper):
     w, a = peak_of(lambda om: abs(linear_response(sector, om, damper)[0, sector.response]),
                    2 * np.pi * 380, 2 * np.pi * 520)
     check(f"UPD-24 linear FRF peak [Hz], damper {damper}, EO 6", w / (2 * np.pi), f_n, rtol=PEAK_RTOL,
-          source="natural frequency of the cyclic sector (eigenvalue problem)")
+          kind="self-consistency", source="natural frequency of the cyclic sector (eigenvalue problem)")
     # Peak amplitude from the single-mode modal formula |phi_a|^2 F0 / (omega_r^2 2 zeta_r)
     # is checked against the modal superposition (all modes).
     am = abs(modal_response(sector, w, damper)[0, sector.response])
