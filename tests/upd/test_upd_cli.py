@@ -5,6 +5,11 @@ import numpy as np
 import pytest
 
 from damper.cli import main
+from harmonic_balance.bladed_disk.solve import TOL_REL
+
+#: Energy imbalance at the peak: the Newton stopping tolerance |R| < solve.TOL_REL max(F0, CF)
+#: bounds it (the solver's guarantee); measured <= 2.4e-15 over these tests (revision a12e5f1).
+ENERGY_IMBALANCE = TOL_REL
 
 
 def _run(argv, capsys):
@@ -22,7 +27,7 @@ def test_frf_json_keys(capsys, tmp_path):
     assert len(out["normal_load_mean"]) == len(out["lift_off"]) == 3
     # the refined peak is not below the grid's largest value
     assert out["peak_amplitude"] >= max(out["amplitude"])
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < ENERGY_IMBALANCE
     assert (tmp_path / "upd_frf.png").exists()
 
 

@@ -6,6 +6,11 @@ import pytest
 
 from harmonic_balance.bladed_disk import solve
 from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.solve import TOL_REL
+
+#: Energy imbalance at the peak: the Newton stopping tolerance |R| < solve.TOL_REL max(F0, CF)
+#: bounds it (the solver's guarantee); measured <= 2.4e-15 over these tests (revision a12e5f1).
+ENERGY_IMBALANCE = TOL_REL
 
 #: Interpolated grid values against Newton at the grid points: measured 1.7e-4 at H = 7
 #: over 400-500 Hz (solve.UPD_TOL); the AFT sampling error of the contacts is as large.
@@ -72,4 +77,4 @@ def test_folded_curve_of_the_craig_bampton_blade_is_followed(tmp_path, capsys):
     amps = a[cross]
     assert amps.max() > 2.5 * amps.min()
     assert out["peak_frequency_hz"] == pytest.approx(422.85, abs=0.01)
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < ENERGY_IMBALANCE

@@ -13,6 +13,11 @@ from damper.cache import Store
 from damper.cli import main
 from damper.upd_geometry import contact_specs, geometry_contacts, geometry_params
 from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.solve import TOL_REL
+
+#: Energy imbalance at the peak: the Newton stopping tolerance |R| < solve.TOL_REL max(F0, CF)
+#: bounds it (the solver's guarantee); measured <= 2.4e-15 over these tests (revision a12e5f1).
+ENERGY_IMBALANCE = TOL_REL
 
 #: Coarse contact grid of the tests (the default is 15).
 GRID = 7
@@ -137,7 +142,7 @@ def test_cli_frf_end_to_end_geometry_contacts(tmp_path, capsys, monkeypatch):
     assert set(rep["points"]) == {"left", "right1", "right2"}
     assert not any(c["cached"] for c in rep["contacts"].values())
     assert rep["time_s"] > 0 and out["peak_amplitude"] > 0
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < ENERGY_IMBALANCE
     # --cf sets the nominal loads: the run's frictionless static loads, CF / (2 cos g)
     N = 300.0 / (2 * np.cos(np.radians(45.0)))
     assert rep["contacts"]["left"]["N_ref"] == pytest.approx(N, rel=1e-9)
