@@ -20,6 +20,11 @@ from harmonic_balance.bladed_disk.sector import (
 from harmonic_balance.bladed_disk.solve import frf, start_point
 from harmonic_balance.bladed_disk.timeint import march_ring
 
+#: Linear peak frequency against the natural frequency: the displacement peak lies ~zeta^2
+#: = 4e-6 below it (0.2 % damping); measured 5.0e-6 (revision a12e5f1); as
+#: test_upd_linear.PEAK_RTOL.
+PEAK_RTOL = 2e-5
+
 #: The same matrices through a file: npz is exact and mmwrite(precision=17) round-trips
 #: a double exactly, so only the order of operations could differ: measured 0 (equal).
 SAME_RTOL = 1e-13
@@ -74,7 +79,7 @@ def test_cli_runs_a_blade_file(from_file, capsys):
     assert modes == json.loads(capsys.readouterr().out)
     assert main(["upd", "frf", "--config", from_file, "--damper", "stuck", "--json"]) == 0
     stuck = json.loads(capsys.readouterr().out)
-    assert stuck["peak_frequency_hz"] == pytest.approx(modes["stuck_hz"][6][0], rel=1e-3)
+    assert stuck["peak_frequency_hz"] == pytest.approx(modes["stuck_hz"][6][0], rel=PEAK_RTOL)
     assert stuck["response_dof"] == "u_a"
 
 

@@ -91,7 +91,7 @@ def test_given_pattern_and_linear_limit(tmp_path, capsys):
     """One given pattern of ones is the tuned disk (amplification 1); linear limit free."""
     out = _run(SMALL + ["--factors", "1", "1", "1", "1", "--damper", "free", "--serial", "--json",
                         "--cache-dir", str(tmp_path)], capsys)
-    assert len(out["samples"]) == 1 and out["max_amplification"] == pytest.approx(1.0, abs=1e-9)
+    assert len(out["samples"]) == 1 and out["max_amplification"] == pytest.approx(1.0, abs=1e-12)  # measured 5.6e-15
 
 
 @pytest.mark.slow
