@@ -17,6 +17,9 @@ DF_RESIDUAL_ATOL = 1e-8
 #: Peak against the describing-function peak (brentq to 1e-14 over minimize_scalar to
 #: 1e-12): measured 6.8e-12 relative (a12e5f1); 150x, as above.
 DF_PEAK_RTOL = 1e-9
+#: Growth of the peak's error the validation check lets pass (refcheck.GROWTH is 10):
+#: set by the searches' tolerances, within which it may move by more than 10x elsewhere.
+SEARCH_GROWTH = 100.0
 #: Energy balance with exact links: W_ext = W_visc + W_friction to the Newton tolerance.
 #: Measured 3.1e-10 of the input work (a12e5f1); 100x, as above.
 ENERGY_RTOL = 3e-8
@@ -62,7 +65,8 @@ def test_h1_reproduces_the_jenkins_describing_function(h1_curve):
 def test_h1_peak_matches_the_describing_function_peak(h1_curve):
     assert h1_curve.peak_interior
     check("H = 1 peak amplitude [m], Jenkins oscillator m = k = kt = 1, c = 0.01, fs = P = 0.05",
-          h1_curve.peak_amplitude, df_peak(), rtol=DF_PEAK_RTOL, source="describing-function peak")
+          h1_curve.peak_amplitude, df_peak(), rtol=DF_PEAK_RTOL, source="describing-function peak",
+          growth=SEARCH_GROWTH)
     assert abs(h1_curve.peak_amplitude / h1_curve.peak_amplitude_h1 - 1) < SAME_PEAK_RTOL  # H = 1
     assert h1_curve.peak_amplitude >= h1_curve.amplitude.max()
 

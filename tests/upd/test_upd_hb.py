@@ -28,6 +28,10 @@ LIMIT_OMEGA_RTOL = 1e-5
 #: squared; measured 9.6e-10 (CF = 3e5 N, the remaining slip) and 7.1e-11 (mu = 0)
 #: (a12e5f1); 1e-7, 100x the larger.
 LIMIT_AMP_RTOL = 1e-7
+#: Growth of these peak errors the validation check lets pass (refcheck.GROWTH is 10):
+#: a peak's position is set by the searches' tolerances, within which it may move by
+#: more than 10x on another platform (and the amplitude's error with its square).
+SEARCH_GROWTH = 100.0
 
 
 def test_frictionless_statics_closed_form(sector):
@@ -86,9 +90,9 @@ def test_high_cf_tends_to_stuck(sector):
     c = frf(hb, 2 * np.pi * np.linspace(470, 490, 21))
     lin = "linear FRF of the stuck sector"
     check("UPD-24 HB peak frequency [rad/s], CF = 3e5 N (stuck limit)", c.peak_omega, w_l, rtol=LIMIT_OMEGA_RTOL,
-          kind="self-consistency", source=lin)
+          kind="self-consistency", source=lin, growth=SEARCH_GROWTH)
     check("UPD-24 HB peak amplitude [m], CF = 3e5 N (stuck limit)", c.peak_amplitude, a_l, rtol=LIMIT_AMP_RTOL,
-          kind="self-consistency", source=lin)
+          kind="self-consistency", source=lin, growth=SEARCH_GROWTH)
 
 
 def test_mu_zero_is_sliding_linear(sector):
@@ -98,9 +102,9 @@ def test_mu_zero_is_sliding_linear(sector):
     c = frf(hb, np.linspace(w_l * 0.97, w_l * 1.03, 21))
     lin = "linear FRF of the sector with sliding contacts"
     check("UPD-24 HB peak frequency [rad/s], mu = 0", c.peak_omega, w_l, rtol=LIMIT_OMEGA_RTOL,
-          kind="self-consistency", source=lin)
+          kind="self-consistency", source=lin, growth=SEARCH_GROWTH)
     check("UPD-24 HB peak amplitude [m], mu = 0", c.peak_amplitude, a_l, rtol=LIMIT_AMP_RTOL,
-          kind="self-consistency", source=lin)
+          kind="self-consistency", source=lin, growth=SEARCH_GROWTH)
 
 
 def test_sector_equals_ring(sector):
