@@ -11,6 +11,9 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
   record each check through ``tests/reference.py``);
 * ``limits.md``: the table of the bounds every size a user types is checked against,
   from the constants of ``damper/limits.py`` and their ``#:`` comments;
+* ``formats.md`` and ``extra/schemas/<name>.schema.json``: every input file format's
+  keys (type, bounds, meaning) and its JSON Schema, from the typed models
+  (``damper.formats``); the schema files are copied into the site's ``schemas/``;
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -144,6 +147,78 @@ def limits_page(docs: Path) -> None:
     _write(docs / "_generated" / "limits.md", text)
 
 
+def formats_page(docs: Path) -> None:
+    """``_generated/formats.md`` (a table of keys per format) and the schema files."""
+    from damper.formats import FORMATS, json_schema, write_schemas
+
+    write_schemas(docs / "_generated" / "extra" / "schemas")
+    parts = []
+    for name, (what, used, _) in FORMATS.items():
+        schema = json_schema(name)
+        parts += [f"## {what}", "", f"Read by {used}. Schema: `schemas/{name}.schema.json` in this site "
+                  f"(`python -m damper.formats DIR` writes it).", "",
+                  "| key | type | bounds | meaning |", "|---|---|---|---|"]
+        parts += [_schema_row(k, v) for k, v in _schema_keys(schema, schema)]
+        parts.append("")
+    _write(docs / "_generated" / "formats.md", "\n".join(parts))
+
+
+def _resolve(node: dict, root: dict) -> dict:
+    ref = node.get("$ref")
+    return root["$defs"][ref.rsplit("/", 1)[-1]] if ref else node
+
+
+def _schema_keys(node: dict, root: dict, prefix: str = ""):
+    """(dotted key, schema) of every leaf key, one level of tables deep (and a named table's items)."""
+    for key, sub in _resolve(node, root).get("properties", {}).items():
+        sub = _resolve(sub, root)
+        inner = sub.get("additionalProperties") if isinstance(sub.get("additionalProperties"), dict) else None
+        kinds = sub.get("items", {}).get("oneOf", []) if sub.get("type") == "array" else []
+        if kinds and not prefix:   # an array of tagged tables ([[element]] of each type)
+            for ref in kinds:
+                table = _resolve(ref, root)
+                tag = table["properties"].get("type", {})
+                yield from _schema_keys(table, root, f"{key}[type={tag.get('const', tag.get('default'))}].")
+        elif "properties" in sub and not prefix:
+            yield from _schema_keys(sub, root, f"{key}.")
+        elif inner and "properties" in inner and not prefix:
+            yield from _schema_keys(inner, root, f"{key}.NAME.")
+        else:
+            yield prefix + key, sub
+
+
+def _schema_type(node: dict) -> str:
+    if "enum" in node or "const" in node:
+        return " or ".join(json.dumps(v) for v in node.get("enum", [node.get("const")]))
+    if "anyOf" in node or "oneOf" in node:
+        kinds = [_schema_type(n) for n in node.get("anyOf", node.get("oneOf")) if n.get("type") != "null"]
+        return " or ".join(k for k in kinds if k) + (" (optional)" if any(
+            n.get("type") == "null" for n in node.get("anyOf", [])) else "")
+    if node.get("type") == "array":
+        n = [node.get("minItems"), node.get("maxItems")]
+        size = f" of {n[0]}" if n[0] is not None and n[0] == n[1] else ""
+        return f"list{size} of {_schema_type(node.get('items', {})) or 'values'}"
+    return {"number": "number", "integer": "integer", "string": "string", "boolean": "boolean",
+            "object": "table"}.get(node.get("type"), "")
+
+
+def _schema_bounds(node: dict) -> str:
+    if node.get("type") == "array":
+        node = node.get("items", {})
+    for alt in node.get("anyOf", []):
+        if alt.get("type") != "null":
+            node = alt.get("items", alt) if alt.get("type") == "array" else alt
+            break
+    marks = (("exclusiveMinimum", "> {}"), ("minimum", ">= {}"), ("exclusiveMaximum", "< {}"), ("maximum", "<= {}"))
+    return ", ".join(f.format(f"{node[k]:g}" if isinstance(node[k], float) else node[k])
+                     for k, f in marks if k in node)
+
+
+def _schema_row(key: str, node: dict) -> str:
+    doc = node.get("description", "").replace("|", "/").replace("\n", " ")
+    return f"| `{key}` | {_schema_type(node).replace('|', '/')} | {_schema_bounds(node)} | {doc} |"
+
+
 def data_page(docs: Path, name: str, render) -> None:
     """Render ``docs/data/<name>.json`` with ``render(data) -> markdown``, or say how to make it."""
     src = docs / "data" / f"{name}.json"
@@ -158,6 +233,7 @@ def all_pages(docs: Path) -> None:
     api_pages(docs)
     cli_page(docs)
     limits_page(docs)
+    formats_page(docs)
     more_pages(docs)
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)
