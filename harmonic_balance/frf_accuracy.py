@@ -1,0 +1,178 @@
+"""Truncation error of a forced-response curve's peak, and curves to a requested accuracy.
+
+:func:`truncation_error` estimates the error in H of a :class:`frf.FRFResult`'s peak
+amplitude and frequency by :mod:`accuracy`'s check at a richer harmonic set;
+:func:`frf_to_accuracy` traces curves with more harmonics until that estimate is below
+a relative tolerance on the peak amplitude, choosing the next H from the observed (or
+assumed) convergence order.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import accuracy as acc
+from .fourier import default_samples, parse_harmonics
+
+#: Highest harmonic the library goes to when raising H for an accuracy (the CLI passes
+#: its own limit): ~H^2 time per curve point.
+MAX_HARMONIC = 200
+#: Margin on the H predicted to meet a tolerance (the order is an estimate).
+H_MARGIN = 1.15
+
+
+def check_problem(prob, harmonics):
+    """The FRFProblem of ``prob``'s model at the richer ``harmonics`` (same residual kind,
+    at least the curve's AFT samples)."""
+    from .frf import FRFProblem
+    from .residual import CondensedResidual
+
+    n_t = max(prob.basis.n_t, default_samples(max(harmonics)))
+    return FRFProblem(prob.model, harmonics, n_t, isinstance(prob.residual, CondensedResidual))
+
+
+def check_peak(result, limit: int = MAX_HARMONIC):
+    """(H', amplitude, omega, seconds) of ``result``'s peak re-solved at the richer set
+    (:func:`accuracy.richer`, capped at ``limit``), or None when the limit leaves no
+    richer set. RuntimeError when the richer set finds no peak there."""
+    import time
+
+    from .frf import TOL_REL
+
+    t0 = time.perf_counter()
+    prob = result.problem
+    hs = acc.richer(prob.basis.harmonics, limit=limit)
+    if hs == prob.basis.harmonics:
+        return None
+    rich = check_problem(prob, hs)
+    xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+    om = np.asarray(result.omega)
+    tol = TOL_REL * max(rich.reference(result.peak_omega), 1e-300)
+    if result.peak_interior:
+        i = int(np.argmax(result.amplitude))
+        _, w, a, _ = acc.peak_at(rich, rich.amplitude, xs, om, i, tol, 1e-6 * abs(om[i]))
+    else:  # the maximum is at an end of the band: the amplitude there
+        from .newton import newton
+
+        i = int(np.argmax(result.amplitude))
+        w = float(om[i])
+        x = newton(lambda z: rich(z, w)[:2], xs[i], tol, 40).x
+        a = rich.amplitude(x, w)
+    return hs[-1], float(a), float(w), time.perf_counter() - t0
+
+
+def truncation_error(result, limit: int = MAX_HARMONIC, levels=()) -> dict:
+    """The ``truncation_error`` record (:func:`accuracy.estimate`) of ``result``'s peak.
+
+    ``levels``: earlier (H, peak amplitude, peak omega) of the same curve at fewer
+    harmonics (an accuracy run), used for the observed order. A check that fails or
+    finds no richer set within ``limit`` gives a record with null estimates and a
+    ``note`` saying why.
+    """
+    H = result.problem.basis.H
+    base = {"method": "richer harmonic set at the peak", "H_used": int(H)}
+    if not np.isfinite(result.peak_amplitude):
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": "no peak to check"}
+    try:
+        got = check_peak(result, limit)
+    except RuntimeError as err:
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": f"check failed: {err}"}
+    if got is None:
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": f"no richer harmonic set within the limit H <= {limit}"}
+    Hc, ac, wc, dt = got
+    w = result.peak_omega if result.peak_interior else float("nan")
+    own = [lv for lv in levels if lv[0] < H] + [(H, result.peak_amplitude, w), (Hc, ac, wc)]
+    out = acc.estimate(own, base["method"] + (" (band end: amplitude only)" if not result.peak_interior
+                                              else ""))
+    out["time_s"] = dt
+    return out
+
+
+def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
+                    limit: int = MAX_HARMONIC, **kwargs):
+    """Forced-response curve whose peak amplitude's estimated truncation error is below
+    ``accuracy`` (relative), raising H per curve.
+
+    Starts at ``harmonics`` (its kind, odd or all, is kept); after each curve the peak
+    is checked at a richer set (:func:`truncation_error`); while the estimate e exceeds
+    ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
+    observed order, else :data:`accuracy.ASSUMED_ORDER`), at least the check's H, at
+    most the highest H whose check still fits within ``limit``. Other keyword arguments
+    go to :func:`frf.compute_frf`.
+
+    Returns
+    -------
+    FRFResult of the last curve, ``truncation_error`` set, ``extra["accuracy"]``:
+    target, met (bool), levels (H, peak amplitude, peak omega per curve and check),
+    H_sequence, message (when the limit stopped it).
+
+    Raises
+    ------
+    ValueError (bad accuracy), frf.FRFError when the first curve fails (a later curve
+    that fails ends the run with the previous result, said in its status).
+    """
+    from .frf import FRFError, compute_frf
+
+    tol = acc.check_accuracy(accuracy)
+    hs = parse_harmonics(harmonics)
+    odd = all(h % 2 for h in hs)
+    top = _curve_limit(hs, limit)
+    levels, seq, best = [], [], None
+    while True:
+        try:
+            res = compute_frf(model, hs, omega_range, truncation_check=False, **kwargs)
+        except FRFError as err:
+            if best is None:
+                raise
+            best.status += (f"; warning: the curve at H = {hs[-1]} failed ({err}), the result at "
+                            f"H = {best.problem.basis.H} is kept")
+            break
+        best = res
+        seq.append(hs[-1])
+        rec = truncation_error(res, limit, levels)
+        res.truncation_error = rec
+        levels = [lv for lv in levels if lv[0] < hs[-1]] + [(hs[-1], res.peak_amplitude, res.peak_omega)]
+        if "check" in rec:
+            levels_all = levels + [(rec["H_check"], rec["check"]["peak_amplitude"], rec["check"]["peak_omega"])]
+        else:
+            levels_all = levels
+        e = rec.get("peak_amplitude_rel")
+        if e is not None and e <= tol:
+            break
+        if e is None or hs[-1] >= top:
+            why = rec.get("note") or f"H = {hs[-1]} is the highest whose check fits the limit H <= {limit}"
+            res.extra["accuracy_message"] = (f"accuracy {tol:g} not reached: {why}; the estimate "
+                                             f"is {_pct(e)} at H = {hs[-1]}")
+            break
+        p = rec.get("order") or acc.ASSUMED_ORDER
+        want = hs[-1] * (e / tol) ** (1.0 / p) * H_MARGIN
+        H_next = min(max(int(math.ceil(want)), rec["H_check"]), top)
+        hs = _harmonic_set(H_next, odd, 0 in hs)
+    best.extra["accuracy"] = {"target": tol, "met": (best.truncation_error or {}).get(
+        "peak_amplitude_rel") is not None and best.truncation_error["peak_amplitude_rel"] <= tol,
+        "H_sequence": seq, "levels": [list(lv) for lv in levels_all],
+        "message": best.extra.get("accuracy_message")}
+    return best
+
+
+def _pct(e) -> str:
+    return "unknown" if e is None else f"{100 * e:.3g} %"
+
+
+def _harmonic_set(H: int, odd: bool, zero: bool) -> tuple:
+    if odd:
+        return tuple(range(1, H + 1 + (H % 2 == 0), 2))
+    return tuple(range(0 if zero else 1, H + 1))
+
+
+def _curve_limit(hs, limit: int) -> int:
+    """Highest H of a curve whose richer check set still fits within ``limit``."""
+    odd = all(h % 2 for h in hs)
+    H = limit
+    while H > hs[-1] and acc.richer(_harmonic_set(H, odd, 0 in hs), limit=None)[-1] > limit:
+        H -= 1
+    return max(H, hs[-1])
