@@ -70,7 +70,8 @@ def check_accuracy(tol) -> float:
 
 def richer(harmonics: tuple, factor: float = RICHER_FACTOR, limit: int | None = None) -> tuple:
     """The harmonic set of the same kind as ``harmonics`` up to the next admissible
-    harmonic at or above ``factor`` H (at least H + 1, or H + 2 for an odd set), capped at
+    harmonic at or above ``factor`` H (at least H + 2, so that a new odd harmonic enters: the
+    even ones vanish on a symmetric friction loop and would check nothing), capped at
     ``limit``: an odd-only set stays odd, a set with 0 keeps 0 and every harmonic.
 
     Returns the new tuple (equal to ``harmonics`` when the limit leaves no room).
@@ -78,7 +79,7 @@ def richer(harmonics: tuple, factor: float = RICHER_FACTOR, limit: int | None = 
     hs = tuple(harmonics)
     H = hs[-1]
     odd = all(h % 2 for h in hs)
-    top = max(int(math.ceil(factor * H - 1e-9)), H + 1)
+    top = max(int(math.ceil(factor * H - 1e-9)), H + 2)
     if odd and top % 2 == 0:
         top += 1
     if limit is not None:

@@ -106,7 +106,8 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
 
     Returns
     -------
-    FRFResult of the last curve, ``truncation_error`` set, ``extra["accuracy"]``:
+    FRFResult of the last curve (``time_s`` and ``evaluations`` of the whole run),
+    ``truncation_error`` set, ``extra["accuracy"]``:
     target, met (bool), levels (H, peak amplitude, peak omega per curve and check),
     H_sequence, message (when the limit stopped it).
 
@@ -121,6 +122,9 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
     hs = parse_harmonics(harmonics)
     odd = all(h % 2 for h in hs)
     top = _curve_limit(hs, limit)
+    import time
+
+    t0, evaluations = time.perf_counter(), 0
     levels, seq, best = [], [], None
     while True:
         try:
@@ -132,9 +136,11 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
                             f"H = {best.problem.basis.H} is kept")
             break
         best = res
+        evaluations += res.evaluations
         seq.append(hs[-1])
         rec = truncation_error(res, limit, levels)
         res.truncation_error = rec
+        res.extra["truncation_warning"] = acc.warning(rec)
         levels = [lv for lv in levels if lv[0] < hs[-1]] + [(hs[-1], res.peak_amplitude, res.peak_omega)]
         if "check" in rec:
             levels_all = levels + [(rec["H_check"], rec["check"]["peak_amplitude"], rec["check"]["peak_omega"])]
@@ -156,6 +162,8 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
         "peak_amplitude_rel") is not None and best.truncation_error["peak_amplitude_rel"] <= tol,
         "H_sequence": seq, "levels": [list(lv) for lv in levels_all],
         "message": best.extra.get("accuracy_message")}
+    best.time_s = time.perf_counter() - t0   # every curve and check of the run
+    best.evaluations = evaluations
     return best
 
 
