@@ -184,3 +184,38 @@ def _curve_limit(hs, limit: int) -> int:
     while H > hs[-1] and acc.richer(_harmonic_set(H, odd, 0 in hs), limit=None)[-1] > limit:
         H -= 1
     return max(H, hs[-1])
+
+
+def summary_lines(summary, hz: bool = False) -> list[str]:
+    """Text lines of the truncation-error estimate, the accuracy run and its warnings
+    (``hz``: frequencies in Hz, else rad/s)."""
+    rec = summary.get("truncation_error") or {}
+    if not rec:
+        return []
+    e, ef = rec.get("peak_amplitude_rel"), rec.get("peak_frequency_rel")
+    if e is None:
+        lines = [f"truncation error: not estimated ({rec.get('note', 'no check')})"]
+    else:
+        lines = [f"truncation error (estimate, H = {rec['H_used']} checked at H = {rec['H_check']}, "
+                 f"order {rec['order']:.2g}{' observed' if rec.get('order_observed') else ' assumed'}): "
+                 f"peak amplitude {100 * e:.2g} %"
+                 + ("" if ef is None else f", peak frequency {100 * ef:.2g} %")]
+    ex = rec.get("extrapolated")
+    if ex:
+        w = ex["peak_omega"]
+        at = (f"{_num(None if w is None else w / (2 * math.pi))} Hz" if hz
+              else f"omega = {_num(w)} rad/s")
+        lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m at {at}")
+    a = summary.get("accuracy")
+    if a:
+        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
+                     f"tried {a['H_sequence']}")
+        if a.get("message"):
+            lines.append(f"warning: {a['message']}")
+    if summary.get("truncation_warning") and not (a and a["met"]):
+        lines.append(summary["truncation_warning"])
+    return lines
+
+
+def _num(v, fmt=".9g") -> str:
+    return "none" if v is None else format(v, fmt)

@@ -259,6 +259,8 @@ def _report_curve_fits(model) -> None:
 
 
 def _emit(args, summary, print_json, atomic_write, dumps):
+    from harmonic_balance.frf_accuracy import summary_lines as accuracy_lines
+
     if args.out:
         atomic_write(args.out, dumps(summary, indent=1) + "\n")
     if args.json:
@@ -290,30 +292,3 @@ def _num(v, fmt=".9g") -> str:
     """A number for the text summary; 'none' when undefined (no converged point)."""
     return "none" if v is None else format(v, fmt)
 
-
-def accuracy_lines(summary) -> list[str]:
-    """Text lines of the truncation-error estimate, the accuracy run and its warnings."""
-    rec = summary.get("truncation_error") or {}
-    if not rec:
-        return []
-    e, ef = rec.get("peak_amplitude_rel"), rec.get("peak_frequency_rel")
-    if e is None:
-        lines = [f"truncation error: not estimated ({rec.get('note', 'no check')})"]
-    else:
-        lines = [f"truncation error (estimate, H = {rec['H_used']} checked at H = {rec['H_check']}, "
-                 f"order {rec['order']:.2g}{' observed' if rec.get('order_observed') else ' assumed'}): "
-                 f"peak amplitude {100 * e:.2g} %"
-                 + ("" if ef is None else f", peak frequency {100 * ef:.2g} %")]
-    ex = rec.get("extrapolated")
-    if ex:
-        lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m at omega = "
-                     f"{_num(ex['peak_omega'])} rad/s")
-    a = summary.get("accuracy")
-    if a:
-        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
-                     f"tried {a['H_sequence']}")
-        if a.get("message"):
-            lines.append(f"warning: {a['message']}")
-    if summary.get("truncation_warning") and not (a and a["met"]):
-        lines.append(summary["truncation_warning"])
-    return lines
