@@ -199,14 +199,16 @@ def estimate(levels, method: str) -> dict:
     p_obs = observed_order([(lv[0], lv[1]) for lv in levels])
     p = ASSUMED_ORDER if p_obs is None else p_obs
     gain = 1.0 / (1.0 - (H / Hc) ** p)
+    # relative to the best value known: the extrapolated one, else the check's
+    a_ref, w_ref = ac + gain * (ac - a) * (H / Hc) ** p, wc + gain * (wc - w) * (H / Hc) ** p
     out = {"method": method, "H_used": int(H), "H_check": int(Hc), "order": p,
            "order_observed": p_obs,
-           "peak_amplitude_rel": gain * abs(a - ac) / abs(ac),
-           "peak_frequency_rel": gain * abs(w - wc) / abs(wc) if np.isfinite(w) and np.isfinite(wc) else None,
+           "peak_amplitude_rel": gain * abs(a - ac) / abs(a_ref if p_obs is not None else ac),
+           "peak_frequency_rel": (gain * abs(w - wc) / abs(w_ref if p_obs is not None else wc)
+                                  if np.isfinite(w) and np.isfinite(wc) else None),
            "check": {"peak_amplitude": ac, "peak_omega": wc}, "extrapolated": None}
     if p_obs is not None:
-        q = (Hc / H) ** p_obs - 1.0
-        out["extrapolated"] = {"peak_amplitude": ac + (ac - a) / q, "peak_omega": wc + (wc - w) / q}
+        out["extrapolated"] = {"peak_amplitude": a_ref, "peak_omega": w_ref}
     return out
 
 
