@@ -118,4 +118,5 @@ class FRF(Kind):
         s = result.data
         return {"peak_frequency_Hz": s["peak_omega"] / (2 * math.pi) if s["peak_omega"] else None,
                 "peak_amplitude_m": s["peak_amplitude"], "points": s["points"],
+                "harmonics_H": max(s["harmonics"]) if s.get("harmonics") else None,
                 "truncation_error_rel": (s.get("truncation_error") or {}).get("peak_amplitude_rel")}
