@@ -319,14 +319,40 @@ def _check_optimize(args) -> None:
     check_out_dir(args.plot, "--plot")
 
 
+def _optimum_truncation(sector, out, args) -> dict:
+    """Truncation-error estimate of the peak at the optimum CF (its curve on the search's
+    grid, checked at ~1.5 H: :mod:`harmonic_balance.bladed_disk.accuracy`)."""
+    from damper import limits
+    from harmonic_balance.bladed_disk.accuracy import truncation_error
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.solve import SolverError, frf
+
+    lo, hi = sector.cfg["load.band_hz"]
+    hb = SectorHB(sector, args.harmonics, cf=out["optimum_cf"])
+    try:
+        c = frf(hb, 2 * np.pi * np.linspace(lo, hi, args.grid))
+    except SolverError as err:
+        return {"method": "richer harmonic set at the peak", "H_used": args.harmonics,
+                "peak_amplitude_rel": None, "peak_frequency_rel": None, "note": f"check failed: {err}"}
+    rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    rec["at"] = "the optimum CF"
+    return rec
+
+
 def run_optimize(args) -> int:
+    import sys
+
+    from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.optimize import optimal_load
 
     from .common import print_json
 
     _check_optimize(args)
-    out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
+    sector = _sector(args)
+    out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
                        workers=args.workers)
+    out["truncation_error"] = _optimum_truncation(sector, out, args)
+    out["truncation_warning"] = warning(out["truncation_error"])
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_optimize(out, args.plot)
@@ -338,6 +364,9 @@ def run_optimize(args) -> int:
         band = out.get("optimum_band_cf")
         if band:  # the minimum is flat: the CF range a design can use
             print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
+    for line in _accuracy_lines(out):
+        if not args.json or line.startswith("warning"):
+            print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
 
 
