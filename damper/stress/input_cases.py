@@ -266,7 +266,8 @@ def _system() -> list[InputCase]:
 def _run() -> list[InputCase]:
     rows = [(f"scene {n[2:-5]}", f"{{fx}}/{n}") for n in (
         "s_loopamp.toml", "s_grid.toml", "s_grid2.toml", "s_forces.toml", "s_forceneg.toml", "s_harm.toml",
-        "s_harm0.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml", "s_fmax.toml",
+        "s_harm0.toml", "s_accuracy.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml",
+        "s_fmax.toml",
         "s_fhuge.toml", "s_zone.toml", "s_hertz.toml", "s_unknown.toml", "s_ckey.toml", "s_want.toml",
         "s_elcontact.toml", "s_fmi.toml", "s_body.toml", "s_both.toml", "s_nu.toml", "s_type.toml", "s_dofs.toml",
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
