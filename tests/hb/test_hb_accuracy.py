@@ -133,3 +133,12 @@ def test_cli_refuses_an_accuracy_outside_its_range(capsys, cmd):
     assert main(cmd) == 2
     cap = capsys.readouterr()
     assert "--accuracy" in cap.err and cap.out == ""
+
+
+def test_upd_frf_json_carries_the_estimate(capsys):
+    """UPD-24 at H = 3 (cheap): the estimate is checked at H = 5 and lands in the JSON."""
+    assert main(["upd", "frf", "--harmonics", "3", "--points", "40", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rec = out["truncation_error"]
+    assert rec["H_used"] == 3 and rec["H_check"] == 5 and rec["peak_amplitude_rel"] > 0
+    assert "truncation_warning" in out
