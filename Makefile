@@ -103,7 +103,9 @@ docs-bench-peers: $(STAMP) cbuild
 # docs-accuracy: the truncation-error estimate against the true error (about 30 minutes).
 docs-accuracy: $(STAMP) cbuild
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy.json -- \
-	  $(PY) -m damper.bench.hb_accuracy --json
+	  $(PY) -m damper.bench.hb_accuracy --only frf --json
+	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy_upd.json -- \
+	  $(PY) -m damper.bench.hb_accuracy --only upd --json
 docs-stress: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/stress.json -- $(VENV)/bin/damper stress --json --out out/stress
 

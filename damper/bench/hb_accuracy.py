@@ -112,17 +112,26 @@ def upd_rows(quick: bool = False) -> list[dict]:
     return rows
 
 
+#: Where each row is printed as soon as it is computed (None: not printed).
+ECHO = None
+
+
 def _row(model, setting, amp, rec, ref, dt) -> dict:
     est = (rec or {}).get("peak_amplitude_rel")
     true = abs(amp - ref) / abs(ref)
-    return {"model": model, "setting": setting, "peak_amplitude": amp, "estimate": est,
-            "true_error": true, "ratio": est / true if est is not None and true > 0 else None,
-            "check_time_s": (rec or {}).get("time_s"), "time_s": dt}
+    row = {"model": model, "setting": setting, "peak_amplitude": amp, "estimate": est,
+           "true_error": true, "ratio": est / true if est is not None and true > 0 else None,
+           "order": (rec or {}).get("order_observed"), "check_time_s": (rec or {}).get("time_s"),
+           "time_s": dt}
+    if ECHO is not None:
+        print_table([row], ECHO, header=False)
+    return row
 
 
-def print_table(rows, out=sys.stdout) -> None:
-    print(f"{'model':24s} {'setting':18s} {'peak':>12s} {'estimate':>9s} {'true':>9s} "
-          f"{'ratio':>6s} {'check s':>8s} {'total s':>8s}", file=out)
+def print_table(rows, out=sys.stdout, header: bool = True) -> None:
+    if header:
+        print(f"{'model':24s} {'setting':18s} {'peak':>12s} {'estimate':>9s} {'true':>9s} "
+              f"{'ratio':>6s} {'check s':>8s} {'total s':>8s}", file=out)
     for r in rows:
         def pct(v):
             return "-" if v is None else f"{100 * v:.3g}%"
@@ -139,12 +148,16 @@ def main(argv=None) -> int:
     ap.add_argument("--json", action="store_true",
                     help="print the rows as one JSON object on stdout (the table on stderr)")
     a = ap.parse_args(argv)
+    global ECHO
+    ECHO = sys.stderr
+    print_table([], sys.stderr)
     rows = []
     if a.only in (None, "frf"):
         rows += frf_rows(a.quick)
     if a.only in (None, "upd"):
         rows += upd_rows(a.quick)
-    print_table(rows, sys.stderr if a.json else sys.stdout)
+    if not a.json:
+        print_table(rows)
     if a.json:
         print(json.dumps({"reference_H": REFERENCE_H, "reference_H_upd": REFERENCE_H_UPD,
                           "quick": a.quick, "rows": rows}))

@@ -11,7 +11,8 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
   record each check through ``tests/reference.py``);
 * ``limits.md``: the table of the bounds every size a user types is checked against,
   from the constants of ``damper/limits.py`` and their ``#:`` comments;
-* ``accuracy.md``: the truncation-error table, from ``docs/data/accuracy.json``
+* ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
+  of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
   (``make docs-accuracy``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
@@ -151,3 +152,4 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "bench_peers", tables.bench)
     data_page(docs, "stress", tables.stress)
     data_page(docs, "accuracy", tables.accuracy)
+    data_page(docs, "accuracy_upd", tables.accuracy)

@@ -12,6 +12,7 @@ MAKE = {
     "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
     "stress": "make docs-stress",
     "accuracy": "make docs-accuracy",
+    "accuracy_upd": "make docs-accuracy",
 }
 
 
