@@ -20,6 +20,10 @@ from .fourier import default_samples, parse_harmonics
 MAX_HARMONIC = 200
 #: Margin on the H predicted to meet a tolerance (the order is an estimate).
 H_MARGIN = 1.15
+#: Largest factor on H from one curve to the next: an assumed order below the true one
+#: would otherwise overshoot (the 3-mass chain at 1e-3 from H = 3: order ~4, predicted
+#: H = 40 where 11 suffices).
+RAISE_MAX = 2.5
 
 
 def check_problem(prob, harmonics):
@@ -32,63 +36,71 @@ def check_problem(prob, harmonics):
     return FRFProblem(prob.model, harmonics, n_t, isinstance(prob.residual, CondensedResidual))
 
 
-def check_peak(result, limit: int = MAX_HARMONIC):
-    """(H', amplitude, omega, seconds) of ``result``'s peak re-solved at the richer set
-    (:func:`accuracy.richer`, capped at ``limit``), or None when the limit leaves no
-    richer set. RuntimeError when the richer set finds no peak there."""
-    import time
+#: Richer levels checked at the peak (H' and H'' = richer(H')): three levels give the
+#: observed order; on the 5-mass chain (order ~1) a single check with the assumed order
+#: underestimates the error 3-7 times, while the second check costs ~2-3 times the first,
+#: 5-30 % of the curve (docs/method/accuracy.md).
+CHECK_LEVELS = 2
 
+
+def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> list:
+    """[(H', amplitude, omega), ...] of ``result``'s peak re-solved at up to ``levels``
+    successively richer sets (:func:`accuracy.richer`, capped at ``limit``; empty when
+    the limit leaves no richer set). RuntimeError when the first richer set finds no peak."""
     from .frf import TOL_REL
 
-    t0 = time.perf_counter()
     prob = result.problem
-    hs = acc.richer(prob.basis.harmonics, limit=limit)
-    if hs == prob.basis.harmonics:
-        return None
-    rich = check_problem(prob, hs)
-    xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+    out, hs = [], prob.basis.harmonics
     om = np.asarray(result.omega)
-    tol = TOL_REL * max(rich.reference(result.peak_omega), 1e-300)
-    if result.peak_interior:
-        i = int(np.argmax(result.amplitude))
-        _, w, a, _ = acc.peak_at(rich, rich.amplitude, xs, om, i, tol, 1e-6 * abs(om[i]))
-    else:  # the maximum is at an end of the band: the amplitude there
-        from .newton import newton
+    i = int(np.argmax(result.amplitude))
+    for k in range(levels):
+        nxt = acc.richer(hs, limit=limit)
+        if nxt == hs:
+            break
+        hs = nxt
+        rich = check_problem(prob, hs)
+        xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+        tol = TOL_REL * max(rich.reference(result.peak_omega), 1e-300)
+        try:
+            if result.peak_interior:
+                _, w, a, _ = acc.peak_at(rich, rich.amplitude, xs, om, i, tol, 1e-6 * abs(om[i]))
+            else:  # the maximum is at an end of the band: the amplitude there
+                from .newton import newton
 
-        i = int(np.argmax(result.amplitude))
-        w = float(om[i])
-        x = newton(lambda z: rich(z, w)[:2], xs[i], tol, 40).x
-        a = rich.amplitude(x, w)
-    return hs[-1], float(a), float(w), time.perf_counter() - t0
+                w = float(om[i])
+                a = rich.amplitude(newton(lambda z, r=rich, w=w: r(z, w)[:2], xs[i], tol, 40).x, w)
+        except RuntimeError:
+            if k == 0:
+                raise
+            break   # the first check stands alone
+        out.append((hs[-1], float(a), float(w)))
+    return out
 
 
-def truncation_error(result, limit: int = MAX_HARMONIC, levels=()) -> dict:
-    """The ``truncation_error`` record (:func:`accuracy.estimate`) of ``result``'s peak.
+def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> dict:
+    """The ``truncation_error`` record (:func:`accuracy.estimate`) of ``result``'s peak,
+    checked at up to ``levels`` richer sets. A check that fails or finds no richer set
+    within ``limit`` gives a record with null estimates and a ``note`` saying why."""
+    import time
 
-    ``levels``: earlier (H, peak amplitude, peak omega) of the same curve at fewer
-    harmonics (an accuracy run), used for the observed order. A check that fails or
-    finds no richer set within ``limit`` gives a record with null estimates and a
-    ``note`` saying why.
-    """
+    t0 = time.perf_counter()
     H = result.problem.basis.H
-    base = {"method": "richer harmonic set at the peak", "H_used": int(H)}
+    base = {"method": "richer harmonic sets at the peak", "H_used": int(H)}
     if not np.isfinite(result.peak_amplitude):
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": "no peak to check"}
     try:
-        got = check_peak(result, limit)
+        checks = check_peak(result, limit, levels)
     except RuntimeError as err:
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": f"check failed: {err}"}
-    if got is None:
+    if not checks:
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": f"no richer harmonic set within the limit H <= {limit}"}
-    Hc, ac, wc, dt = got
     w = result.peak_omega if result.peak_interior else float("nan")
-    own = [lv for lv in levels if lv[0] < H] + [(H, result.peak_amplitude, w), (Hc, ac, wc)]
-    out = acc.estimate(own, base["method"] + (" (band end: amplitude only)" if not result.peak_interior
-                                              else ""))
-    out["time_s"] = dt
+    out = acc.estimate([(H, result.peak_amplitude, w)] + checks,
+                       base["method"] + ("" if result.peak_interior else " (band end: amplitude only)"))
+    out["time_s"] = time.perf_counter() - t0
     return out
 
 
@@ -138,14 +150,11 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
         best = res
         evaluations += res.evaluations
         seq.append(hs[-1])
-        rec = truncation_error(res, limit, levels)
+        rec = truncation_error(res, limit)
         res.truncation_error = rec
         res.extra["truncation_warning"] = acc.warning(rec)
-        levels = [lv for lv in levels if lv[0] < hs[-1]] + [(hs[-1], res.peak_amplitude, res.peak_omega)]
-        if "check" in rec:
-            levels_all = levels + [(rec["H_check"], rec["check"]["peak_amplitude"], rec["check"]["peak_omega"])]
-        else:
-            levels_all = levels
+        levels.append((hs[-1], res.peak_amplitude, res.peak_omega))
+        levels += [(c["H"], c["peak_amplitude"], c["peak_omega"]) for c in rec.get("checks", ())]
         e = rec.get("peak_amplitude_rel")
         if e is not None and e <= tol:
             break
@@ -155,12 +164,12 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
                                              f"is {_pct(e)} at H = {hs[-1]}")
             break
         p = rec.get("order") or acc.ASSUMED_ORDER
-        want = hs[-1] * (e / tol) ** (1.0 / p) * H_MARGIN
-        H_next = min(max(int(math.ceil(want)), rec["H_check"]), top)
+        want = min(hs[-1] * (e / tol) ** (1.0 / p) * H_MARGIN, RAISE_MAX * hs[-1])
+        H_next = min(max(int(math.ceil(want)), rec["checks"][0]["H"]), top)
         hs = _harmonic_set(H_next, odd, 0 in hs)
     best.extra["accuracy"] = {"target": tol, "met": (best.truncation_error or {}).get(
         "peak_amplitude_rel") is not None and best.truncation_error["peak_amplitude_rel"] <= tol,
-        "H_sequence": seq, "levels": [list(lv) for lv in levels_all],
+        "H_sequence": seq, "levels": [list(lv) for lv in levels],
         "message": best.extra.get("accuracy_message")}
     best.time_s = time.perf_counter() - t0   # every curve and check of the run
     best.evaluations = evaluations

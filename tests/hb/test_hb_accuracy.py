@@ -91,8 +91,17 @@ def test_observed_order_and_extrapolation_recover_a_power_law():
     assert abs(acc.observed_order([lv[:2] for lv in levels]) - p) < 1e-9
     rec = acc.estimate(levels, "test")
     assert abs(rec["extrapolated"]["peak_amplitude"] - a_inf) < 1e-12
-    true = abs(levels[1][1] / a_inf - 1)
+    true = abs(levels[0][1] / a_inf - 1)
     assert abs(rec["peak_amplitude_rel"] / true - 1) < 1e-9
+    assert rec["order_observed"] == rec["order"]
+
+
+def test_differences_that_change_sign_fall_back_to_the_largest_two_level_estimate():
+    levels = [(7, 1.02, 1.0), (11, 0.99, 1.0), (17, 1.0, 1.0)]
+    rec = acc.estimate(levels, "test")
+    assert rec["order_observed"] is None and rec["extrapolated"] is None
+    worst = max(abs(1.02 / a - 1) / (1 - (7 / H) ** acc.ASSUMED_ORDER) for H, a, _ in levels[1:])
+    assert abs(rec["peak_amplitude_rel"] / worst - 1) < 1e-12
 
 
 def test_first_harmonics_own_peak_is_not_below_its_value_at_the_peak_of_max_x():
@@ -107,9 +116,10 @@ def test_cli_json_carries_the_estimate_and_both_peaks(capsys):
     assert main(SDOF_ARGS + ["--harmonics", "3", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     rec = out["truncation_error"]
-    for key in ("method", "H_used", "H_check", "peak_amplitude_rel", "peak_frequency_rel", "extrapolated"):
+    for key in ("method", "H_used", "H_check", "checks", "peak_amplitude_rel", "peak_frequency_rel",
+                "extrapolated"):
         assert key in rec
-    assert rec["H_used"] == 3 and rec["H_check"] == 5
+    assert rec["H_used"] == 3 and [c["H"] for c in rec["checks"]] == [5, 8] and rec["H_check"] == 8
     for key in ("peak_h1_max", "peak_h1_max_omega", "peak_amplitude_h1", "truncation_warning"):
         assert key in out
 
@@ -141,4 +151,5 @@ def test_upd_frf_json_carries_the_estimate(capsys):
     out = json.loads(capsys.readouterr().out)
     rec = out["truncation_error"]
     assert rec["H_used"] == 3 and rec["H_check"] == 5 and rec["peak_amplitude_rel"] > 0
+    assert len(rec["checks"]) == 1   # one check on the sector (CHECK_LEVELS)
     assert "truncation_warning" in out
