@@ -220,7 +220,7 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     fails keeps the curve's highest point (``extra["peak_refined"]`` False, a warning in
     the status; :mod:`peaks`). ``truncation_check``: estimate the truncation error of
     the peak in H (``result.truncation_error``, :func:`frf_accuracy.truncation_error`:
-    the peak re-solved with ~1.5 H harmonics, capped at ``max_harmonic``), with a
+    the peak re-solved with ~1.5 H and ~2.25 H harmonics, capped at ``max_harmonic``), with a
     warning in ``extra["truncation_warning"]`` above :data:`accuracy.WARN_REL`.
     ``accuracy``: a relative tolerance on the peak amplitude; the harmonics are then
     raised per curve from ``harmonics`` until the estimate is below it

@@ -110,10 +110,10 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
     ``accuracy`` (relative), raising H per curve.
 
     Starts at ``harmonics`` (its kind, odd or all, is kept); after each curve the peak
-    is checked at a richer set (:func:`truncation_error`); while the estimate e exceeds
+    is checked at richer sets (:func:`truncation_error`); while the estimate e exceeds
     ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
-    observed order, else :data:`accuracy.ASSUMED_ORDER`), at least the check's H, at
-    most the highest H whose check still fits within ``limit``. Other keyword arguments
+    observed order, else :data:`accuracy.ASSUMED_ORDER`), at most RAISE_MAX H, at least
+    the first check's H, at most the highest H whose checks still fit within ``limit``. Other keyword arguments
     go to :func:`frf.compute_frf`.
 
     Returns

@@ -10,7 +10,7 @@ Examples::
 Harmonics and accuracy: ``--harmonics`` fixes the harmonic set; ``--accuracy TOL``
 raises H per curve (from ``--harmonics``, default 3) until the estimated truncation
 error of the peak amplitude is below TOL; with neither, ``--accuracy 0.01`` from H = 3.
-Every result carries that estimate (the peak re-solved with ~1.5 H harmonics,
+Every result carries that estimate (the peak re-solved with ~1.5 H and ~2.25 H harmonics,
 docs/method/accuracy.md) and a warning line when it exceeds 1 %.
 
 ``--model`` is ``sdof`` (a mass on a spring and dashpot with one Jenkins element to
