@@ -19,9 +19,16 @@ Three back ends, the same answers to round-off (tests/bench/test_linsolve.py):
 
 ``DAMPER_SOLVER`` = ``cholmod``, ``pardiso`` or ``scipy`` forces one back end
 (an unavailable one is an error, not a silent fallback).
+
+Reproducibility: a parallel sparse factorization sums in an order that depends on its
+thread count, so the last bits of k_t differed between a serial run (MKL's default, one
+thread per core) and a Dask worker (whose nanny sets ``MKL_NUM_THREADS=1``). Every PARDISO
+call therefore runs on :data:`SOLVER_THREADS` threads wherever it runs (serial, Dask
+worker, any machine): results are bit-for-bit the same across them. SuperLU is serial.
 """
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import functools
 import os
@@ -33,6 +40,40 @@ import scipy.sparse.linalg as spla
 
 #: Right-hand sides per block solve (bounds the dense work array).
 RHS_BLOCK = 256
+
+
+#: Threads of every PARDISO call, whatever MKL_NUM_THREADS or the machine says
+#: (``DAMPER_SOLVER_THREADS`` sets another count; results then differ in the last bits
+#: from runs with another count). One: a Dask worker runs one task per core anyway; a
+#: serial condensation gives up at most the second core's share of its wall time (CPU time
+#: equal: 2.4 s vs 2.5 s user for a 64k-DOF Laplacian on one and two threads, 6d412c9).
+SOLVER_THREADS_DEFAULT = 1
+
+
+def solver_threads() -> int:
+    """Threads of every PARDISO call: ``DAMPER_SOLVER_THREADS`` or :data:`SOLVER_THREADS_DEFAULT`."""
+    text = os.environ.get("DAMPER_SOLVER_THREADS", "").strip()
+    if not text:
+        return SOLVER_THREADS_DEFAULT
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if not 1 <= n <= 1024:
+        raise ValueError(f"DAMPER_SOLVER_THREADS={text!r}: give a whole number of threads from 1 to 1024")
+    return n
+
+
+@contextlib.contextmanager
+def _pinned_mkl_threads():
+    """Run the enclosed PARDISO calls on :func:`solver_threads` threads (MKL's thread-local
+    setting, restored after: other MKL users in the process keep theirs)."""
+    local = _mkl_set_threads_local()
+    previous = local(solver_threads())
+    try:
+        yield
+    finally:
+        local(previous)
 
 
 #: Back ends in order of preference; "superlu" is always available.
@@ -89,8 +130,13 @@ def factorize(K: sp.spmatrix):
 
         solver = pypardiso.PyPardisoSolver(mtype=2)  # real symmetric positive definite
         A = sp.triu(K, format="csr")
-        solver.factorize(A)
-        return lambda B: solver.solve(A, B)
+        with _pinned_mkl_threads():
+            solver.factorize(A)
+
+        def solve(B):
+            with _pinned_mkl_threads():
+                return solver.solve(A, B)
+        return solve
     lu = spla.splu(sp.csc_matrix(K), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options={"SymmetricMode": True})
     return lu.solve
@@ -172,6 +218,18 @@ def _schur_superlu(K: sp.csc_matrix, dofs: np.ndarray, order: np.ndarray) -> np.
 
 
 @functools.cache
+def _mkl_set_threads_local():
+    """MKL's ``mkl_set_num_threads_local(n) -> previous`` (0 restores the global setting)."""
+    import pypardiso
+
+    # the C entry point (the lower-case name is the Fortran one, taking a pointer)
+    fn = pypardiso.PyPardisoSolver().libmkl.MKL_Set_Num_Threads_Local
+    fn.argtypes = [ctypes.c_int]
+    fn.restype = ctypes.c_int
+    return fn
+
+
+@functools.cache
 def _pardiso_lib():
     """The MKL runtime's ``pardiso`` entry point, typed (loaded by pypardiso's lookup)."""
     import pypardiso
@@ -216,13 +274,15 @@ def _schur_pardiso(K: sp.spmatrix, dofs: np.ndarray) -> np.ndarray:
            ctypes.byref(err))
 
     try:
-        call(12, S)  # analysis + factorisation; S receives the Schur complement
+        with _pinned_mkl_threads():
+            call(12, S)  # analysis + factorisation; S receives the Schur complement
         if err.value != 0:
             why = "not positive definite" if err.value == -4 else "see the MKL PARDISO manual"
             raise np.linalg.LinAlgError(f"PARDISO error {err.value} factoring the stiffness ({why}); "
                                         "check the material data and the boundary conditions")
     finally:
-        call(-1, np.zeros(1))  # release PARDISO's memory
+        with _pinned_mkl_threads():
+            call(-1, np.zeros(1))  # release PARDISO's memory
     S = S.reshape(m, m)
     C = sla.inv(0.5 * (S + S.T), check_finite=False)[np.ix_(inv, inv)]
     return 0.5 * (C + C.T)

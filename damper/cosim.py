@@ -37,6 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core.fileformat import parse
+from damper.ring_info import RingInfo
+
 #: Harmonics fitted to one period's samples (0..FIT_HARMONICS).
 FIT_HARMONICS = 9
 #: Default settling tolerance (relative change of the first harmonic, extrapolated).
@@ -58,7 +61,8 @@ class EngineMissing(ValueError):
 
 
 def read_info(ssp) -> dict:
-    """The archive's ``resources/system.json`` (ValueError if it is not a ring archive)."""
+    """The archive's ``resources/system.json``, checked (:class:`damper.ring_info.RingInfo`);
+    ValueError if it is not a ring archive or its description is malformed."""
     path = Path(ssp)
     if not path.is_file():
         raise ValueError(f"{path}: no such SSP archive")
@@ -68,9 +72,10 @@ def read_info(ssp) -> dict:
     except (zipfile.BadZipFile, KeyError, json.JSONDecodeError):
         raise ValueError(f"{path} is not a ring archive of `damper system` (no "
                          "resources/system.json): build one with damper system -o ring.ssp") from None
-    if info.get("kind") != "damper-ring":
+    if not isinstance(info, dict) or info.get("kind") != "damper-ring":
         raise ValueError(f"{path}: resources/system.json is not a damper-ring description")
-    if info.get("fmi_version", 2) != 2:
+    info = parse(RingInfo, info, f"{path}: resources/system.json").model_dump()
+    if info["fmi_version"] != 2:
         raise ValueError(f"{path} holds FMI {info['fmi_version']} FMUs; libcosim runs FMI 2 "
                          "only (build it with damper system --fmi-version 2)")
     return info

@@ -1,8 +1,18 @@
 """Fixtures shared by every test folder."""
 import importlib.util
+import os
 from pathlib import Path
 
-import pytest
+# One BLAS thread in this process and every child, as the ``damper`` command runs (its
+# cli module sets the same): bit-for-bit comparisons between an in-process run and a
+# subprocess or Dask worker then hold whatever the machine's core count, and whether or
+# not pytest is started through the Makefile (which sets it too).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import pytest  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
+
+threadpool_limits(limits=int(os.environ["OPENBLAS_NUM_THREADS"]), user_api="blas")  # numpy may be loaded already
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -84,6 +84,7 @@ def _one_line_warnings(command: str) -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the ``damper`` command; return the process exit code."""
     command = "damper"
+    _blas_threads_as_set()
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
@@ -101,6 +102,20 @@ def main(argv: list[str] | None = None) -> int:
         where = getattr(err, "message", "")
         print(f"damper {command}: {where or 'interrupted'}", file=sys.stderr)
         return 130
+
+
+def _blas_threads_as_set() -> None:
+    """Apply OPENBLAS_NUM_THREADS also when numpy was loaded before this module (``main``
+    called from Python, a test): the environment variable alone is read only at load, and a
+    run in-process must give the same bits as the command."""
+    if "numpy" not in sys.modules:
+        return
+    try:
+        threads = int(os.environ["OPENBLAS_NUM_THREADS"])
+        from threadpoolctl import threadpool_limits
+    except (KeyError, ValueError, ImportError):  # a user's own odd setting: leave BLAS as it is
+        return
+    threadpool_limits(limits=threads, user_api="blas")
 
 
 def _text(err: BaseException) -> str:

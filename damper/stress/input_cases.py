@@ -351,7 +351,28 @@ def _duties() -> list[InputCase]:
     ]
 
 
+def _typed() -> list[InputCase]:
+    """Files well-formed as JSON / TOML that the typed file models refuse (input_fixtures.typed_files)."""
+    cases = []
+    for kind in ("mutrue", "Tstr", "wobble", "plateau", "huge"):
+        cases += _table("loop", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json --amplitude 2e-6")], "loop")
+        cases += _table("fmu", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu")], "fmu")
+    for kind in ("wobble", "Nstr"):
+        cases += _table("fmu", [(f"point: normal curve {kind}",
+                                 f"--curve {{fx}}/curve.json -o d.fmu --normal {{fx}}/normal_{kind}.json")], "fmu")
+    for kind in ("mutrue", "mdstr", "band3", "bandnan", "blades"):
+        cases += _table("upd", [(f"config {kind}", f"frf --config {{fx}}/upd_{kind}.toml --points 5")], "upd")
+    cases += _table("upd", [("modes config blades 1e8", "modes --config {fx}/upd_blades.toml")], "upd")
+    cases += _table("system", [("system config blades 1e8", "system --config {fx}/upd_blades.toml -o r.ssp")])
+    from .input_fixtures import forged_ring_infos
+
+    cases += _table("system", [(f"cosim forged system.json: {name}",
+                                f"cosim {{fx}}/ring_{name}.ssp --frequency-hz 448 --periods 2")
+                               for name in forged_ring_infos()])
+    return cases
+
+
 def all_cases() -> list[InputCase]:
     """Every input case, grouped by subcommand."""
     return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _system() + _run()
-            + _sweep() + _cache_and_rest() + _duties())
+            + _sweep() + _cache_and_rest() + _duties() + _typed())

@@ -86,23 +86,38 @@ def cli_page(docs: Path) -> None:
     _write(docs / "_generated" / "cli.md", "\n".join(lines))
 
 
-#: Pages the toctrees of index.md and user/index.md name; any other page found in docs/ or
-#: docs/user/ (added by a part of the project the index does not know yet) is listed
-#: under "More" in the user guide, so the build neither warns nor hides it.
-KNOWN = {
-    "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
-         "changes"},
-    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "system", "scenes",
-             "limits", "studies", "bench_stress"},
-}
+#: The two index pages whose toctrees place the pages of docs/ and docs/user/. Any other
+#: page found there (added by a part of the project the indexes do not name yet) is
+#: listed under "More" in the user guide, so the build neither warns nor hides it.
+INDEXES = ("index.md", "user/index.md")
+
+
+def toctree_pages(docs: Path) -> set[str]:
+    """Pages the toctrees of :data:`INDEXES` name, as paths relative to docs/ without the
+    suffix (``"getting_started"``, ``"user/mistuning"``), the indexes themselves included."""
+    named = {Path(index).with_suffix("").as_posix() for index in INDEXES}
+    for index in INDEXES:
+        base = Path(index).parent
+        inside = False
+        for line in (docs / index).read_text().splitlines():
+            line = line.strip()
+            if line.startswith("```{toctree}"):
+                inside = True
+            elif line.startswith("```"):
+                inside = False
+            elif inside and line and not line.startswith(":"):
+                named.add((base / line).as_posix())
+    return named
 
 
 def more_pages(docs: Path) -> None:
-    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages not in KNOWN."""
+    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages in docs/ and
+    docs/user/ that no toctree of :data:`INDEXES` names."""
+    named = toctree_pages(docs)
     extra = []
-    for sub, known in KNOWN.items():
+    for sub in ("", "user"):
         for p in sorted((docs / sub).glob("*.md")):
-            if p.stem not in known:
+            if (Path(sub) / p.stem).as_posix() not in named:
                 extra.append(p.stem if sub == "user" else f"../{p.stem}")
     text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
     _write(docs / "_generated" / "more.md", text)

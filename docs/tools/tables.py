@@ -54,16 +54,26 @@ def stamp_text(data: dict, name: str) -> str:
             f"are upper bounds and only ratios within one run compare.\n")
 
 
-def validation(data: dict) -> str:
-    recs = data.get("records", [])
-    out = [stamp_text(data, "validation"), "",
-           f"{len(recs)} reference checks in {len({r['test'] for r in recs})} tests; "
-           f"{sum(r['passed'] for r in recs)} passed, {sum(not r['passed'] for r in recs)} failed.", ""]
+#: The two kinds of reference check (tests/refcheck.py), in page order: heading, what it means.
+KINDS = {
+    "independent": ("Independent references",
+                    "The reference owes nothing to this code: a closed form, a published value."),
+    "self-consistency": ("Self-consistency",
+                         "The reference is another part of the same code (a time integration through the "
+                         "same friction element, the linear limit from the same sector matrices, the EPMC "
+                         "backbone of the same model): it catches a part that drifts from the others, not "
+                         "an error they share."),
+}
+
+
+def _validation_rows(recs: list[dict]) -> list[str]:
+    """One table per test folder."""
+    out: list[str] = []
     groups: dict[str, list[dict]] = {}
     for r in recs:
         groups.setdefault(r["test"].split("/")[1] if r["test"].count("/") > 1 else "tests", []).append(r)
     for group in sorted(groups):
-        out += [f"## {group}", "",
+        out += [f"### {group}", "",
                 "| quantity | reference | our value | reference value | tolerance | test |",
                 "|---|---|---|---|---|---|"]
         for r in sorted(groups[group], key=lambda r: (r["test"], r["quantity"])):
@@ -71,6 +81,20 @@ def validation(data: dict) -> str:
             out.append(f"| {_cell(r['quantity'])} | {_cell(r['source'])} | {_g(r['value'], 6)} | "
                        f"{_g(r['reference'], 6)} | {_cell(r['tolerance'])}{mark} | `{r['test']}` |")
         out.append("")
+    return out
+
+
+def validation(data: dict) -> str:
+    recs = data.get("records", [])
+    kind = {k: [r for r in recs if r.get("kind", "independent") == k] for k in KINDS}
+    out = [stamp_text(data, "validation"), "",
+           f"{len(recs)} reference checks in {len({r['test'] for r in recs})} tests "
+           f"({len(kind['independent'])} against independent references, "
+           f"{len(kind['self-consistency'])} of self-consistency); "
+           f"{sum(r['passed'] for r in recs)} passed, {sum(not r['passed'] for r in recs)} failed.", ""]
+    for k, (title, text) in KINDS.items():
+        if kind[k]:
+            out += [f"## {title}", "", text, "", *_validation_rows(kind[k])]
     return "\n".join(out) + "\n"
 
 

@@ -53,3 +53,51 @@ def test_unknown_or_missing_backend_is_an_error(monkeypatch):
     monkeypatch.setenv("DAMPER_SOLVER", "magic")
     with pytest.raises(ValueError, match="use one of"):
         linsolve.backend()
+
+
+#: A 3D Laplacian-like SPD matrix (n^3 DOFs) and 40 right-hand sides: large enough that
+#: MKL PARDISO's forward/backward solves run in parallel on two threads and their last
+#: bits then differ from one thread (seen without the pinned thread count).
+_THREADS_SCRIPT = """
+import hashlib, numpy as np, scipy.sparse as sp
+from contact_core import linsolve
+n = 20
+I = sp.identity(n)
+D = sp.diags([-np.ones(n - 1), 2.05 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1])
+K = (sp.kron(sp.kron(D, I), I) + sp.kron(sp.kron(I, D), I) + sp.kron(sp.kron(I, I), D)).tocsr()
+K = K + sp.diags(np.random.default_rng(20261127).random(K.shape[0]))
+B = np.random.default_rng(11).standard_normal((K.shape[0], 40))
+X = linsolve.factorize(K)(B)
+C = linsolve.compliance_block(K, np.arange(0, n * n, 3))
+print(hashlib.sha1(X.tobytes() + C.tobytes()).hexdigest())
+"""
+
+
+@pytest.mark.slow
+def test_pardiso_bits_do_not_depend_on_mkl_thread_count():
+    """A serial run (MKL: one thread per core) and a Dask worker (MKL_NUM_THREADS=1) give the
+    same bits: every PARDISO call runs on linsolve.SOLVER_THREADS_DEFAULT threads."""
+    import os
+    import subprocess
+    import sys
+
+    if "pardiso" not in linsolve.available_backends():
+        pytest.skip("pypardiso is not installed here")
+    digests = set()
+    for threads in ("1", "2"):
+        env = dict(os.environ, MKL_NUM_THREADS=threads, MKL_DYNAMIC="FALSE", DAMPER_SOLVER="pardiso")
+        env.pop("DAMPER_SOLVER_THREADS", None)
+        out = subprocess.run([sys.executable, "-c", _THREADS_SCRIPT], env=env, capture_output=True, text=True,
+                             check=True)
+        digests.add(out.stdout.strip())
+    assert len(digests) == 1
+
+
+def test_solver_threads_setting_is_checked(monkeypatch):
+    monkeypatch.setenv("DAMPER_SOLVER_THREADS", "two")
+    with pytest.raises(ValueError, match="DAMPER_SOLVER_THREADS='two': give a whole number"):
+        linsolve.solver_threads()
+    monkeypatch.setenv("DAMPER_SOLVER_THREADS", "3")
+    assert linsolve.solver_threads() == 3
+    monkeypatch.delenv("DAMPER_SOLVER_THREADS")
+    assert linsolve.solver_threads() == linsolve.SOLVER_THREADS_DEFAULT

@@ -91,7 +91,7 @@ def test_given_pattern_and_linear_limit(tmp_path, capsys):
     """One given pattern of ones is the tuned disk (amplification 1); linear limit free."""
     out = _run(SMALL + ["--factors", "1", "1", "1", "1", "--damper", "free", "--serial", "--json",
                         "--cache-dir", str(tmp_path)], capsys)
-    assert len(out["samples"]) == 1 and out["max_amplification"] == pytest.approx(1.0, abs=1e-9)
+    assert len(out["samples"]) == 1 and out["max_amplification"] == pytest.approx(1.0, abs=1e-12)  # measured 5.6e-15
 
 
 @pytest.mark.slow
@@ -129,7 +129,6 @@ def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
     import signal
     import subprocess
     import sys
-    import time
 
     code = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
             "from damper.cli import main; sys.exit(main(sys.argv[1:]))")
@@ -138,9 +137,10 @@ def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
     p = subprocess.Popen([sys.executable, "-c", code, *argv], stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     seen = ""
-    while "samples of" not in seen and p.poll() is None:   # the study's line: workers are up
+    # the study's line: the workers are up and the samples go to them; the interrupt
+    # follows it, not a wait
+    while "samples of" not in seen and p.poll() is None:
         seen += p.stderr.readline()
-    time.sleep(1.0)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 130, err
