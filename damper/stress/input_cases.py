@@ -194,6 +194,9 @@ def _frf() -> list[InputCase]:
         ("--out an existing folder", f"{SDOF} {o} --out {{fx}}"),
         ("--out below a file", f"{SDOF} {o} --out {{fx}}/a_file/f.json"),
         ("--plot a file", f"{SDOF} {o} --plot {{fx}}/a_file"),
+        ("accuracy 0", f"{SDOF} {o} --accuracy 0"), ("accuracy 0.5", f"{SDOF} {o} --accuracy 0.5"),
+        ("accuracy 1e-7", f"{SDOF} {o} --accuracy 1e-7"), ("accuracy nan", f"{SDOF} {o} --accuracy nan"),
+        ("accuracy -0.01", f"{SDOF} {o} --accuracy=-0.01"),
     ]
     for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc"):
         rows.append((f"npz {m}", f"--model {{fx}}/m_{m}.npz --elements {{fx}}/el_good.toml --omega 100 300"))
@@ -224,6 +227,7 @@ def _upd() -> list[InputCase]:
         ("frf band nan 1", "frf --band nan 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
         ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
+        ("frf accuracy 0.6", "frf --accuracy 0.6"), ("frf accuracy nan", "frf --accuracy nan"),
         ("config missing", "modes --config {fx}/nowhere.toml"),
         ("config binary", "modes --config {fx}/upd_binary.toml"),
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
@@ -262,7 +266,8 @@ def _system() -> list[InputCase]:
 def _run() -> list[InputCase]:
     rows = [(f"scene {n[2:-5]}", f"{{fx}}/{n}") for n in (
         "s_loopamp.toml", "s_grid.toml", "s_grid2.toml", "s_forces.toml", "s_forceneg.toml", "s_harm.toml",
-        "s_harm0.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml", "s_fmax.toml",
+        "s_harm0.toml", "s_accuracy.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml",
+        "s_fmax.toml",
         "s_fhuge.toml", "s_zone.toml", "s_hertz.toml", "s_unknown.toml", "s_ckey.toml", "s_want.toml",
         "s_elcontact.toml", "s_fmi.toml", "s_body.toml", "s_both.toml", "s_nu.toml", "s_type.toml", "s_dofs.toml",
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",

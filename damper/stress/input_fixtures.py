@@ -132,6 +132,7 @@ SCENE_EDITS = {
     "s_forceneg.toml": ("forces = [30.0]", "forces = [-30.0]"),
     "s_harm.toml": ("harmonics = 3", "harmonics = 100000"),
     "s_harm0.toml": ("harmonics = 3", "harmonics = 0"),
+    "s_accuracy.toml": ("harmonics = 3", "harmonics = 3\naccuracy = 0.6"),
     "s_samples.toml": ("fmi_versions = [2]", "fmi_versions = [2]\nloop_samples = 1000000000"),
     "s_mu0.toml": ("mu = 0.5", "mu = 0.0"),
     "s_mubig.toml": ("mu = 0.5", "mu = 1e300"),

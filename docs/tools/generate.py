@@ -14,6 +14,9 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
 * ``formats.md`` and ``extra/schemas/<name>.schema.json``: every input file format's
   keys (type, bounds, meaning) and its JSON Schema, from the typed models
   (``damper.formats``); the schema files are copied into the site's ``schemas/``;
+* ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
+  of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
+  (``make docs-accuracy``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -239,3 +242,5 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "bench", tables.bench)
     data_page(docs, "bench_peers", tables.bench)
     data_page(docs, "stress", tables.stress)
+    data_page(docs, "accuracy", tables.accuracy)
+    data_page(docs, "accuracy_upd", tables.accuracy)

@@ -11,6 +11,8 @@ MAKE = {
     "bench": "make docs-bench",
     "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
     "stress": "make docs-stress",
+    "accuracy": "make docs-accuracy",
+    "accuracy_upd": "make docs-accuracy",
 }
 
 
@@ -119,6 +121,27 @@ def bench(data: dict) -> str:
             out += ["Model classes (error: |first-harmonic peak / dense reference - 1|):", "",
                     *markdown(models), ""]
     return "\n".join(out) + "\n"
+
+
+def accuracy(data: dict) -> str:
+    """The truncation-error table of ``python -m damper.bench.hb_accuracy --json``."""
+    res = data.get("result", {})
+    out = [stamp_text(data, "accuracy"), "",
+           f"True error: against the curve's peak re-solved with 0..{res.get('reference_H', '?')} "
+           f"harmonics (UPD-24: 0..{res.get('reference_H_upd', '?')}). Ratio: estimate / true error "
+           "(the goal: between 1/3 and 3). Check: the time of the estimate; total: the curve and "
+           "its check (for an accuracy target, every curve and check of the run).", "",
+           "| model | H or target | peak | estimate | true error | ratio | check [s] | total [s] |",
+           "|---|---|---|---|---|---|---|---|"]
+    for r in res.get("rows", []):
+        out.append(f"| {_cell(r['model'])} | {_cell(r['setting'])} | {_g(r['peak_amplitude'], 6)} | "
+                   f"{_pct(r['estimate'])} | {_pct(r['true_error'])} | {_g(r['ratio'])} | "
+                   f"{_g(r['check_time_s'])} | {_g(r['time_s'])} |")
+    return "\n".join(out) + "\n"
+
+
+def _pct(x) -> str:
+    return "-" if x is None else f"{100 * x:.2g} %"
 
 
 def stress(data: dict) -> str:
