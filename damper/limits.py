@@ -58,6 +58,15 @@ MAX_MU = 100.0
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
+#: Normal load range [N] of a friction element (``fmu --n-ref``, ``--preload``): contacts
+#: of friction dampers carry mN to MN, and the slip limits scale with N / N_ref, which
+#: underflows or overflows far outside (N_ref = 1e-320 fails at the FMU's start, 1e308
+#: gives F = 0).
+MIN_NORMAL_LOAD, MAX_NORMAL_LOAD = 1e-6, 1e9
+#: Penalty normal stiffness range [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is a
+#: 0.2 m penetration, at 1e15 N/m a 1 N load one of 1e-15 m (below an atom); far outside,
+#: the start penetration N / k_n overflows or vanishes (k_n = 1e-300 fails at the start).
+MIN_PENALTY_STIFFNESS, MAX_PENALTY_STIFFNESS = 1e3, 1e15
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6
@@ -101,6 +110,16 @@ def harmonics_why(high: int) -> str:
     if high == MAX_UPD_HARMONICS:
         return "the sector's harmonic balance grows as H^2 (H = 15: 7 s for 200 points; H = 50: minutes)"
     return "the harmonic balance grows as H^2 or faster (one DOF: H = 61 takes 27 s; H = 200: minutes)"
+
+
+def check_range(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
+    """``value`` finite in [low, high] (``low`` > 0), else ValueError naming ``name``, the
+    range and ``why``."""
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be finite and > 0 {unit}, got {value:g}")
+    if not low <= value <= high:
+        raise ValueError(f"{name} {value:g} {unit} is outside [{low:g}, {high:g}] {unit}: {why}")
+    return value
 
 
 def check_omega_range(name: str, lo: float, hi: float, unit: str = "rad/s", scale: float = 1.0) -> None:
