@@ -6,6 +6,8 @@ import pytest
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.mistuning import (
+    KAPPA_MAX,
+    KAPPA_MIN,
     LinearRing,
     check_factors,
     draw_factors,
@@ -56,6 +58,37 @@ def test_patterns_seeded_per_sample_and_checked():
         check_factors([1, 1, 1], 4)
     with pytest.raises(ValueError, match="std"):
         draw_factors(4, -0.1, 1, 0)
+
+
+@pytest.mark.parametrize("factors, kind", [([1.0, 1e-300], "stiffness"), ([1.0, 1e308], "stiffness"),
+                                           ([1.0, 0.24], "stiffness"), ([1.0, 4.1], "stiffness"),
+                                           ([1.0, 0.49], "frequency"), ([1.0, 2.01], "frequency")])
+def test_a_factor_outside_the_range_is_refused(factors, kind):
+    """kappa in [0.25, 4], f in [0.5, 2]: a blade beyond is another blade (1e-300: a peak at
+    -1e-124 Hz; 1e308: a singular ring)."""
+    with pytest.raises(ValueError, match=f"blade 1 {kind} factor .* is outside"):
+        check_factors(factors, 2, kind=kind)
+
+
+def test_the_range_ends_are_accepted_and_frequency_factors_squared():
+    assert check_factors([KAPPA_MIN, KAPPA_MAX], 2).tolist() == [KAPPA_MIN, KAPPA_MAX]
+    assert check_factors([0.5, 2.0], 2, kind="frequency").tolist() == [KAPPA_MIN, KAPPA_MAX]
+    # a drawn uniform scatter that leaves the range is refused, not truncated
+    with pytest.raises(ValueError, match="outside \\[0.5, 2\\]"):
+        draw_factors(24, 0.5, 1, 0, "frequency", "uniform")
+    assert np.all(draw_factors(10_000, 0.28, 1, 0, "frequency", "uniform") >= KAPPA_MIN)
+
+
+def test_the_default_band_stays_positive_for_any_scatter():
+    """The band's ends stay within BAND_MARGIN beyond the frequencies a blade can reach
+    (0.5 ... 2 times the tuned ones): positive even for w = 0.02 + 3 * 0.5 (1 - w < 0)."""
+    from damper.mistuning import BAND_MARGIN, default_band
+
+    lo, hi = default_band(422.0, 470.0, 0.02 + 3 * 0.5)
+    assert lo == pytest.approx(422.0 * 0.5 * (1 - BAND_MARGIN), rel=1e-15)
+    assert hi == pytest.approx(470.0 * 2.0 * (1 + BAND_MARGIN), rel=1e-15)
+    lo, hi = default_band(422.0, 470.0, 0.05)              # a small scatter: the margin itself
+    assert (lo, hi) == pytest.approx((422.0 * 0.95, 470.0 * 1.05), rel=1e-15)
 
 
 def test_sparse_ring_residual_equals_dense(sector4):
