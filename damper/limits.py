@@ -67,6 +67,16 @@ MIN_NORMAL_LOAD, MAX_NORMAL_LOAD = 1e-6, 1e9
 #: 0.2 m penetration, at 1e15 N/m a 1 N load one of 1e-15 m (below an atom); far outside,
 #: the start penetration N / k_n overflows or vanishes (k_n = 1e-300 fails at the start).
 MIN_PENALTY_STIFFNESS, MAX_PENALTY_STIFFNESS = 1e3, 1e15
+#: Steps a period of ``damper cosim``: the time-series buffer holds two periods of every
+#: blade's response (1e6 steps: 16 MB a blade), and the default step gives ~2500.
+MAX_COSIM_STEPS_PER_PERIOD = 1_000_000
+#: Periods of ``damper cosim --periods``: a friction-damped ring settles in tens to a few
+#: hundred periods; at the default step a period costs ~0.7 s (UPD-24 ring of 4 blades,
+#: 2428 steps of ~0.3 ms), so 100000 periods is most of a day.
+MAX_COSIM_PERIODS = 100_000
+#: Communication steps of one ``damper cosim`` run (periods x steps a period): ~0.3 ms
+#: each on the 2-core machine, so 5e7 steps is about four hours.
+MAX_COSIM_STEPS = 50_000_000
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6

@@ -274,7 +274,14 @@ def _system() -> list[InputCase]:
         ("cosim archive missing", "cosim {fx}/nowhere.ssp --frequency-hz 400"),
         ("cosim archive binary", "cosim {fx}/binary.bin --frequency-hz 400"),
         ("cosim a text file", "cosim {fx}/a_file --frequency-hz 400"),
-    ])
+        ("cosim an FMU missing from the archive", "cosim {fx}/ring_nofmu.ssp --frequency-hz 400 --json"),
+    ]) + [_case("system", name, f"cosim r.ssp {cmd}", pre=[shlex.split("system --cf 120 --f0 30 -o r.ssp")],
+                timeout=120.0) for name, cmd in (
+        ("cosim frequency 1e-300", "--frequency-hz 1e-300"),
+        ("cosim periods 1e12", "--frequency-hz 448 --periods 1000000000000"),
+        ("cosim 1.2e8 steps", "--frequency-hz 448 --periods 50000"),
+        ("cosim a diverging coupling (--force, 13 x the step limit)",
+         "--frequency-hz 448 --step 1e-4 --periods 20 --force --json"))]
 
 
 def _run() -> list[InputCase]:

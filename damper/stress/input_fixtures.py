@@ -242,18 +242,25 @@ def forged_ring_infos() -> dict[str, object]:
             "coupling_text": info | {"K_next_coupling": "x"}}
 
 
-def _ring_archive(info) -> bytes:
+def _ring_archive(info, ssd: str = "<ssd:SystemStructureDescription/>\n") -> bytes:
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as zf:
-        zf.writestr("SystemStructure.ssd", "<ssd:SystemStructureDescription/>\n")
+        zf.writestr("SystemStructure.ssd", ssd)
         zf.writestr("resources/system.json", json.dumps(info))
     return buf.getvalue()
+
+
+def archives() -> dict[str, bytes]:
+    """A ring archive whose SystemStructure.ssd uses an FMU the archive does not hold."""
+    ssd = ('<ssd:SystemStructureDescription><ssd:System><ssd:Elements><ssd:Component name="blade0" '
+           'source="resources/blade.fmu"/></ssd:Elements></ssd:System></ssd:SystemStructureDescription>\n')
+    return {"ring_nofmu.ssp": _ring_archive(_ring_info(), ssd)}
 
 
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
-    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files()):
+    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):
