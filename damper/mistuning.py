@@ -49,6 +49,15 @@ BAND_MARGIN, BAND_SIGMAS = 0.02, 3.0
 DAMPERS = ("nonlinear", "free", "stuck")
 
 
+class AllSamplesFailed(RuntimeError):
+    """Every sample's solve failed; ``summary`` is the study's JSON with each sample's error
+    (statistics None)."""
+
+    def __init__(self, message: str, summary: dict):
+        super().__init__(message)
+        self.summary = summary
+
+
 @dataclass
 class Study:
     """What a mistuning study computes (SI units; frequencies in Hz).
@@ -295,9 +304,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             s |= {"peak_per_blade": None, "amplification": None, "frequency_hz": None}
         samples.append(s)
     amp = np.array([s["amplification"] for s in samples if s["error"] is None])
-    if amp.size == 0:
-        raise RuntimeError(f"every sample failed; the first: {samples[0]['error']}")
-    return {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
+    out = {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
             "kind": study.kind, "distribution": study.distribution,
             "std": None if study.factors is not None else study.std, "seed": study.seed,
             "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
@@ -305,10 +312,14 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),
-            "max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
-            "std_amplification": float(amp.std()),
-            "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
             "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}
+    if amp.size == 0:
+        raise AllSamplesFailed(f"every sample failed; the first: {samples[0]['error']}",
+                               out | {"max_amplification": None, "mean_amplification": None,
+                                      "std_amplification": None, "quantiles": None})
+    return out | {"max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
+                  "std_amplification": float(amp.std()),
+                  "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES}}
 
 
 def plot_study(out: dict, folder) -> dict:

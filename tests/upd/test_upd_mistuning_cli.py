@@ -87,6 +87,22 @@ def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
     assert last["cached"] == 2 and last["failed"] == 0
 
 
+def test_every_sample_failing_prints_the_object_with_the_errors_and_exits_3(tmp_path, capsys, monkeypatch):
+    import damper.mistuning as mt
+
+    def failing(study, kappa, band, f):
+        raise RuntimeError("ring harmonic balance failed (test)")
+
+    monkeypatch.setattr(mt, "_solve_sample", failing)
+    code = main(SMALL + ["--damper", "stuck", "--std", "0.02", "--samples", "2", "--serial", "--json",
+                         "--cache-dir", str(tmp_path / "c")])
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert code == 3 and "every sample failed" in cap.err.splitlines()[-1]
+    assert out["failed"] == 2 and out["max_amplification"] is None and out["quantiles"] is None
+    assert all("failed (test)" in s["error"] and s["amplification"] is None for s in out["samples"])
+
+
 def test_given_pattern_and_linear_limit(tmp_path, capsys):
     """One given pattern of ones is the tuned disk (amplification 1); linear limit free."""
     out = _run(SMALL + ["--factors", "1", "1", "1", "1", "--damper", "free", "--serial", "--json",
