@@ -141,23 +141,24 @@ def test_scene_mistuning_stage(tmp_path, capsys):
 
 @pytest.mark.slow  # a child process that starts a two-worker Dask cluster: ~10 s
 def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
-    """Ctrl-C while Dask workers run samples: exit 130, our one line, no Dask traceback."""
+    """Ctrl-C while Dask workers run samples: exit 130, our one line, no Dask traceback.
+    SIGINT goes to the whole process group, as a terminal's Ctrl-C does (the workers get it
+    too), as soon as the study's line shows (the workers are up and taking samples)."""
+    import os
     import signal
     import subprocess
     import sys
-    import time
 
     code = ("import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
             "from damper.cli import main; sys.exit(main(sys.argv[1:]))")
     argv = [*SMALL, "--harmonics", "7", "--points", "41", "--std", "0.02", "--samples", "12",
             "--workers", "2", "--json", "--cache-dir", str(tmp_path / "c")]
     p = subprocess.Popen([sys.executable, "-c", code, *argv], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
+                         stderr=subprocess.PIPE, text=True, start_new_session=True)
     seen = ""
     while "samples of" not in seen and p.poll() is None:   # the study's line: workers are up
         seen += p.stderr.readline()
-    time.sleep(1.0)
-    p.send_signal(signal.SIGINT)
+    os.killpg(p.pid, signal.SIGINT)
     out, err = p.communicate(timeout=120)
     assert p.returncode == 130, err
     assert out == "" and "Traceback" not in err and "AllExit" not in err, err
