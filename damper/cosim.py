@@ -86,7 +86,6 @@ def read_info(ssp) -> dict:
     except (zipfile.BadZipFile, KeyError, json.JSONDecodeError):
         raise ValueError(f"{path} is not a ring archive of `damper system` (no "
                          "resources/system.json): build one with damper system -o ring.ssp") from None
-    _check_members(path)
     if not isinstance(info, dict) or info.get("kind") != "damper-ring":
         raise ValueError(f"{path}: resources/system.json is not a damper-ring description")
     info = parse(RingInfo, info, f"{path}: resources/system.json").model_dump()
@@ -356,6 +355,7 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
         balance off by more than :data:`MAX_ENERGY_RESIDUAL`).
     """
     info = read_info(ssp)
+    _check_members(Path(ssp))
     limits.check_size("--periods", periods, 1, limits.MAX_COSIM_PERIODS,
                       "a ring settles in tens to hundreds of periods; a period costs ~0.7 s at the default step")
     if not (np.isfinite(tol) and tol >= 0):
