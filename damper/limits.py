@@ -58,15 +58,20 @@ MAX_MU = 100.0
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
-#: Normal load range [N] of a friction element (``fmu --n-ref``, ``--preload``): contacts
-#: of friction dampers carry mN to MN, and the slip limits scale with N / N_ref, which
-#: underflows or overflows far outside (N_ref = 1e-320 fails at the FMU's start, 1e308
-#: gives F = 0).
-MIN_NORMAL_LOAD, MAX_NORMAL_LOAD = 1e-6, 1e9
-#: Penalty normal stiffness range [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is a
-#: 0.2 m penetration, at 1e15 N/m a 1 N load one of 1e-15 m (below an atom); far outside,
-#: the start penetration N / k_n overflows or vanishes (k_n = 1e-300 fails at the start).
-MIN_PENALTY_STIFFNESS, MAX_PENALTY_STIFFNESS = 1e3, 1e15
+#: Smallest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): the
+#: slip limits scale with N / N_ref, which overflows far below (N_ref = 1e-320 fails at
+#: the FMU's start); contacts of friction dampers carry mN to MN.
+MIN_NORMAL_LOAD = 1e-6
+#: Largest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): far
+#: above, N / N_ref underflows (N_ref = 1e308 gives F = 0).
+MAX_NORMAL_LOAD = 1e9
+#: Smallest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is
+#: a 0.2 m penetration; far below, the start penetration N / k_n overflows (k_n = 1e-300
+#: fails at the start).
+MIN_PENALTY_STIFFNESS = 1e3
+#: Largest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e15 N/m a 1 N load is a
+#: penetration of 1e-15 m, below an atom.
+MAX_PENALTY_STIFFNESS = 1e15
 #: Steps a period of ``damper cosim``: the time-series buffer holds two periods of every
 #: blade's response (1e6 steps: 16 MB a blade), and the default step gives ~2500.
 MAX_COSIM_STEPS_PER_PERIOD = 1_000_000
