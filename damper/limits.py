@@ -38,7 +38,7 @@ MAX_UPD_GRID = 2000
 #: Points of the F-approach curve of ``damper normal --curve``: one normal solve each.
 MAX_APPROACH_POINTS = 1000
 #: Samples of a mistuning study: each is a curve of the whole ring (~20 s CPU at 24
-#: blades, H = 7; ~2 s in a linear limit, every local peak refined), so 10000 samples is days of CPU.
+#: blades, H = 7; ~4 s in a linear limit, every local peak refined), so 10000 samples is days of CPU.
 MAX_MISTUNING_SAMPLES = 10000
 #: Blades of a mistuned ring: its prestress statics use dense matrices ((7 N_b)^2 numbers,
 #: 190 MB for three at 400 blades) and a curve costs ~0.4 s CPU per blade at H = 7.

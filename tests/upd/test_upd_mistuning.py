@@ -157,12 +157,15 @@ def test_linear_tuned_ring_equals_sector_and_amplification_at_zero(sector24):
 DENSE_RTOL = 1e-7
 
 
-def test_every_local_peak_of_a_blade_is_refined(sector24):
-    """Damper free, std 0.02, sample 0 of seed 1 on the study's default band (41 points):
-    blade 14 has two peaks 3 Hz apart (423.3 and 426.1 Hz), the grid's largest value next
-    to the lower one. Each blade's refined peak must reach a dense solve's largest value
-    (801 points); refining the grid's largest value alone gave blade 14 5.4 % low."""
-    kappa = draw_factors(24, 0.02, 1, 0)
+@pytest.mark.parametrize("sample", [0, 9])
+def test_every_local_peak_of_a_blade_is_refined(sector24, sample):
+    """Damper free, std 0.02, samples of seed 1 on the study's default band (41 points).
+    Sample 0: blade 14 has two peaks 3 Hz apart (423.3 and 426.1 Hz); refining the grid's
+    largest value alone gave it 5.4 % low. Sample 9: blade 1's highest peak (427.8 Hz)
+    lies on the flank of another and is no local maximum of the grid; refining the grid's
+    local maxima alone gave it 1.9 % low (the largest alone: blade 22 12 % low). Each
+    blade's refined peak must reach a dense solve's largest value (801 points)."""
+    kappa = draw_factors(24, 0.02, 1, sample)
     band = (404.82083293076846, 447.43355218663885)   # damper.mistuning.tuned_reference
     ring = LinearRing(sector24, kappa, "free")
     peaks, w = ring.peaks(2 * np.pi * np.linspace(*band, 41))
@@ -170,7 +173,7 @@ def test_every_local_peak_of_a_blade_is_refined(sector24):
     A = np.abs(np.array([ring.response(x) for x in dense]))
     assert np.all(peaks >= A.max(axis=0) * (1 - DENSE_RTOL)), (peaks / A.max(axis=0) - 1).min()
     # the refined values are the curve's own (not an overshoot of the search)
-    for j in (14, int(peaks.argmax())):
+    for j in (1, 14, int(peaks.argmax())):
         assert abs(ring.response(w[j])[j]) == pytest.approx(peaks[j], rel=1e-12)
 
 
