@@ -90,7 +90,7 @@ def _mistuning(s) -> None:
 def run_mistuning(args) -> int:
     import sys
 
-    from damper.mistuning import Study, plot_study, run_study
+    from damper.mistuning import AllSamplesFailed, Study, plot_study, run_study
 
     from .cache import store_from_args
     from .common import check_out_dir, print_json
@@ -120,21 +120,31 @@ def run_mistuning(args) -> int:
 
         raise Interrupted("mistuning interrupted; the samples finished so far are in the cache, "
                           "the same command resumes") from None
+    except AllSamplesFailed as err:  # the object with every sample's error, then exit 3
+        if args.json:
+            print_json(err.summary)
+        else:
+            _print_samples(err.summary)
+        raise
     if args.plot:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
         return 0
-    for s in out["samples"]:
-        print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
-              f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
-              else f"failed: {s['error']}"))
+    _print_samples(out)
     q = out["quantiles"]
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
           f"max {out['max_amplification']:.4f}, mean {out['mean_amplification']:.4f}, median {q['0.5']:.4f}, "
           f"95 % {q['0.95']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); {out['failed']} failed, "
           f"{out['cached']} from the cache, {out['time_s']:.1f} s")
     return 0
+
+
+def _print_samples(out: dict) -> None:
+    for s in out["samples"]:
+        print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
+              f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
+              else f"failed: {s['error']}"))
 
 
 def _common(p) -> None:

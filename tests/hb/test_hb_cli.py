@@ -98,6 +98,23 @@ def test_npz_and_toml_model_equals_the_same_model_built_in_python(tmp_path, caps
     assert abs(out["peak_omega"] / ref.peak_omega - 1) < SAME_MODEL_RTOL
 
 
+@pytest.mark.parametrize("command", ["frf", "backbone"])
+def test_a_complex_stiffness_is_refused_not_made_real(tmp_path, capsys, command):
+    """K (1 + i eta), a loss factor: refused with what to give instead (real K and C), no
+    ComplexWarning and no result from the real part alone."""
+    write_two_dof(tmp_path)
+    with np.load(tmp_path / "m.npz") as z:
+        arrays = dict(z)
+    np.savez(tmp_path / "m.npz", **(arrays | {"K": arrays["K"] * (1 + 0.02j)}))
+    span = ["--omega", "0.6", "2.0"] if command == "frf" else ["--amplitude", "1e-3", "1"]
+    code = main([command, "--model", str(tmp_path / "m.npz"), "--elements", str(tmp_path / "e.toml"),
+                 *span, "--json"])
+    cap = capsys.readouterr()
+    assert code == 2 and cap.out == ""
+    assert "K is complex" in cap.err and "damping as a real matrix C" in cap.err
+    assert "ComplexWarning" not in cap.err and len(cap.err.splitlines()) == 1
+
+
 def test_bad_elements_file_exits_2(tmp_path, capsys):
     write_two_dof(tmp_path)
     (tmp_path / "e.toml").write_text('[[element]]\ndofs = [0, 5]\nk = 1.0\nfs = 0.1\n')

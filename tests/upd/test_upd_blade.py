@@ -143,12 +143,15 @@ def _bad_arrays(builtin, case):
         arr["K_next"][0, 0] = np.nan
     elif case == "missing K":
         del arr["K"]
+    elif case == "complex K":  # a loss factor: hysteretic damping is not modelled
+        arr["K"] = arr["K"] * (1 + 0.01j)
     return arr
 
 
 BAD = {"nonsymmetric M": "M is not symmetric", "indefinite M": "M is not positive definite",
        "indefinite K": "K \\+ K_next \\+ K_next\\^T is indefinite", "wrong shape": "K has shape",
-       "unknown DOF": "unknown DOF 'w_p'", "NaN": "K_next has NaN", "missing K": "M and K"}
+       "unknown DOF": "unknown DOF 'w_p'", "NaN": "K_next has NaN", "missing K": "M and K",
+       "complex K": "K is complex"}
 
 
 @pytest.mark.parametrize("case", sorted(BAD))
