@@ -243,8 +243,24 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
         raise ValueError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
 
 
+#: Arrays of a model file that must be real (the structure's matrices and modal data; the
+#: force may be complex: its phase).
+REAL_ARRAYS = ("M", "K", "C", "phi", "omega_r", "zeta_r")
+
+
+def refuse_complex(data: dict, names, where: str) -> None:
+    """ValueError when one of ``names`` in ``data`` is complex (e.g. K (1 + i eta), a loss
+    factor): hysteretic damping is not modelled, and making it real would drop it silently."""
+    for k in names:
+        if k in data and data[k] is not None and np.iscomplexobj(data[k]):
+            raise ValueError(f"{where}: {k} is complex (a loss factor, i.e. hysteretic damping, is not "
+                             f"supported): give a real {k} and the damping as a real matrix C "
+                             "(viscous; e.g. C = eta K / omega at the frequency of interest)")
+
+
 def _matrices_from(data: dict, path: Path) -> tuple[LinearModel, dict, int]:
     keys = set(data)
+    refuse_complex(data, REAL_ARRAYS, str(path))
     if {"M", "K"} <= keys:
         lin = LinearModel(M=data["M"], C=data["C"] if "C" in keys else None, K=data["K"])
         try:

@@ -148,6 +148,9 @@ SWEEP = {
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
                       "sizes the steps below it)", default=0.5, gt=0),
+    "accuracy": Field("float", "relative accuracy of the peak amplitude: the harmonics are raised "
+                      "from `harmonics` until the estimated truncation error is below it (unset: "
+                      "the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
 }
 
 BACKBONE = {

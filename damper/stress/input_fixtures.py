@@ -39,7 +39,15 @@ def curves() -> dict[str, str | bytes]:
             "curve_convex.json": json.dumps(convex), "curve_dip.json": json.dumps(dip),
             "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
             "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
-            "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")})}
+            "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")}),
+            "normal_120.json": json.dumps(_normal_curve(120.0))}
+
+
+def _normal_curve(top: float, n: int = 8) -> dict:
+    """A Hertzian normal approach curve N = top (p / p_top)^(3/2) up to ``top`` [N]."""
+    N = top * np.linspace(0.0, 1.0, n)
+    return {"schema": "damper-normal-curve/1", "approach": (1e-6 * (N / top) ** (2 / 3)).tolist(),
+            "N": N.tolist(), "load": top}
 
 
 def _npz(**arrays) -> bytes:
@@ -64,7 +72,8 @@ def matrices() -> dict[str, bytes]:
             "m_forcelen.npz": _npz(M=M, K=K, force=np.ones(5)),
             "m_cnan.npz": _npz(M=M, K=K, C=np.full((2, 2), np.inf), force=f),
             "m_text.npz": b"M = [[1, 0], [0, 1]]\n", "m_empty.npz": b"",
-            "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200]}
+            "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200],
+            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f)}
 
 
 def elements() -> dict[str, str | bytes]:
@@ -132,6 +141,7 @@ SCENE_EDITS = {
     "s_forceneg.toml": ("forces = [30.0]", "forces = [-30.0]"),
     "s_harm.toml": ("harmonics = 3", "harmonics = 100000"),
     "s_harm0.toml": ("harmonics = 3", "harmonics = 0"),
+    "s_accuracy.toml": ("harmonics = 3", "harmonics = 3\naccuracy = 0.6"),
     "s_samples.toml": ("fmi_versions = [2]", "fmi_versions = [2]\nloop_samples = 1000000000"),
     "s_mu0.toml": ("mu = 0.5", "mu = 0.0"),
     "s_mubig.toml": ("mu = 0.5", "mu = 1e300"),
@@ -198,7 +208,7 @@ def _forged_sizes(blob: bytes, size: int) -> bytes:
     return bytes(out)
 
 
-def archives() -> dict[str, bytes]:
+def forged_archives() -> dict[str, bytes]:
     """Forged archives: members declaring 4 GiB (an SSP, a model .npz), an SSP of 5000
     members, Matrix Market headers declaring a 1e8 x 1e8 matrix and 1e12 entries."""
     buf = io.BytesIO()
@@ -261,18 +271,26 @@ def forged_ring_infos() -> dict[str, object]:
             "coupling_text": info | {"K_next_coupling": "x"}}
 
 
-def _ring_archive(info) -> bytes:
+def _ring_archive(info, ssd: str = "<ssd:SystemStructureDescription/>\n") -> bytes:
     buf = io.BytesIO()
     with zipfile.ZipFile(buf, "w") as zf:
-        zf.writestr("SystemStructure.ssd", "<ssd:SystemStructureDescription/>\n")
+        zf.writestr("SystemStructure.ssd", ssd)
         zf.writestr("resources/system.json", json.dumps(info))
     return buf.getvalue()
+
+
+def archives() -> dict[str, bytes]:
+    """A ring archive whose SystemStructure.ssd uses an FMU the archive does not hold."""
+    ssd = ('<ssd:SystemStructureDescription><ssd:System><ssd:Elements><ssd:Component name="blade0" '
+           'source="resources/blade.fmu"/></ssd:Elements></ssd:System></ssd:SystemStructureDescription>\n')
+    return {"ring_nofmu.ssp": _ring_archive(_ring_info(), ssd)}
 
 
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
-    for group in (curves(), matrices(), elements(), scenes(), upd_files(), archives(), typed_files()):
+    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives(),
+                  forged_archives()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):

@@ -14,6 +14,9 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
 * ``formats.md`` and ``extra/schemas/<name>.schema.json``: every input file format's
   keys (type, bounds, meaning) and its JSON Schema, from the typed models
   (``damper.formats``); the schema files are copied into the site's ``schemas/``;
+* ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
+  of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
+  (``make docs-accuracy``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -86,23 +89,38 @@ def cli_page(docs: Path) -> None:
     _write(docs / "_generated" / "cli.md", "\n".join(lines))
 
 
-#: Pages the toctrees of index.md and user/index.md name; any other page found in docs/ or
-#: docs/user/ (added by a part of the project the index does not know yet) is listed
-#: under "More" in the user guide, so the build neither warns nor hides it.
-KNOWN = {
-    "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
-         "changes"},
-    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "system", "scenes",
-             "limits", "studies", "bench_stress", "formats"},
-}
+#: The two index pages whose toctrees place the pages of docs/ and docs/user/. Any other
+#: page found there (added by a part of the project the indexes do not name yet) is
+#: listed under "More" in the user guide, so the build neither warns nor hides it.
+INDEXES = ("index.md", "user/index.md")
+
+
+def toctree_pages(docs: Path) -> set[str]:
+    """Pages the toctrees of :data:`INDEXES` name, as paths relative to docs/ without the
+    suffix (``"getting_started"``, ``"user/mistuning"``), the indexes themselves included."""
+    named = {Path(index).with_suffix("").as_posix() for index in INDEXES}
+    for index in INDEXES:
+        base = Path(index).parent
+        inside = False
+        for line in (docs / index).read_text().splitlines():
+            line = line.strip()
+            if line.startswith("```{toctree}"):
+                inside = True
+            elif line.startswith("```"):
+                inside = False
+            elif inside and line and not line.startswith(":"):
+                named.add((base / line).as_posix())
+    return named
 
 
 def more_pages(docs: Path) -> None:
-    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages not in KNOWN."""
+    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages in docs/ and
+    docs/user/ that no toctree of :data:`INDEXES` names."""
+    named = toctree_pages(docs)
     extra = []
-    for sub, known in KNOWN.items():
+    for sub in ("", "user"):
         for p in sorted((docs / sub).glob("*.md")):
-            if p.stem not in known:
+            if (Path(sub) / p.stem).as_posix() not in named:
                 extra.append(p.stem if sub == "user" else f"../{p.stem}")
     text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
     _write(docs / "_generated" / "more.md", text)
@@ -250,3 +268,5 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "bench", tables.bench)
     data_page(docs, "bench_peers", tables.bench)
     data_page(docs, "stress", tables.stress)
+    data_page(docs, "accuracy", tables.accuracy)
+    data_page(docs, "accuracy_upd", tables.accuracy)

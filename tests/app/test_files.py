@@ -183,7 +183,7 @@ def test_garbage_as_npz_is_not_called_pickled_data(tmp_path):
 
 
 def test_forged_archives_are_refused_before_unpacking(tmp_path):
-    arch = fx.archives()
+    arch = fx.forged_archives()
     for name in ("bomb.ssp", "many.ssp", "m_bomb.npz"):
         (tmp_path / name).write_bytes(arch[name])
     with pytest.raises(ValueError, match="unpack to 4.0 GiB, above the limit"):
@@ -197,7 +197,7 @@ def test_forged_archives_are_refused_before_unpacking(tmp_path):
 
 
 def test_a_matrix_market_header_declaring_1e8_squared_is_refused_from_the_header(tmp_path, capsys):
-    arch = fx.archives()
+    arch = fx.forged_archives()
     for name in ("big_M.mtx", "big_K.mtx", "upd_bigmtx.toml"):
         (tmp_path / name).write_bytes(arch[name])
     with pytest.raises(ValueError, match=r"100000000 x 100000000 matrix .* 71.1 PiB"):
