@@ -242,7 +242,8 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if accuracy is not None:
         from .frf_accuracy import frf_to_accuracy
 
-        return frf_to_accuracy(model, accuracy, omega_range, harmonics, max_harmonic, n_t=n_t,
+        return frf_to_accuracy(compute_frf, model, accuracy, omega_range, harmonics, max_harmonic,
+                               tol_rel=TOL_REL, n_t=n_t,
                                condensed=condensed, ds_max=ds_max, max_points=max_points,
                                refine=refine, stability=stability, progress=progress, aft=aft,
                                tolerance=tolerance)
@@ -303,7 +304,7 @@ def _check_truncation(result: FRFResult, max_harmonic: int) -> None:
     from .accuracy import warning
     from .frf_accuracy import truncation_error
 
-    result.truncation_error = truncation_error(result, max_harmonic)
+    result.truncation_error = truncation_error(result, max_harmonic, tol_rel=TOL_REL)
     result.extra["truncation_warning"] = warning(result.truncation_error)
 
 
