@@ -142,9 +142,18 @@ class _Scaled:
     def __init__(self, fun, s_x, s_lam, tol):
         self.fun, self.s_x, self.s_lam, self.tol = fun, s_x, s_lam, tol
 
-    def jac(self, y):
+    def jac(self, y, row=None):
+        """R and the scaled Jacobian [R_x s_x, R_lam s_lam] (N, N + 1), with ``row`` (N + 1,)
+        appended as its last row when given (the corrector's plane: one (N + 1)^2 array
+        written once, not stacked from copies)."""
         R, Jx, Jl = self.fun(y[:-1] * self.s_x, y[-1] * self.s_lam)
-        return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
+        n = Jx.shape[0]
+        J = np.empty((n + (row is not None), Jx.shape[1] + 1))
+        np.multiply(Jx, self.s_x, out=J[:n, :-1])
+        J[:n, -1] = Jl * self.s_lam
+        if row is not None:
+            J[n] = row
+        return R, J
 
     def value(self, y):
         """R alone at y (``fun.value``), or None when ``fun`` has no such method."""
@@ -190,8 +199,8 @@ class _Scaled:
         in scaled units, e.g. during peak refinement).
         """
         def aug(d):
-            R, J = self.jac(y_pred + d)
-            return np.append(R, normal @ d), np.vstack([J, normal])
+            R, J = self.jac(y_pred + d, normal)
+            return np.append(R, normal @ d), J
 
         def value(d):
             return np.append(self.value(y_pred + d), normal @ d)
