@@ -139,8 +139,21 @@ class FRFProblem:
         self.evaluations = 0
 
     def __call__(self, x, omega):
-        self.evaluations += 1
+        if not self._valued(x, omega):
+            self.evaluations += 1
         return self.residual(x, omega)
+
+    def value(self, x, omega):
+        """R alone (the residual's ``value``: a line search's trial point)."""
+        self.evaluations += 1
+        self._last_value = (x.copy(), omega)
+        return self.residual.value(x, omega)
+
+    def _valued(self, x, omega) -> bool:
+        """True when :meth:`value` was last called at this point (its Jacobian is no new
+        evaluation of the elements)."""
+        last, self._last_value = getattr(self, "_last_value", None), None
+        return last is not None and last[1] == omega and np.array_equal(last[0], x)
 
     def response(self, x, omega) -> np.ndarray:
         """Harmonics (n_b,) of the response DOF."""
