@@ -87,23 +87,24 @@ def quantile_ci(x, q: float, level: float = LEVEL) -> dict:
         ``q``, ``value`` (numpy's default linear interpolation), ``low``, ``high`` (order
         statistics, None where the sample is too small to bound that side), ``coverage``
         (the interval's exact coverage, >= level when both ends exist), ``half_width``
-        ((high - low) / 2, inf when a side is missing).
+        ((high - low) / 2, None when a side is missing: JSON has no infinity).
     """
     xs = np.sort(_sample(x))
     lo, hi, cov = quantile_ci_ranks(xs.size, q, level)
     low = None if lo is None else float(xs[lo - 1])
     high = None if hi is None else float(xs[hi - 1])
-    half = math.inf if low is None or high is None else (high - low) / 2.0
+    half = None if low is None or high is None else (high - low) / 2.0
     return {"q": q, "value": float(np.quantile(xs, q)), "low": low, "high": high,
             "coverage": cov, "half_width": half}
 
 
 def mean_ci(x, level: float = LEVEL) -> dict:
-    """Sample mean of ``x`` (n,) and its Student-t interval (None bounds when n = 1)."""
+    """Sample mean of ``x`` (n,) and its Student-t interval (None bounds and half-width
+    when n = 1)."""
     x = _sample(x)
     m = float(x.mean())
     if x.size < 2:
-        return {"value": m, "low": None, "high": None, "half_width": math.inf}
+        return {"value": m, "low": None, "high": None, "half_width": None}
     half = float(stats.t.ppf(0.5 + level / 2.0, x.size - 1) * x.std(ddof=1) / math.sqrt(x.size))
     return {"value": m, "low": m - half, "high": m + half, "half_width": half}
 
@@ -181,4 +182,5 @@ def summary(x, quantiles=QUANTILES, level: float = LEVEL) -> dict:
 
 def quantile_half_width(x, q: float = 0.95, level: float = LEVEL) -> float:
     """Half-width of the q-quantile's interval (inf while the sample is too small)."""
-    return quantile_ci(x, q, level)["half_width"]
+    h = quantile_ci(x, q, level)["half_width"]
+    return math.inf if h is None else h

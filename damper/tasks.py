@@ -14,13 +14,18 @@ import os
 CONNECT_TIMEOUT = 10
 
 
-def executor(scheduler, workers, serial):
+def executor(scheduler, workers, serial, info: dict | None = None):
     """(submit, gather, close) for a Dask client, or plain calls for ``serial``.
+
+    ``info``, when given, receives ``workers``: the number of processes that run tasks
+    (1 for ``serial``; the cluster's workers when connected).
 
     Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
     be reached within :data:`CONNECT_TIMEOUT` seconds.
     """
+    info = {} if info is None else info
     if serial:
+        info["workers"] = 1
         return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
     from dask.distributed import Client, LocalCluster
 
@@ -31,11 +36,13 @@ def executor(scheduler, workers, serial):
             raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
                           "or give the right --scheduler address (tcp://host:8786)") from None
         cluster = None
+        info["workers"] = max(1, len(client.scheduler_info().get("workers", {})))
     else:
         n = workers or os.cpu_count() or 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
                                silence_logs=logging.CRITICAL)
         client = Client(cluster)
+        info["workers"] = n
 
     def close():
         # After Ctrl-C Dask's gather task ends with an exception nobody retrieves; asyncio

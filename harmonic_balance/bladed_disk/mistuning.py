@@ -254,3 +254,32 @@ def whitehead_bound(n_blades: int) -> float:
     """Whitehead's (1966) largest forced-response amplification of a mistuned disk,
     (1 + sqrt(N_b)) / 2."""
     return 0.5 * (1.0 + np.sqrt(n_blades))
+
+
+class LinearRingFamily:
+    """The linear rings (M2) of one sector and damper state, for any pattern: the tuned
+    ring's matrices and blockdiag(K0) built once, a pattern's stiffness one sparse sum
+    (M1). For a batch of patterns (a Monte Carlo chunk).
+
+    Parameters
+    ----------
+    sector : Sector
+    damper : 'free', 'stuck' or 'sliding'
+    f0 : float, optional  EO force amplitude [N] (default: config)
+    """
+
+    def __init__(self, sector: Sector, damper: str, f0: float | None = None):
+        nb = sector.cfg.blades
+        self.tuned = LinearRing(sector, np.ones(nb), damper, f0)
+        self.B = blade_stiffness(sector, nb, damper == "free")
+
+    def ring(self, kappa) -> LinearRing:
+        """The LinearRing of the stiffness factors ``kappa`` (N_b,), equal to
+        ``LinearRing(sector, kappa, damper, f0)`` to round-off."""
+        import copy
+
+        r = copy.copy(self.tuned)
+        r.kappa = check_factors(kappa, self.tuned.kappa.size)
+        r.K = (self.tuned.K + sp.diags(np.repeat(r.kappa - 1.0, r.n)) @ self.B).tocsr()
+        r.solves = 0
+        return r

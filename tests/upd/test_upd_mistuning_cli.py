@@ -71,10 +71,10 @@ def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
     assert first["cached"] == 0 and first["failed"] == 0
     solve, third = mt._solve_sample, draw_factors(4, 0.02, 3, 2).tolist()
 
-    def failing(study, kappa, band, f):
+    def failing(model, kappa):
         if kappa == third:
             raise RuntimeError("ring harmonic balance failed (test)")
-        return solve(study, kappa, band, f)
+        return solve(model, kappa)
 
     monkeypatch.setattr(mt, "_solve_sample", failing)
     again = _run(args + ["--samples", "3"], capsys)
