@@ -373,7 +373,7 @@ def _run_chunks(common, items, size, submit, gather, window, until_ci, tuned_pea
     wall = time.perf_counter() - t0
     return {"results": results,
             "efficiency": {"cpu_s": cpu, "wall_s": wall, "chunks": len(chunks), "chunk_size": size},
-            "until_ci": {"half_width_target": until_ci, "half_width": half,
+            "until_ci": {"half_width_target": until_ci, "half_width": None if half == float("inf") else half,
                          "samples_used": len(results), "reached": half <= (until_ci or 0.0)}}
 
 

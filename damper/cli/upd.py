@@ -164,8 +164,8 @@ def statistics_lines(out: dict) -> list:
         u = out["until_ci"]
         lines.append(f"  --until-ci {u['half_width_target']:g}: " + (
             f"reached after {u['samples_used']} samples" if u["reached"] else
-            f"not reached after {u['samples_used']} samples (half-width {u['half_width']:.4g}; "
-            "give more --samples)"))
+            f"not reached after {u['samples_used']} samples (half-width "
+            f"{'unbounded' if u['half_width'] is None else format(u['half_width'], '.4g')}; give more --samples)"))
     e = out["efficiency"]
     lines.append(f"parallel efficiency {e['efficiency']:.2f}: {e['cpu_s']:.1f} s CPU in {e['chunks']} "
                  f"chunks of {e['chunk_size']} on {e['workers']} worker(s) in {e['wall_s']:.1f} s")

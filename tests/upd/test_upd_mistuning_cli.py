@@ -35,6 +35,11 @@ def _run(argv, capsys, code=0):
     (["--factors", "1", "1", "1", "1", "--std", "0.1"], "not both"),
     (["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler"),
     (["--workers", "2", "--serial"], "give one of"),
+    (["--until-ci", "0"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "-0.01"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "nan"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "inf"], "until-ci half-width must be finite and > 0"),
+    (["--factors", "1", "1", "1", "1", "--until-ci", "0.01"], "needs random samples"),
 ])
 def test_refused_input_exit_2_nothing_written(tmp_path, capsys, monkeypatch, extra, message):
     monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 1)   # the unreachable scheduler: 1 s
