@@ -82,3 +82,15 @@ def test_printed_summary_has_intervals_fit_and_efficiency(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "mean" in text and "quantile 0.95" in text and "fit " in text
     assert "parallel efficiency" in text
+
+
+def test_scene_until_ci_stops_the_same_as_the_command(tmp_path, capsys):
+    scene = tmp_path / "s.toml"
+    scene.write_text('want = ["mistuning"]\n[mistuning]\nblades = 4\nengine_order = 1\nsamples = 200\n'
+                     'damper = "free"\npoints = 21\nstd = 0.02\nseed = 11\nuntil_ci = 1.0\n')
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--cache-dir", str(tmp_path / "c")]) == 0
+    res = json.loads((tmp_path / "out" / "mistuning" / "result.json").read_text())
+    data = res.get("data", res)
+    capsys.readouterr()
+    cli = _run(SMALL + ["--samples", "200", "--until-ci", "1.0", "--cache-dir", str(tmp_path / "c")], capsys)
+    assert data["until_ci"] == cli["until_ci"] and cli["cached"] == len(cli["samples"])
