@@ -237,6 +237,8 @@ def run_chunk(task: dict) -> dict:
         if model is None:   # a chunk read wholly from the cache builds nothing
             model = SampleModel(Study(**task["study"]), task["band_hz"], task["tuned_frequency_hz"])
         results.append(_run_one(model, store, item))
+    if model is not None:
+        store.evict()       # once per chunk: each check lists the whole cache folder
     return {"results": results, "cpu_s": time.process_time() - c0, "wall_s": time.perf_counter() - t0}
 
 
@@ -252,7 +254,7 @@ def _run_one(model: SampleModel, store: Store, item: dict) -> dict:
         return {"index": item["index"], "error": f"{type(err).__name__}: {err}", "cached": False,
                 "time_s": time.perf_counter() - t0}
     out |= {"index": item["index"], "error": None, "time_s": time.perf_counter() - t0}
-    store.put(item["key"], {}, {"data": out})
+    store.put(item["key"], {}, {"data": out}, evict=False)
     return out | {"cached": False}
 
 

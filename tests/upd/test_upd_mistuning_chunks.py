@@ -94,3 +94,20 @@ def test_scene_until_ci_stops_the_same_as_the_command(tmp_path, capsys):
     capsys.readouterr()
     cli = _run(SMALL + ["--samples", "200", "--until-ci", "1.0", "--cache-dir", str(tmp_path / "c")], capsys)
     assert data["until_ci"] == cli["until_ci"] and cli["cached"] == len(cli["samples"])
+
+
+def test_store_put_without_eviction_then_evict_trims_to_the_limit_oldest_first(tmp_path):
+    """A chunk stores its samples with ``evict=False`` and evicts once at its end."""
+    import os
+    import time
+
+    from damper.cache import Store
+
+    store = Store(tmp_path / "c", max_bytes=10**9)
+    paths = [store.put(f"k{i}", {"a": np.zeros(2000)}, {}, evict=False) for i in range(3)]
+    for i, p in enumerate(paths):        # distinct use times: k0 the least recently used
+        os.utime(p, (time.time() - 100 + i, time.time() - 100 + i))
+    size = paths[0].stat().st_size
+    store.max_bytes = 2 * size + size // 2
+    store.evict()
+    assert [p.exists() for p in paths] == [False, True, True]
