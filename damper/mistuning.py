@@ -355,14 +355,14 @@ def _run_chunks(common, items, size, submit, gather, window, until_ci, tuned_pea
     from damper.mistuning_stats import quantile_half_width
 
     chunks = [items[i:i + size] for i in range(0, len(items), size)]
-    t0, cpu, results = time.perf_counter(), 0.0, []
+    t0, cpu, results, gathered = time.perf_counter(), 0.0, [], 0
     pending, nxt, half = deque(), 0, float("inf")
     while pending or nxt < len(chunks):
         while nxt < len(chunks) and len(pending) < (window if until_ci else len(chunks)):
             pending.append(submit(run_chunk, common | {"items": chunks[nxt]}))
             nxt += 1
         r = gather([pending.popleft()])[0]
-        cpu += r["cpu_s"]
+        cpu, gathered = cpu + r["cpu_s"], gathered + 1
         results += r["results"]
         if until_ci is None:
             continue
@@ -374,7 +374,7 @@ def _run_chunks(common, items, size, submit, gather, window, until_ci, tuned_pea
             break
     wall = time.perf_counter() - t0
     return {"results": results,
-            "efficiency": {"cpu_s": cpu, "wall_s": wall, "chunks": len(chunks), "chunk_size": size},
+            "efficiency": {"cpu_s": cpu, "wall_s": wall, "chunks": gathered, "chunk_size": size},
             "until_ci": {"half_width_target": until_ci, "half_width": None if half == float("inf") else half,
                          "samples_used": len(results), "reached": half <= (until_ci or 0.0)}}
 

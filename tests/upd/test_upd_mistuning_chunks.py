@@ -111,3 +111,25 @@ def test_store_put_without_eviction_then_evict_trims_to_the_limit_oldest_first(t
     store.max_bytes = 2 * size + size // 2
     store.evict()
     assert [p.exists() for p in paths] == [False, True, True]
+
+
+def test_friction_sample_in_a_chunk_equals_the_sample_alone(tmp_path):
+    """The chunk's tuned sector (the starts of every ring solve) carries nothing from one
+    sample to the next: the second sample of a chunk equals the same sample run alone."""
+    from dataclasses import asdict
+
+    from damper.mistuning import Study, fingerprint, run_chunk, run_sample, sample_key, tuned_reference
+
+    study = Study(blades=4, engine_order=1, harmonics=3, points=11, std=0.02, seed=5, samples=2)
+    cfg = study.load()
+    ref = tuned_reference(study, cfg)
+    fp = fingerprint(cfg)
+    common = {"study": asdict(study), "band_hz": ref["band_hz"], "tuned_frequency_hz": ref["tuned_frequency_hz"],
+              "max_bytes": 2**30}
+    items = [{"index": i, "kappa": k.tolist(), "key": sample_key(study, fp, ref["band_hz"], k)}
+             for i, k in enumerate(study.patterns(4))]
+    chunk = run_chunk(common | {"folder": str(tmp_path / "a"), "items": items})["results"]
+    alone = run_sample(common | {"folder": str(tmp_path / "b")} | items[1])
+    assert chunk[1]["error"] is None and not chunk[1]["cached"]
+    assert chunk[1]["peak_per_blade"] == alone["peak_per_blade"]
+    assert chunk[1]["peak_frequency_per_blade_hz"] == alone["peak_frequency_per_blade_hz"]
