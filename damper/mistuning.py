@@ -3,13 +3,16 @@
 A study draws every mistuning pattern first (``harmonic_balance.bladed_disk.mistuning``:
 seeded per sample, so a resumed or extended study draws the same patterns) and refuses
 a bad one before any work. The tuned sector's peak on the band is the reference (the
-sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). Each
-sample is one task: the full ring's forced response (``ring_hb`` / ``ring_solve``, or
-the linear ring) and every blade's peak; its result is stored in the shared cache
+sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). A
+sample is the full ring's forced response (``ring_hb`` / ``ring_solve``, or the linear
+ring) and every blade's peak; a task is a chunk of samples solved with one
+:class:`SampleModel` (:func:`run_chunk`). Each sample's result is stored in the shared cache
 (:class:`damper.cache.Store`) under a key of the model, the solver settings, the
 pattern and the code version, so an interrupted study computes only the samples it has
 not stored. A sample whose solve fails is reported with its message (not cached: a
-later run tries it again), the study goes on.
+later run tries it again), the study goes on. ``until_ci`` stops the study after the
+first chunk (in index order) at which the 0.95 quantile's interval
+(:mod:`damper.mistuning_stats`) is narrow enough.
 
 Symbols: N_b blades; a_j the peak first-harmonic amplitude of blade j's response DOF;
 amplification = max_j a_j / a_tuned; sigma_f the standard deviation of the blade
@@ -328,7 +331,8 @@ def run_study(study: Study, store: Store, scheduler: str | None = None, workers:
         close()
     n = len(run["results"])
     run["efficiency"] |= {"workers": n_workers}
-    run["efficiency"]["efficiency"] = run["efficiency"]["cpu_s"] / (n_workers * run["efficiency"]["wall_s"])
+    e = run["efficiency"]
+    e["efficiency"] = e["cpu_s"] / (n_workers * max(e["wall_s"], 1e-9))   # (a study read from the cache: ~0)
     out = summarize(study, cfg, ref, kappas[:n], run["results"], time.perf_counter() - t0)
     out["efficiency"] = run["efficiency"]
     if study.until_ci is not None:
