@@ -1,5 +1,5 @@
 """Confidence of a mistuning study: does the 0.95 quantile's interval hold?
-=======================================================================
+========================================================================
 
 A study of N samples (``damper.mistuning``, UPD-24, damper free: the linear ring, cheap)
 gives the amplification's 0.95 quantile with its distribution-free 95 % interval
