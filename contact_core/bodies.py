@@ -87,9 +87,18 @@ def share_far(out: dict, cc, sol, size: float) -> None:
         out["body1_share_far_at"] = float(cc.probe_x[i])
 
 
+#: Largest body dimension [m] (radius, length, width, height): the bodies of a friction
+#: contact are millimetres to centimetres; far beyond, the Hertz relations (a^3 / R, the
+#: force for a contact radius) leave double precision (R = 1e308 m overflows).
+MAX_SIZE = 1e3
+
+
 def _positive(name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+    if value > MAX_SIZE:
+        raise ValueError(f"{name} = {value:.4g} m is above the limit {MAX_SIZE:g} m (a contact body "
+                         "of a friction damper is millimetres to centimetres)")
 
 
 class Body:

@@ -25,8 +25,11 @@ File format (JSON, ``schema`` = ``SCHEMA``)::
     }
 
 Only ``u`` and ``T`` (and, in version 2, ``tail``) are required, so a
-hand-made table works too. Unknown keys are kept in ``extra`` and written back
-unchanged.
+hand-made table works too. The file is typed (:class:`CurveFile`): numbers are JSON
+numbers (not strings, not booleans), finite and within :data:`MAX_DISPLACEMENT`,
+:data:`MAX_FORCE`, :data:`MAX_STIFFNESS` and :data:`MAX_MU`; an unknown key is
+refused. A file that states mu > 0 and N must agree with them: no T above mu N (by more
+than :data:`MU_N_RTOL`), the gross-slip force the curve cannot exceed.
 
 Version 1 files (``"damper-virgin-curve/1"`` or no ``schema`` key) carry no tail:
 it is decided once, here, by one rule (:func:`_v1_tail`):
@@ -40,9 +43,12 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import Field, model_validator
 
+from contact_core.fileformat import FileModel, parse
 from contact_core.fileio import atomic_write
 
 #: Schema tag written to every curve file.
@@ -54,6 +60,20 @@ TAILS = ("flat", "slope")
 #: Version 1 only: a curve ends at gross slip when T[-1] = mu N to this relative
 #: tolerance (the file stores mu N rounded; the flat tail's force is T[-1] itself).
 V1_GROSS_SLIP_RTOL = 1e-6
+#: Largest |u| of a curve file [m]: a contact's tangential displacement to gross slip is
+#: micrometres; a metre is a unit error.
+MAX_DISPLACEMENT = 1.0
+#: Largest |T| and N of a curve file [N]: far above any contact of a machine (1 GN), far
+#: below where the harmonic balance's squares of forces overflow (~1e154).
+MAX_FORCE = 1e9
+#: Largest stiffness k_t, k_n of a curve file [N/m] (a steel contact is ~1e8-1e9).
+MAX_STIFFNESS = 1e16
+#: Largest friction coefficient: dry contacts have mu below a few; beyond 100 it is a typo.
+MAX_MU = 100.0
+#: T may exceed the stated mu N by this fraction of mu N: a computed curve ends at gross
+#: slip to its step tolerance (``tangential_curve.CURVE_TOL`` = 1e-3 of mu N) and the
+#: file stores mu and N rounded; a plateau at 3 mu N (a wrong mu or N) is far beyond it.
+MU_N_RTOL = 1e-2
 _KNOWN_SCALARS = ("N", "mu", "k_t", "k_n")
 _KNOWN_TEXT = ("load_case",)
 _KNOWN_DICTS = ("geometry", "materials", "grid", "provenance")
@@ -77,7 +97,7 @@ class VirginCurve:
     tail : {"slope", "flat"}
         Beyond ``u[-1]``: the last slope continues, or T stays at ``T[-1]`` (gross
         slip). A producer whose curve ends at gross slip says ``"flat"``.
-    geometry, materials, grid, provenance, extra : dict
+    geometry, materials, grid, provenance : dict
         Descriptive metadata, written back unchanged.
     """
 
@@ -93,7 +113,6 @@ class VirginCurve:
     materials: dict = field(default_factory=dict)
     grid: dict = field(default_factory=dict)
     provenance: dict = field(default_factory=dict)
-    extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
         u = np.array(self.u, dtype=float)
@@ -128,7 +147,6 @@ class VirginCurve:
         for name in _KNOWN_DICTS:
             if getattr(self, name):
                 out[name] = getattr(self, name)
-        out.update(self.extra)
         return out
 
     @classmethod
@@ -144,19 +162,11 @@ class VirginCurve:
         if schema == SCHEMA and data.get("tail") not in TAILS:
             raise ValueError(f"{source}: schema {SCHEMA!r} needs \"tail\": one of {TAILS}, "
                              f"got {data.get('tail')!r}")
-        for key in ("u", "T"):
-            if key not in data:
-                raise ValueError(f"{source}: missing required array {key!r}")
-            if not isinstance(data[key], list) or not all(
-                isinstance(v, (int, float)) and not isinstance(v, bool) for v in data[key]
-            ):
-                raise ValueError(f"{source}: {key!r} must be a list of numbers")
-        kwargs = {"u": data["u"], "T": data["T"]}
+        fields = parse(CurveFile, data, source)
+        kwargs = {"u": fields.u, "T": fields.T}
         for name in _KNOWN_SCALARS + _KNOWN_TEXT + _KNOWN_DICTS:
-            if name in data:
-                kwargs[name] = data[name]
-        known = {"schema", "u", "T", "tail", *_KNOWN_SCALARS, *_KNOWN_TEXT, *_KNOWN_DICTS}
-        kwargs["extra"] = {k: v for k, v in data.items() if k not in known}
+            if getattr(fields, name) not in (None, {}):
+                kwargs[name] = getattr(fields, name)
         try:
             if schema == SCHEMA:
                 kwargs["tail"] = data["tail"]
@@ -165,6 +175,48 @@ class VirginCurve:
             return cls(**kwargs)
         except (TypeError, ValueError) as err:
             raise ValueError(f"{source}: {err}") from None
+
+
+_Displacement = Annotated[float, Field(ge=-MAX_DISPLACEMENT, le=MAX_DISPLACEMENT)]
+_Force = Annotated[float, Field(ge=-MAX_FORCE, le=MAX_FORCE)]
+_Stiffness = Annotated[float, Field(ge=0.0, le=MAX_STIFFNESS)]
+
+
+class CurveFile(FileModel):
+    """The curve file's keys and types (module docstring). The table's own rules (start
+    at (0, 0), u increasing, T non-negative) are :func:`check_table`'s."""
+
+    schema_: Literal["damper-virgin-curve/2", "damper-virgin-curve/1"] = Field(
+        SCHEMA_V1, alias="schema", description="format tag; version 1 (or none) has no tail")
+    u: list[_Displacement] = Field(description="tangential displacement [m], strictly increasing from 0",
+                                   json_schema_extra={"why": "a contact slips within micrometres: metres "
+                                                      "are a unit error"})
+    T: list[_Force] = Field(description="tangential force [N] from 0, non-negative, at most mu N",
+                            json_schema_extra={"why": "1 GN is far above any contact of a machine"})
+    tail: Literal["flat", "slope"] | None = Field(
+        None, description="beyond the last point: flat (gross slip) or the last slope (version 2: required)")
+    N: Annotated[float, Field(gt=0.0, le=MAX_FORCE)] | None = Field(None, description="normal load [N]")
+    mu: Annotated[float, Field(ge=0.0, le=MAX_MU)] | None = Field(None, description="friction coefficient")
+    k_t: _Stiffness | None = Field(None, description="initial tangential stiffness [N/m]")
+    k_n: _Stiffness | None = Field(None, description="normal contact stiffness at N [N/m]")
+    load_case: Literal["CNF", "CND"] | None = Field(None, description="constant normal force or displacement")
+    geometry: dict[str, Any] = Field(default_factory=dict, description="descriptive (body, sizes)")
+    materials: dict[str, Any] = Field(default_factory=dict, description="descriptive (E, nu)")
+    grid: dict[str, Any] = Field(default_factory=dict, description="descriptive (FE grid)")
+    provenance: dict[str, Any] = Field(default_factory=dict, description="code version, date, command")
+
+    @model_validator(mode="after")
+    def _within_gross_slip(self):
+        """No T above the gross-slip force mu N the file states (to :data:`MU_N_RTOL`); mu = 0
+        states no friction law (as for the version 1 tail, :func:`_v1_tail`)."""
+        if self.mu and self.N is not None and self.T:
+            bound = self.mu * self.N
+            i = int(np.argmax(self.T))
+            if self.T[i] > bound + MU_N_RTOL * bound:
+                raise ValueError(f"T[{i}] = {self.T[i]:.6g} N is above mu N = {self.mu:g} x {self.N:g} "
+                                 f"= {bound:.6g} N (by more than {MU_N_RTOL:.0%}): the curve contradicts "
+                                 "its own mu and N; correct mu, N or the table")
+        return self
 
 
 def _v1_tail(curve: VirginCurve) -> str:

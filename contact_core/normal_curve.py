@@ -19,7 +19,10 @@ File format (JSON, ``schema`` = ``SCHEMA``)::
       "geometry": {...}, "materials": {...}, "provenance": {...}   # optional
     }
 
-Unknown keys are kept in ``extra`` and written back unchanged.
+The file is typed (:class:`NormalCurveFile`): JSON numbers (not strings, not
+booleans), finite and within the curve file's bounds (``contact_core.curve``:
+:data:`~contact_core.curve.MAX_DISPLACEMENT`, :data:`~contact_core.curve.MAX_FORCE`,
+:data:`~contact_core.curve.MAX_STIFFNESS`); an unknown key is refused.
 """
 from __future__ import annotations
 
@@ -27,14 +30,35 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import Field
 
+from contact_core.curve import MAX_DISPLACEMENT, MAX_FORCE, MAX_STIFFNESS
+from contact_core.fileformat import FileModel, parse
 from contact_core.fileio import atomic_write
 
 #: Schema tag written to every normal-curve file.
 SCHEMA = "damper-normal-curve/1"
-_KNOWN = ("schema", "approach", "N", "load", "k_n", "geometry", "materials", "provenance")
+
+
+class NormalCurveFile(FileModel):
+    """The normal-curve file's keys and types (module docstring); the table's own rules
+    (from (0, 0), both strictly increasing) are :func:`check_normal_table`'s."""
+
+    schema_: Literal["damper-normal-curve/1"] = Field(alias="schema", description="format tag")
+    approach: list[Annotated[float, Field(ge=-MAX_DISPLACEMENT, le=MAX_DISPLACEMENT)]] = Field(
+        description="approach p [m], strictly increasing from 0")
+    N: list[Annotated[float, Field(ge=-MAX_FORCE, le=MAX_FORCE)]] = Field(
+        description="normal load [N], strictly increasing from 0")
+    load: Annotated[float, Field(gt=0.0, le=MAX_FORCE)] | None = Field(
+        None, description="the load the curve was computed up to [N] (default: the last N)")
+    k_n: list[Annotated[float, Field(ge=-MAX_STIFFNESS, le=MAX_STIFFNESS)]] | None = Field(
+        None, description="dN/dp at each point [N/m]")
+    geometry: dict[str, Any] = Field(default_factory=dict, description="descriptive")
+    materials: dict[str, Any] = Field(default_factory=dict, description="descriptive")
+    provenance: dict[str, Any] = Field(default_factory=dict, description="code version, date, command")
 
 
 def check_normal_table(p: np.ndarray, N: np.ndarray) -> None:
@@ -66,7 +90,7 @@ class NormalCurve:
         The load the curve was computed up to [N] (default N[-1]).
     k_n : ndarray or None
         Normal stiffness dN/dp at each point [N/m].
-    geometry, materials, provenance, extra : dict
+    geometry, materials, provenance : dict
     """
 
     approach: np.ndarray
@@ -76,7 +100,6 @@ class NormalCurve:
     geometry: dict = field(default_factory=dict)
     materials: dict = field(default_factory=dict)
     provenance: dict = field(default_factory=dict)
-    extra: dict = field(default_factory=dict)
 
     def __post_init__(self):
         p, N = np.array(self.approach, dtype=float), np.array(self.N, dtype=float)
@@ -100,19 +123,18 @@ class NormalCurve:
         for name in ("geometry", "materials", "provenance"):
             if getattr(self, name):
                 out[name] = getattr(self, name)
-        return {**out, **self.extra}
+        return out
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "normal curve") -> NormalCurve:
-        if data.get("schema") != SCHEMA:
-            raise ValueError(f"{source}: not a {SCHEMA} file (schema {data.get('schema')!r})")
+        """Validate a JSON object (:class:`NormalCurveFile`) and build the curve; ValueError
+        names the file and the key."""
+        if not isinstance(data, dict) or data.get("schema") != SCHEMA:
+            got = data.get("schema") if isinstance(data, dict) else type(data).__name__
+            raise ValueError(f"{source}: not a {SCHEMA} file (schema {got!r})")
+        f = parse(NormalCurveFile, data, source)
         try:
-            return cls(data["approach"], data["N"], data.get("load"), data.get("k_n"),
-                       data.get("geometry", {}), data.get("materials", {}),
-                       data.get("provenance", {}),
-                       {k: v for k, v in data.items() if k not in _KNOWN})
-        except KeyError as err:
-            raise ValueError(f"{source}: missing key {err.args[0]!r}") from None
+            return cls(f.approach, f.N, f.load, f.k_n, f.geometry, f.materials, f.provenance)
         except ValueError as err:
             raise ValueError(f"{source}: {err}") from None
 

@@ -22,6 +22,9 @@ STEEL_NU = 0.3
 #: for the sphere (see also mesh.MAX_CONTACT_NODES).
 MAX_GRID = 81
 MODELS = ("real", "halfspace")
+#: Largest Young's modulus [Pa]: ten times diamond's (1.2e12 Pa); far beyond, the Hertz
+#: relations (E* a^3) leave double precision.
+MAX_MODULUS = 1e13
 
 
 @dataclass(frozen=True)
@@ -126,6 +129,9 @@ def validate(spec: ContactSpec) -> None:
         raise ValueError(f"model must be one of {MODELS}, got {spec.model!r}")
     for name in ("E1", "E2"):
         _positive(name, getattr(spec, name))
+        if getattr(spec, name) > MAX_MODULUS:
+            raise ValueError(f"{name} = {getattr(spec, name):.4g} Pa is above the limit {MAX_MODULUS:g} Pa "
+                             "(ten times diamond's Young's modulus)")
     for name in ("nu1", "nu2"):
         nu = getattr(spec, name)
         if not (-1.0 < nu < 0.5):

@@ -27,15 +27,22 @@ blades from minus the platforms' work on the dampers) and the dampers' quadratur
 """
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import json
-import math
+import os
 import re
+import sys
 import tempfile
 import time
 import zipfile
 from pathlib import Path
 
 import numpy as np
+
+from contact_core.fileformat import parse
+from damper import limits
+from damper.ring_info import RingInfo
 
 #: Harmonics fitted to one period's samples (0..FIT_HARMONICS).
 FIT_HARMONICS = 9
@@ -45,8 +52,18 @@ SETTLE_TOL = 1e-4
 MIN_PERIODS = 5
 #: Fewest steps a period (the fit of the first harmonic needs samples of the period).
 MIN_STEPS_PER_PERIOD = 2 * FIT_HARMONICS + 2
-#: Most steps a period (the time-series buffer holds two periods of every blade's response).
-MAX_STEPS_PER_PERIOD = 1_000_000
+#: Most steps a period (:data:`damper.limits.MAX_COSIM_STEPS_PER_PERIOD`).
+MAX_STEPS_PER_PERIOD = limits.MAX_COSIM_STEPS_PER_PERIOD
+#: Largest growth of a blade's first harmonic from one period to the next once the start
+#: transient is over (after MIN_PERIODS): a forced response from rest grows at most by
+#: (k + 1) / k in period k + 1; an unstable coupling multiplies it by 1e4-1e6 a period
+#: (measured: step 1e-4 s, 13 times the coupling limit, 1.7e97 m after 20 periods).
+MAX_GROWTH = 2.0
+#: Largest |relative residual| of the last period's energy balance: measured 6e-6 at the
+#: default step (1/8 of the coupling limit), 0.47 at 0.95 of the limit, 1.2 at 1.4 times
+#: it (amplitude 7 % off), 1e64 in a diverged run. Beyond, the balance misses more than
+#: the excitation's whole work: the numbers are not a response of the ring.
+MAX_ENERGY_RESIDUAL = 1.0
 #: libcosim worker threads: eight small FMUs a step cost less on one thread than on a
 #: pool (measured on the shared 2-core machine: 136 us a step with 1, 184 with 0, 488
 #: with libcosim's default; tmp/speed run of the UPD-24 ring, 2000 steps).
@@ -58,7 +75,8 @@ class EngineMissing(ValueError):
 
 
 def read_info(ssp) -> dict:
-    """The archive's ``resources/system.json`` (ValueError if it is not a ring archive)."""
+    """The archive's ``resources/system.json``, checked (:class:`damper.ring_info.RingInfo`);
+    ValueError if it is not a ring archive or its description is malformed."""
     path = Path(ssp)
     if not path.is_file():
         raise ValueError(f"{path}: no such SSP archive")
@@ -68,12 +86,27 @@ def read_info(ssp) -> dict:
     except (zipfile.BadZipFile, KeyError, json.JSONDecodeError):
         raise ValueError(f"{path} is not a ring archive of `damper system` (no "
                          "resources/system.json): build one with damper system -o ring.ssp") from None
-    if info.get("kind") != "damper-ring":
+    if not isinstance(info, dict) or info.get("kind") != "damper-ring":
         raise ValueError(f"{path}: resources/system.json is not a damper-ring description")
-    if info.get("fmi_version", 2) != 2:
+    info = parse(RingInfo, info, f"{path}: resources/system.json").model_dump()
+    if info["fmi_version"] != 2:
         raise ValueError(f"{path} holds FMI {info['fmi_version']} FMUs; libcosim runs FMI 2 "
                          "only (build it with damper system --fmi-version 2)")
     return info
+
+
+def _check_members(path: Path) -> None:
+    """ValueError naming an FMU that ``SystemStructure.ssd`` uses and the archive lacks
+    (libcosim would only say that it cannot create the execution)."""
+    with zipfile.ZipFile(path) as zf:
+        names = set(zf.namelist())
+        if "SystemStructure.ssd" not in names:
+            raise ValueError(f"{path}: the archive has no SystemStructure.ssd: rebuild it with damper system")
+        ssd = zf.read("SystemStructure.ssd").decode("utf-8", "replace")
+    for source in sorted(set(re.findall(r'<ssd:Component\b[^>]*\bsource="([^"]+)"', ssd))):
+        if source not in names:
+            raise ValueError(f"{path}: SystemStructure.ssd uses {source}, which the archive does not hold: "
+                             "rebuild it with damper system")
 
 
 def _engine():
@@ -110,6 +143,8 @@ def plan_step(info: dict, frequency_hz: float, step: float | None, force: bool) 
     against the coupling limit (ValueError above it unless ``force``)."""
     if not (np.isfinite(frequency_hz) and frequency_hz > 0):
         raise ValueError(f"--frequency-hz must be finite and > 0, got {frequency_hz}")
+    if 2 * np.pi * frequency_hz > limits.MAX_OMEGA:
+        raise ValueError(f"--frequency-hz {frequency_hz:g} is above the limit {limits.MAX_OMEGA / 2 / np.pi:.3g} Hz")
     h = info["default_step"] if step is None else float(step)
     if not (np.isfinite(h) and h > 0):
         raise ValueError(f"--step must be finite and > 0 s, got {step}")
@@ -123,13 +158,15 @@ def plan_step(info: dict, frequency_hz: float, step: float | None, force: bool) 
     if T_ns < MIN_STEPS_PER_PERIOD:
         raise ValueError(f"--frequency-hz {frequency_hz:g}: a period of {T_ns:.3g} ns cannot hold "
                          f"{MIN_STEPS_PER_PERIOD} of libcosim's whole-ns steps")
-    n = max(int(math.ceil(T_ns / (h * 1e9) - 1e-9)), MIN_STEPS_PER_PERIOD)
+    n_real = max(float(np.ceil(T_ns / (h * 1e9) - 1e-9)), MIN_STEPS_PER_PERIOD)  # may be huge or inf
+    if not n_real <= MAX_STEPS_PER_PERIOD:
+        raise ValueError(f"--step {h:.3g} s gives {n_real:.3g} steps a period at {frequency_hz:g} Hz (at "
+                         f"most {MAX_STEPS_PER_PERIOD}: the response buffer holds two periods): use a "
+                         "larger step or a higher frequency")
+    n = int(n_real)
     h_ns = int(round(T_ns / n))
     if h_ns < 1:
         raise ValueError(f"--step {h} s is below libcosim's resolution (1 ns) at {frequency_hz} Hz")
-    if n > MAX_STEPS_PER_PERIOD:
-        raise ValueError(f"--step {h:.3g} s gives {n} steps a period at {frequency_hz} Hz (at most "
-                         f"{MAX_STEPS_PER_PERIOD}): use a larger step")
     return {"steps_per_period": n, "step_ns": h_ns, "step": h_ns * 1e-9,
             "period_error": (n * h_ns - T_ns) / T_ns}
 
@@ -222,6 +259,79 @@ def energy_balance(e0: dict, e1: dict) -> dict:
             "residual": residual, "relative_residual": residual / exc if exc else None}
 
 
+def _smaller_step(plan: dict, info: dict) -> str:
+    return (f"the explicit coupling is unstable or inaccurate at the step {plan['step']:.3g} s: use a smaller "
+            f"--step (the coupling limit is {info['step_limit']:.3g} s, the archive's default "
+            f"{info['default_step']:.3g} s)")
+
+
+def _check_growth(k: int, h1: np.ndarray, h1_prev, plan: dict, info: dict) -> None:
+    """RuntimeError when period k's first harmonics are not finite or, after the start
+    transient, grew by more than :data:`MAX_GROWTH` in one period (a diverging coupling)."""
+    if not np.all(np.isfinite(h1)):
+        raise RuntimeError(f"the co-simulation diverged in period {k} (not a number): {_smaller_step(plan, info)}")
+    if h1_prev is None or k <= MIN_PERIODS:
+        return
+    growth = float(np.max(np.abs(h1) / np.maximum(np.abs(h1_prev), np.finfo(float).tiny)))
+    if growth > MAX_GROWTH:
+        raise RuntimeError(f"the co-simulation diverged in period {k}: the response grew {growth:.3g} times "
+                           f"in one period (to {np.abs(h1).max():.3g} m): {_smaller_step(plan, info)}")
+
+
+def _check_balance(balance: dict, plan: dict, info: dict) -> None:
+    """RuntimeError when the last period's energy balance misses more than
+    :data:`MAX_ENERGY_RESIDUAL` of the excitation's work."""
+    rel = balance["relative_residual"]
+    if rel is not None and not abs(rel) <= MAX_ENERGY_RESIDUAL:
+        raise RuntimeError(f"the co-simulation's energy balance is off by {abs(rel):.3g} times the excitation's "
+                           f"work over the last period (at most {MAX_ENERGY_RESIDUAL:g}): "
+                           f"{_smaller_step(plan, info)}")
+
+
+def _march(ring: _Ring, plan: dict, periods: int, tol: float, omega: float):
+    """Step period by period until settled (module docstring) or ``periods`` ran;
+    (k, h1, t, x, balance, deltas, est, settled) of the last period."""
+    e_prev, h1_prev, deltas = ring.energies(), None, []
+    settled, est = False, float("inf")
+    for k in range(1, periods + 1):
+        if not ring.ex.step(ring.n):
+            raise RuntimeError(f"libcosim failed in period {k} (an FMU refused a step: see its message above)")
+        t, x = ring.response(k)
+        h1 = np.array([first_harmonic(t, xi, omega) for xi in x])
+        e_now = ring.energies()
+        balance = energy_balance(e_prev, e_now)
+        e_prev = e_now
+        _check_growth(k, h1, h1_prev, plan, ring.info)
+        if h1_prev is not None:
+            deltas.append(float(np.max(np.abs(h1 - h1_prev)) / np.max(np.abs(h1))))
+            if len(deltas) >= 2:
+                rho = min(max(deltas[-1] / max(deltas[-2], 1e-300), 0.0), 0.999)
+                est = deltas[-1] * rho / (1.0 - rho)
+                if k >= MIN_PERIODS and max(est, deltas[-1]) < tol:
+                    settled = True
+                    break
+        h1_prev = h1
+    return k, h1, t, x, balance, deltas, est, settled
+
+
+@contextlib.contextmanager
+def _stdout_to_stderr():
+    """File descriptor 1 pointed at standard error inside (libcosim's C++ log sink writes to
+    fd 1; Python's own stdout is flushed first and restored after)."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        try:
+            ctypes.CDLL(None).fflush(None)  # C stdio buffers (std::cout syncs with them)
+        except (OSError, AttributeError):
+            pass
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force: bool = False,
         tol: float = SETTLE_TOL, keep_last: bool = False) -> dict:
     """Co-simulate the ring of ``ssp`` at ``frequency_hz`` until settled (<= ``periods``).
@@ -240,42 +350,31 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
         Not a ring archive, bad frequency / periods / step, a step above the coupling
         limit without ``force``, libcosim missing (:class:`EngineMissing`).
     RuntimeError
-        libcosim failed to load or step the system.
+        libcosim failed to load or step the system, or the coupling diverged (a
+        response growing more than :data:`MAX_GROWTH` times a period, or an energy
+        balance off by more than :data:`MAX_ENERGY_RESIDUAL`).
     """
     info = read_info(ssp)
-    if not (isinstance(periods, int) and periods >= 1):
-        raise ValueError(f"--periods must be an integer >= 1, got {periods}")
+    _check_members(Path(ssp))
+    limits.check_size("--periods", periods, 1, limits.MAX_COSIM_PERIODS,
+                      "a ring settles in tens to hundreds of periods; a period costs ~0.7 s at the default step")
     if not (np.isfinite(tol) and tol >= 0):
         raise ValueError(f"--tol must be finite and >= 0, got {tol}")
     plan = plan_step(info, frequency_hz, step, force)
+    if periods * plan["steps_per_period"] > limits.MAX_COSIM_STEPS:
+        raise ValueError(f"--periods {periods} of {plan['steps_per_period']} steps is "
+                         f"{periods * plan['steps_per_period']:.3g} steps, above the limit "
+                         f"{limits.MAX_COSIM_STEPS:.0e} (~0.3 ms each: hours): fewer --periods or a larger --step")
     omega = 2 * np.pi * frequency_hz
     t0 = time.perf_counter()
-    try:
-        ring = _Ring(ssp, info, plan, frequency_hz)
-    except AssertionError as err:  # libcosimpy reports failures with assert
-        raise RuntimeError(f"libcosim could not load {ssp}: {err}") from None
-    e_prev, h1_prev, deltas = ring.energies(), None, []
-    settled, est = False, float("inf")
-    for k in range(1, periods + 1):
-        if not ring.ex.step(ring.n):
-            raise RuntimeError(f"libcosim failed in period {k} (an FMU refused a step)")
-        t, x = ring.response(k)
-        h1 = np.array([first_harmonic(t, xi, omega) for xi in x])
-        e_now = ring.energies()
-        balance = energy_balance(e_prev, e_now)
-        e_prev = e_now
-        if not np.all(np.isfinite(h1)):
-            raise RuntimeError(f"the co-simulation diverged in period {k} (step {plan['step']:.3g} s)")
-        if h1_prev is not None:
-            deltas.append(float(np.max(np.abs(h1 - h1_prev)) / np.max(np.abs(h1))))
-            if len(deltas) >= 2:
-                rho = min(max(deltas[-1] / max(deltas[-2], 1e-300), 0.0), 0.999)
-                est = deltas[-1] * rho / (1.0 - rho)
-                if k >= MIN_PERIODS and max(est, deltas[-1]) < tol:
-                    settled = True
-                    break
-        h1_prev = h1
+    with _stdout_to_stderr():  # libcosim logs on stdout, which holds the --json object
+        try:
+            ring = _Ring(ssp, info, plan, frequency_hz)
+        except AssertionError as err:  # libcosimpy reports failures with assert
+            raise RuntimeError(f"libcosim could not load {ssp}: {err}") from None
+        k, h1, t, x, balance, deltas, est, settled = _march(ring, plan, periods, tol, omega)
     wall = time.perf_counter() - t0
+    _check_balance(balance, plan, info)
     nr = len(h1)
     out = {"frequency_hz": frequency_hz, "amplitude": float(abs(h1[0])),
            "amplitude_blades": np.abs(h1).tolist(),

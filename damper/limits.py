@@ -38,7 +38,7 @@ MAX_UPD_GRID = 2000
 #: Points of the F-approach curve of ``damper normal --curve``: one normal solve each.
 MAX_APPROACH_POINTS = 1000
 #: Samples of a mistuning study: each is a curve of the whole ring (~20 s CPU at 24
-#: blades, H = 7; 0.1-0.5 s in a linear limit), so 10000 samples is days of CPU.
+#: blades, H = 7; ~4 s in a linear limit, every local peak refined), so 10000 samples is days of CPU.
 MAX_MISTUNING_SAMPLES = 10000
 #: Blades of a mistuned ring: its prestress statics use dense matrices ((7 N_b)^2 numbers,
 #: 190 MB for three at 400 blades) and a curve costs ~0.4 s CPU per blade at H = 7.
@@ -58,6 +58,30 @@ MAX_MU = 100.0
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
+#: Smallest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): the
+#: slip limits scale with N / N_ref, which overflows far below (N_ref = 1e-320 fails at
+#: the FMU's start); contacts of friction dampers carry mN to MN.
+MIN_NORMAL_LOAD = 1e-6
+#: Largest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): far
+#: above, N / N_ref underflows (N_ref = 1e308 gives F = 0).
+MAX_NORMAL_LOAD = 1e9
+#: Smallest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is
+#: a 0.2 m penetration; far below, the start penetration N / k_n overflows (k_n = 1e-300
+#: fails at the start).
+MIN_PENALTY_STIFFNESS = 1e3
+#: Largest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e15 N/m a 1 N load is a
+#: penetration of 1e-15 m, below an atom.
+MAX_PENALTY_STIFFNESS = 1e15
+#: Steps a period of ``damper cosim``: the time-series buffer holds two periods of every
+#: blade's response (1e6 steps: 16 MB a blade), and the default step gives ~2500.
+MAX_COSIM_STEPS_PER_PERIOD = 1_000_000
+#: Periods of ``damper cosim --periods``: a friction-damped ring settles in tens to a few
+#: hundred periods; at the default step a period costs ~0.7 s (UPD-24 ring of 4 blades,
+#: 2428 steps of ~0.3 ms), so 100000 periods is most of a day.
+MAX_COSIM_PERIODS = 100_000
+#: Communication steps of one ``damper cosim`` run (periods x steps a period): ~0.3 ms
+#: each on the 2-core machine, so 5e7 steps is about four hours.
+MAX_COSIM_STEPS = 50_000_000
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6
@@ -101,6 +125,16 @@ def harmonics_why(high: int) -> str:
     if high == MAX_UPD_HARMONICS:
         return "the sector's harmonic balance grows as H^2 (H = 15: 7 s for 200 points; H = 50: minutes)"
     return "the harmonic balance grows as H^2 or faster (one DOF: H = 61 takes 27 s; H = 200: minutes)"
+
+
+def check_range(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
+    """``value`` finite in [low, high] (``low`` > 0), else ValueError naming ``name``, the
+    range and ``why``."""
+    if not (math.isfinite(value) and value > 0):
+        raise ValueError(f"{name} must be finite and > 0 {unit}, got {value:g}")
+    if not low <= value <= high:
+        raise ValueError(f"{name} {value:g} {unit} is outside [{low:g}, {high:g}] {unit}: {why}")
+    return value
 
 
 def check_omega_range(name: str, lo: float, hi: float, unit: str = "rad/s", scale: float = 1.0) -> None:

@@ -22,8 +22,9 @@ Band: ``band_hz``, else around the tuned peak f_t (found on the config's
 ``load.band_hz``): from f_t (1 - w) to f_t (1 + w), with the damper up to the tuned
 stuck linear peak f_stuck (1 + w) when that is higher (mistuning can move a blade's
 peak up to the stuck one: measured on four blades), w = :data:`BAND_MARGIN` +
-:data:`BAND_SIGMAS` sigma_f. Below the tuned peak the friction-damped peaks do not move
-much, and far below it the dampers are stuck and slow to solve (``ring_solve``). A
+:data:`BAND_SIGMAS` sigma_f, each end kept within the frequencies a blade's factor can
+reach (0.5 ... 2 times the tuned ones, :func:`default_band`). Below the tuned peak the
+friction-damped peaks do not move much, and far below it the dampers are stuck and slow to solve (``ring_solve``). A
 sample whose largest peak lies at an end of the band fails (the peak is outside).
 """
 from __future__ import annotations
@@ -56,6 +57,15 @@ DAMPERS = ("nonlinear", "free", "stuck")
 #: an interruption loses. With ``until_ci`` the chunks have CHUNK_UNTIL_CI samples and the
 #: interval is checked after each, in index order.
 CHUNKS_PER_WORKER, MAX_CHUNK, CHUNK_UNTIL_CI = 4, 100, 20
+
+
+class AllSamplesFailed(RuntimeError):
+    """Every sample's solve failed; ``summary`` is the study's JSON with each sample's error
+    (statistics None)."""
+
+    def __init__(self, message: str, summary: dict):
+        super().__init__(message)
+        self.summary = summary
 
 
 @dataclass
@@ -134,8 +144,7 @@ class Study:
         if self.factors is not None:
             if self.kind not in KINDS:
                 raise ValueError(f"mistuning kind must be one of {KINDS}, got {self.kind!r}")
-            f = check_factors(self.factors, n_blades, "factors")
-            return [f if self.kind == "stiffness" else f * f]
+            return [check_factors(self.factors, n_blades, "factors", self.kind)]
         return [draw_factors(n_blades, self.std, self.seed, i, self.kind, self.distribution)
                 for i in range(self.samples)]
 
@@ -190,8 +199,19 @@ def tuned_reference(study: Study, cfg) -> dict:
         f_t = w / (2 * np.pi)
         hi = f_t if study.damper != "nonlinear" else max(
             f_t, tuned_linear_peak(sector, om, "stuck", study.f0)[0] / (2 * np.pi))
-        band = [f_t * (1 - margin), hi * (1 + margin)]
+        band = default_band(f_t, hi, margin)
     return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band}
+
+
+def default_band(f_low: float, f_high: float, margin: float) -> list:
+    """[f_low (1 - margin), f_high (1 + margin)] [Hz], each end kept within BAND_MARGIN
+    beyond the frequencies a blade can reach (factors sqrt(KAPPA_MIN) ... sqrt(KAPPA_MAX)
+    of the tuned ones), so a large scatter never gives a band below zero."""
+    from harmonic_balance.bladed_disk.mistuning import KAPPA_MAX, KAPPA_MIN
+
+    lo = max(1.0 - margin, KAPPA_MIN ** 0.5 * (1.0 - BAND_MARGIN))
+    hi = min(1.0 + margin, KAPPA_MAX ** 0.5 * (1.0 + BAND_MARGIN))
+    return [f_low * lo, f_high * hi]
 
 
 def sample_key(study: Study, fp: str, band: list, kappa) -> str:
@@ -404,9 +424,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             s |= {"peak_per_blade": None, "amplification": None, "frequency_hz": None}
         samples.append(s)
     amp = np.array([s["amplification"] for s in samples if s["error"] is None])
-    if amp.size == 0:
-        raise RuntimeError(f"every sample failed; the first: {samples[0]['error']}")
-    return {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
+    out = {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
             "kind": study.kind, "distribution": study.distribution,
             "std": None if study.factors is not None else study.std, "seed": study.seed,
             "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
@@ -414,11 +432,15 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),
-            "max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
-            "std_amplification": float(amp.std()),
-            "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
-            "statistics": mistuning_stats.summary(amp),
             "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}
+    if amp.size == 0:
+        raise AllSamplesFailed(f"every sample failed; the first: {samples[0]['error']}",
+                               out | {"max_amplification": None, "mean_amplification": None,
+                                      "std_amplification": None, "quantiles": None, "statistics": None})
+    return out | {"max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
+                  "std_amplification": float(amp.std()),
+                  "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
+                  "statistics": mistuning_stats.summary(amp)}
 
 
 def plot_study(out: dict, folder) -> dict:

@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from damper.ring_info import RingInfo
 from damper.ssp import Component, ssd_text, write_ssp
 
 #: Default communication step as a fraction of the coupling limit 2 / omega_max.
@@ -144,6 +145,7 @@ def build_ring(cfg, cf: float, f0: float, out, fmi_version: int = 2,
             # the energy balance of a transient
             "coupling_dofs": [bspec.dofs[d] for d in bspec.coupling_dofs()],
             "K_next_coupling": _coupling_block(bspec)}
+    RingInfo.model_validate(info)   # what damper cosim will read back (no archive it would refuse)
     ssd = ssd_text("upd_ring", comps, _connections(nr, bspec), step, 100.0 / freq,
                    f"{config_name}: {nr} blades of {cfg.blades} (EO {cfg.engine_order}) "
                    f"with underplatform dampers, CF {cf} N, F0 {f0} N")

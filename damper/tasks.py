@@ -9,9 +9,22 @@ from __future__ import annotations
 
 import logging
 import os
+import signal
 
 #: Seconds to wait for a scheduler given by address before giving up.
 CONNECT_TIMEOUT = 10
+
+
+def _ignore_sigint_plugin():
+    """A Dask worker plugin that makes a local worker process ignore SIGINT (its setup runs
+    in the worker's main thread, the only one that may set a signal handler)."""
+    from distributed import WorkerPlugin
+
+    class IgnoreSigint(WorkerPlugin):
+        def setup(self, worker):
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+    return IgnoreSigint()
 
 
 def executor(scheduler, workers, serial, info: dict | None = None):
@@ -43,6 +56,9 @@ def executor(scheduler, workers, serial, info: dict | None = None):
                                silence_logs=logging.CRITICAL)
         client = Client(cluster)
         info["workers"] = n
+        # A terminal's Ctrl-C reaches the whole process group: this process alone handles it
+        # (one line, exit 130) and closes the cluster; each worker would print a traceback.
+        client.register_plugin(_ignore_sigint_plugin(), name="damper-ignore-sigint")
 
     def close():
         # After Ctrl-C Dask's gather task ends with an exception nobody retrieves; asyncio

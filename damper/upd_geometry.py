@@ -55,9 +55,8 @@ ZONE_LOAD_FACTOR = 1.5
 #: Steps of the zone's design pressure (2^(1/4): the zone's half-width in steps of 19 %, so
 #: the zone holds the contact of 1.5-2.1 times the load; factor 2 changed k_n by < 1 %).
 ZONE_STEP = 2.0 ** 0.25
-#: Cylinder FE variants (``contact_core``); the flat is always the block model.
-CYLINDER_MODELS = ("real", "halfspace")
-#: The [geometry] keys that must be positive / in (-1, 0.5) / >= 0 (0: from CF).
+#: The [geometry] keys: positive / Poisson ratios / loads >= 0 (0: from CF); the cylinder
+#: FE variant is ``real`` or ``halfspace`` (the flat is always the block model).
 _POSITIVE = ("cylinder_radius", "flat_height", "E_damper", "E_blade")
 _POISSON = ("nu_damper", "nu_blade")
 _LOADS = ("normal_load_left", "normal_load_flat")
@@ -85,28 +84,10 @@ def geometry_params(cfg, cf: float | None = None) -> dict:
     ValueError
         A missing or unusable value, named with its key and what to change.
     """
-    geo = cfg.data.get("geometry")
-    if not isinstance(geo, dict):
-        raise ValueError("config: no [geometry] section (the contacts from geometry need it)")
-    val = {}
-    for key in _POSITIVE + _POISSON + _LOADS:
-        val[key] = _number(geo, key)
-    for key in _POSITIVE:
-        if not val[key] > 0:
-            raise ValueError(f"config: geometry.{key} = {val[key]:g} must be > 0")
-    for key in _POISSON:
-        if not -1.0 < val[key] < 0.5:
-            raise ValueError(f"config: geometry.{key} = {val[key]:g} must lie in (-1, 0.5) "
-                             "(0.5 is incompressible)")
-    for key in _LOADS:
-        if val[key] < 0:
-            raise ValueError(f"config: geometry.{key} = {val[key]:g} must be >= 0 "
-                             "(0: the frictionless static load at the run's CF)")
-    grid, model = geo.get("grid"), geo.get("cylinder_model")
-    if not isinstance(grid, int) or isinstance(grid, bool) or grid < 3:
-        raise ValueError(f"config: geometry.grid = {grid!r} must be an integer >= 3")
-    if model not in CYLINDER_MODELS:
-        raise ValueError(f"config: geometry.cylinder_model = {model!r} must be one of {CYLINDER_MODELS}")
+    # types and ranges of the [geometry] keys: the config's typed model (config_model.GeometrySection)
+    geo = cfg.data["geometry"]
+    val = {key: float(geo[key]) for key in _POSITIVE + _POISSON + _LOADS}
+    grid, model = geo["grid"], geo["cylinder_model"]
     mu = cfg.mu
     if not mu > 0:
         raise ValueError(f"config: damper.mu = {mu:g}: the contacts from geometry need mu > 0 "
@@ -123,13 +104,6 @@ def geometry_params(cfg, cf: float | None = None) -> dict:
             "nu2": val["nu_blade"], "mu": mu, "grid": grid, "cylinder_model": model,
             "N_left": val["normal_load_left"] or N_static,
             "N_flat": val["normal_load_flat"] or N_static}
-
-
-def _number(table: dict, key: str) -> float:
-    v = table.get(key)
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise ValueError(f"config: geometry.{key} = {v!r} must be a finite number")
-    return float(v)
 
 
 def contact_specs(p: dict) -> dict:

@@ -74,6 +74,7 @@ numpydoc_validation_checks: set[str] = set()
 html_theme = "furo"
 html_title = "damper-toolkit"
 html_static_path: list[str] = []
+html_extra_path = ["_generated/extra"]   # schemas/*.schema.json: the input files' JSON Schemas
 html_show_sourcelink = False
 html_last_updated_fmt = None
 

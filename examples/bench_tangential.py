@@ -6,7 +6,8 @@ and grid: contact nodes, largest error of the virgin curve against Mindlin
 (fraction of mu N), k_t against 8 G* a, time per stage (condense, normal,
 tangential) cold and cached (FE models: second run from the condensation
 cache; the BEM has no cache, its build is the cold figure), and the process's
-peak memory so far (ru_maxrss, so it only grows down the table). ::
+peak memory so far (ru_maxrss, so it only grows down the table), and whether the
+condensed model came from the cache (hit, miss; - for the BEM). ::
 
     python examples/bench_tangential.py                       # BEM 21/41/61, FE 11/21
     python examples/bench_tangential.py --bem 21 41 --fe 21 --fe-models halfspace real
@@ -43,7 +44,8 @@ def one(model: str, grid: int, cache) -> dict:
     T_ref = tr.mindlin_force(run.virgin.u, run.problem.N, MU, a, Gs)
     return {"nodes": run.problem.n_c, "points": len(run.virgin.points),
             "curve_err": float(np.abs(run.virgin.T - T_ref).max() / (MU * run.problem.N)),
-            "kt_err": run.problem.k_t / (8 * Gs * a) - 1.0, "total": total, **{
+            "kt_err": run.problem.k_t / (8 * Gs * a) - 1.0, "total": total,
+            "cache": run.contact.meta.get("cache", {}).get("hit"), **{
                 k: run.timings[k] for k in ("condense", "normal", "tangential")}}
 
 
@@ -51,7 +53,8 @@ def line(model: str, grid: int, label: str, r: dict) -> str:
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # kB -> MB (Linux)
     return (f"{model:9s} {grid:4d} {label:6s} {r['nodes']:6d} {r['points']:6d} "
             f"{r['curve_err']:9.2e} {r['kt_err']:+8.2%} {r['condense']:9.3f} {r['normal']:7.3f} "
-            f"{r['tangential']:7.3f} {r['total']:7.3f} {peak:8.0f}")
+            f"{r['tangential']:7.3f} {r['total']:7.3f} {peak:8.0f} "
+            f"{ {None: '-', True: 'hit', False: 'miss'}[r['cache']]:>5s}")
 
 
 def main(argv=None) -> int:
@@ -64,7 +67,7 @@ def main(argv=None) -> int:
     if args.smoke:
         args.bem, args.fe, args.fe_models = [9], [5], ["halfspace"]
     print(f"{'model':9s} {'grid':>4s} {'run':6s} {'nodes':>6s} {'points':>6s} {'err/muN':>9s} "
-          f"{'k_t err':>8s} {'condense':>9s} {'normal':>7s} {'tang.':>7s} {'total':>7s} {'peak MB':>8s}")
+          f"{'k_t err':>8s} {'condense':>9s} {'normal':>7s} {'tang.':>7s} {'total':>7s} {'peak MB':>8s} {'cache':>5s}")
     for g in args.bem:
         print(line("bem", g, "cold", one("bem", g, False)), flush=True)
     with tempfile.TemporaryDirectory(prefix="bench_tangential_") as cache:

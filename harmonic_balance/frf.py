@@ -72,6 +72,8 @@ class FRFResult:
     peak_omega: float = float("nan")
     peak_amplitude: float = float("nan")
     peak_amplitude_h1: float = float("nan")
+    peak_h1_max: float = float("nan")
+    peak_h1_max_omega: float = float("nan")
     peak_solution: np.ndarray | None = None
     peak_interior: bool = False
     alias_ratio: float = float("nan")
@@ -79,6 +81,7 @@ class FRFResult:
     status: str = "complete"
     stable: list | None = None    # per point: Hill stability (None: not computed)
     extra: dict = field(default_factory=dict)
+    truncation_error: dict | None = None
     problem: FRFProblem | None = field(default=None, repr=False)
 
     @property
@@ -90,7 +93,8 @@ class FRFResult:
         out = {
             "omega": self.omega, "amplitude": self.amplitude, "amplitude_h1": self.amplitude_h1,
             "peak_omega": self.peak_omega, "peak_amplitude": self.peak_amplitude,
-            "peak_amplitude_h1": self.peak_amplitude_h1, "peak_interior": self.peak_interior,
+            "peak_amplitude_h1": self.peak_amplitude_h1, "peak_h1_max": self.peak_h1_max,
+            "peak_h1_max_omega": self.peak_h1_max_omega, "peak_interior": self.peak_interior,
             "peaks": [{k: _finite(v) for k, v in p.items()} for p in self.peaks],
             "points": self.points, "newton_iterations": self.newton_iterations,
             "residual_evaluations": self.evaluations, "time_s": self.time_s,
@@ -99,8 +103,21 @@ class FRFResult:
             "status": self.status, "stable": self.stable,
             "stability_checks": self.extra.get("stability_checks", 0),
             "peak_refined": self.extra.get("peak_refined"),
+            "truncation_error": _finite_dict(self.truncation_error),
+            "truncation_warning": self.extra.get("truncation_warning"),
         }
+        if "accuracy" in self.extra:
+            out["accuracy"] = _finite_dict(self.extra["accuracy"])
         return {k: _finite(v) for k, v in out.items()}
+
+
+def _finite_dict(d):
+    """A nested record with NaN/inf -> None (JSON has no NaN)."""
+    if isinstance(d, dict):
+        return {k: _finite_dict(v) for k, v in d.items()}
+    if isinstance(d, (list, tuple)):
+        return [_finite_dict(v) for v in d]
+    return _finite(float(d)) if isinstance(d, (float, np.floating)) else d
 
 
 def _finite(v):
@@ -179,7 +196,8 @@ STABILITY_AUTO_MAX = 200
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
                 ds_max: float = DS_MAX, max_points: int = 2000, refine: bool = True,
                 stability="auto", progress=None, aft: str = "exact",
-                tolerance: float = CURVE_TOL) -> FRFResult:
+                tolerance: float = CURVE_TOL, truncation_check: bool = True,
+                accuracy: float | None = None, max_harmonic: int = 200) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
@@ -200,7 +218,13 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     accuracy, which sizes the continuation's steps (:mod:`continuation`, at least
     MIN_TOLERANCE); ``ds_max`` bounds them (scaled arclength). A peak refinement that
     fails keeps the curve's highest point (``extra["peak_refined"]`` False, a warning in
-    the status; :mod:`peaks`).
+    the status; :mod:`peaks`). ``truncation_check``: estimate the truncation error of
+    the peak in H (``result.truncation_error``, :func:`frf_accuracy.truncation_error`:
+    the peak re-solved with ~1.5 H and ~2.25 H harmonics, capped at ``max_harmonic``), with a
+    warning in ``extra["truncation_warning"]`` above :data:`accuracy.WARN_REL`.
+    ``accuracy``: a relative tolerance on the peak amplitude; the harmonics are then
+    raised per curve from ``harmonics`` until the estimate is below it
+    (:func:`frf_accuracy.frf_to_accuracy`; ``extra["accuracy"]`` says what was used).
 
     Raises
     ------
@@ -215,6 +239,13 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if not (MIN_TOLERANCE <= tolerance < 1 and np.isfinite(ds_max) and ds_max > 0):
         raise ValueError(f"the curve tolerance must be in [{MIN_TOLERANCE:g}, 1) and the largest "
                          f"step a finite number > 0, got {tolerance}, {ds_max}")
+    if accuracy is not None:
+        from .frf_accuracy import frf_to_accuracy
+
+        return frf_to_accuracy(model, accuracy, omega_range, harmonics, max_harmonic, n_t=n_t,
+                               condensed=condensed, ds_max=ds_max, max_points=max_points,
+                               refine=refine, stability=stability, progress=progress, aft=aft,
+                               tolerance=tolerance)
     t0 = time.perf_counter()
     model = exact_links(model, aft == "exact")
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
@@ -261,8 +292,19 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
                           f"{result.alias_ratio:.1e} of the force spectrum near Nyquist: "
                           "raise n_t")
     result.evaluations = prob.evaluations
+    if truncation_check and refine:
+        _check_truncation(result, max_harmonic)
     result.time_s = time.perf_counter() - t0
     return result
+
+
+def _check_truncation(result: FRFResult, max_harmonic: int) -> None:
+    """``result.truncation_error`` and its warning (:mod:`frf_accuracy`), in place."""
+    from .accuracy import warning
+    from .frf_accuracy import truncation_error
+
+    result.truncation_error = truncation_error(result, max_harmonic)
+    result.extra["truncation_warning"] = warning(result.truncation_error)
 
 
 #: Stiffness ratio (stiffest friction link over the structure) up to which the

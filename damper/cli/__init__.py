@@ -31,9 +31,46 @@ SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "
                "bench", "stress")
 
 
+#: A negative number as a command-line value (``--k-n -5e7``, ``--shift -.5``, ``-inf``):
+#: argparse's own pattern knows only ``-5`` and ``-0.5`` and reads ``-5e7`` as an option.
+NEGATIVE_NUMBER = re.compile(r"^-(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE)
+
+
+class Parser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose errors are one line (``prog: error: message``,
+    exit 2, no usage block) and which reads any negative number as a value.
+
+    Subparsers are of the same class (``add_subparsers`` takes the parent's class).
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
+    def error(self, message: str):
+        """Print one line naming the command and where its options are listed; exit 2."""
+        text = " ".join(str(message).split())
+        self.exit(2, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+
+    def add_subparsers(self, **kwargs):
+        kwargs.setdefault("parser_class", _SubParser)
+        return super().add_subparsers(**kwargs)
+
+
+class _SubParser(Parser):
+    """A subcommand's parser: refuses arguments it does not know itself, so the message
+    names the subcommand (argparse would leave them to ``damper``'s parser)."""
+
+    def parse_known_args(self, args=None, namespace=None):
+        namespace, extras = super().parse_known_args(args, namespace)
+        if extras:
+            self.error(f"unrecognized arguments: {' '.join(extras)}")
+        return namespace, extras
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the top-level parser with every available subcommand."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="damper",
         description="Friction-damper design toolkit: contact stiffness and virgin "
         "curves (FE), the Masing/Iwan friction element, harmonic balance.",

@@ -62,18 +62,38 @@ def run(args) -> int:
 
     from .common import check_out_file
 
-    if args.n_ref is not None and not (args.n_ref > 0 and args.n_ref < float("inf")):
-        raise ValueError(f"--n-ref must be a positive finite normal load [N], got {args.n_ref:g}")
+    check_numbers(args)
     check_out_file(args.output, "--output")
     source = read_curve(args.curve)
     n_ref = args.n_ref if args.n_ref is not None else source.N
     if n_ref is None:
         raise ValueError(f"{args.curve}: the curve has no normal load N; pass --n-ref")
+    if args.n_ref is None:
+        from damper import limits
+
+        limits.check_range(f"{args.curve}: N", n_ref, limits.MIN_NORMAL_LOAD, limits.MAX_NORMAL_LOAD, "N",
+                           "the slip limits scale with N / N_ref; give --n-ref")
     if args.normal is None and args.k_n is None:
         if args.preload is not None:
             raise ValueError("--preload needs a normal law: --normal FILE or --k-n K")
         return _run_element(args, source, n_ref)
     return _run_point(args, source, n_ref)
+
+
+def check_numbers(args) -> None:
+    """--n-ref, --preload, --k-n within :mod:`damper.limits`' ranges (ValueError)."""
+    from damper import limits
+
+    load_why = "the slip limits scale with N / N_ref, which underflows or overflows far outside"
+    for name in ("n_ref", "preload"):
+        v = getattr(args, name)
+        if v is not None:
+            limits.check_range(f"--{name.replace('_', '-')}", v, limits.MIN_NORMAL_LOAD,
+                               limits.MAX_NORMAL_LOAD, "N", load_why)
+    if args.k_n is not None:
+        limits.check_range("--k-n", args.k_n, limits.MIN_PENALTY_STIFFNESS, limits.MAX_PENALTY_STIFFNESS,
+                           "N/m", "the start penetration N / k_n would be beyond any contact "
+                           "(0.2 m at 200 N and 1e3 N/m) or below an atom")
 
 
 def _run_element(args, source, n_ref) -> int:
@@ -116,6 +136,11 @@ def _normal_law(args, n_ref: float):
     from contact_core.normal_curve import read_normal_curve
 
     normal = read_normal_curve(args.normal)
+    top = float(normal.N[-1])
+    if args.preload is not None and args.preload > top * (1.0 + SAME_LOAD_RTOL):
+        raise ValueError(f"--preload {args.preload:g} N is beyond the normal curve {args.normal}, which "
+                         f"covers 0 ... {top:g} N: give a preload in that range or a normal curve "
+                         "computed up to a higher load (damper normal --force)")
     if args.preload is None and abs(normal.load - n_ref) > SAME_LOAD_RTOL * n_ref:
         raise ValueError(f"{args.curve} was computed at N = {n_ref:g} N but {args.normal} up to "
                          f"{normal.load:g} N: pass --preload N to say at which normal load the "
@@ -130,8 +155,6 @@ def _run_point(args, source, n_ref) -> int:
     from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_point import build_point_fmu
 
-    if args.preload is not None and not (args.preload > 0 and args.preload < float("inf")):
-        raise ValueError(f"--preload must be finite and > 0, got {args.preload}")
     p, N, normal_text, law = _normal_law(args, n_ref)
     try:
         curve, error = reduce_virgin_curve(source, fit=args.fit)

@@ -7,6 +7,12 @@ Examples::
     damper frf --model matrices.npz --elements elements.toml --harmonics odd:7 \\
         --omega 100 300 --json --plot out/frf
 
+Harmonics and accuracy: ``--harmonics`` fixes the harmonic set; ``--accuracy TOL``
+raises H per curve (from ``--harmonics``, default 3) until the estimated truncation
+error of the peak amplitude is below TOL; with neither, ``--accuracy 0.01`` from H = 3.
+Every result carries that estimate (the peak re-solved with ~1.5 H and ~2.25 H harmonics,
+docs/method/accuracy.md) and a warning line when it exceeds 1 %.
+
 ``--model`` is ``sdof`` (a mass on a spring and dashpot with one Jenkins element to
 the ground, forced by ``--force`` cos(omega t)) or a ``.npz`` file with an
 ``--elements`` ``.toml`` file; both formats are documented in
@@ -15,7 +21,14 @@ or ``all:H``.
 
 JSON output (SI units): ``omega`` [rad/s] per point, ``amplitude`` (peak |x| of the
 response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitude),
-``peak_omega`` and ``peak_amplitude`` (the highest refined peak), ``peaks`` (every
+``peak_omega`` and ``peak_amplitude`` (the highest refined peak of max|x|),
+``peak_amplitude_h1`` (the first harmonic at that peak), ``peak_h1_max`` and
+``peak_h1_max_omega`` (the first harmonic's own refined maximum), ``truncation_error``
+(method, H_used, H_check, order, peak_amplitude_rel and peak_frequency_rel: the
+estimated relative error in H of the peak, check: the peak at H_check, extrapolated:
+the peak extrapolated in H when the order was observed, else null),
+``truncation_warning``, ``accuracy`` (with --accuracy: target, met, H_sequence,
+levels, message), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``aft``
 ("exact": the links' Fourier coefficients without sampling, the default, n_t then only
 scans for extrema; "sampled" with ``--aft sampled``; "mixed" with contacts), ``points``,
@@ -42,7 +55,11 @@ def register(subparsers) -> None:
         "frf", help="forced-response curve of a friction-damped model (harmonic balance)",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_model_arguments(p)
-    p.add_argument("--harmonics", default="1", help="H, odd:H or all:H (default 1)")
+    p.add_argument("--harmonics", help="H, odd:H or all:H: a fixed harmonic set (with --accuracy: "
+                   "the first one tried; default: --accuracy 0.01 from H = 3)")
+    p.add_argument("--accuracy", type=float, metavar="TOL",
+                   help="relative accuracy of the peak amplitude, in (1e-6, 0.5): the harmonics are "
+                   "raised per curve until the estimated truncation error is below TOL")
     p.add_argument("--samples", type=int, default=0,
                    help="AFT samples per period (0: auto); exact links only scan them for the extrema")
     p.add_argument("--aft", choices=("exact", "sampled"), default="exact",
@@ -143,6 +160,7 @@ def run(args) -> int:
     import os
 
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # small dense work: one thread is faster
+    from damper import limits
     from harmonic_balance.frf import FRFError, compute_frf
 
     from .common import atomic_write, dumps, print_json
@@ -155,7 +173,8 @@ def run(args) -> int:
     try:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
                              max_points=args.max_points, aft=args.aft, **steps,
-                             stability=args.stability)
+                             stability=args.stability, accuracy=args.accuracy,
+                             max_harmonic=limits.MAX_HARMONICS)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
@@ -192,6 +211,7 @@ def check_run_arguments(args) -> None:
     from damper.cli.common import check_out_dir, check_out_file
 
     check_model_arguments(args)
+    check_accuracy_arguments(args)
     limits.check_harmonics("--harmonics", args.harmonics)
     check_samples(args.samples)
     limits.check_omega_range("--omega", *args.omega)
@@ -206,6 +226,27 @@ def check_run_arguments(args) -> None:
     check_out_dir(args.plot, "--plot")
 
 
+#: Accuracy of a run that gives neither --harmonics nor --accuracy (relative, on the peak
+#: amplitude), and the harmonics it starts from: measured on the bench models
+#: (docs/method/accuracy.md) at 1.1-1.6 times the cost of one curve at H = 3.
+DEFAULT_ACCURACY, DEFAULT_START = 1e-2, "3"
+
+
+def check_accuracy_arguments(args) -> None:
+    """``--accuracy`` inside (1e-6, 0.5); without it and without ``--harmonics`` the default
+    accuracy and start (the arguments are filled in)."""
+    from harmonic_balance.accuracy import ACCURACY_RANGE
+
+    lo, hi = ACCURACY_RANGE
+    if args.accuracy is not None and not lo < args.accuracy < hi:
+        raise ValueError(f"--accuracy must be a relative tolerance in ({lo:g}, {hi:g}) on the peak "
+                         f"amplitude, got {args.accuracy:g}")
+    if args.accuracy is None and args.harmonics is None:
+        args.accuracy = DEFAULT_ACCURACY
+    if args.harmonics is None:
+        args.harmonics = DEFAULT_START
+
+
 def _report_curve_fits(model) -> None:
     """Say on stderr which element curves were reduced to the C element's slider limit."""
     import sys
@@ -218,17 +259,29 @@ def _report_curve_fits(model) -> None:
 
 
 def _emit(args, summary, print_json, atomic_write, dumps):
+    from harmonic_balance.frf_accuracy import summary_lines as accuracy_lines
+
     if args.out:
         atomic_write(args.out, dumps(summary, indent=1) + "\n")
     if args.json:
         print_json(summary)
+        for line in accuracy_lines(summary)[1:]:
+            if line.startswith("warning"):
+                import sys
+
+                print(line, file=sys.stderr)
         return
     print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
           f"{_num(summary['time_s'], '.3f')} s, harmonics {summary['harmonics']}, "
           f"n_t {summary['n_t']}" + (f", {summary['aft']} AFT" if summary.get("aft") else ""))
     print(f"peak: omega = {_num(summary['peak_omega'])} rad/s, amplitude = "
           f"{_num(summary['peak_amplitude'])} m (first harmonic "
-          f"{_num(summary['peak_amplitude_h1'])} m)")
+          f"{_num(summary['peak_amplitude_h1'])} m there)")
+    if summary.get("peak_h1_max") is not None:
+        print(f"first harmonic's own peak: omega = {_num(summary['peak_h1_max_omega'])} rad/s, "
+              f"amplitude = {_num(summary['peak_h1_max'])} m")
+    for line in accuracy_lines(summary):
+        print(line)
     if summary.get("stable") is not None:
         n_unst = sum(1 for s in summary["stable"] if s is False)
         print(f"stability (Hill): {n_unst} of {summary['points']} points unstable")
@@ -238,3 +291,4 @@ def _emit(args, summary, print_json, atomic_write, dumps):
 def _num(v, fmt=".9g") -> str:
     """A number for the text summary; 'none' when undefined (no converged point)."""
     return "none" if v is None else format(v, fmt)
+

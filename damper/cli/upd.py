@@ -26,7 +26,12 @@ def register(sub) -> None:
     _common(f)
     f.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
     f.add_argument("--f0", type=float, help="EO force amplitude on the airfoil [N] (default: config)")
-    f.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (0..H kept)")
+    f.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (0..H kept; with "
+                   "--accuracy the first one tried)")
+    f.add_argument("--accuracy", type=float, metavar="TOL",
+                   help="relative accuracy of the peak amplitude, in (1e-6, 0.5): H is raised per curve "
+                   "until the estimated truncation error is below TOL (default: the fixed --harmonics, "
+                   "its estimate reported, a warning above 1 %%)")
     f.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="band [Hz]")
     f.add_argument("--points", type=int, default=200, help="frequency points")
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
@@ -88,7 +93,7 @@ def _mistuning(s) -> None:
 def run_mistuning(args) -> int:
     import sys
 
-    from damper.mistuning import Study, plot_study, run_study
+    from damper.mistuning import AllSamplesFailed, Study, plot_study, run_study
 
     from .cache import store_from_args
     from .common import check_out_dir, print_json
@@ -120,15 +125,18 @@ def run_mistuning(args) -> int:
 
         raise Interrupted("mistuning interrupted; the samples finished so far are in the cache, "
                           "the same command resumes") from None
+    except AllSamplesFailed as err:  # the object with every sample's error, then exit 3
+        if args.json:
+            print_json(err.summary)
+        else:
+            _print_samples(err.summary)
+        raise
     if args.plot:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
         return 0
-    for s in out["samples"]:
-        print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
-              f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
-              else f"failed: {s['error']}"))
+    _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
           f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
           f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
@@ -170,6 +178,13 @@ def statistics_lines(out: dict) -> list:
     lines.append(f"parallel efficiency {e['efficiency']:.2f}: {e['cpu_s']:.1f} s CPU in {e['chunks']} "
                  f"chunks of {e['chunk_size']} on {e['workers']} worker(s) in {e['wall_s']:.1f} s")
     return lines
+
+
+def _print_samples(out: dict) -> None:
+    for s in out["samples"]:
+        print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
+              f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
+              else f"failed: {s['error']}"))
 
 
 def _common(p) -> None:
@@ -220,6 +235,7 @@ def _check_frf(args) -> None:
                       "each frequency point is a harmonic-balance solve (~7 ms at H = 7; 10000 points ~1 min)")
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
                       limits.harmonics_why(limits.MAX_UPD_HARMONICS))
+    check_accuracy_option(args.accuracy)
     for name in ("cf", "f0"):
         v = getattr(args, name)
         if v is not None and not (np.isfinite(v) and v > 0):
@@ -227,7 +243,19 @@ def _check_frf(args) -> None:
     check_out_dir(args.plot, "--plot")
 
 
+def check_accuracy_option(tol) -> None:
+    """``--accuracy`` unset or inside (1e-6, 0.5)."""
+    from harmonic_balance.accuracy import ACCURACY_RANGE
+
+    lo, hi = ACCURACY_RANGE
+    if tol is not None and not lo < tol < hi:
+        raise ValueError(f"--accuracy must be a relative tolerance in ({lo:g}, {hi:g}) on the peak "
+                         f"amplitude, got {tol:g}")
+
+
 def run_frf(args) -> int:
+    import sys
+
     from .common import print_json
 
     _check_frf(args)
@@ -249,7 +277,22 @@ def run_frf(args) -> int:
               f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
         if "warning" in out:
             print(f"warning: {out['warning']}")
+    for line in _accuracy_lines(out):
+        if not args.json or line.startswith("warning"):
+            print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def _accuracy_lines(out) -> list[str]:
+    """The truncation-error lines of a ``upd frf`` result (frequencies in Hz)."""
+    from harmonic_balance.frf_accuracy import summary_lines
+
+    rec = out.get("truncation_error")
+    if not rec:
+        return []
+    summary = {"truncation_error": rec, "accuracy": rec.get("accuracy"),
+               "truncation_warning": out.get("truncation_warning")}
+    return summary_lines(summary, hz=True)
 
 
 def _frf_linear(sector, args, omegas) -> dict:
@@ -271,11 +314,23 @@ def _frf_linear(sector, args, omegas) -> dict:
 
 
 def _frf_nonlinear(sector, args, omegas) -> dict:
+    from damper import limits
+    from harmonic_balance.accuracy import warning
+    from harmonic_balance.bladed_disk.accuracy import frf_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
 
-    hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
-    c = frf(hb, omegas)
+    if args.accuracy is None:
+        hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
+        c = frf(hb, omegas)
+        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    else:
+        import time
+
+        t0 = time.perf_counter()
+        hb, c, rec = frf_to_accuracy(sector, omegas, args.accuracy, args.harmonics,
+                                     limits.MAX_UPD_HARMONICS, cf=args.cf, f0=args.f0)
+        c.time_s = time.perf_counter() - t0
     summ = hb.contact_summary(c.peak_x)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
@@ -288,7 +343,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
             "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
-            "time_s": c.time_s}
+            "time_s": c.time_s, "truncation_error": rec,
+            "truncation_warning": warning(rec)}
     if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
         out["warning"] = c.extra["warning"]
     return out
@@ -313,14 +369,40 @@ def _check_optimize(args) -> None:
     check_out_dir(args.plot, "--plot")
 
 
+def _optimum_truncation(sector, out, args) -> dict:
+    """Truncation-error estimate of the peak at the optimum CF (its curve on the search's
+    grid, checked at ~1.5 H: :mod:`harmonic_balance.bladed_disk.accuracy`)."""
+    from damper import limits
+    from harmonic_balance.bladed_disk.accuracy import truncation_error
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.solve import SolverError, frf
+
+    lo, hi = sector.cfg["load.band_hz"]
+    hb = SectorHB(sector, args.harmonics, cf=out["optimum_cf"])
+    try:
+        c = frf(hb, 2 * np.pi * np.linspace(lo, hi, args.grid))
+    except SolverError as err:
+        return {"method": "richer harmonic set at the peak", "H_used": args.harmonics,
+                "peak_amplitude_rel": None, "peak_frequency_rel": None, "note": f"check failed: {err}"}
+    rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    rec["at"] = "the optimum CF"
+    return rec
+
+
 def run_optimize(args) -> int:
+    import sys
+
+    from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.optimize import optimal_load
 
     from .common import print_json
 
     _check_optimize(args)
-    out = optimal_load(_sector(args), args.cf_range, args.points, args.harmonics, grid=args.grid,
+    sector = _sector(args)
+    out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
                        workers=args.workers)
+    out["truncation_error"] = _optimum_truncation(sector, out, args)
+    out["truncation_warning"] = warning(out["truncation_error"])
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
         _plot_optimize(out, args.plot)
@@ -332,6 +414,9 @@ def run_optimize(args) -> int:
         band = out.get("optimum_band_cf")
         if band:  # the minimum is flat: the CF range a design can use
             print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
+    for line in _accuracy_lines(out):
+        if not args.json or line.startswith("warning"):
+            print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

@@ -72,6 +72,7 @@ class FRF(Kind):
                       extra={"matrices": s.get("matrices")}) for F in ex["forces"]]
 
     def compute(self, stage, inputs, ctx):
+        from damper import limits
         from fmu_src.element import IwanElement
         from harmonic_balance.frf import FRFError, compute_frf
         from harmonic_balance.plots import plot_frf
@@ -86,7 +87,8 @@ class FRF(Kind):
         omega = (2 * math.pi * sw["f_min"], 2 * math.pi * sw["f_max"])
         try:
             result = compute_frf(model, str(sw["harmonics"]), omega, ds_max=sw["max_step"], max_points=MAX_POINTS,
-                                 progress=ctx.progress)
+                                 progress=ctx.progress, accuracy=sw.get("accuracy"),
+                                 max_harmonic=limits.MAX_HARMONICS)
         except FRFError as err:
             raise RuntimeError(f"{err} ({err.result.points} points kept)") from None
         with tempfile.TemporaryDirectory() as tmp:
@@ -98,13 +100,16 @@ class FRF(Kind):
         return {"frf": "result.json"}
 
     def lines(self, stage, result):
+        from harmonic_balance.frf_accuracy import summary_lines
+
         s = result.data
         level = (f"P = {stage.params['force']:g} N" if stage.params["structure"]["model"] == "two_dof"
                  else f"force x {stage.params['force']:g}")
         return [f"{s['points']} points, {s['newton_iterations']} Newton iterations, "
                 f"{s['time_s']:.3f} s, harmonics {s['harmonics']}, n_t {s['n_t']}",
                 f"peak: omega = {s['peak_omega']:.9g} rad/s, amplitude = "
-                f"{s['peak_amplitude']:.9g} m (first harmonic {s['peak_amplitude_h1']:.9g} m)",
+                f"{s['peak_amplitude']:.9g} m (first harmonic {s['peak_amplitude_h1']:.9g} m there)",
+                *summary_lines(s),
                 f"status: {s['status']}",
                 f"   {level}: peak {s['peak_amplitude']:.3e} m at "
                 f"{s['peak_omega'] / (2 * math.pi):.1f} Hz ({s['points']} points, {s['time_s']:.2f} s)"]
@@ -112,4 +117,6 @@ class FRF(Kind):
     def scalars(self, stage, result):
         s = result.data
         return {"peak_frequency_Hz": s["peak_omega"] / (2 * math.pi) if s["peak_omega"] else None,
-                "peak_amplitude_m": s["peak_amplitude"], "points": s["points"]}
+                "peak_amplitude_m": s["peak_amplitude"], "points": s["points"],
+                "harmonics_H": max(s["harmonics"]) if s.get("harmonics") else None,
+                "truncation_error_rel": (s.get("truncation_error") or {}).get("peak_amplitude_rel")}

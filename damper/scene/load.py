@@ -233,6 +233,7 @@ def _check_wants(data: dict, problems: list) -> None:
             if bad:
                 problems.append((("contact", name, "want"), f"not a contact result: {bad[0]!r} (contact "
                                  f"results: {', '.join(k for k, v in schema.RESULTS.items() if v[1])})"))
+                continue   # its stages cannot be named
         c["want"] = list(own) if own is not None else list(contact_wants)
         if any(schema.RESULTS[w][0] == "tangential" for w in c["want"]) and "mu" not in c:
             problems.append((("contact", name, "mu"), "missing: needed for "

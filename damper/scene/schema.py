@@ -148,6 +148,9 @@ SWEEP = {
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
                       "sizes the steps below it)", default=0.5, gt=0),
+    "accuracy": Field("float", "relative accuracy of the peak amplitude: the harmonics are raised "
+                      "from `harmonics` until the estimated truncation error is below it (unset: "
+                      "the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
 }
 
 BACKBONE = {
@@ -267,3 +270,40 @@ def _check_scalar(f: Field, scalar: str, v) -> str | None:
 def _kind(v) -> str:
     return {dict: "a table", list: "a list", str: "a string", bool: "a boolean",
             int: "an integer", float: "a number"}.get(type(v), type(v).__name__)
+
+
+def json_schema() -> dict:
+    """The scene file as a JSON Schema (draft 2020-12), from the tables above: what an
+    editor checks and completes a scene with (keys, types, choices, bounds, docs)."""
+    props = {k: _field_schema(f) for k, f in TOP.items()}
+    for name, (fields, named) in TABLES.items():
+        table = _table_schema(fields, f"[{name}]")
+        props[name] = ({"type": "object", "description": f"[{name}.NAME] tables, one per item",
+                        "additionalProperties": table} if named else table)
+    return {"$schema": "https://json-schema.org/draft/2020-12/schema", "title": "damper scene",
+            "description": "A scene (TOML, SI units): one analysis `damper run` runs. Checks that relate "
+                           "keys (a body's sizes, wants and the tables they need) are the loader's.",
+            "type": "object", "properties": props, "required": [k for k, f in TOP.items() if f.required],
+            "additionalProperties": False}
+
+
+def _table_schema(fields: dict, title: str) -> dict:
+    return {"type": "object", "title": title, "properties": {k: _field_schema(f) for k, f in fields.items()},
+            "required": [k for k, f in fields.items() if f.required], "additionalProperties": False}
+
+
+def _field_schema(f: Field) -> dict:
+    scalar = f.type.removeprefix("list[").removesuffix("]")
+    out: dict = {"type": {"float": "number", "int": "integer", "str": "string", "bool": "boolean"}[scalar]}
+    if f.choices:
+        out["enum"] = list(f.choices)
+    for key, bound in (("exclusiveMinimum", f.gt), ("minimum", f.ge), ("exclusiveMaximum", f.lt),
+                       ("maximum", f.le)):
+        if bound is not None:
+            out[key] = bound
+    if f.type.startswith("list["):
+        out = {"type": "array", "items": out}
+    out["description"] = f.doc + (f" (bounded: {f.why})" if f.why else "")
+    if f.default is not None:
+        out["default"] = f.default
+    return out

@@ -56,6 +56,9 @@ def _cli() -> list[InputCase]:
     return _table("cli", [
         ("no subcommand", ""), ("unknown subcommand", "frobnicate"), ("frf without options", "frf"),
         ("run without a scene", "run"), ("unknown option", "loop --curve {fx}/curve.json --amplitude 1e-6 --wobble"),
+        ("an integer option given 1.5", "upd mistuning --seed 1.5"),
+        ("a negative number as a value", "fmu --curve {fx}/curve.json -o d.fmu --k-n -5e7"),
+        ("an unknown option of a subcommand without arguments", "bench --no-such-option"),
     ]) + [_case("cli", "--version", "--version", expect="converged", check="version")]
 
 
@@ -65,6 +68,7 @@ def _normal() -> list[InputCase]:
         ("force nan", f"{SPHERE} --force nan"), ("force inf", f"{SPHERE} --force inf"),
         ("approach -1e-6", f"{SPHERE} --approach=-1e-6"), ("force and approach", f"{SPHERE} --force 1 --approach 1e-6"),
         ("radius 0", "--body sphere --radius 0 --force 100"),
+        ("radius 1e308", "--body sphere --radius 1e308 --force 200"), ("E 1e308", f"{SPHERE} --force 200 --E 1e308"),
         ("radius -0.01", "--body sphere --radius=-0.01 --force 1"),
         ("sphere without radius", "--body sphere --force 100"),
         ("radius and diameter", "--body sphere --radius 0.01 --diameter 0.02 --force 100"),
@@ -161,6 +165,13 @@ def _fmu() -> list[InputCase]:
         ("point: normal curve missing", "--curve {fx}/curve.json -o d.fmu --normal {fx}/nowhere.json"),
         ("point: normal curve is a virgin curve", "--curve {fx}/curve.json -o d.fmu --normal {fx}/curve.json"),
         ("point: k-n and normal", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --normal {fx}/curve.json"),
+        ("n-ref 1e-320", "--curve {fx}/curve.json -o d.fmu --n-ref 1e-320"),
+        ("n-ref 1e308", "--curve {fx}/curve.json -o d.fmu --n-ref 1e308"),
+        ("point: k-n 1e-300", "--curve {fx}/curve.json -o d.fmu --k-n 1e-300"),
+        ("point: k-n -5e7", "--curve {fx}/curve.json -o d.fmu --k-n -5e7"),
+        ("point: preload 1e12", "--curve {fx}/curve.json -o d.fmu --k-n 1e8 --preload 1e12"),
+        ("point: preload beyond the normal curve",
+         "--curve {fx}/curve.json -o d.fmu --normal {fx}/normal_120.json --preload 1e7"),
     ], "fmu")
 
 
@@ -194,8 +205,12 @@ def _frf() -> list[InputCase]:
         ("--out an existing folder", f"{SDOF} {o} --out {{fx}}"),
         ("--out below a file", f"{SDOF} {o} --out {{fx}}/a_file/f.json"),
         ("--plot a file", f"{SDOF} {o} --plot {{fx}}/a_file"),
+        ("accuracy 0", f"{SDOF} {o} --accuracy 0"), ("accuracy 0.5", f"{SDOF} {o} --accuracy 0.5"),
+        ("accuracy 1e-7", f"{SDOF} {o} --accuracy 1e-7"), ("accuracy nan", f"{SDOF} {o} --accuracy nan"),
+        ("accuracy -0.01", f"{SDOF} {o} --accuracy=-0.01"),
     ]
-    for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc"):
+    for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc",
+              "complex"):
         rows.append((f"npz {m}", f"--model {{fx}}/m_{m}.npz --elements {{fx}}/el_good.toml --omega 100 300"))
     for e in ("wobble", "scael", "top", "badtoml", "binary", "none", "dof9", "nok", "type", "path", "negk",
               "dofstr", "same", "contact"):
@@ -213,6 +228,7 @@ def _backbone() -> list[InputCase]:
         ("npz M = -I", "--model {fx}/m_negM.npz --elements {fx}/el_good.toml " + a),
         ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
         ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),
+        ("npz complex K", "--model {fx}/m_complex.npz --elements {fx}/el_good.toml " + a),
     ], "backbone")
 
 
@@ -224,6 +240,7 @@ def _upd() -> list[InputCase]:
         ("frf band nan 1", "frf --band nan 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
         ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
+        ("frf accuracy 0.6", "frf --accuracy 0.6"), ("frf accuracy nan", "frf --accuracy nan"),
         ("config missing", "modes --config {fx}/nowhere.toml"),
         ("config binary", "modes --config {fx}/upd_binary.toml"),
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
@@ -241,6 +258,11 @@ def _upd() -> list[InputCase]:
         ("mistuning factor -1", "mistuning --blades 4 --engine-order 1 --factors 1 -1 1 1"),
         ("mistuning factor nan", "mistuning --blades 4 --engine-order 1 --factors 1 nan 1 1"),
         ("mistuning 3 factors for 4 blades", "mistuning --blades 4 --engine-order 1 --factors 1 1 1"),
+        ("mistuning factor 1e-300", "mistuning --blades 4 --engine-order 1 --factors 1 1e-300 1 1"),
+        ("mistuning factor 1e308", "mistuning --blades 4 --engine-order 1 --factors 1 1e308 1 1"),
+        ("mistuning frequency factor 3", "mistuning --blades 4 --engine-order 1 --kind frequency --factors 1 3 1 1"),
+        ("mistuning uniform frequency std 0.5",
+         "mistuning --kind frequency --distribution uniform --std 0.5 --samples 2"),
         ("mistuning unreachable scheduler", "mistuning --scheduler tcp://127.0.0.1:9 --samples 2"),
         ("mistuning workers and serial", "mistuning --workers 2 --serial"),
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
@@ -259,13 +281,21 @@ def _system() -> list[InputCase]:
         ("cosim archive missing", "cosim {fx}/nowhere.ssp --frequency-hz 400"),
         ("cosim archive binary", "cosim {fx}/binary.bin --frequency-hz 400"),
         ("cosim a text file", "cosim {fx}/a_file --frequency-hz 400"),
-    ])
+        ("cosim an FMU missing from the archive", "cosim {fx}/ring_nofmu.ssp --frequency-hz 400 --json"),
+    ]) + [_case("system", name, f"cosim r.ssp {cmd}", pre=[shlex.split("system --cf 120 --f0 30 -o r.ssp")],
+                timeout=120.0) for name, cmd in (
+        ("cosim frequency 1e-300", "--frequency-hz 1e-300"),
+        ("cosim periods 1e12", "--frequency-hz 448 --periods 1000000000000"),
+        ("cosim 1.2e8 steps", "--frequency-hz 448 --periods 50000"),
+        ("cosim a diverging coupling (--force, 13 x the step limit)",
+         "--frequency-hz 448 --step 1e-4 --periods 20 --force --json"))]
 
 
 def _run() -> list[InputCase]:
     rows = [(f"scene {n[2:-5]}", f"{{fx}}/{n}") for n in (
         "s_loopamp.toml", "s_grid.toml", "s_grid2.toml", "s_forces.toml", "s_forceneg.toml", "s_harm.toml",
-        "s_harm0.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml", "s_fmax.toml",
+        "s_harm0.toml", "s_accuracy.toml", "s_samples.toml", "s_mu0.toml", "s_mubig.toml", "s_munan.toml",
+        "s_fmax.toml",
         "s_fhuge.toml", "s_zone.toml", "s_hertz.toml", "s_unknown.toml", "s_ckey.toml", "s_want.toml",
         "s_elcontact.toml", "s_fmi.toml", "s_body.toml", "s_both.toml", "s_nu.toml", "s_type.toml", "s_dofs.toml",
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
@@ -349,7 +379,28 @@ def _duties() -> list[InputCase]:
     ]
 
 
+def _typed() -> list[InputCase]:
+    """Files well-formed as JSON / TOML that the typed file models refuse (input_fixtures.typed_files)."""
+    cases = []
+    for kind in ("mutrue", "Tstr", "wobble", "plateau", "huge"):
+        cases += _table("loop", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json --amplitude 2e-6")], "loop")
+        cases += _table("fmu", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu")], "fmu")
+    for kind in ("wobble", "Nstr"):
+        cases += _table("fmu", [(f"point: normal curve {kind}",
+                                 f"--curve {{fx}}/curve.json -o d.fmu --normal {{fx}}/normal_{kind}.json")], "fmu")
+    for kind in ("mutrue", "mdstr", "band3", "bandnan", "blades"):
+        cases += _table("upd", [(f"config {kind}", f"frf --config {{fx}}/upd_{kind}.toml --points 5")], "upd")
+    cases += _table("upd", [("modes config blades 1e8", "modes --config {fx}/upd_blades.toml")], "upd")
+    cases += _table("system", [("system config blades 1e8", "system --config {fx}/upd_blades.toml -o r.ssp")])
+    from .input_fixtures import forged_ring_infos
+
+    cases += _table("system", [(f"cosim forged system.json: {name}",
+                                f"cosim {{fx}}/ring_{name}.ssp --frequency-hz 448 --periods 2")
+                               for name in forged_ring_infos()])
+    return cases
+
+
 def all_cases() -> list[InputCase]:
     """Every input case, grouped by subcommand."""
     return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _system() + _run()
-            + _sweep() + _cache_and_rest() + _duties())
+            + _sweep() + _cache_and_rest() + _duties() + _typed())

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import json
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -38,7 +39,15 @@ def curves() -> dict[str, str | bytes]:
             "curve_convex.json": json.dumps(convex), "curve_dip.json": json.dumps(dip),
             "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
             "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
-            "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")})}
+            "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")}),
+            "normal_120.json": json.dumps(_normal_curve(120.0))}
+
+
+def _normal_curve(top: float, n: int = 8) -> dict:
+    """A Hertzian normal approach curve N = top (p / p_top)^(3/2) up to ``top`` [N]."""
+    N = top * np.linspace(0.0, 1.0, n)
+    return {"schema": "damper-normal-curve/1", "approach": (1e-6 * (N / top) ** (2 / 3)).tolist(),
+            "N": N.tolist(), "load": top}
 
 
 def _npz(**arrays) -> bytes:
@@ -63,7 +72,8 @@ def matrices() -> dict[str, bytes]:
             "m_forcelen.npz": _npz(M=M, K=K, force=np.ones(5)),
             "m_cnan.npz": _npz(M=M, K=K, C=np.full((2, 2), np.inf), force=f),
             "m_text.npz": b"M = [[1, 0], [0, 1]]\n", "m_empty.npz": b"",
-            "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200]}
+            "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200],
+            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f)}
 
 
 def elements() -> dict[str, str | bytes]:
@@ -131,6 +141,7 @@ SCENE_EDITS = {
     "s_forceneg.toml": ("forces = [30.0]", "forces = [-30.0]"),
     "s_harm.toml": ("harmonics = 3", "harmonics = 100000"),
     "s_harm0.toml": ("harmonics = 3", "harmonics = 0"),
+    "s_accuracy.toml": ("harmonics = 3", "harmonics = 3\naccuracy = 0.6"),
     "s_samples.toml": ("fmi_versions = [2]", "fmi_versions = [2]\nloop_samples = 1000000000"),
     "s_mu0.toml": ("mu = 0.5", "mu = 0.0"),
     "s_mubig.toml": ("mu = 0.5", "mu = 1e300"),
@@ -186,10 +197,71 @@ def upd_files() -> dict[str, str | bytes]:
             "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
 
 
+def typed_files() -> dict[str, str | bytes]:
+    """Files well-formed as JSON / TOML whose content the typed models refuse: booleans or
+    strings as numbers, lists of the wrong length, unknown keys, a curve above its own
+    mu N, sizes out of bounds, and ring archives whose ``system.json`` is forged."""
+    good = _curve()
+    normal = {"schema": "damper-normal-curve/1", "approach": [0.0, 1e-6, 2e-6], "N": [0.0, 50.0, 140.0]}
+    out = {"curve_mutrue.json": json.dumps(dict(good, mu=True)),
+           "curve_Tstr.json": json.dumps(dict(good, T=[str(t) for t in good["T"]])),
+           "curve_wobble.json": json.dumps(dict(good, wobble=3)),
+           # plateau 180 N against the file's mu N = 0.5 x 120 N = 60 N
+           "curve_plateau.json": json.dumps(dict(good, T=[1.8 * t for t in good["T"]], N=120.0)),
+           "curve_huge.json": json.dumps(dict(good, T=[t * 1e300 for t in good["T"]])),
+           "normal_good.json": json.dumps(normal),
+           "normal_wobble.json": json.dumps(dict(normal, wobble=3)),
+           "normal_Nstr.json": json.dumps(dict(normal, N=["0", "50", "140"])),
+           "upd_mutrue.toml": "[damper]\nmu = true\n", "upd_mdstr.toml": '[damper]\nm_d = "0.005"\n',
+           "upd_band3.toml": "[load]\nband_hz = [400.0, 450.0, 500.0]\n",
+           "upd_bandnan.toml": "[load]\nband_hz = [nan, 500.0]\n",
+           "upd_blades.toml": "[disk]\nblades = 100000000\n"}
+    for name, info in forged_ring_infos().items():
+        out[f"ring_{name}.ssp"] = _ring_archive(info)
+    return out
+
+
+def _ring_info() -> dict:
+    """A ring archive's description as ``damper system`` writes it (UPD-24, 4 ring blades)."""
+    return {"kind": "damper-ring", "config": "UPD-24", "blades": 24, "engine_order": 6, "ring_blades": 4,
+            "interblade_phase": 1.5707963267948966, "cf": 120.0, "f0": 30.0, "frequency_hz": 450.0,
+            "fmi_version": 2, "omega_max": 271903.68, "step_limit": 7.3555e-06, "default_step": 9.1944e-07,
+            "step_fraction": 0.125, "damper_substep": 3.2116e-06,
+            "blades_components": [f"blade{j}" for j in range(4)],
+            "damper_components": [f"damper{j}" for j in range(4)],
+            "response": "q_u_a", "response_dof": "u_a", "contacts": ["left", "right1", "right2"],
+            "coupling_dofs": ["u_r"], "K_next_coupling": [[-2e7]]}
+
+
+def forged_ring_infos() -> dict[str, object]:
+    """Seven forged ``resources/system.json``: keys missing, wrong types, null, a list."""
+    info = _ring_info()
+    return {"no_step_limit": {k: v for k, v in info.items() if k != "step_limit"},
+            "no_components": {k: v for k, v in info.items() if k != "blades_components"},
+            "step_abc": info | {"default_step": "abc"}, "limit_null": info | {"step_limit": None},
+            "list": [info], "components_text": info | {"blades_components": "blade0"},
+            "coupling_text": info | {"K_next_coupling": "x"}}
+
+
+def _ring_archive(info, ssd: str = "<ssd:SystemStructureDescription/>\n") -> bytes:
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        zf.writestr("SystemStructure.ssd", ssd)
+        zf.writestr("resources/system.json", json.dumps(info))
+    return buf.getvalue()
+
+
+def archives() -> dict[str, bytes]:
+    """A ring archive whose SystemStructure.ssd uses an FMU the archive does not hold."""
+    ssd = ('<ssd:SystemStructureDescription><ssd:System><ssd:Elements><ssd:Component name="blade0" '
+           'source="resources/blade.fmu"/></ssd:Elements></ssd:System></ssd:SystemStructureDescription>\n')
+    return {"ring_nofmu.ssp": _ring_archive(_ring_info(), ssd)}
+
+
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
-    for group in (curves(), matrices(), elements(), scenes(), upd_files()):
+    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):

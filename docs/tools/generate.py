@@ -11,6 +11,12 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
   record each check through ``tests/reference.py``);
 * ``limits.md``: the table of the bounds every size a user types is checked against,
   from the constants of ``damper/limits.py`` and their ``#:`` comments;
+* ``formats.md`` and ``extra/schemas/<name>.schema.json``: every input file format's
+  keys (type, bounds, meaning) and its JSON Schema, from the typed models
+  (``damper.formats``); the schema files are copied into the site's ``schemas/``;
+* ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
+  of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
+  (``make docs-accuracy``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -83,23 +89,38 @@ def cli_page(docs: Path) -> None:
     _write(docs / "_generated" / "cli.md", "\n".join(lines))
 
 
-#: Pages the toctrees of index.md and user/index.md name; any other page found in docs/ or
-#: docs/user/ (added by a part of the project the index does not know yet) is listed
-#: under "More" in the user guide, so the build neither warns nor hides it.
-KNOWN = {
-    "": {"index", "getting_started", "validation", "performance", "stability", "architecture", "contributing",
-         "changes"},
-    "user": {"index", "cli", "contact", "element", "fmu", "forced_response", "bladed_disk", "system", "scenes",
-             "limits", "studies", "bench_stress"},
-}
+#: The two index pages whose toctrees place the pages of docs/ and docs/user/. Any other
+#: page found there (added by a part of the project the indexes do not name yet) is
+#: listed under "More" in the user guide, so the build neither warns nor hides it.
+INDEXES = ("index.md", "user/index.md")
+
+
+def toctree_pages(docs: Path) -> set[str]:
+    """Pages the toctrees of :data:`INDEXES` name, as paths relative to docs/ without the
+    suffix (``"getting_started"``, ``"user/mistuning"``), the indexes themselves included."""
+    named = {Path(index).with_suffix("").as_posix() for index in INDEXES}
+    for index in INDEXES:
+        base = Path(index).parent
+        inside = False
+        for line in (docs / index).read_text().splitlines():
+            line = line.strip()
+            if line.startswith("```{toctree}"):
+                inside = True
+            elif line.startswith("```"):
+                inside = False
+            elif inside and line and not line.startswith(":"):
+                named.add((base / line).as_posix())
+    return named
 
 
 def more_pages(docs: Path) -> None:
-    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages not in KNOWN."""
+    """``_generated/more.md``: a toctree (relative to docs/user/) of the pages in docs/ and
+    docs/user/ that no toctree of :data:`INDEXES` names."""
+    named = toctree_pages(docs)
     extra = []
-    for sub, known in KNOWN.items():
+    for sub in ("", "user"):
         for p in sorted((docs / sub).glob("*.md")):
-            if p.stem not in known:
+            if (Path(sub) / p.stem).as_posix() not in named:
                 extra.append(p.stem if sub == "user" else f"../{p.stem}")
     text = ("```{toctree}\n:maxdepth: 1\n:caption: More\n\n" + "\n".join(extra) + "\n```\n") if extra else ""
     _write(docs / "_generated" / "more.md", text)
@@ -129,6 +150,78 @@ def limits_page(docs: Path) -> None:
     _write(docs / "_generated" / "limits.md", text)
 
 
+def formats_page(docs: Path) -> None:
+    """``_generated/formats.md`` (a table of keys per format) and the schema files."""
+    from damper.formats import FORMATS, json_schema, write_schemas
+
+    write_schemas(docs / "_generated" / "extra" / "schemas")
+    parts = []
+    for name, (what, used, _) in FORMATS.items():
+        schema = json_schema(name)
+        parts += [f"## {what}", "", f"Read by {used}. Schema: `schemas/{name}.schema.json` in this site "
+                  f"(`python -m damper.formats DIR` writes it).", "",
+                  "| key | type | bounds | meaning |", "|---|---|---|---|"]
+        parts += [_schema_row(k, v) for k, v in _schema_keys(schema, schema)]
+        parts.append("")
+    _write(docs / "_generated" / "formats.md", "\n".join(parts))
+
+
+def _resolve(node: dict, root: dict) -> dict:
+    ref = node.get("$ref")
+    return root["$defs"][ref.rsplit("/", 1)[-1]] if ref else node
+
+
+def _schema_keys(node: dict, root: dict, prefix: str = ""):
+    """(dotted key, schema) of every leaf key, one level of tables deep (and a named table's items)."""
+    for key, sub in _resolve(node, root).get("properties", {}).items():
+        sub = _resolve(sub, root)
+        inner = sub.get("additionalProperties") if isinstance(sub.get("additionalProperties"), dict) else None
+        kinds = sub.get("items", {}).get("oneOf", []) if sub.get("type") == "array" else []
+        if kinds and not prefix:   # an array of tagged tables ([[element]] of each type)
+            for ref in kinds:
+                table = _resolve(ref, root)
+                tag = table["properties"].get("type", {})
+                yield from _schema_keys(table, root, f"{key}[type={tag.get('const', tag.get('default'))}].")
+        elif "properties" in sub and not prefix:
+            yield from _schema_keys(sub, root, f"{key}.")
+        elif inner and "properties" in inner and not prefix:
+            yield from _schema_keys(inner, root, f"{key}.NAME.")
+        else:
+            yield prefix + key, sub
+
+
+def _schema_type(node: dict) -> str:
+    if "enum" in node or "const" in node:
+        return " or ".join(json.dumps(v) for v in node.get("enum", [node.get("const")]))
+    if "anyOf" in node or "oneOf" in node:
+        kinds = [_schema_type(n) for n in node.get("anyOf", node.get("oneOf")) if n.get("type") != "null"]
+        return " or ".join(k for k in kinds if k) + (" (optional)" if any(
+            n.get("type") == "null" for n in node.get("anyOf", [])) else "")
+    if node.get("type") == "array":
+        n = [node.get("minItems"), node.get("maxItems")]
+        size = f" of {n[0]}" if n[0] is not None and n[0] == n[1] else ""
+        return f"list{size} of {_schema_type(node.get('items', {})) or 'values'}"
+    return {"number": "number", "integer": "integer", "string": "string", "boolean": "boolean",
+            "object": "table"}.get(node.get("type"), "")
+
+
+def _schema_bounds(node: dict) -> str:
+    if node.get("type") == "array":
+        node = node.get("items", {})
+    for alt in node.get("anyOf", []):
+        if alt.get("type") != "null":
+            node = alt.get("items", alt) if alt.get("type") == "array" else alt
+            break
+    marks = (("exclusiveMinimum", "> {}"), ("minimum", ">= {}"), ("exclusiveMaximum", "< {}"), ("maximum", "<= {}"))
+    return ", ".join(f.format(f"{node[k]:g}" if isinstance(node[k], float) else node[k])
+                     for k, f in marks if k in node)
+
+
+def _schema_row(key: str, node: dict) -> str:
+    doc = node.get("description", "").replace("|", "/").replace("\n", " ")
+    return f"| `{key}` | {_schema_type(node).replace('|', '/')} | {_schema_bounds(node)} | {doc} |"
+
+
 def data_page(docs: Path, name: str, render) -> None:
     """Render ``docs/data/<name>.json`` with ``render(data) -> markdown``, or say how to make it."""
     src = docs / "data" / f"{name}.json"
@@ -143,8 +236,11 @@ def all_pages(docs: Path) -> None:
     api_pages(docs)
     cli_page(docs)
     limits_page(docs)
+    formats_page(docs)
     more_pages(docs)
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)
     data_page(docs, "bench_peers", tables.bench)
     data_page(docs, "stress", tables.stress)
+    data_page(docs, "accuracy", tables.accuracy)
+    data_page(docs, "accuracy_upd", tables.accuracy)

@@ -11,6 +11,8 @@ MAKE = {
     "bench": "make docs-bench",
     "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
     "stress": "make docs-stress",
+    "accuracy": "make docs-accuracy",
+    "accuracy_upd": "make docs-accuracy",
 }
 
 
@@ -52,16 +54,26 @@ def stamp_text(data: dict, name: str) -> str:
             f"are upper bounds and only ratios within one run compare.\n")
 
 
-def validation(data: dict) -> str:
-    recs = data.get("records", [])
-    out = [stamp_text(data, "validation"), "",
-           f"{len(recs)} reference checks in {len({r['test'] for r in recs})} tests; "
-           f"{sum(r['passed'] for r in recs)} passed, {sum(not r['passed'] for r in recs)} failed.", ""]
+#: The two kinds of reference check (tests/refcheck.py), in page order: heading, what it means.
+KINDS = {
+    "independent": ("Independent references",
+                    "The reference owes nothing to this code: a closed form, a published value."),
+    "self-consistency": ("Self-consistency",
+                         "The reference is another part of the same code (a time integration through the "
+                         "same friction element, the linear limit from the same sector matrices, the EPMC "
+                         "backbone of the same model): it catches a part that drifts from the others, not "
+                         "an error they share."),
+}
+
+
+def _validation_rows(recs: list[dict]) -> list[str]:
+    """One table per test folder."""
+    out: list[str] = []
     groups: dict[str, list[dict]] = {}
     for r in recs:
         groups.setdefault(r["test"].split("/")[1] if r["test"].count("/") > 1 else "tests", []).append(r)
     for group in sorted(groups):
-        out += [f"## {group}", "",
+        out += [f"### {group}", "",
                 "| quantity | reference | our value | reference value | tolerance | test |",
                 "|---|---|---|---|---|---|"]
         for r in sorted(groups[group], key=lambda r: (r["test"], r["quantity"])):
@@ -69,6 +81,20 @@ def validation(data: dict) -> str:
             out.append(f"| {_cell(r['quantity'])} | {_cell(r['source'])} | {_g(r['value'], 6)} | "
                        f"{_g(r['reference'], 6)} | {_cell(r['tolerance'])}{mark} | `{r['test']}` |")
         out.append("")
+    return out
+
+
+def validation(data: dict) -> str:
+    recs = data.get("records", [])
+    kind = {k: [r for r in recs if r.get("kind", "independent") == k] for k in KINDS}
+    out = [stamp_text(data, "validation"), "",
+           f"{len(recs)} reference checks in {len({r['test'] for r in recs})} tests "
+           f"({len(kind['independent'])} against independent references, "
+           f"{len(kind['self-consistency'])} of self-consistency); "
+           f"{sum(r['passed'] for r in recs)} passed, {sum(not r['passed'] for r in recs)} failed.", ""]
+    for k, (title, text) in KINDS.items():
+        if kind[k]:
+            out += [f"## {title}", "", text, "", *_validation_rows(kind[k])]
     return "\n".join(out) + "\n"
 
 
@@ -95,6 +121,27 @@ def bench(data: dict) -> str:
             out += ["Model classes (error: |first-harmonic peak / dense reference - 1|):", "",
                     *markdown(models), ""]
     return "\n".join(out) + "\n"
+
+
+def accuracy(data: dict) -> str:
+    """The truncation-error table of ``python -m damper.bench.hb_accuracy --json``."""
+    res = data.get("result", {})
+    out = [stamp_text(data, "accuracy"), "",
+           f"True error: against the curve's peak re-solved with 0..{res.get('reference_H', '?')} "
+           f"harmonics (UPD-24: 0..{res.get('reference_H_upd', '?')}). Ratio: estimate / true error "
+           "(the goal: between 1/3 and 3). Check: the time of the estimate; total: the curve and "
+           "its check (for an accuracy target, every curve and check of the run).", "",
+           "| model | H or target | peak | estimate | true error | ratio | check [s] | total [s] |",
+           "|---|---|---|---|---|---|---|---|"]
+    for r in res.get("rows", []):
+        out.append(f"| {_cell(r['model'])} | {_cell(r['setting'])} | {_g(r['peak_amplitude'], 6)} | "
+                   f"{_pct(r['estimate'])} | {_pct(r['true_error'])} | {_g(r['ratio'])} | "
+                   f"{_g(r['check_time_s'])} | {_g(r['time_s'])} |")
+    return "\n".join(out) + "\n"
+
+
+def _pct(x) -> str:
+    return "-" if x is None else f"{100 * x:.2g} %"
 
 
 def stress(data: dict) -> str:

@@ -345,6 +345,9 @@ fmu_status fmu_do_step(fmu_instance *inst, double t, double h)
     if (!isfinite(t) || !isfinite(h) || !(h > 0.0))
         return fmu_log(inst, FMU_ERROR, "DoStep: bad step t = %g, h = %g (the step size must "
                        "be finite and > 0)", t, h);
+    if (!isfinite(t + h))  /* the time after the step must be a number too */
+        return fmu_log(inst, FMU_ERROR, "DoStep: t + h = %g + %g overflows (the end of the step "
+                       "must be finite)", t, h);
     if (fabs(t - inst->h.time) > TIME_TOLERANCE * fmax(1.0, fabs(inst->h.time)))
         return fmu_log(inst, FMU_ERROR, "DoStep at t = %.17g, but the FMU is at t = %.17g",
                        t, inst->h.time);

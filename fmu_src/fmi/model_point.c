@@ -23,11 +23,30 @@
 /* A slider stretch may exceed its slip radius by this much (relative), plus the
  * round-off of u - z at |u| (a deserialized history is checked against it). */
 #define STRETCH_RTOL 1e-9
+/* Input bound of the penetration: |p| where the normal spring's stored energy int_0^p N dp
+ * reaches this [J]. Far beyond any contact, and DBL_MAX / 1e8, which leaves room for the
+ * sums and products the outputs form from N(p) (a larger p would overflow them at the
+ * next call, so SetReal refuses it). */
+#define P_BOUND_ENERGY 1e300
 
 typedef struct {
     cpoint_model m;
     double u_bound;   /* largest |u_x|, |u_y| accepted [m] */
+    double p_bound;   /* largest |p| accepted [m] (P_BOUND_ENERGY) */
 } point_fmu_model;
+
+/* The penetration where the normal spring's energy reaches P_BOUND_ENERGY: on the law's
+ * last segment (extended) E = E_l + N_l d + s d^2 / 2, d = p - p_l, solved for d >= 0. */
+static double penetration_bound(const cpoint_model *m)
+{
+    const int32_t l = m->n_normal - 1;
+    const double s = (m->N[l] - m->N[l - 1]) / (m->p[l] - m->p[l - 1]);
+    const double room = P_BOUND_ENERGY - m->E_n[l];
+    double root;
+    if (!(room > 0.0)) return m->p[l];
+    root = hypot(m->N[l], sqrt(2.0 * s) * sqrt(room));  /* sqrt(N_l^2 + 2 s room), no overflow */
+    return m->p[l] + 2.0 * room / (m->N[l] + root);     /* (root - N_l) / s, without cancellation */
+}
 
 /* The outputs' value references, in the order of cpoint_output.K (row-major). */
 static const unsigned int VR_K[9] = {VR_K_XX, VR_K_XY, VR_K_XP, VR_K_YX, VR_K_YY, VR_K_YP,
@@ -73,6 +92,7 @@ const char *model_build(void *model, const void *res, const double *value)
     if (st != IWAN_OK) return iwan_status_text(st);
     for (j = 0; j < tm.n; j++) rmin = fmin(rmin, tm.rad[j]);
     md->u_bound = tm.n > 0 ? U_BOUND_RTOL * rmin / DBL_EPSILON : HUGE_VAL;
+    md->p_bound = penetration_bound(&md->m);
     return NULL;
 }
 
@@ -205,7 +225,9 @@ const char *model_check_history(const void *model, const void *history)
 
 double model_input_bound(const void *model, unsigned int vr)
 {
-    return (vr == VR_U_X || vr == VR_U_Y) ? ((const point_fmu_model *)model)->u_bound : HUGE_VAL;
+    const point_fmu_model *md = (const point_fmu_model *)model;
+    if (vr == VR_P) return md->p_bound;
+    return (vr == VR_U_X || vr == VR_U_Y) ? md->u_bound : HUGE_VAL;
 }
 
 const char *model_check_parameter(const void *res, unsigned int vr, double v)

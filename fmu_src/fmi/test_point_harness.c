@@ -87,6 +87,23 @@ static void test_start_and_refusals(const api *a)
             CHECK(memcmp(&before, &after, sizeof before) == 0, "FMI %d: bad input stored", a->v);
         }
     expect_error(&x, set(&x, VR_U_X, 1e12), "u_x beyond the bound");
+    /* a penetration whose normal energy would overflow: refused at SetReal (not at the
+     * next call), the input unchanged; a deep but representable one is accepted */
+    get(&x, VR_P, &before);
+    expect_error(&x, set(&x, VR_P, 1e300), "p beyond the bound");
+    CHECK(strstr(g_last_log, "beyond the bound") != NULL, "FMI %d: p bound not logged: '%s'",
+          a->v, g_last_log);
+    get(&x, VR_P, &after);
+    CHECK(before == after, "FMI %d: p beyond the bound stored", a->v);
+    CHECK(set(&x, VR_P, 1e3 * P_REF) == 0 && do_step(&x, 1e-3) == 0 && get(&x, VR_N, &N) == 0
+          && isfinite(N) && N > N_CURVE, "FMI %d: a deep penetration refused: %s", a->v, g_last_log);
+    CHECK(set(&x, VR_P, p) == 0, "FMI %d: p back to the start", a->v);
+    /* a step whose end t + h is not a finite number: refused, the time unchanged */
+    CHECK(do_step(&x, 1e308) == 0, "FMI %d: a step of 1e308 s: %s", a->v, g_last_log);
+    expect_error(&x, do_step(&x, 1e308), "t + h = inf");
+    CHECK(strstr(g_last_log, "overflows") != NULL, "FMI %d: t + h overflow not logged: '%s'",
+          a->v, g_last_log);
+    CHECK(do_step(&x, 1.0) == 0, "FMI %d: a finite step after the refusal: %s", a->v, g_last_log);
     release(&x);
     x.t = 0.0;
     x.c = instantiate(a, "neg", DAMPER_TOKEN, a->resources);

@@ -45,6 +45,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..model import refuse_complex
+
 #: Matrix keys of a blade file, required first.
 MATRICES = ("M", "K", "C", "K_next", "C_next")
 #: Role keys (names of DOFs).
@@ -210,6 +212,7 @@ def make_blade(arrays: dict, source: str = "arrays") -> Blade:
     if "M" not in arrays or "K" not in arrays:
         raise ValueError(f"{where}: M and K are required")
     n = np.shape(arrays["M"])[0] if np.ndim(arrays["M"]) == 2 else -1
+    refuse_complex(arrays, MATRICES, where)
     mats = {}
     for k in MATRICES:
         if arrays.get(k) is None:

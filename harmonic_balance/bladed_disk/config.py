@@ -13,7 +13,9 @@ beta_c structural and contact stiffness-proportional damping [s].
 
 The ``[blade]`` section is either UPD-24's lumped keys or a blade of reduced matrices
 (``file`` / Matrix Market keys, :mod:`.blade`); relative paths are taken from the
-TOML file's directory (resolved by :func:`load_config`).
+TOML file's directory (resolved by :func:`load_config`). The keys, types and ranges
+are :class:`.config_model.UPDFile`'s (strict: no booleans or strings as numbers, finite
+numbers, unknown keys refused, the key's path in every message).
 """
 from __future__ import annotations
 
@@ -25,7 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core.fileformat import parse
+
 from .blade import MATRICES, Blade, load_blade
+from .config_model import UPDFile
 
 #: The bundled default model.
 DEFAULT_CONFIG = Path(__file__).with_name("upd24.toml")
@@ -66,11 +71,13 @@ class UPDConfig:
     ``contacts`` optionally replaces the TOML's contact laws per point name
     ("left", "right1", "right2"): ``{"kn": float, "friction": IwanElement}`` (either
     key may be missing). It carries computed data (e.g. ``contact_core`` virgin
-    curves), not TOML keys, and is kept by :meth:`with_values`.
+    curves), not TOML keys, and is kept by :meth:`with_values`. ``source`` names the
+    file in messages.
     """
 
     data: dict
     contacts: dict | None = None
+    source: str = "config"
 
     # ------------------------------------------------------------ access
     def blade(self) -> Blade:
@@ -119,7 +126,7 @@ class UPDConfig:
         for k, v in changes.items():
             sec, _, name = k.partition("__")
             data[sec][name] = v
-        out = UPDConfig(data, self.contacts)
+        out = UPDConfig(data, self.contacts, self.source)
         if data["blade"] == self.data["blade"]:
             out._blade = getattr(self, "_blade", None)
         out.validate()
@@ -163,31 +170,8 @@ class UPDConfig:
             kn = over.get("kn", 1.0)
             if not (np.isfinite(kn) and kn > 0):
                 raise ValueError(f"contact override {name}: kn = {kn} must be finite and > 0")
-        positive = ["blade.m_r", "blade.m_p", "blade.m_a", "blade.k_g", "blade.k_rp", "blade.k_v",
-                    "blade.k_pa", "damper.m_d", "damper.I_d", "damper.contact_length",
-                    "damper.kn_per_length", "damper.kt_ratio", "load.f0"]
-        nonneg = ["blade.k_c", "blade.beta", "damper.beta_c", "damper.mu", "load.cf",
-                  "damper.right_width", "damper.R_d"]
-        for key in positive + nonneg:
-            try:
-                v = float(self[key])
-            except (KeyError, TypeError, ValueError):
-                raise ValueError(f"config: {key} missing or not a number") from None
-            if not np.isfinite(v) or v < 0 or (key in positive and v == 0):
-                raise ValueError(f"config: {key} = {v} must be finite and "
-                                 f"{'> 0' if key in positive else '>= 0'}")
-        nb, eo = self["disk.blades"], self["disk.engine_order"]
-        if not (isinstance(nb, int) and isinstance(eo, int)) or nb < 2 or not 0 <= eo <= nb // 2:
-            raise ValueError(f"config: disk.blades = {nb} must be an integer >= 2 and "
-                             f"disk.engine_order = {eo} an integer in 0..blades/2")
+        parse(UPDFile, self.data, self.source)   # keys, types, ranges (config_model)
         self.blade()  # the blade's matrices and DOF names (ValueError naming the problem)
-        g = float(self["damper.angle_deg"])
-        if not 0.0 < g < 90.0:
-            raise ValueError(f"config: damper.angle_deg = {g} must lie in (0, 90)")
-        for key in ("damper.left_point", "damper.right_centre"):
-            p = np.asarray(self[key], dtype=float)
-            if p.shape != (2,) or not np.all(np.isfinite(p)):
-                raise ValueError(f"config: {key} must be two finite numbers [x, y] in metres")
 
 
 def load_config(path=None) -> UPDConfig:
@@ -212,17 +196,15 @@ def load_config(path=None) -> UPDConfig:
             raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
         except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise ValueError(f"cannot read config {path} (TOML): {err}") from None
-        for sec, table in user.items():
-            if sec not in data or not isinstance(table, dict):
-                raise ValueError(f"config {path}: unknown section [{sec}] "
-                                 f"(known: {', '.join(data)})")
-            for k, v in table.items():
-                if k not in data[sec]:
-                    raise ValueError(f"config {path}: unknown key {sec}.{k}")
-                data[sec][k] = v
+        for sec, table in user.items():   # unknown sections and keys: UPDFile refuses them
+            if isinstance(data.get(sec), dict) and isinstance(table, dict):
+                data[sec].update(table)
+            else:
+                data[sec] = table
         for k in ("file",) + MATRICES:  # blade files relative to the TOML's directory
-            if isinstance(data["blade"].get(k), str) and data["blade"][k] and k in user.get("blade", {}):
+            if (isinstance(data["blade"], dict) and isinstance(data["blade"].get(k), str)
+                    and data["blade"][k] and isinstance(user.get("blade"), dict) and k in user["blade"]):
                 data["blade"][k] = str(path.parent / data["blade"][k])
-    cfg = UPDConfig(data)
+    cfg = UPDConfig(data, source=str(path) if path is not None else "config")
     cfg.validate()
     return cfg

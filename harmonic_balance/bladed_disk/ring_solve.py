@@ -18,8 +18,8 @@ residual is then only piecewise smooth in many contacts at once and Newton can s
 such a flank ends there (reported), the curve keeps the solved part.
 
 Peaks: every blade's first-harmonic amplitude of its response DOF on the grid; each
-blade's peak from the parabola through its largest grid value and the two neighbours;
-the largest over blades and frequency refined by Brent's bounded search (each
+blade's peak from the parabolas through each local maximum of its grid values and the
+two neighbours (the largest vertex); the largest over blades and frequency refined by Brent's bounded search (each
 evaluation a Newton solve), which gives the worst blade and the amplification factor.
 """
 from __future__ import annotations
@@ -276,19 +276,22 @@ class RingSolver:
 
 
 def parabola_peaks(omegas: np.ndarray, A: np.ndarray):
-    """Per column of A (n_f, N_b): the vertex of the parabola through the largest value
-    and its neighbours (kept inside them), else the grid maximum; (peaks, omegas)."""
+    """Per column of A (n_f, N_b): the largest vertex of the parabolas through each local
+    maximum of the grid and its neighbours (kept inside them), or the grid maximum when
+    that is larger (a mistuned blade has several close peaks; the grid's largest value
+    need not be the highest peak); (peaks, omegas)."""
     nf, nb = A.shape
     pk, wk = A.max(axis=0).copy(), omegas[A.argmax(axis=0)].copy()
     for j in range(nb):
-        i = int(A[:, j].argmax())
-        if not 0 < i < nf - 1:
-            continue
-        w, a = omegas[i - 1:i + 2], A[i - 1:i + 2, j]
-        c2, c1, c0 = np.polyfit(w - w[1], a, 2)
-        if c2 < 0:
-            d = np.clip(-c1 / (2 * c2), w[0] - w[1], w[2] - w[1])
-            pk[j], wk[j] = max(c0 + c1 * d + c2 * d * d, a[1]), w[1] + d
+        col = A[:, j]
+        for i in np.flatnonzero((col[1:-1] >= col[:-2]) & (col[1:-1] >= col[2:])) + 1:
+            w, a = omegas[i - 1:i + 2], col[i - 1:i + 2]
+            c2, c1, c0 = np.polyfit(w - w[1], a, 2)
+            if c2 < 0:
+                d = np.clip(-c1 / (2 * c2), w[0] - w[1], w[2] - w[1])
+                v = max(c0 + c1 * d + c2 * d * d, a[1])
+                if v > pk[j]:
+                    pk[j], wk[j] = v, w[1] + d
     return pk, wk
 
 
@@ -333,8 +336,8 @@ def ring_frf(ring: MistunedRingHB, omegas, tuned: SectorHB | None = None,
 
 def _refine(solver: RingSolver, c: RingCurve, A: np.ndarray) -> None:
     """Largest amplitude over blades and frequency, g(omega) = max_j a_j(omega), by Brent's
-    search between the grid neighbours of g's grid maximum; again in the interval of any
-    blade whose parabola estimate still exceeds the refined peak. Per-blade peaks are
+    search between the grid neighbours of the largest blade's parabola estimate; again
+    around the estimate of any blade that still exceeds the refined peak. Per-blade peaks are
     then capped at the refined peak and raised to the exact values met on the way."""
     ring, nf, seen, met = solver.ring, c.omega.size, set(), {}
 
@@ -343,12 +346,14 @@ def _refine(solver: RingSolver, c: RingCurve, A: np.ndarray) -> None:
         met[w] = (x, ring.amplitudes(x))
         return -met[w][1].max()
 
+    # the grid point nearest each blade's parabola vertex: its two cells hold the vertex
+    cell = [int(np.argmin(np.abs(c.omega - w))) for w in c.peak_omega_per_blade]
     best = -np.inf
     while True:
-        todo = [j for j in np.argsort(-c.peak_per_blade) if int(A[:, j].argmax()) not in seen]
+        todo = [j for j in np.argsort(-c.peak_per_blade) if cell[j] not in seen]
         if not todo or (best > -np.inf and c.peak_per_blade[todo[0]] <= best):
             break
-        i = int(A[:, todo[0]].argmax())
+        i = cell[todo[0]]
         seen.add(i)
         if not 0 < i < nf - 1:
             w, val = c.omega[i], A[i].max()

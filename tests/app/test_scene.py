@@ -46,6 +46,7 @@ def _line(text: str, needle: str) -> int:
     (('contact = "damper"', 'contact = "other"'), "element.contact", 'contact = "other"', "no contact named"),
     (("f_max = 1300.0", "f_max = 800.0"), "sweep.f_max", "f_max = 800.0", "must be > f_min"),
     (("forces = [30.0]", "forces = [30.0, -1]"), "excitation.forces", "forces =", "item 1: must be > 0"),
+    (("f_max = 1300.0", "f_max = 1300.0\naccuracy = 0.6"), "sweep.accuracy", "accuracy = 0.6", "must be < 0.5"),
 ])
 def test_malformed_scene_names_key_and_line(edit, key, line_of, words):
     text = SMALL.replace(*edit)

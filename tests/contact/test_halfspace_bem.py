@@ -9,8 +9,10 @@ from contact_core import halfspace_bem as hb
 #: Closed-form rectangle integrals against adaptive quadrature (smooth integrand
 #: on cells away from the source): quadrature accuracy.
 QUAD_RTOL = 1e-9
-#: Far cells act as point forces: relative error ~ (cell / distance)^2 / 24.
-FAR_RTOL = 2e-3
+#: Far cells act as point forces: relative error ~ (cell / distance)^2 / 24 = 2.6e-5 at
+#: 40 cells. Measured 2.2e-5 (normal) and 1.3e-5 (tangential) (revision a12e5f1);
+#: 2.5e-4, ~10x: the error is the discretisation's, the same on every platform.
+FAR_RTOL = 2.5e-4
 
 E, NU = 200e9, 0.3
 G = E / (2 * (1 + NU))

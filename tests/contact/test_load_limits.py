@@ -4,6 +4,7 @@ import re
 import pytest
 
 from contact_core import bodies, hertz
+from contact_core import spec as spec_module
 from contact_core.spec import ContactSpec
 from damper.cli import main as damper
 
@@ -18,6 +19,22 @@ def test_sphere_load_beyond_the_body_is_refused_with_the_limit(args, capsys):
     R = float(args[1])
     a = hertz.sphere(f_max, R, hertz.contact_modulus(200e9, 0.3, 200e9, 0.3))["a"]
     assert a == pytest.approx(bodies.MAX_CONTACT_SHARE * R, rel=1e-3)  # the limit is the stated share
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--body", "sphere", "--radius", "1e308"], "radius = 1e+308 m is above the limit"),   # Hertz overflowed
+    (["--body", "cylinder", "--radius", "2.5e-3", "--length", "1e308"], "length = 1e+308 m is above"),
+    (["--body", "flat", "--width", "1e308", "--length", "5e-3"], "width = 1e+308 m is above"),
+    (["--body", "sphere", "--radius", "0.01", "--E", "1e308"], "E1 = 1e+308 Pa is above the limit"),
+])
+def test_a_size_or_modulus_beyond_any_contact_is_refused(argv, words, capsys):
+    assert damper(["normal", *argv, "--force", "200", "--grid", "5", "--no-cache"]) == 2
+    err = capsys.readouterr().err
+    assert words in err and len(err.splitlines()) == 1
+
+
+def test_the_largest_size_and_modulus_are_accepted():
+    ContactSpec(body="sphere", radius=bodies.MAX_SIZE, E1=spec_module.MAX_MODULUS, grid=5)
 
 
 def test_cylinder_load_beyond_the_body_is_refused():

@@ -18,10 +18,10 @@ HERTZ_RTOL = 0.05
 
 def test_round_trip_keeps_every_number(tmp_path):
     c = NormalCurve([0.0, 1e-6, 2e-6], [0.0, 50.0, 140.0], load=140.0, k_n=[5e7, 5e7, 9e7],
-                    extra={"note": "kept"})
+                    provenance={"note": "kept"})
     back = read_normal_curve(write_normal_curve(c, tmp_path / "n.json"))
     assert np.array_equal(back.approach, c.approach) and np.array_equal(back.N, c.N)
-    assert back.load == 140.0 and back.extra == {"note": "kept"}
+    assert back.load == 140.0 and back.provenance == {"note": "kept"}
 
 
 @pytest.mark.parametrize("p, N, message", [

@@ -31,8 +31,8 @@ def test_bench_contact_quick_case_runs(tmp_path, monkeypatch, load_example):
     bench = load_example("bench_contact")
     assert bench.main(["--quick", "--out", str(tmp_path)]) == 0
     rows = json.loads((tmp_path / "bench_contact.json").read_text())
+    # the second run loads the condensed model (what happened, not how long it took)
     assert not rows[0]["cold"]["cache_hit"] and rows[0]["cached"]["cache_hit"]
-    assert rows[0]["cached"]["end_to_end"] < rows[0]["cold"]["end_to_end"]
 
 
 @pytest.mark.slow

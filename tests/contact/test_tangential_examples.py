@@ -16,5 +16,5 @@ def test_bench_tangential_smoke(capsys, load_example):
     rows = [r.split() for r in capsys.readouterr().out.splitlines()[1:]]
     assert [r[:3] for r in rows] == [["bem", "9", "cold"], ["halfspace", "5", "cold"],
                                      ["halfspace", "5", "cached"]]
-    # the cached run reads the condensed model instead of building it
-    assert float(rows[2][7]) < float(rows[1][7])
+    # the cached run reads the condensed model instead of building it (the BEM has no cache)
+    assert [r[-1] for r in rows] == ["-", "miss", "hit"]

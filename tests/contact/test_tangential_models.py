@@ -26,6 +26,9 @@ HERTZ_RTOL = 0.017
 CURVE_TOL = 0.01
 #: k_t against 8 G* a (1.1 % measured at 21 nodes per side; k_t ~ contact size).
 KT_RTOL = 0.017
+#: k_t / k_n: the contact size's grid error cancels in the ratio (both ~ a). Measured
+#: 1.1e-4 (revision a12e5f1); 1e-3, ~10x: deterministic discretisation error.
+KT_KN_RTOL = 1e-3
 #: 2D Cattaneo traction at mid-length, as a fraction of mu p0: the traction has
 #: a kink at the stick edge x = +-c that a grid of spacing dx ~ 0.07 b smears
 #: (3.4 % measured).
@@ -65,7 +68,7 @@ def test_bem_virgin_curve_matches_cattaneo_mindlin(sphere_run):
     check(f"virgin curve T(u) [N] over the curve, {case}", path.T, T_ref, atol=CURVE_TOL * MU * 200.0, source=cm)
     check(f"k_t [N/m], {case}", sphere_run.problem.k_t, 8 * G_STAR * a, rtol=KT_RTOL, source="Mindlin k_t = 8 G* a")
     # like bodies: k_t / k_n = 2 (1 - nu) / (2 - nu) (references.md)
-    check(f"k_t / k_n, {case}", sphere_run.problem.k_t / sphere_run.k_n, 2 * 0.7 / 1.7, rtol=KT_RTOL,
+    check(f"k_t / k_n, {case}", sphere_run.problem.k_t / sphere_run.k_n, 2 * 0.7 / 1.7, rtol=KT_KN_RTOL,
           source="Mindlin 1949: 2(1 - nu)/(2 - nu)")
 
 

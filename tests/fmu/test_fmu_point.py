@@ -92,6 +92,29 @@ def history(n=150):
 
 
 @pytest.mark.parametrize("version", [2, 3])
+def test_an_overflowing_penetration_or_step_end_is_refused_at_the_call(point_fmus, version, capfd):
+    """SetReal(p = 1e300) is refused (the normal energy would overflow at the next call),
+    the instance keeps its inputs; DoStep whose end t + h is not finite is refused, the
+    time unchanged; a representable deep penetration and the next step still work."""
+    from fmpy.fmi1 import FMICallException
+
+    fmu = PointSlave(point_fmus[version], version)
+    p0 = fmu.get(["p"])[0]
+    with pytest.raises(FMICallException):
+        fmu.set({"p": 1e300})
+    assert "beyond the bound" in capfd.readouterr().out and fmu.get(["p"])[0] == p0
+    deep = fmu.step([0.0, 0.0, 1e3 * P_REF], names=("N", "stored_energy"))
+    assert np.all(np.isfinite(deep)) and deep[0] > N_CURVE
+    fmu.fmu.doStep(fmu.t, 1e308)                            # t + h = 1e308: finite, accepted
+    with pytest.raises(FMICallException):
+        fmu.fmu.doStep(1e308, 1e308)
+    assert "overflows" in capfd.readouterr().out
+    fmu.fmu.doStep(1e308, 1.0)                              # still at t = 1e308
+    fmu.fmu.terminate()
+    fmu.fmu.freeInstance()
+
+
+@pytest.mark.parametrize("version", [2, 3])
 def test_fmpy_validates_the_point_fmu(point_fmus, version):
     assert validate_fmu(str(point_fmus[version])) == []
 
@@ -288,8 +311,8 @@ def test_cli_refuses_bad_normal_laws(curve_file, tmp_path, capsys, args, N, load
     (["--k-n", "-1"], "--k-n must be finite and > 0"),
     (["--k-n", "inf"], "--k-n must be finite and > 0"),
     (["--preload", "100"], "--preload needs a normal law"),
-    (["--k-n", "1e-310"], "overflows"),                                  # p at N_ref: inf
-    (["--k-n", "1e8", "--preload", "1e300"], "overflows"),              # stored energy: inf
+    (["--k-n", "1e-310"], "N/m is outside"),                             # p at N_ref: inf
+    (["--k-n", "1e8", "--preload", "1e300"], "N is outside"),           # stored energy: inf
 ])
 def test_cli_refuses_bad_penalty_options(curve_file, tmp_path, capsys, args, message):
     out = tmp_path / "bad.fmu"

@@ -16,8 +16,11 @@ from harmonic_balance.timeint import march
 
 #: Newton tolerance on |R| (forces of order 1 N).
 NEWTON_TOL = 1e-11
-#: Same law and Newton tolerance on both sides: the HB solutions agree to this (relative).
-SOLVE_RTOL = 1e-8
+#: Same law and Newton tolerance on both sides: the HB solutions agree to what Newton
+#: guarantees, NEWTON_TOL on forces of order 1 N. Measured 3.1e-15 relative (revision
+#: a12e5f1: quadratic convergence overshoots the stopping test, which one iteration
+#: fewer on another platform may not).
+SOLVE_RTOL = NEWTON_TOL
 #: Central differences at 1e-7 of the coefficient scale (kinks away), relative.
 FD_STEP, FD_RTOL = 1e-7, 1e-6
 #: The required accuracy of HB against time integration (measured: see the test).
@@ -138,7 +141,7 @@ def test_elements_toml_with_two_tangents(tmp_path):
     assert np.array_equal(el.stuck_stiffness(), np.diag([2.0, 2.0, 10.0]))
     (tmp_path / "bad.toml").write_text((tmp_path / "e.toml").read_text().replace(
         "slip_ref = [1e-3, -2e-3]", "slip_ref = [1e-3, -2e-3, 0.0]"))
-    with pytest.raises(ValueError, match="slip_ref must be a number or 2 numbers"):
+    with pytest.raises(ValueError, match=r"slip_ref: no allowed form fits"):
         load_elements(tmp_path / "bad.toml")
 
 

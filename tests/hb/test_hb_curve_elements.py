@@ -50,5 +50,5 @@ def test_contact_elements_from_the_elements_file(tmp_path):
     assert np.array_equal(iwan.kinematics.Q, [[0.8, 0.6], [-0.6, 0.8]])  # [t; -n] @ delta
     assert iwan.friction.N_ref == N and normal.m == 1 and normal.friction is None
     (tmp_path / "bad.toml").write_text('[[element]]\ntype = "contact"\ndofs = [0]\nnormal = [1.0]\n')
-    with pytest.raises(ValueError, match="element 0: contact needs key 'k_n'"):
+    with pytest.raises(ValueError, match=r"element\[0\]\.contact\.k_n: missing"):
         load_elements(tmp_path / "bad.toml")

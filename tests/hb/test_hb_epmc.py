@@ -8,9 +8,11 @@ from harmonic_balance.epmc import compute_backbone
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.model import sdof_model
 
-#: Backbone within 0.1 % of the H = 1 describing function (measured at the
-#: default n_t = 256: frequency 4.5e-6, damping 8.1e-5 relative; the AFT sampling).
-DF_RTOL = 1e-3
+#: Backbone against the H = 1 describing function: the AFT sampling error at the default
+#: n_t = 256, deterministic (no round-off at this level). Measured 3.3e-6 in frequency,
+#: 5.4e-5 in damping (revision a12e5f1); 10x each.
+DF_OMEGA_RTOL = 3e-5
+DF_XI_RTOL = 5e-4
 #: Forced peaks on the backbone: 1 % (measured 0.27 % at the largest forcing).
 PEAK_RTOL = 1e-2
 
@@ -26,9 +28,9 @@ def test_sdof_jenkins_backbone_matches_the_describing_function():
         xi_ex.append(c - b1 / (a * w_ex[-1]))           # (xi m - c) a omega = -b1
     df = "describing function of the Jenkins element"
     check("EPMC backbone frequency [rad/s], Jenkins oscillator, H = 1, every point", bb.omega, w_ex,
-          rtol=DF_RTOL, source=df)
+          rtol=DF_OMEGA_RTOL, source=df)
     check("EPMC artificial damping xi [1/s], Jenkins oscillator, H = 1, every point", bb.xi, xi_ex,
-          rtol=DF_RTOL, source=df)
+          rtol=DF_XI_RTOL, source=df)
     assert bb.damping_ratio.max() > 5 * bb.damping_ratio[0]  # friction damping shows (9x)
 
 
@@ -39,7 +41,7 @@ def test_two_dof_forced_peaks_lie_on_the_backbone():
         r = compute_frf(two_dof(True, P=P), "odd:3", (0.5, 1.3))
         w_bb = np.interp(r.peak_amplitude, bb.amplitude, bb.omega)
         check(f"forced peak frequency [rad/s], 2-DOF Jenkins model, P = {P:g}", r.peak_omega, w_bb, rtol=PEAK_RTOL,
-              source="EPMC backbone at the peak's amplitude (phase resonance)")
+              kind="self-consistency", source="EPMC backbone at the peak's amplitude (phase resonance)")
 
 
 def test_backbone_cli_json(capsys):

@@ -9,14 +9,26 @@ from scipy.optimize import brentq, minimize_scalar
 from harmonic_balance.frf import FRFProblem, compute_frf
 from harmonic_balance.newton import newton
 
-#: Describing-function agreement required (0.1 %); the AFT sampling
-#: error at n_t = 256 is ~0.02 % (fourier.MIN_SAMPLES).
-DF_RTOL = 1e-3
-#: Energy balance against the sampled loops' dissipation: same O(n_t^-2) sampling
-#: error as the force harmonics, measured <= 3e-4 of the input work at n_t = 256.
-ENERGY_RTOL = 2e-3
-#: Identities that hold to Newton tolerance (1e-10 relative) and round-off.
-EXACT_RTOL = 1e-8
+#: H = 1 with exact links against the describing function: both sides are exact, the
+#: residual |...| / P - 1 at the curve's points is what Newton and the reference's root
+#: finders leave. Measured 8.5e-11 (revision a12e5f1); 100x for the solvers' stopping
+#: points on another platform.
+DF_RESIDUAL_ATOL = 1e-8
+#: Peak against the describing-function peak (brentq to 1e-14 over minimize_scalar to
+#: 1e-12): measured 6.8e-12 relative (a12e5f1); 150x, as above.
+DF_PEAK_RTOL = 1e-9
+#: Growth of the peak's error the validation check lets pass (refcheck.GROWTH is 10):
+#: set by the searches' tolerances, within which it may move by more than 10x elsewhere.
+SEARCH_GROWTH = 100.0
+#: Energy balance with exact links: W_ext = W_visc + W_friction to the Newton tolerance.
+#: Measured 3.1e-10 of the input work (a12e5f1); 100x, as above.
+ENERGY_RTOL = 3e-8
+#: Identities that hold to round-off (stuck, free, scaled systems). Measured 4.8e-15
+#: (a12e5f1); 200x for other BLAS builds and thread counts.
+EXACT_RTOL = 1e-12
+#: Two evaluations of the same H = 1 peak (peak_amplitude and peak_amplitude_h1):
+#: measured 1.4e-16 relative (a12e5f1); round-off, 700x.
+SAME_PEAK_RTOL = 1e-13
 
 M, K, C, KT, FS, P = 1.0, 1.0, 0.01, 1.0, 0.05, 0.05
 
@@ -44,7 +56,7 @@ def test_h1_reproduces_the_jenkins_describing_function(h1_curve):
     r = h1_curve
     assert r.status == "complete" and r.omega[0] == 0.9 and r.omega[-1] == 1.3
     err = [df_residual(w, a) / P for w, a in zip(r.omega, r.amplitude_h1)]
-    check("H = 1 FRF residual |...| / P - 1 of the Jenkins oscillator, every point", err, 0.0, atol=DF_RTOL,
+    check("H = 1 FRF residual |...| / P - 1 of the Jenkins oscillator, every point", err, 0.0, atol=DF_RESIDUAL_ATOL,
           source="describing function (references.md)")
     # the sweep goes through resonance: from stuck to well into slip and back
     assert r.amplitude.max() > 3 * FS / KT and r.amplitude[0] < 0.3 * r.amplitude.max()
@@ -53,8 +65,9 @@ def test_h1_reproduces_the_jenkins_describing_function(h1_curve):
 def test_h1_peak_matches_the_describing_function_peak(h1_curve):
     assert h1_curve.peak_interior
     check("H = 1 peak amplitude [m], Jenkins oscillator m = k = kt = 1, c = 0.01, fs = P = 0.05",
-          h1_curve.peak_amplitude, df_peak(), rtol=DF_RTOL, source="describing-function peak")
-    assert abs(h1_curve.peak_amplitude - h1_curve.peak_amplitude_h1) < 1e-12  # H = 1
+          h1_curve.peak_amplitude, df_peak(), rtol=DF_PEAK_RTOL, source="describing-function peak",
+          growth=SEARCH_GROWTH)
+    assert abs(h1_curve.peak_amplitude / h1_curve.peak_amplitude_h1 - 1) < SAME_PEAK_RTOL  # H = 1
     assert h1_curve.peak_amplitude >= h1_curve.amplitude.max()
 
 
@@ -107,8 +120,9 @@ def test_a_coarse_time_grid_is_flagged_as_aliased():
 
 
 #: Peak of the exact links on a 16-point scan against the default 256: the scan only
-#: brackets the extrema of u (refined by Newton), so only round-off differs.
-SCAN_RTOL = 1e-9
+#: brackets the extrema of u (refined by Newton), so only round-off differs. Measured
+#: 6.4e-15 (a12e5f1); 150x for other BLAS builds and thread counts.
+SCAN_RTOL = 1e-12
 
 
 def test_exact_links_do_not_depend_on_the_scan_grid():

@@ -7,6 +7,12 @@ from harmonic_balance.frf import compute_frf, parameter_curve
 from harmonic_balance.model import sdof_model
 from harmonic_balance.parameter import forcing_level, slip_scale
 
+#: A parameter curve's end point against the FRF solved directly with that parameter,
+#: and the stuck part's linearity in the level: the same equations solved to the Newton
+#: tolerance from different starts. Measured 2.2e-16 and 1.3e-15 (revision a12e5f1;
+#: 1e-14 at an earlier one); 1e-12 for other BLAS builds and thread counts.
+SAME_SOLUTION_RTOL = 1e-12
+
 
 @pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
 def test_forcing_level_curve_ends_on_the_frf_solution():
@@ -17,10 +23,10 @@ def test_forcing_level_curve_ends_on_the_frf_solution():
     c = parameter_curve(forcing_level(model), "odd:7", (0.1, 2.0), 1.0, affine=True)
     assert c.status == "complete" and c.lam[-1] == 2.0 and all(c.stable)
     r = compute_frf(sdof_model(1, 1, 0.04, 30, 0.5, 2.0), "odd:7", (1.0, 1.01), refine=False)
-    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < 1e-9  # measured 1e-14
+    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < SAME_SOLUTION_RTOL
     stuck = c.lam < 0.4  # slip force 0.5 not reached at omega = 1
     np.testing.assert_allclose(c.amplitude[stuck] / c.lam[stuck], c.amplitude[0] / c.lam[0],
-                               rtol=1e-9)
+                               rtol=SAME_SOLUTION_RTOL)
 
 
 def test_slip_scale_curve_matches_the_model_built_with_that_slip_force():
@@ -28,7 +34,7 @@ def test_slip_scale_curve_matches_the_model_built_with_that_slip_force():
     c = parameter_curve(slip_scale(m), "odd:3", (0.1, 3.0), 1.1)
     assert c.status == "complete" and c.lam[-1] == 3.0
     r = compute_frf(two_dof(True, fs=0.04 * 3.0), "odd:3", (1.1, 1.11), refine=False)
-    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < 1e-8
+    assert abs(c.amplitude[-1] / r.amplitude[0] - 1) < SAME_SOLUTION_RTOL
 
 
 def test_contact_stiffness_family_shares_the_first_residual_operators():

@@ -6,8 +6,10 @@ from refcheck import check
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, steady_amplitude
 
-#: Agreement required between the converged HB and the reference.
-TI_RTOL = 5e-3
+#: Converged HB against the time integration: H truncation and the march's time-step
+#: error, both deterministic. Measured 1.1e-4 (Jenkins oscillator, H = 7) and 3.6e-5
+#: (2-DOF, H = 5) (revision a12e5f1); 1e-3, 9x the larger.
+TI_RTOL = 1e-3
 #: Steady-state tolerance of the march (extrapolated change per period).
 SS_TOL = 1e-8
 
@@ -32,7 +34,7 @@ def test_converged_hb_peak_agrees_with_time_integration(peaks):
     amp, _, step_err, ss = steady_amplitude(model, r[7].peak_omega, 256, tol=SS_TOL)
     assert ss.converged and step_err < 1e-3  # the reference itself is converged in dt
     check("HB peak amplitude [m], Jenkins oscillator, H = odd:7", r[7].peak_amplitude, amp, rtol=TI_RTOL,
-          source="time integration to steady state (harmonic_balance.timeint)")
+          kind="self-consistency", source="time integration to steady state (harmonic_balance.timeint)")
 
 
 @pytest.mark.slow  # > 1 s: outside the `-m "not slow"` inner loop
@@ -43,4 +45,4 @@ def test_two_dof_hb_agrees_with_time_integration_at_the_peak():
     s = march(model, r.peak_omega, 256, tol=SS_TOL)
     assert s.converged
     check("HB peak amplitude [m], 2-DOF Jenkins model, H = odd:5", r.peak_amplitude, s.amplitude, rtol=TI_RTOL,
-          source="time integration to steady state (harmonic_balance.timeint)")
+          kind="self-consistency", source="time integration to steady state (harmonic_balance.timeint)")

@@ -11,11 +11,17 @@ from hbcases import jenkins, sdof, two_dof
 from harmonic_balance.frf import compute_frf
 from harmonic_balance.timeint import march, march_curve, steady_curve
 
-#: Agreement required between the converged HB and the reference.
-TI_RTOL = 5e-3
+#: Converged HB (H = 7) against the time integration at the peak: H truncation and the
+#: march's time step, deterministic. Measured 1.1e-4 (revision a12e5f1); 9x, as
+#: test_hb_timeint.TI_RTOL.
+TI_RTOL = 1e-3
+#: Beside the peak the HB value is interpolated between the curve's points: measured
+#: 4.6e-3 at 0.98 peak frequency (a12e5f1), the interpolation's error.
+TI_SIDE_RTOL = 5e-3
 #: march and march_curve run the same scheme; they differ by the round-off of an
 #: LU solve against a precomputed inverse, amplified over a few hundred periods.
-SAME_SCHEME_RTOL = 1e-9
+#: Measured 3.3e-13 (a12e5f1); 90x for other BLAS builds and thread counts.
+SAME_SCHEME_RTOL = 3e-11
 #: Steady-state tolerance of the marches (extrapolated change per period).
 SS_TOL = 1e-7
 
@@ -45,7 +51,7 @@ def test_curve_march_agrees_with_converged_harmonic_balance_at_the_peak():
     # the same frequencies on the HB curve (interpolated between its points)
     order = np.argsort(r.omega)
     hb = np.interp(ws[[0, 2]], np.asarray(r.omega)[order], np.asarray(r.amplitude)[order])
-    np.testing.assert_allclose(amp[[0, 2]], hb, rtol=TI_RTOL)
+    np.testing.assert_allclose(amp[[0, 2]], hb, rtol=TI_SIDE_RTOL)
 
 
 def test_element_without_batch_entry_gives_the_same_curve(monkeypatch):

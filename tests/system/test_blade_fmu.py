@@ -1,5 +1,7 @@
 """The blade FMU: exact integration (the linear FRF at steady state, step-size independence,
 the dissipation per cycle), fmpy validation, refusals."""
+import ctypes
+
 import numpy as np
 import pytest
 from slaves import Slave
@@ -124,3 +126,7 @@ def test_generated_sources_compile_without_warnings(specs, tmp_path, model):
     src = tmp_path / model
     names = fmu_build._copy_sources(src, 2, model, itf)
     fmu_build.compile_binary(src, names, tmp_path / f"{model}.so", extra_flags=("-Werror",))
+    # the binary loads and answers as an FMI 2 model
+    lib = ctypes.CDLL(str(tmp_path / f"{model}.so"))
+    lib.fmi2GetVersion.restype = ctypes.c_char_p
+    assert lib.fmi2GetVersion() == b"2.0"

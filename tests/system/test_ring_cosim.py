@@ -1,6 +1,8 @@
 """The ring archive (damper system) in libcosim and fmpy's SSP reader, the runner
 (damper cosim) and their refusals."""
+import importlib.util
 import json
+import sys
 import zipfile
 
 import numpy as np
@@ -11,7 +13,13 @@ from damper.cli import main
 from damper.cosim import read_info, run
 from harmonic_balance.bladed_disk.timeint import march_ring
 
-pytest.importorskip("libcosimpy", reason="libcosimpy (PyPI) is a test dependency")
+#: The tests that run a co-simulation; the others (the archive, fmpy's reader, the
+#: refusals, the message when libcosim is missing) run without it.
+needs_libcosim = pytest.mark.skipif(importlib.util.find_spec("libcosimpy") is None,
+                                    reason="libcosimpy (PyPI) is a test dependency")
+#: The modules the runner imports, hidden to act as a machine without libcosim.
+LIBCOSIM_MODULES = ("libcosimpy", "libcosimpy.CosimExecution", "libcosimpy.CosimEnums",
+                    "libcosimpy.CosimLogging", "libcosimpy.CosimObserver")
 
 #: The co-simulation against the ring time integration after the same 3 periods from the
 #: same prestress (both march the same ODE; measured -4e-4 at the default step).
@@ -53,6 +61,7 @@ def test_fmpy_ssp_simulation_runs(ring_ssp):
     assert np.all(np.isfinite(rows["damper0.F_left_x"]))
 
 
+@needs_libcosim
 def test_libcosim_transient_matches_the_ring_time_integration(ring_ssp, sector):
     """Three periods from the prestress at rest: the co-simulated first harmonic of every
     blade's u_a against the central-difference march of the same ring."""
@@ -72,13 +81,24 @@ def _cli(argv, capsys):
     return code, cap.out, cap.err
 
 
-def test_cli_json_and_refusals(ring_ssp, tmp_path, capsys):
+def _hide_libcosim(monkeypatch):
+    for name in LIBCOSIM_MODULES:
+        monkeypatch.setitem(sys.modules, name, None)  # import fails as if not installed
+
+
+@needs_libcosim
+def test_cli_json(ring_ssp, capsys):
     code, out, _ = _cli(["cosim", str(ring_ssp), "--frequency-hz", "440", "--periods", "1",
                          "--tol", "0", "--json"], capsys)
     r = json.loads(out)
     assert code == 0 and r["periods"] == 1 and r["amplitude"] > 0
     for k in ("amplitude", "periods", "step", "energy", "wall_time_s", "settled"):
         assert k in r
+
+
+def test_cli_refusals_come_before_the_engine(ring_ssp, tmp_path, capsys, monkeypatch):
+    """Bad input is refused (exit 2, what to change) whether or not libcosim is installed."""
+    _hide_libcosim(monkeypatch)
     # a step above the coupling limit: refused unless --force
     code, _, err = _cli(["cosim", str(ring_ssp), "--frequency-hz", "440", "--step", "1e-5"], capsys)
     assert code == 2 and "coupling limit" in err and "--force" in err
@@ -94,11 +114,7 @@ def test_cli_json_and_refusals(ring_ssp, tmp_path, capsys):
 
 
 def test_engine_missing_is_a_clear_refusal(ring_ssp, monkeypatch, capsys):
-    import sys
-
-    for name in ("libcosimpy", "libcosimpy.CosimExecution", "libcosimpy.CosimEnums",
-                 "libcosimpy.CosimLogging", "libcosimpy.CosimObserver"):
-        monkeypatch.setitem(sys.modules, name, None)  # import fails as if not installed
+    _hide_libcosim(monkeypatch)
     code, out, err = _cli(["cosim", str(ring_ssp), "--frequency-hz", "440", "--json"], capsys)
     assert code == 2 and "libcosim" in err and "pip install libcosimpy" in err and out == ""
 
@@ -131,6 +147,7 @@ def test_system_refuses_bad_loads_and_writes_json(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@needs_libcosim
 def test_settled_peak_against_hb_and_ring_time_integration(ring_ssp, sector):
     """CF 120 N at the HB (H = 7) peak frequency, settled to 1e-4: within 0.3 % of the ring
     time integration of the same ODE (measured +0.08 %) and within 2 % of the HB H = 7

@@ -18,7 +18,7 @@ def test_override_and_unknown_key(tmp_path):
     f.write_text("[load]\ncf = 60.0\n")
     assert load_config(f).cf == 60.0
     f.write_text("[load]\ncff = 60.0\n")
-    with pytest.raises(ValueError, match="unknown key load.cff"):
+    with pytest.raises(ValueError, match="load.cff: unknown key"):
         load_config(f)
     f.write_text("[damper]\nmu = -1\n")
     with pytest.raises(ValueError, match="damper.mu"):
@@ -32,3 +32,11 @@ def test_cli_refuses_bad_input(argv, capsys):
     assert main(["upd", *argv]) == 2
     cap = capsys.readouterr()
     assert "error" in cap.err and cap.out == ""
+
+
+def test_upd_file_bounds_the_blades_as_the_mistuned_ring_does():
+    """disk.blades in a UPD file is bounded like `upd mistuning --blades` (the same ring)."""
+    from damper.limits import MAX_RING_BLADES
+    from harmonic_balance.bladed_disk.config_model import MAX_BLADES
+
+    assert MAX_BLADES == MAX_RING_BLADES

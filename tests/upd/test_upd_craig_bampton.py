@@ -7,6 +7,11 @@ import pytest
 
 from damper.cli import main
 from harmonic_balance.bladed_disk.blade import generalized_eigenfrequencies
+from harmonic_balance.bladed_disk.solve import TOL_REL
+
+#: Energy imbalance at the peak: the Newton stopping tolerance |R| < solve.TOL_REL max(F0, CF)
+#: bounds it (the solver's guarantee); measured <= 2.4e-15 over these tests (revision a12e5f1).
+ENERGY_IMBALANCE = TOL_REL
 
 #: CB with 6 fixed-interface modes vs the full FE blade (1016 DOFs), first three modes;
 #: measured 2.5e-6, 1.3e-4, 1.4e-3 (Rayleigh-Ritz: the CB frequencies are upper bounds).
@@ -64,7 +69,7 @@ def test_reduced_blade_runs_with_the_default_damper(example, fe, tmp_path, capsy
     assert main(["upd", "frf", "--config", str(toml), "--harmonics", "3", "--points", "40",
                  "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < ENERGY_IMBALANCE
     # the damper lowers the resonance below the free blade's and lies between the limits
     assert 0 < out["peak_amplitude"] < DAMPED_BELOW * a_free
     assert lo < out["peak_frequency_hz"] < f_stuck

@@ -6,12 +6,18 @@ import pytest
 
 from harmonic_balance.bladed_disk import solve
 from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.solve import TOL_REL
+
+#: Energy imbalance at the peak: the Newton stopping tolerance |R| < solve.TOL_REL max(F0, CF)
+#: bounds it (the solver's guarantee); measured <= 2.4e-15 over these tests (revision a12e5f1).
+ENERGY_IMBALANCE = TOL_REL
 
 #: Interpolated grid values against Newton at the grid points: measured 1.7e-4 at H = 7
-#: over 400-500 Hz (solve.UPD_TOL); the AFT sampling error of the contacts is as large.
+#: over 400-500 Hz (solve.UPD_TOL), 4.3e-4 at H = 3 over 430-470 Hz (revision a12e5f1).
 GRID_RTOL = 5e-4
 #: Two refinements of the same discrete curve's peak: to the frequency tolerance
 #: (PEAK_XTOL = 1e-6), so in amplitude to its square and the correctors' 1e-10.
+#: Measured 7.3e-9 (revision a12e5f1).
 PEAK_RTOL = 1e-8
 
 
@@ -37,7 +43,9 @@ def test_a_start_reached_by_the_force_level_equals_the_curve_s(sector):
     hb = SectorHB(sector, 3, cf=20.0)
     x = solve.start_point(hb, w1)
     c = solve.frf(SectorHB(sector, 3, cf=20.0), np.array([w0, w1]), refine=False)
-    assert np.linalg.norm(c.x[-1] - x) < 1e-8 * np.linalg.norm(x)
+    # two Newton solutions of the same equations: within the stopping tolerance
+    # (solve.TOL_REL); measured 3.5e-15 (revision a12e5f1)
+    assert np.linalg.norm(c.x[-1] - x) < TOL_REL * np.linalg.norm(x)
 
 
 def test_folded_curve_of_the_craig_bampton_blade_is_followed(tmp_path, capsys):
@@ -72,4 +80,4 @@ def test_folded_curve_of_the_craig_bampton_blade_is_followed(tmp_path, capsys):
     amps = a[cross]
     assert amps.max() > 2.5 * amps.min()
     assert out["peak_frequency_hz"] == pytest.approx(422.85, abs=0.01)
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < 1e-6
+    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < ENERGY_IMBALANCE

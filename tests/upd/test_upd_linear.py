@@ -13,9 +13,11 @@ from harmonic_balance.bladed_disk.sector import (
 
 #: Direct solve vs complex modal superposition; measured 2e-8 (free), 4e-7 (stuck).
 MODAL_RTOL = 1e-6
-#: Peak frequency vs undamped natural frequency: shift ~ zeta^2 ~ 4e-6 (0.2 % damping),
-#: measured 3e-6; the required 0.1 % is the bound.
-PEAK_RTOL = 1e-3
+#: Peak frequency vs undamped natural frequency: the displacement peak lies below the
+#: natural frequency by ~zeta^2 = 4e-6 (0.2 % damping). Measured 4.0e-6 (free), 5.0e-6
+#: (stuck) (revision a12e5f1); 2e-5, 4x the larger: deterministic, a shift of the
+#: modes or of the peak search by 2e-5 fails.
+PEAK_RTOL = 2e-5
 
 
 @pytest.mark.parametrize("damper", ["free", "stuck", "sliding"])
@@ -32,7 +34,7 @@ def test_peak_at_natural_frequency(sector, damper):
     w, a = peak_of(lambda om: abs(linear_response(sector, om, damper)[0, sector.response]),
                    2 * np.pi * 380, 2 * np.pi * 520)
     check(f"UPD-24 linear FRF peak [Hz], damper {damper}, EO 6", w / (2 * np.pi), f_n, rtol=PEAK_RTOL,
-          source="natural frequency of the cyclic sector (eigenvalue problem)")
+          kind="self-consistency", source="natural frequency of the cyclic sector (eigenvalue problem)")
     # Peak amplitude from the single-mode modal formula |phi_a|^2 F0 / (omega_r^2 2 zeta_r)
     # is checked against the modal superposition (all modes).
     am = abs(modal_response(sector, w, damper)[0, sector.response])

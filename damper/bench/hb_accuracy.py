@@ -1,0 +1,170 @@
+"""Accuracy table of the harmonic balance: the truncation-error estimate against the true error.
+
+For each model (the bench's Jenkins chains, :mod:`harmonic_balance.bench_models`, and the
+UPD-24 sector at three centrifugal loads) and each H: the refined peak amplitude, its
+estimated truncation error (:mod:`harmonic_balance.accuracy`), the true error against a
+reference peak at REFERENCE_H (the curve's peak re-solved with 0..REFERENCE_H
+harmonics, the same corrector as the estimate's check), their ratio, and the times of
+the curve and of the check; then per accuracy target the H the engine chose, the
+estimate, the true error and the total time.
+
+Run: ``python -m damper.bench.hb_accuracy [--quick] [--only frf|upd] [--json]``
+(``make docs-accuracy`` records it for docs/method/accuracy.md).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+
+#: Harmonics of the reference peak: ~(7 / 61)^1.7 = 2.5 % of the H = 7 error is left.
+REFERENCE_H = 61
+#: Reference of the sector: ~(7 / 33)^1.7 = 7 % of the H = 7 error is left (the sector
+#: costs ~H^2.5 per solve; 33 keeps the table within minutes).
+REFERENCE_H_UPD = 33
+#: H of the table's rows.
+HS = (3, 7, 15)
+#: Accuracy targets of the table's rows.
+TOLS = (1e-2, 1e-3)
+#: Centrifugal loads [N] of the UPD-24 rows (F0 = 30 N).
+UPD_CF = (60.0, 120.0, 600.0)
+
+
+def _frf_cases(quick: bool):
+    from harmonic_balance import bench_models as bm
+
+    cases = [bm.sdof(1.0), bm.sdof(1e4), bm.chain3(1.0, 20.0), bm.chain3(2.0, 200.0), bm.chain5()]
+    return cases[:3] if quick else cases
+
+
+def _frf_reference(result, H_ref: int) -> float:
+    from harmonic_balance import accuracy as acc
+    from harmonic_balance.frf import TOL_REL
+    from harmonic_balance.frf_accuracy import check_problem
+
+    prob = result.problem
+    rich = check_problem(prob, tuple(range(H_ref + 1)))
+    xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+    tol = TOL_REL * rich.reference(result.peak_omega)
+    i = int(np.argmax(result.amplitude))
+    return acc.peak_at(rich, rich.amplitude, xs, np.asarray(result.omega), i, tol,
+                       1e-6 * result.peak_omega)[2]
+
+
+def frf_rows(quick: bool = False) -> list[dict]:
+    """Rows of the chain models: per H and per accuracy target."""
+    from harmonic_balance.frf import compute_frf
+
+    rows = []
+    for case in _frf_cases(quick):
+        model, ref = case.model(), None
+        for H in HS[:2] if quick else HS:
+            t0 = time.perf_counter()
+            r = compute_frf(model, H, case.band, stability="off")
+            dt = time.perf_counter() - t0
+            if ref is None:
+                ref = _frf_reference(r, REFERENCE_H)
+            rows.append(_row(case.name, f"H {H}", r.peak_amplitude, r.truncation_error, ref, dt))
+        slow = case.name.startswith("chain5")   # converges like H^-0.5 up to H ~ 20: no 1e-3
+        for tol in TOLS[:1] if quick or slow else TOLS:
+            t0 = time.perf_counter()
+            r = compute_frf(model, 3, case.band, stability="off", accuracy=tol,
+                            max_harmonic=REFERENCE_H)
+            rows.append(_row(case.name, f"tol {tol:g} -> H {r.problem.basis.H}", r.peak_amplitude,
+                             r.truncation_error, ref, time.perf_counter() - t0))
+    return rows
+
+
+def upd_rows(quick: bool = False) -> list[dict]:
+    """Rows of UPD-24 (F0 = 30 N, the config's band, 200 points) at UPD_CF."""
+    from harmonic_balance import accuracy as acc
+    from harmonic_balance.bladed_disk.accuracy import check_sector, frf_to_accuracy, truncation_error
+    from harmonic_balance.bladed_disk.config import load_config
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.sector import Sector
+    from harmonic_balance.bladed_disk.solve import frf
+
+    sector = Sector(load_config(None))
+    lo, hi = sector.cfg["load.band_hz"]
+    om = 2 * np.pi * np.linspace(lo, hi, 200)
+    rows = []
+    for cf in UPD_CF[1:2] if quick else UPD_CF:
+        name, ref = f"UPD-24 CF {cf:g}", None
+        for H in (7,) if quick else (7, 15):
+            t0 = time.perf_counter()
+            hb = SectorHB(sector, H, cf=cf, f0=30.0)
+            c = frf(hb, om)
+            rec = truncation_error(hb, c)
+            dt = time.perf_counter() - t0
+            if ref is None:
+                rich = check_sector(hb, REFERENCE_H_UPD)
+                xs = [acc.pad(x, hb.basis, rich.basis) for x in c.x]
+                ref = acc.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs, om,
+                                  int(np.argmax(c.amplitude)), 1e-10 * max(hb.f0, hb.cf),
+                                  1e-6 * c.peak_omega)[2]
+            rows.append(_row(name, f"H {H}", c.peak_amplitude, rec, ref, dt))
+        for tol in TOLS[:1]:   # 1e-3 needs H ~ 35-40 on UPD-24: minutes per curve
+            t0 = time.perf_counter()
+            hb, c, rec = frf_to_accuracy(sector, om, tol, 7, cf=cf, f0=30.0)
+            rows.append(_row(name, f"tol {tol:g} -> H {hb.H}", c.peak_amplitude, rec, ref,
+                             time.perf_counter() - t0))
+    return rows
+
+
+#: Where each row is printed as soon as it is computed (None: not printed).
+ECHO = None
+
+
+def _row(model, setting, amp, rec, ref, dt) -> dict:
+    est = (rec or {}).get("peak_amplitude_rel")
+    true = abs(amp - ref) / abs(ref)
+    row = {"model": model, "setting": setting, "peak_amplitude": amp, "estimate": est,
+           "true_error": true, "ratio": est / true if est is not None and true > 0 else None,
+           "order": (rec or {}).get("order_observed"), "check_time_s": (rec or {}).get("time_s"),
+           "time_s": dt}
+    if ECHO is not None:
+        print_table([row], ECHO, header=False)
+    return row
+
+
+def print_table(rows, out=sys.stdout, header: bool = True) -> None:
+    if header:
+        print(f"{'model':24s} {'setting':18s} {'peak':>12s} {'estimate':>9s} {'true':>9s} "
+              f"{'ratio':>6s} {'check s':>8s} {'total s':>8s}", file=out)
+    for r in rows:
+        def pct(v):
+            return "-" if v is None else f"{100 * v:.3g}%"
+        print(f"{r['model']:24s} {r['setting']:18s} {r['peak_amplitude']:12.6g} {pct(r['estimate']):>9s} "
+              f"{pct(r['true_error']):>9s} {'-' if r['ratio'] is None else format(r['ratio'], '.2f'):>6s} "
+              f"{'-' if r['check_time_s'] is None else format(r['check_time_s'], '.2f'):>8s} "
+              f"{r['time_s']:8.2f}", file=out, flush=True)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer models and settings")
+    ap.add_argument("--only", choices=("frf", "upd"), help="one model class")
+    ap.add_argument("--json", action="store_true",
+                    help="print the rows as one JSON object on stdout (the table on stderr)")
+    a = ap.parse_args(argv)
+    global ECHO
+    ECHO = sys.stderr
+    print_table([], sys.stderr)
+    rows = []
+    if a.only in (None, "frf"):
+        rows += frf_rows(a.quick)
+    if a.only in (None, "upd"):
+        rows += upd_rows(a.quick)
+    if not a.json:
+        print_table(rows)
+    if a.json:
+        print(json.dumps({"reference_H": REFERENCE_H, "reference_H_upd": REFERENCE_H_UPD,
+                          "quick": a.quick, "rows": rows}))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

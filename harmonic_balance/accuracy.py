@@ -1,0 +1,244 @@
+"""Truncation error of a forced response's peak: a richer harmonic set at the peak.
+
+Symbols: H the highest retained harmonic of the curve, H' > H that of the check,
+a_H and omega_H the refined peak amplitude [m] and frequency [rad/s] with H harmonics,
+p the convergence order (|a_H - a_inf| ~ C H^-p).
+
+Method (docs/method/accuracy.md). The curve's solutions near its refined peak are padded
+with zeros to a richer harmonic set of the same kind (H' = the next admissible harmonic
+at or above RICHER_FACTOR H: odd sets stay odd), corrected at their frequencies by
+Newton, and the peak of that short branch is refined (:func:`continuation.refine_max`):
+a few dozen solves at H', no curve. A second check at H'' (the same rule from H') gives
+three levels. Where their differences give a convergence order p in ORDER_RANGE
+(|a_H - a_inf| ~ C H^-p), the peak is extrapolated (Richardson 1911; Roache 1998, ch. 5,
+for the observed order of grid-convergence studies),
+
+    a_inf = a_H'' + (a_H'' - a_H') / ((H'' / H')^p - 1),
+
+and the error of a_H is |a_H - a_inf| / |a_inf|. Otherwise (two levels, or differences
+that change sign) the error is the largest two-level estimate over the checks with the
+assumed order p = ASSUMED_ORDER,
+
+    e_H = |a_H - a_c| / |a_c| / (1 - (H / H_c)^p).
+
+The same for omega. A friction force has kinks at stick-slip transitions, so its
+spectrum falls like h^-2 and the response's truncation error slowly (p ~ 0.5-4 measured
+on the bench models and UPD-24): hence checks at 1.5 H and 2.25 H, not H + 2, whose
+difference would be too small to tell the error from.
+
+The estimate is of the truncation in H only: the AFT sampling error (exact friction
+links have none) and the continuation's tolerance (the peak is refined to 1e-6 in
+frequency) are far smaller in the cases measured.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .continuation import Branch, refine_max
+from .fourier import FourierBasis
+from .newton import NewtonError, newton
+
+#: The check's highest harmonic is at least this multiple of H (then the next of the set's
+#: kind): close enough to cost ~2.5x a point of the curve per solve, far enough that the
+#: difference of the two peaks is a fair share of the error left at H.
+RICHER_FACTOR = 1.5
+#: Convergence order assumed with two levels: the friction response's peak converges like
+#: H^-p with p ~ 1.5-2 (kinks in the contact forces); measured in docs/method/accuracy.md.
+ASSUMED_ORDER = 1.7
+#: Observed orders outside this range are not trusted for extrapolation (the peak's
+#: sequence is not yet in its asymptotic range, or changes sign). Low orders occur (the
+#: 5-mass chain of the bench, docs/method/accuracy.md).
+ORDER_RANGE = (0.3, 6.0)
+#: Curve points on each side of the peak padded and corrected at H' (more are added when
+#: the peak at H' lies at the end of that window).
+WINDOW = 3
+#: Largest number of window extensions when the H' peak sits at the window's end.
+MAX_EXTEND = 6
+#: Relative truncation error above which a result carries a warning.
+WARN_REL = 1e-2
+#: Accuracy targets accepted (relative, on the peak amplitude): below 1e-6 the estimate
+#: meets the corrector's and the peak search's own accuracy; above 0.5 it means nothing.
+ACCURACY_RANGE = (1e-6, 0.5)
+
+
+def check_accuracy(tol) -> float:
+    """``tol`` as a float inside ACCURACY_RANGE (open interval), else ValueError."""
+    lo, hi = ACCURACY_RANGE
+    if tol is None or isinstance(tol, bool) or not isinstance(tol, (int, float)) \
+            or not math.isfinite(tol) or not lo < tol < hi:
+        raise ValueError(f"accuracy must be a relative tolerance in ({lo:g}, {hi:g}), got {tol!r}")
+    return float(tol)
+
+
+def richer(harmonics: tuple, factor: float = RICHER_FACTOR, limit: int | None = None) -> tuple:
+    """The harmonic set of the same kind as ``harmonics`` up to the next admissible
+    harmonic at or above ``factor`` H (at least H + 2, so that a new odd harmonic enters: the
+    even ones vanish on a symmetric friction loop and would check nothing), capped at
+    ``limit``: an odd-only set stays odd, a set with 0 keeps 0 and every harmonic.
+
+    Returns the new tuple (equal to ``harmonics`` when the limit leaves no room).
+    """
+    hs = tuple(harmonics)
+    H = hs[-1]
+    odd = all(h % 2 for h in hs)
+    top = max(int(math.ceil(factor * H - 1e-9)), H + 2)
+    if odd and top % 2 == 0:
+        top += 1
+    if limit is not None:
+        top = min(top, limit - (1 if odd and limit % 2 == 0 else 0))
+    if top <= H:
+        return hs
+    extra = range(H + 2, top + 1, 2) if odd else range(H + 1, top + 1)
+    return hs + tuple(extra)
+
+
+def pad(x: np.ndarray, basis: FourierBasis, rich: FourierBasis) -> np.ndarray:
+    """Unknowns ``x`` ((n_b, m) row-major, :mod:`fourier`'s ordering) of ``basis`` in the
+    richer basis ``rich`` (a superset), the new harmonics zero."""
+    X = np.asarray(x).reshape(basis.nb, -1)
+    Y = np.zeros((rich.nb, X.shape[1]))
+    for h in basis.harmonics:
+        (ic, isn), (jc, jsn) = basis.index(h), rich.index(h)
+        Y[jc] = X[ic]
+        if isn is not None:
+            Y[jsn] = X[isn]
+    return Y.ravel()
+
+
+def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
+    """Refined peak of ``amplitude`` on the branch of ``fun`` near the given points.
+
+    Parameters
+    ----------
+    fun : callable (x, omega) -> (R, dR/dx, dR/domega) at the richer set
+    amplitude : callable (x, omega) -> float
+    xs : list of (N,) arrays, starting guesses (padded curve solutions) at ``omegas``
+    omegas : (n,) frequencies [rad/s] of the curve points, monotone
+    i : int, index of the curve's peak in ``xs``
+    tol : float, Newton tolerance on |R|_2
+    tol_lam : float, tolerance on the peak frequency [rad/s]
+
+    Returns
+    -------
+    x, omega, amplitude, solves (int); RuntimeError when no peak is found.
+    """
+    solved = {}
+
+    def at(j):
+        if j not in solved:
+            x0 = xs[j]
+            near = [k for k in solved if solved[k] is not None]
+            if near:  # the nearest corrected point is a better guess than the padded one
+                k = min(near, key=lambda k: abs(k - j))
+                x0 = solved[k] + (xs[j] - xs[k])
+            try:
+                solved[j] = newton(lambda z: fun(z, omegas[j])[:2], x0, tol, 40).x
+            except NewtonError:
+                solved[j] = None
+        return solved[j]
+    lo, hi = max(i - WINDOW, 0), min(i + WINDOW, len(xs) - 1)
+    for _ in range(MAX_EXTEND + 1):
+        idx = [j for j in range(lo, hi + 1) if at(j) is not None]
+        if len(idx) < 3:
+            raise RuntimeError("the richer harmonic set has no solution near the peak")
+        amps = [amplitude(solved[j], omegas[j]) for j in idx]
+        top = int(np.argmax(amps))
+        if 0 < top < len(idx) - 1:
+            break
+        if (top == 0 and lo == 0) or (top == len(idx) - 1 and hi == len(xs) - 1):
+            raise RuntimeError("the peak with the richer harmonic set lies at the band's end")
+        lo, hi = (max(lo - WINDOW, 0), hi) if top == 0 else (lo, min(hi + WINDOW, len(xs) - 1))
+    else:
+        raise RuntimeError("the peak with the richer harmonic set is outside the window searched")
+    j = idx[top]
+    k0, k1 = idx[top - 1], idx[top + 1]
+    branch = Branch(x=[solved[k0], solved[j], solved[k1]],
+                    lam=[omegas[k0], omegas[j], omegas[k1]], iterations=[0, 0, 0])
+    x, w, a, n = refine_max(fun, branch, 1, amplitude, tol, tol_lam)
+    return x, w, a, len(solved) + n
+
+
+def observed_order(levels) -> float | None:
+    """Convergence order p from the last three levels (H, a) of increasing H, solving
+    (a0 - a1) / (a1 - a2) = (H0^-p - H1^-p) / (H1^-p - H2^-p) by bisection; None when the
+    differences change sign or p falls outside ORDER_RANGE."""
+    if len(levels) < 3:
+        return None
+    (H0, a0), (H1, a1), (H2, a2) = [(lv[0], lv[1]) for lv in levels[-3:]]
+    d01, d12 = a0 - a1, a1 - a2
+    if d12 == 0 or d01 * d12 <= 0:
+        return None
+    target = d01 / d12
+
+    def g(p):
+        return (H0**-p - H1**-p) / (H1**-p - H2**-p) - target
+    lo, hi = ORDER_RANGE
+    if g(lo) * g(hi) > 0:
+        return None
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(lo) * g(mid) > 0 else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def estimate(levels, method: str) -> dict:
+    """The ``truncation_error`` record of a peak computed at several harmonic levels.
+
+    Parameters
+    ----------
+    levels : list of (H, peak_amplitude, peak_omega), increasing H; levels[0] is the
+        result's own (H_used), the others its checks at richer sets
+    method : str, how the checks were computed (recorded)
+
+    Returns
+    -------
+    dict: method, H_used, H_check (the richest check), order (p used), order_observed
+    (or None), peak_amplitude_rel, peak_frequency_rel (estimated relative truncation
+    error of H_used's peak), checks (H, peak_amplitude, peak_omega of each check),
+    extrapolated (peak_amplitude, peak_omega at H -> infinity, or None without an
+    observed order).
+
+    With three levels whose differences give an order in ORDER_RANGE the error is
+    |a_H - a_inf| / |a_inf| with a_inf extrapolated from the last two levels; otherwise
+    the largest two-level estimate over the checks with ASSUMED_ORDER (module docstring).
+    """
+    H = levels[0][0]
+    e_a, a_inf, p_a = _error([(lv[0], lv[1]) for lv in levels])
+    e_w, w_inf, _ = _error([(lv[0], lv[2]) for lv in levels])
+    out = {"method": method, "H_used": int(H), "H_check": int(levels[-1][0]),
+           "order": ASSUMED_ORDER if p_a is None else p_a, "order_observed": p_a,
+           "peak_amplitude_rel": e_a, "peak_frequency_rel": e_w,
+           "checks": [{"H": int(h), "peak_amplitude": a, "peak_omega": w} for h, a, w in levels[1:]],
+           "extrapolated": None}
+    if a_inf is not None:
+        out["extrapolated"] = {"peak_amplitude": a_inf, "peak_omega": w_inf}
+    return out
+
+
+def _error(seq):
+    """(relative error of seq[0]'s value, extrapolated value or None, observed order or None)
+    of a sequence (H, value) of increasing H (:func:`estimate`)."""
+    H, v = seq[0]
+    if not all(np.isfinite(x) for _, x in seq):
+        return None, None, None
+    p = observed_order(seq) if len(seq) >= 3 else None
+    if p is not None:
+        (H1, v1), (H2, v2) = seq[-2], seq[-1]
+        v_inf = v2 + (v2 - v1) / ((H2 / H1) ** p - 1.0)
+        return abs(v - v_inf) / abs(v_inf), v_inf, p
+    e = max(abs(v - vc) / abs(vc) / (1.0 - (H / Hc) ** ASSUMED_ORDER) for Hc, vc in seq[1:])
+    return e, None, None
+
+
+def warning(record: dict | None, limit: float = WARN_REL) -> str | None:
+    """One line warning when the estimated peak error exceeds ``limit``, else None."""
+    if not record or record.get("peak_amplitude_rel") is None:
+        return None
+    e = record["peak_amplitude_rel"]
+    if e <= limit:
+        return None
+    return (f"warning: estimated truncation error of the peak amplitude {100 * e:.2g} % "
+            f"(H = {record['H_used']}, checked at H = {record['H_check']}) exceeds "
+            f"{100 * limit:g} %: raise the harmonics or ask for an accuracy")

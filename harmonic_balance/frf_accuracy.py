@@ -1,0 +1,230 @@
+"""Truncation error of a forced-response curve's peak, and curves to a requested accuracy.
+
+:func:`truncation_error` estimates the error in H of a :class:`frf.FRFResult`'s peak
+amplitude and frequency by :mod:`accuracy`'s check at a richer harmonic set;
+:func:`frf_to_accuracy` traces curves with more harmonics until that estimate is below
+a relative tolerance on the peak amplitude, choosing the next H from the observed (or
+assumed) convergence order.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from . import accuracy as acc
+from .fourier import default_samples, parse_harmonics
+
+#: Highest harmonic the library goes to when raising H for an accuracy (the CLI passes
+#: its own limit): ~H^2 time per curve point.
+MAX_HARMONIC = 200
+#: Margin on the H predicted to meet a tolerance (the order is an estimate).
+H_MARGIN = 1.15
+#: Largest factor on H from one curve to the next: an assumed order below the true one
+#: would otherwise overshoot (the 3-mass chain at 1e-3 from H = 3: order ~4, predicted
+#: H = 40 where 11 suffices).
+RAISE_MAX = 2.5
+
+
+def check_problem(prob, harmonics):
+    """The FRFProblem of ``prob``'s model at the richer ``harmonics`` (same residual kind,
+    at least the curve's AFT samples)."""
+    from .frf import FRFProblem
+    from .residual import CondensedResidual
+
+    n_t = max(prob.basis.n_t, default_samples(max(harmonics)))
+    return FRFProblem(prob.model, harmonics, n_t, isinstance(prob.residual, CondensedResidual))
+
+
+#: Richer levels checked at the peak (H' and H'' = richer(H')): three levels give the
+#: observed order; on the 5-mass chain (order ~1) a single check with the assumed order
+#: underestimates the error 3-7 times, while the second check costs ~2-3 times the first,
+#: 5-30 % of the curve (docs/method/accuracy.md).
+CHECK_LEVELS = 2
+
+
+def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> list:
+    """[(H', amplitude, omega), ...] of ``result``'s peak re-solved at up to ``levels``
+    successively richer sets (:func:`accuracy.richer`, capped at ``limit``; empty when
+    the limit leaves no richer set). RuntimeError when the first richer set finds no peak."""
+    from .frf import TOL_REL
+
+    prob = result.problem
+    out, hs = [], prob.basis.harmonics
+    om = np.asarray(result.omega)
+    i = int(np.argmax(result.amplitude))
+    for k in range(levels):
+        nxt = acc.richer(hs, limit=limit)
+        if nxt == hs:
+            break
+        hs = nxt
+        rich = check_problem(prob, hs)
+        xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+        tol = TOL_REL * max(rich.reference(result.peak_omega), 1e-300)
+        try:
+            if result.peak_interior:
+                _, w, a, _ = acc.peak_at(rich, rich.amplitude, xs, om, i, tol, 1e-6 * abs(om[i]))
+            else:  # the maximum is at an end of the band: the amplitude there
+                from .newton import newton
+
+                w = float(om[i])
+                a = rich.amplitude(newton(lambda z, r=rich, w=w: r(z, w)[:2], xs[i], tol, 40).x, w)
+        except RuntimeError:
+            if k == 0:
+                raise
+            break   # the first check stands alone
+        out.append((hs[-1], float(a), float(w)))
+    return out
+
+
+def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> dict:
+    """The ``truncation_error`` record (:func:`accuracy.estimate`) of ``result``'s peak,
+    checked at up to ``levels`` richer sets. A check that fails or finds no richer set
+    within ``limit`` gives a record with null estimates and a ``note`` saying why."""
+    import time
+
+    t0 = time.perf_counter()
+    H = result.problem.basis.H
+    base = {"method": "richer harmonic sets at the peak", "H_used": int(H)}
+    if not np.isfinite(result.peak_amplitude):
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": "no peak to check"}
+    try:
+        checks = check_peak(result, limit, levels)
+    except RuntimeError as err:
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": f"check failed: {err}"}
+    if not checks:
+        return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
+                "note": f"no richer harmonic set within the limit H <= {limit}"}
+    w = result.peak_omega if result.peak_interior else float("nan")
+    out = acc.estimate([(H, result.peak_amplitude, w)] + checks,
+                       base["method"] + ("" if result.peak_interior else " (band end: amplitude only)"))
+    out["time_s"] = time.perf_counter() - t0
+    return out
+
+
+def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
+                    limit: int = MAX_HARMONIC, **kwargs):
+    """Forced-response curve whose peak amplitude's estimated truncation error is below
+    ``accuracy`` (relative), raising H per curve.
+
+    Starts at ``harmonics`` (its kind, odd or all, is kept); after each curve the peak
+    is checked at richer sets (:func:`truncation_error`); while the estimate e exceeds
+    ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
+    observed order, else :data:`accuracy.ASSUMED_ORDER`), at most RAISE_MAX H, at least
+    the first check's H, at most the highest H whose checks still fit within ``limit``. Other keyword arguments
+    go to :func:`frf.compute_frf`.
+
+    Returns
+    -------
+    FRFResult of the last curve (``time_s`` and ``evaluations`` of the whole run),
+    ``truncation_error`` set, ``extra["accuracy"]``:
+    target, met (bool), levels (H, peak amplitude, peak omega per curve and check),
+    H_sequence, message (when the limit stopped it).
+
+    Raises
+    ------
+    ValueError (bad accuracy), frf.FRFError when the first curve fails (a later curve
+    that fails ends the run with the previous result, said in its status).
+    """
+    from .frf import FRFError, compute_frf
+
+    tol = acc.check_accuracy(accuracy)
+    hs = parse_harmonics(harmonics)
+    odd = all(h % 2 for h in hs)
+    top = _curve_limit(hs, limit)
+    import time
+
+    t0, evaluations = time.perf_counter(), 0
+    levels, seq, best = [], [], None
+    while True:
+        try:
+            res = compute_frf(model, hs, omega_range, truncation_check=False, **kwargs)
+        except FRFError as err:
+            if best is None:
+                raise
+            best.status += (f"; warning: the curve at H = {hs[-1]} failed ({err}), the result at "
+                            f"H = {best.problem.basis.H} is kept")
+            break
+        best = res
+        evaluations += res.evaluations
+        seq.append(hs[-1])
+        rec = truncation_error(res, limit)
+        res.truncation_error = rec
+        res.extra["truncation_warning"] = acc.warning(rec)
+        levels.append((hs[-1], res.peak_amplitude, res.peak_omega))
+        levels += [(c["H"], c["peak_amplitude"], c["peak_omega"]) for c in rec.get("checks", ())]
+        e = rec.get("peak_amplitude_rel")
+        if e is not None and e <= tol:
+            break
+        if e is None or hs[-1] >= top:
+            why = rec.get("note") or f"H = {hs[-1]} is the highest whose check fits the limit H <= {limit}"
+            res.extra["accuracy_message"] = (f"accuracy {tol:g} not reached: {why}; the estimate "
+                                             f"is {_pct(e)} at H = {hs[-1]}")
+            break
+        p = rec.get("order") or acc.ASSUMED_ORDER
+        want = min(hs[-1] * (e / tol) ** (1.0 / p) * H_MARGIN, RAISE_MAX * hs[-1])
+        H_next = min(max(int(math.ceil(want)), rec["checks"][0]["H"]), top)
+        hs = _harmonic_set(H_next, odd, 0 in hs)
+    best.extra["accuracy"] = {"target": tol, "met": (best.truncation_error or {}).get(
+        "peak_amplitude_rel") is not None and best.truncation_error["peak_amplitude_rel"] <= tol,
+        "H_sequence": seq, "levels": [list(lv) for lv in levels],
+        "message": best.extra.get("accuracy_message")}
+    best.time_s = time.perf_counter() - t0   # every curve and check of the run
+    best.evaluations = evaluations
+    return best
+
+
+def _pct(e) -> str:
+    return "unknown" if e is None else f"{100 * e:.3g} %"
+
+
+def _harmonic_set(H: int, odd: bool, zero: bool) -> tuple:
+    if odd:
+        return tuple(range(1, H + 1 + (H % 2 == 0), 2))
+    return tuple(range(0 if zero else 1, H + 1))
+
+
+def _curve_limit(hs, limit: int) -> int:
+    """Highest H of a curve whose richer check set still fits within ``limit``."""
+    odd = all(h % 2 for h in hs)
+    H = limit
+    while H > hs[-1] and acc.richer(_harmonic_set(H, odd, 0 in hs), limit=None)[-1] > limit:
+        H -= 1
+    return max(H, hs[-1])
+
+
+def summary_lines(summary, hz: bool = False) -> list[str]:
+    """Text lines of the truncation-error estimate, the accuracy run and its warnings
+    (``hz``: frequencies in Hz, else rad/s)."""
+    rec = summary.get("truncation_error") or {}
+    if not rec:
+        return []
+    e, ef = rec.get("peak_amplitude_rel"), rec.get("peak_frequency_rel")
+    if e is None:
+        lines = [f"truncation error: not estimated ({rec.get('note', 'no check')})"]
+    else:
+        lines = [f"truncation error (estimate, H = {rec['H_used']} checked at H = {rec['H_check']}, "
+                 f"order {rec['order']:.2g}{' observed' if rec.get('order_observed') else ' assumed'}): "
+                 f"peak amplitude {100 * e:.2g} %"
+                 + ("" if ef is None else f", peak frequency {100 * ef:.2g} %")]
+    ex = rec.get("extrapolated")
+    if ex:
+        w = ex["peak_omega"]
+        at = (f"{_num(None if w is None else w / (2 * math.pi))} Hz" if hz
+              else f"omega = {_num(w)} rad/s")
+        lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m at {at}")
+    a = summary.get("accuracy")
+    if a:
+        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
+                     f"tried {a['H_sequence']}")
+        if a.get("message"):
+            lines.append(f"warning: {a['message']}")
+    if summary.get("truncation_warning") and not (a and a["met"]):
+        lines.append(summary["truncation_warning"])
+    return lines
+
+
+def _num(v, fmt=".9g") -> str:
+    return "none" if v is None else format(v, fmt)

@@ -1,0 +1,155 @@
+"""Truncation-error estimate of a forced response's peak, and curves to a requested accuracy."""
+import json
+
+import numpy as np
+import pytest
+
+from damper.cli import main
+from harmonic_balance import accuracy as acc
+from harmonic_balance import bench_models as bm
+from harmonic_balance.fourier import FourierBasis
+from harmonic_balance.frf import TOL_REL, compute_frf
+from harmonic_balance.frf_accuracy import check_problem
+
+#: The estimate must be within this factor of the true error (the method's stated goal:
+#: a two-level estimate with an assumed order is an order-of-magnitude statement).
+ESTIMATE_FACTOR = 3.0
+#: Harmonics of the reference peak: the error left there is ~(7 / 41)^1.7 = 5 % of the
+#: H = 7 error, well inside ESTIMATE_FACTOR.
+REFERENCE_H = 41
+SDOF_ARGS = ["frf", "--model", "sdof", "--omega", "0.9", "1.3"]
+#: The CLI's default sdof oscillator (c = 0.01, f_s = F = 0.05): the describing function
+#: (H = 1) is ~2 % high at the peak.
+SDOF = bm.sdof(1.0, damping=0.01, slip_force=0.05, force=0.05, band=(0.9, 1.3), name="sdof cli")
+
+
+def reference_peak(result, H_ref=REFERENCE_H) -> float:
+    """The curve's peak re-solved with 0..H_ref harmonics (an independent, richer solve)."""
+    prob = result.problem
+    rich = check_problem(prob, tuple(range(H_ref + 1)))
+    xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
+    tol = TOL_REL * rich.reference(result.peak_omega)
+    return acc.peak_at(rich, rich.amplitude, xs, np.asarray(result.omega),
+                       int(np.argmax(result.amplitude)), tol, 1e-6 * result.peak_omega)[2]
+
+
+@pytest.mark.parametrize("case, H", [(SDOF, 1), (SDOF, 3),
+                                     (bm.chain3(1.0, 20.0), 5)])
+def test_estimate_is_within_a_factor_3_of_the_true_error(case, H):
+    r = compute_frf(case.model(), H, case.band, stability="off")
+    est = r.truncation_error["peak_amplitude_rel"]
+    true = abs(r.peak_amplitude / reference_peak(r) - 1.0)
+    assert est is not None and true > 0
+    assert 1.0 / ESTIMATE_FACTOR < est / true < ESTIMATE_FACTOR, (est, true)
+
+
+def test_accuracy_meets_its_target_on_the_sdof_jenkins_oscillator():
+    case = SDOF
+    tol = 2e-3
+    r = compute_frf(case.model(), 1, case.band, stability="off", accuracy=tol)
+    a = r.extra["accuracy"]
+    assert a["met"] and r.truncation_error["peak_amplitude_rel"] <= tol
+    assert a["H_sequence"][-1] == r.problem.basis.H > 1
+    assert abs(r.peak_amplitude / reference_peak(r) - 1.0) < tol
+
+
+def test_an_unreachable_accuracy_ends_with_the_best_result_and_names_the_limit():
+    case = SDOF
+    r = compute_frf(case.model(), 1, case.band, stability="off", accuracy=1e-5, max_harmonic=5)
+    a = r.extra["accuracy"]
+    assert not a["met"] and "limit H <= 5" in a["message"]
+    assert r.truncation_error["peak_amplitude_rel"] > 1e-5 and np.isfinite(r.peak_amplitude)
+
+
+@pytest.mark.parametrize("tol", [0.0, 0.5, 1e-7, float("nan"), -1e-2])
+def test_accuracy_outside_its_range_is_refused(tol):
+    with pytest.raises(ValueError, match="accuracy"):
+        acc.check_accuracy(tol)
+
+
+def test_richer_set_keeps_the_kind_and_adds_an_odd_harmonic():
+    assert acc.richer((1, 3, 5, 7)) == (1, 3, 5, 7, 9, 11)
+    assert acc.richer(tuple(range(2))) == (0, 1, 2, 3)         # H + 2: a new odd harmonic
+    assert acc.richer(tuple(range(8)))[-1] == 11
+    assert acc.richer(tuple(range(8)), limit=7) == tuple(range(8))   # no room: unchanged
+    assert acc.richer(tuple(range(8)), limit=9)[-1] == 9
+
+
+def test_padding_keeps_the_signal():
+    rng = np.random.default_rng(20261127)
+    small, big = FourierBasis((0, 1, 2, 3)), FourierBasis(tuple(range(8)))
+    x = rng.standard_normal(small.nb * 2)
+    theta = np.linspace(0, 2 * np.pi, 17)
+    y = acc.pad(x, small, big)
+    assert np.allclose(small.evaluate(x.reshape(small.nb, 2), theta),
+                       big.evaluate(y.reshape(big.nb, 2), theta), atol=1e-14)
+
+
+def test_observed_order_and_extrapolation_recover_a_power_law():
+    p, a_inf, C = 1.7, 2.0, 0.3
+    levels = [(H, a_inf + C * H**-p, 1.0) for H in (7, 11, 17)]
+    assert abs(acc.observed_order([lv[:2] for lv in levels]) - p) < 1e-9
+    rec = acc.estimate(levels, "test")
+    assert abs(rec["extrapolated"]["peak_amplitude"] - a_inf) < 1e-12
+    true = abs(levels[0][1] / a_inf - 1)
+    assert abs(rec["peak_amplitude_rel"] / true - 1) < 1e-9
+    assert rec["order_observed"] == rec["order"]
+
+
+def test_differences_that_change_sign_fall_back_to_the_largest_two_level_estimate():
+    levels = [(7, 1.02, 1.0), (11, 0.99, 1.0), (17, 1.0, 1.0)]
+    rec = acc.estimate(levels, "test")
+    assert rec["order_observed"] is None and rec["extrapolated"] is None
+    worst = max(abs(1.02 / a - 1) / (1 - (7 / H) ** acc.ASSUMED_ORDER) for H, a, _ in levels[1:])
+    assert abs(rec["peak_amplitude_rel"] / worst - 1) < 1e-12
+
+
+def test_first_harmonics_own_peak_is_not_below_its_value_at_the_peak_of_max_x():
+    case = bm.chain3(1.0, 20.0)
+    r = compute_frf(case.model(), 5, case.band, stability="off", truncation_check=False)
+    assert r.peak_h1_max >= r.peak_amplitude_h1 - 1e-12 * r.peak_h1_max
+    assert r.peak_h1_max >= np.max(r.amplitude_h1) - 1e-12 * r.peak_h1_max
+    assert r.peak_h1_max_omega != r.peak_omega   # the two peaks differ on this chain
+
+
+def test_cli_json_carries_the_estimate_and_both_peaks(capsys):
+    assert main(SDOF_ARGS + ["--harmonics", "3", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rec = out["truncation_error"]
+    for key in ("method", "H_used", "H_check", "checks", "peak_amplitude_rel", "peak_frequency_rel",
+                "extrapolated"):
+        assert key in rec
+    assert rec["H_used"] == 3 and [c["H"] for c in rec["checks"]] == [5, 8] and rec["H_check"] == 8
+    for key in ("peak_h1_max", "peak_h1_max_omega", "peak_amplitude_h1", "truncation_warning"):
+        assert key in out
+
+
+def test_cli_without_harmonics_meets_the_default_accuracy(capsys):
+    assert main(SDOF_ARGS + ["--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["accuracy"]["target"] == 1e-2 and out["accuracy"]["met"]
+    assert out["truncation_error"]["peak_amplitude_rel"] <= 1e-2
+
+
+def test_cli_warns_when_the_estimate_exceeds_one_percent(capsys):
+    assert main(SDOF_ARGS + ["--harmonics", "1"]) == 0
+    assert "warning: estimated truncation error" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("cmd", [SDOF_ARGS + ["--accuracy", "0.5"], SDOF_ARGS + ["--accuracy", "1e-7"],
+                                 SDOF_ARGS + ["--accuracy", "nan", "--json"],
+                                 ["upd", "frf", "--accuracy", "0.6"]])
+def test_cli_refuses_an_accuracy_outside_its_range(capsys, cmd):
+    assert main(cmd) == 2
+    cap = capsys.readouterr()
+    assert "--accuracy" in cap.err and cap.out == ""
+
+
+def test_upd_frf_json_carries_the_estimate(capsys):
+    """UPD-24 at H = 3 (cheap): the estimate is checked at H = 5 and lands in the JSON."""
+    assert main(["upd", "frf", "--harmonics", "3", "--points", "40", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rec = out["truncation_error"]
+    assert rec["H_used"] == 3 and rec["H_check"] == 5 and rec["peak_amplitude_rel"] > 0
+    assert len(rec["checks"]) == 1   # one check on the sector (CHECK_LEVELS)
+    assert "truncation_warning" in out
