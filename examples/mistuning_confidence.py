@@ -1,7 +1,7 @@
 """Confidence of a mistuning study: does the 0.95 quantile's interval hold?
 ========================================================================
 
-A study of N samples (``damper.mistuning``, UPD-24, damper free: the linear ring, cheap)
+A study of N samples (``damper.mistuning``, UPD-24, damper free: the linear ring)
 gives the amplification's 0.95 quantile with its distribution-free 95 % interval
 (``damper.mistuning_stats``, order statistics). An independent study of 4 N samples
 (another seed, so other patterns) estimates the same quantile more precisely: the first
@@ -16,7 +16,9 @@ them). ::
     OPENBLAS_NUM_THREADS=1 nice python examples/mistuning_confidence.py --out out/mt_confidence \\
         [--samples 1000] [--damper free] [--cache-dir out/mt_cache] [--quick]
 
-``--quick`` (the documentation build): 100 against 400 samples.
+``--quick`` (the documentation build): 80 against 320 samples of an 8-blade disk. A
+damper-free sample of UPD-24 costs ~0.35 s CPU (the peak search refines every local
+maximum of every blade), so the full run takes about half an hour of CPU.
 """
 from __future__ import annotations
 
@@ -36,10 +38,11 @@ from damper.mistuning_stats import quantile_ci, quantile_half_width
 STD, SEEDS = 0.02, (1, 2)
 
 
-def study(n: int, seed: int, damper: str, store: Store) -> dict:
+def study(n: int, seed: int, damper: str, store: Store, blades: int | None) -> dict:
     t0 = time.process_time()
-    out = run_study(Study(std=STD, samples=n, seed=seed, damper=damper), store, serial=True,
-                    echo=lambda t: None)
+    eo = None if blades is None else blades // 4      # the interblade phase of UPD-24 (EO 6 of 24)
+    out = run_study(Study(std=STD, samples=n, seed=seed, damper=damper, blades=blades, engine_order=eo),
+                    store, serial=True, echo=lambda t: None)
     out["cpu_s"] = time.process_time() - t0
     return out
 
@@ -84,14 +87,16 @@ def main(argv=None) -> int:
     p.add_argument("--samples", type=int, default=1000, help="samples of the first study (the second: 4x)")
     p.add_argument("--damper", choices=("free", "stuck", "nonlinear"), default="free")
     p.add_argument("--cache-dir", type=Path, help="sample cache (default: a temporary folder)")
-    p.add_argument("--quick", action="store_true", help="100 against 400 samples")
+    p.add_argument("--blades", type=int, help="N_b (default: the UPD model's 24; EO = N_b / 4)")
+    p.add_argument("--quick", action="store_true", help="80 against 320 samples of 8 blades")
     a = p.parse_args(argv)
-    n = 100 if a.quick else a.samples
+    n, blades = (80, 8) if a.quick else (a.samples, a.blades)
     if n < 72:
         p.error("--samples must be >= 72 (the 0.95 quantile's two-sided interval needs them)")
     with tempfile.TemporaryDirectory() as tmp:
         store = Store(a.cache_dir or tmp)
-        small, large = study(n, SEEDS[0], a.damper, store), study(4 * n, SEEDS[1], a.damper, store)
+        small = study(n, SEEDS[0], a.damper, store, blades)
+        large = study(4 * n, SEEDS[1], a.damper, store, blades)
     x, y = amplifications(small), amplifications(large)
     q, ref = quantile_ci(x, 0.95), float(np.quantile(y, 0.95))
     fits = {k: o["statistics"]["fit"] for k, o in (("small", small), ("large", large))}
@@ -108,7 +113,9 @@ def main(argv=None) -> int:
     print(f"0.95 quantile of {x.size} samples: {q['value']:.4f}, 95 % interval [{q['low']:.4f}, "
           f"{q['high']:.4f}] (coverage {q['coverage']:.4f})")
     print(f"0.95 quantile of {y.size} independent samples: {ref:.4f} -> "
-          + ("inside the interval" if row["contained"] else "OUTSIDE the interval"))
+          + ("inside the interval" if row["contained"] else
+             "outside the interval (a 95 % interval misses about one pair in 20, more when the "
+             "large study's own estimate scatters)"))
     print(f"fitted {row['fit_best']['small']} 0.95 quantile (small study): {row['fit_q95']['small']}")
     print("samples --until-ci would need (large study's sequence): "
           + ", ".join(f"+-{w}: {m}" for w, m in row["until_ci_samples"].items()))
@@ -116,7 +123,7 @@ def main(argv=None) -> int:
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "mistuning_confidence.json").write_text(json.dumps(row, indent=1) + "\n")
     plot(x, y, q, ref, a.out / "mistuning_confidence.png")
-    return 0 if row["contained"] else 1
+    return 0   # a miss is a possible outcome of a 95 % interval, reported, not an error
 
 
 if __name__ == "__main__":
