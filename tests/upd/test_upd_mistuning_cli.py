@@ -95,7 +95,7 @@ def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
 def test_every_sample_failing_prints_the_object_with_the_errors_and_exits_3(tmp_path, capsys, monkeypatch):
     import damper.mistuning as mt
 
-    def failing(study, kappa, band, f):
+    def failing(model, kappa):
         raise RuntimeError("ring harmonic balance failed (test)")
 
     monkeypatch.setattr(mt, "_solve_sample", failing)
@@ -105,6 +105,7 @@ def test_every_sample_failing_prints_the_object_with_the_errors_and_exits_3(tmp_
     out = json.loads(cap.out)
     assert code == 3 and "every sample failed" in cap.err.splitlines()[-1]
     assert out["failed"] == 2 and out["max_amplification"] is None and out["quantiles"] is None
+    assert out["statistics"] is None
     assert all("failed (test)" in s["error"] and s["amplification"] is None for s in out["samples"])
 
 
