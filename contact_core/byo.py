@@ -30,6 +30,7 @@ from . import linsolve
 from .cache import make_key, resolve
 from .condense import tributary
 from .condensed import CondensedContact, ContactGrid
+from .fileio import check_matrix_market, open_npz
 
 SYMMETRIES = {"full": 1.0, "half": 2.0, "quarter": 4.0}
 #: Relative asymmetry of an imported stiffness matrix that is still accepted.
@@ -42,8 +43,12 @@ def load_matrix(path: str | Path) -> sp.csr_matrix:
     """A stiffness matrix from ``.mtx`` or ``.npz``; ValueError if unreadable or not square."""
     path = Path(path)
     if path.suffix == ".mtx":
+        check_matrix_market(path, dense=False, what="stiffness file")
         K = scipy.io.mmread(str(path))
     elif path.suffix == ".npz":
+        with open_npz(path, "stiffness file") as data:   # sizes checked; scipy reads the same members
+            if "format" not in data.files:
+                raise ValueError(f"{path}: not a scipy sparse .npz (scipy.sparse.save_npz writes one)")
         K = sp.load_npz(path)
     else:
         raise ValueError(f"{path}: stiffness must be a Matrix Market .mtx or a scipy .npz file")
@@ -55,7 +60,7 @@ def load_matrix(path: str | Path) -> sp.csr_matrix:
 
 def load_nodes(path: str | Path) -> dict:
     """The node file as a dict of arrays; ValueError for missing entries."""
-    with np.load(path, allow_pickle=False) as data:
+    with open_npz(path, "node file") as data:
         nodes = {k: data[k] for k in data.files}
     for key in ("coords", "contact", "distant"):
         if key not in nodes:

@@ -49,7 +49,7 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from contact_core.fileformat import FileModel, parse
-from contact_core.fileio import atomic_write
+from contact_core.fileio import atomic_write, read_text_bounded
 
 #: Schema tag written to every curve file.
 SCHEMA = "damper-virgin-curve/2"
@@ -276,7 +276,7 @@ def read_curve(path: str | Path) -> VirginCurve:
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        text = read_text_bounded(path, what="curve file")
     except UnicodeDecodeError:
         raise ValueError(f"{path}: not a text file (a curve file is JSON)") from None
     try:

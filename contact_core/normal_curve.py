@@ -37,7 +37,7 @@ from pydantic import Field
 
 from contact_core.curve import MAX_DISPLACEMENT, MAX_FORCE, MAX_STIFFNESS
 from contact_core.fileformat import FileModel, parse
-from contact_core.fileio import atomic_write
+from contact_core.fileio import atomic_write, read_text_bounded
 
 #: Schema tag written to every normal-curve file.
 SCHEMA = "damper-normal-curve/1"
@@ -157,7 +157,7 @@ def read_normal_curve(path: str | Path) -> NormalCurve:
     """Read and validate a normal-curve JSON file (ValueError with the path on bad content)."""
     path = Path(path)
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(read_text_bounded(path, what="normal-curve file"))
     except json.JSONDecodeError as err:
         raise ValueError(f"{path}: not JSON ({err})") from None
     except UnicodeDecodeError:

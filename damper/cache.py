@@ -47,6 +47,7 @@ import io
 import json
 import os
 import re
+import stat
 import sys
 import tempfile
 import time
@@ -67,11 +68,9 @@ PREFIX, SUFFIX = "entry-", ".damper-cache"
 KEY_CHARS = "0123456789abcdefghijklmnopqrstuvwxyz_-"
 ENTRY_NAME = re.compile(r"^entry-[0-9a-z_-]+\.damper-cache$")
 TEMP_NAME = re.compile(r"^\.entry-[0-9a-z_-]+\.damper-cache\..*\.tmp$")
-#: Files of the cache layout before entries were named and the folder tagged (24-hex
-#: ``<key>.npz``): a folder holding only these is taken over (tagged) as a cache.
-LEGACY_NAME = re.compile(r"^(\.?[0-9a-f]{24}\.npz|\.[0-9a-f]{24}\.npz\..*\.tmp|\.lock)$")
-#: The tag while another run writes it (a folder holding only this is being made a cache).
-TAG_TEMP = re.compile(r"^(CACHEDIR\.TAG|\.CACHEDIR\.TAG\..*\.tmp)$")
+#: The tag while another run writes it, and the eviction lock (a folder holding only
+#: these, entries and their temporary files is being made a cache by another run).
+TAG_TEMP = re.compile(r"^(CACHEDIR\.TAG|\.CACHEDIR\.TAG\..*\.tmp|\.lock)$")
 TAG_NAME = "CACHEDIR.TAG"
 TAG_SIGNATURE = "Signature: 8a477f597d28d172789f06886806bc55"
 TAG_TEXT = (f"{TAG_SIGNATURE}\n# This file is a cache directory tag created by damper (the friction-damper\n"
@@ -113,6 +112,21 @@ def is_cache_folder(folder: Path) -> bool:
         return (folder / TAG_NAME).read_text(errors="replace").startswith(TAG_SIGNATURE)
     except OSError:
         return False
+
+
+def _open_entry(path: Path, blob: bytes | None):
+    """The entry's bytes as a file object: ``blob`` (in memory) or the file at ``path``.
+
+    The file is opened without blocking and must be a regular file: a FIFO or a device
+    named like an entry would block the run or never end (OSError: a miss).
+    """
+    if blob is not None:
+        return io.BytesIO(blob)
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC)
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise OSError(f"{path.name} is not a regular file")
+    return os.fdopen(fd, "rb")
 
 
 def _stderr_warning(text: str) -> None:
@@ -204,7 +218,7 @@ class Store:
             names = os.listdir(self.folder)
         except OSError:
             return
-        ours = (LEGACY_NAME, TAG_TEMP, ENTRY_NAME, TEMP_NAME)
+        ours = (TAG_TEMP, ENTRY_NAME, TEMP_NAME)
         foreign = sorted(n for n in names if not any(p.match(n) for p in ours))
         if foreign and not is_cache_folder(self.folder):   # (another run may have tagged it meanwhile)
             shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
@@ -254,11 +268,10 @@ class Store:
         path = self.path(key)
         blob = self._mem.get(key)
         try:
-            source = io.BytesIO(blob) if blob is not None else (None if self.memory else path)
-            if source is None:
+            if blob is None and self.memory:
                 self.misses += 1
                 return None
-            with np.load(source, allow_pickle=False) as data:
+            with _open_entry(path, blob) as source, np.load(source, allow_pickle=False) as data:
                 arrays = {k: data[k] for k in data.files if k != "meta"}
                 head = json.loads(str(data["meta"]))
         except FileNotFoundError:
@@ -369,7 +382,7 @@ class Store:
             self._check_owned()              # refuses a folder of the user's
             if not os.listdir(self.folder):
                 return 0                     # an empty folder: nothing to do, not tagged
-            self._ensure_tag()               # the layout before the tag: taken over, then cleared
+            self._ensure_tag()               # entries of a run that is tagging it: ours
         n = 0
         with self._lock():
             for p, _ in self.entries():
@@ -377,7 +390,7 @@ class Store:
                     p.unlink()
                     n += 1
             for p in self.folder.iterdir():
-                if TEMP_NAME.match(p.name) or (LEGACY_NAME.match(p.name) and p.name != ".lock"):
+                if TEMP_NAME.match(p.name):
                     with contextlib.suppress(FileNotFoundError):
                         p.unlink()
         return n

@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from contact_core.fileformat import parse
+from contact_core.fileio import MAX_SSP_BYTES, check_regular_input, check_zip_members
 from damper import limits
 from damper.ring_info import RingInfo
 
@@ -78,12 +79,14 @@ def read_info(ssp) -> dict:
     """The archive's ``resources/system.json``, checked (:class:`damper.ring_info.RingInfo`);
     ValueError if it is not a ring archive or its description is malformed."""
     path = Path(ssp)
-    if not path.is_file():
+    if not path.exists():
         raise ValueError(f"{path}: no such SSP archive")
+    check_regular_input(path, MAX_SSP_BYTES, "SSP archive")
     try:
         with zipfile.ZipFile(path) as zf:
+            check_zip_members(zf, MAX_SSP_BYTES, f"SSP archive {path}")
             info = json.loads(zf.read("resources/system.json"))
-    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError):
+    except (zipfile.BadZipFile, KeyError, json.JSONDecodeError, UnicodeDecodeError):
         raise ValueError(f"{path} is not a ring archive of `damper system` (no "
                          "resources/system.json): build one with damper system -o ring.ssp") from None
     if not isinstance(info, dict) or info.get("kind") != "damper-ring":
@@ -127,6 +130,7 @@ def _unpack(ssp, step_ns: int, directory: Path) -> Path:
     SSD's fixed-step annotation (libcosim truncates the step to whole ns: written as
     step_ns + 1/2 ns)."""
     with zipfile.ZipFile(ssp) as zf:
+        check_zip_members(zf, MAX_SSP_BYTES, f"SSP archive {ssp}")   # again: it may have changed
         zf.extractall(directory)
     ssd = directory / "SystemStructure.ssd"
     text, n = re.subn(r'<osp:FixedStepAlgorithm[^>]*/>',
@@ -185,8 +189,20 @@ class _Ring:
     """The loaded execution with the variables the runner reads."""
 
     def __init__(self, ssp, info, plan, frequency_hz):
-        CosimExecution, CosimObserver, vt = _engine()
+        _engine()   # EngineMissing before any temporary folder
         self._tmp = tempfile.TemporaryDirectory(prefix="damper_cosim_")
+        try:
+            self._load(ssp, info, plan, frequency_hz)
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        """Remove the unpacked archive (also after an error, Ctrl-C or SIGTERM)."""
+        self._tmp.cleanup()
+
+    def _load(self, ssp, info, plan, frequency_hz) -> None:
+        CosimExecution, CosimObserver, vt = _engine()
         root = _unpack(ssp, plan["step_ns"], Path(self._tmp.name))
         self.ex = CosimExecution.from_ssp_file(str(root))
         self.info, self.n = info, plan["steps_per_period"]
@@ -372,7 +388,10 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
             ring = _Ring(ssp, info, plan, frequency_hz)
         except AssertionError as err:  # libcosimpy reports failures with assert
             raise RuntimeError(f"libcosim could not load {ssp}: {err}") from None
-        k, h1, t, x, balance, deltas, est, settled = _march(ring, plan, periods, tol, omega)
+        try:
+            k, h1, t, x, balance, deltas, est, settled = _march(ring, plan, periods, tol, omega)
+        finally:
+            ring.close()   # the unpacked archive, also after an error, Ctrl-C or SIGTERM
     wall = time.perf_counter() - t0
     _check_balance(balance, plan, info)
     nr = len(h1)

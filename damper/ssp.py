@@ -106,5 +106,4 @@ def write_ssp(out: str | os.PathLike, ssd: str, resources: dict) -> Path:
             else:
                 zf.writestr(f"resources/{name}", data)
     path = atomic_write(out, buf.getvalue())
-    os.chmod(path, 0o644)
     return path

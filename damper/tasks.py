@@ -4,12 +4,18 @@
 worker process per core by default), an existing cluster at a scheduler address, or
 plain calls in this process (``serial``, the reference tests compare against). Used by
 the scene sweeps (:mod:`damper.sweep`) and the mistuning study (:mod:`damper.mistuning`).
+
+The local cluster's workers keep their temporary files (``TMPDIR``) and Dask's scratch
+space in one ``damper_workers_*`` folder that ``close`` removes: a worker stopped by
+Ctrl-C in the middle of a task never runs its own cleanup.
 """
 from __future__ import annotations
 
 import logging
 import os
+import shutil
 import signal
+import tempfile
 
 #: Seconds to wait for a scheduler given by address before giving up.
 CONNECT_TIMEOUT = 10
@@ -40,6 +46,7 @@ def executor(scheduler, workers, serial, info: dict | None = None):
     if serial:
         info["workers"] = 1
         return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
+    import dask
     from dask.distributed import Client, LocalCluster
 
     if scheduler:
@@ -48,25 +55,36 @@ def executor(scheduler, workers, serial, info: dict | None = None):
         except (OSError, ValueError, TypeError) as err:
             raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
                           "or give the right --scheduler address (tcp://host:8786)") from None
-        cluster = None
+        cluster = scratch = None
         info["workers"] = max(1, len(client.scheduler_info().get("workers", {})))
     else:
         n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                               silence_logs=logging.CRITICAL)
-        client = Client(cluster)
-        info["workers"] = n
-        # A terminal's Ctrl-C reaches the whole process group: this process alone handles it
-        # (one line, exit 130) and closes the cluster; each worker would print a traceback.
-        client.register_plugin(_ignore_sigint_plugin(), name="damper-ignore-sigint")
+        scratch = tempfile.mkdtemp(prefix="damper_workers_")
+        try:
+            with dask.config.set({"temporary-directory": scratch}):   # the scheduler's scratch space too
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       silence_logs=logging.CRITICAL, local_directory=scratch,
+                                       env={"TMPDIR": scratch})
+            client = Client(cluster)
+            info["workers"] = n
+            # A terminal's Ctrl-C reaches the whole process group: this process alone handles it
+            # (one line, exit 130) and closes the cluster; each worker would print a traceback.
+            client.register_plugin(_ignore_sigint_plugin(), name="damper-ignore-sigint")
+        except BaseException:
+            shutil.rmtree(scratch, ignore_errors=True)
+            raise
 
     def close():
         # After Ctrl-C Dask's gather task ends with an exception nobody retrieves; asyncio
         # and distributed would log it with a traceback after our one-line message.
         for name in ("asyncio", "distributed"):
             logging.getLogger(name).setLevel(logging.CRITICAL)
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        try:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        finally:
+            if scratch is not None:
+                shutil.rmtree(scratch, ignore_errors=True)
 
     return (lambda f, *a: client.submit(f, *a, pure=False)), client.gather, close

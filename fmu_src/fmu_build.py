@@ -281,7 +281,6 @@ def package_fmu(out: str | os.PathLike, fmi_version: int, model: str,
         binary = root / "binaries" / PLATFORM[fmi_version] / f"{iface.model_identifier}.so"
         compile_binary(root / "sources", names, binary, compiler)
         path = atomic_write(out, _zip_dir(root))
-    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
     return path
 
 
@@ -350,7 +349,6 @@ def build_fmu(u, T, n_ref: float, out: str | os.PathLike, fmi_version: int = 2,
         binary = root / "binaries" / PLATFORM[fmi_version] / f"{fmu_xml.MODEL_IDENTIFIER}.so"
         compile_binary(root / "sources", names, binary, compiler)
         path = atomic_write(out, _zip_dir(root))
-    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
     return path
 
 

@@ -136,7 +136,6 @@ def build_point_fmu(u, T, n_ref: float, p, N, out: str | os.PathLike, fmi_versio
         binary = root / "binaries" / fmu_build.PLATFORM[fmi_version] / f"{iface.model_identifier}.so"
         fmu_build.compile_binary(root / "sources", names, binary, compiler)
         path = atomic_write(out, fmu_build._zip_dir(root))
-    os.chmod(path, 0o644)  # the temporary file behind atomic_write is private (0600)
     return path
 
 

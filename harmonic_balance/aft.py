@@ -181,8 +181,17 @@ def aft_link(link: FrictionLink, U: np.ndarray, basis: FourierBasis, jac: bool =
     if stuck_test and W <= 0.0 and _stuck(F, u, link.k0):
         # Fully stuck: apply the virgin-state convention of the module docstring.
         F = link.k0 * u
-        return basis.D @ F, link.k0 * (basis.D @ basis.E) if jac else None, float(W), F
+        return basis.D @ F, link.k0 * _projector(basis) if jac else None, float(W), F
     return (Fh if exact else basis.D @ F), dFh, float(W), F
+
+
+def _projector(basis: FourierBasis) -> np.ndarray:
+    """D E (n_b, n_b), the identity to round-off, kept per basis: the stuck line's
+    Jacobian, whose product cost O(n_t n_b^2) per call (at H = 31, a millisecond)."""
+    cache = basis.__dict__.setdefault("_projector_cache", [])
+    if not cache:
+        cache.append(basis.D @ basis.E)
+    return cache[0]
 
 
 def _project_rows(D, dF):

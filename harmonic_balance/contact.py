@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .aft import FrictionLink
+from .aft import FrictionLink, _project_rows
 from .forces import ForceElement, LinearElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
@@ -170,9 +170,9 @@ class ContactElement(ForceElement):
                 s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
                 max_periods=self.max_periods, tol=self.tol)
             f[:, 0] = Ft
-            if jac:
-                dF[0::2, 0::2] = D @ dFs
-                dF[0::2, 1::2] = D @ dFp
+            if jac:   # rows of zeros (slipping, resp. stuck samples) skipped
+                dF[0::2, 0::2] = _project_rows(D, dFs)
+                dF[0::2, 1::2] = _project_rows(D, dFp)
         F = D @ f
         dw, C = None, self._local_damping_cached()
         if C is not None:

@@ -142,9 +142,27 @@ class _Scaled:
     def __init__(self, fun, s_x, s_lam, tol):
         self.fun, self.s_x, self.s_lam, self.tol = fun, s_x, s_lam, tol
 
-    def jac(self, y):
+    def jac(self, y, row=None):
+        """R and the scaled Jacobian [R_x s_x, R_lam s_lam] (N, N + 1), with ``row`` (N + 1,)
+        appended as its last row when given (the corrector's plane: one (N + 1)^2 array
+        written once, not stacked from copies)."""
         R, Jx, Jl = self.fun(y[:-1] * self.s_x, y[-1] * self.s_lam)
-        return R, np.column_stack([Jx * self.s_x, Jl * self.s_lam])
+        n = Jx.shape[0]
+        J = np.empty((n + (row is not None), Jx.shape[1] + 1))
+        np.multiply(Jx, self.s_x, out=J[:n, :-1])
+        J[:n, -1] = Jl * self.s_lam
+        if row is not None:
+            J[n] = row
+        return R, J
+
+    def value(self, y):
+        """R alone at y (``fun.value``), or None when ``fun`` has no such method."""
+        f = getattr(self.fun, "value", None)
+        return None if f is None else f(y[:-1] * self.s_x, y[-1] * self.s_lam)
+
+    @property
+    def has_value(self) -> bool:
+        return callable(getattr(self.fun, "value", None))
 
     def tangent(self, J, t_prev):
         """Unit tangent t (N+1,) with t . t_prev > 0, the sign of det([J; t^T]) and the
@@ -181,10 +199,13 @@ class _Scaled:
         in scaled units, e.g. during peak refinement).
         """
         def aug(d):
-            R, J = self.jac(y_pred + d)
-            return np.append(R, normal @ d), np.vstack([J, normal])
+            R, J = self.jac(y_pred + d, normal)
+            return np.append(R, normal @ d), J
+
+        def value(d):
+            return np.append(self.value(y_pred + d), normal @ d)
         res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred),
-                     **CORRECTOR_NEWTON)
+                     value=value if self.has_value else None, **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
 
@@ -204,9 +225,13 @@ class _Scaled:
         def fixed(d):
             R, J = self.jac(np.append(y_pred[:-1] + d, lam))
             return R, J[:, :-1]
+
+        def value(d):
+            return self.value(np.append(y_pred[:-1] + d, lam))
         try:
             res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter,
-                         np.linalg.norm(y_pred[:-1]), **FIXED_NEWTON)
+                         np.linalg.norm(y_pred[:-1]), value=value if self.has_value else None,
+                         **FIXED_NEWTON)
         except NewtonError:
             return None
         R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))
@@ -420,8 +445,10 @@ def _backwards(dlam, t_lam, t_new_lam) -> bool:
 
 
 def _solve_fixed(fun, x, lam, tol, branch):
+    value = getattr(fun, "value", None)
     try:
-        return newton(lambda z: fun(z, lam)[:2], x, tol)
+        return newton(lambda z: fun(z, lam)[:2], x, tol,
+                      value=None if value is None else (lambda z: value(z, lam)))
     except NewtonError as err:
         raise _stop(f"no solution at fixed parameter {lam:.6g}: {err}", branch) from None
 

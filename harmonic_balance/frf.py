@@ -139,8 +139,21 @@ class FRFProblem:
         self.evaluations = 0
 
     def __call__(self, x, omega):
-        self.evaluations += 1
+        if not self._valued(x, omega):
+            self.evaluations += 1
         return self.residual(x, omega)
+
+    def value(self, x, omega):
+        """R alone (the residual's ``value``: a line search's trial point)."""
+        self.evaluations += 1
+        self._last_value = (x.copy(), omega)
+        return self.residual.value(x, omega)
+
+    def _valued(self, x, omega) -> bool:
+        """True when :meth:`value` was last called at this point (its Jacobian is no new
+        evaluation of the elements)."""
+        last, self._last_value = getattr(self, "_last_value", None), None
+        return last is not None and last[1] == omega and np.array_equal(last[0], x)
 
     def response(self, x, omega) -> np.ndarray:
         """Harmonics (n_b,) of the response DOF."""
@@ -242,7 +255,8 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if accuracy is not None:
         from .frf_accuracy import frf_to_accuracy
 
-        return frf_to_accuracy(model, accuracy, omega_range, harmonics, max_harmonic, n_t=n_t,
+        return frf_to_accuracy(compute_frf, model, accuracy, omega_range, harmonics, max_harmonic,
+                               tol_rel=TOL_REL, n_t=n_t,
                                condensed=condensed, ds_max=ds_max, max_points=max_points,
                                refine=refine, stability=stability, progress=progress, aft=aft,
                                tolerance=tolerance)
@@ -303,7 +317,7 @@ def _check_truncation(result: FRFResult, max_harmonic: int) -> None:
     from .accuracy import warning
     from .frf_accuracy import truncation_error
 
-    result.truncation_error = truncation_error(result, max_harmonic)
+    result.truncation_error = truncation_error(result, max_harmonic, tol_rel=TOL_REL)
     result.extra["truncation_warning"] = warning(result.truncation_error)
 
 

@@ -29,11 +29,11 @@ RAISE_MAX = 2.5
 def check_problem(prob, harmonics):
     """The FRFProblem of ``prob``'s model at the richer ``harmonics`` (same residual kind,
     at least the curve's AFT samples)."""
-    from .frf import FRFProblem
     from .residual import CondensedResidual
 
     n_t = max(prob.basis.n_t, default_samples(max(harmonics)))
-    return FRFProblem(prob.model, harmonics, n_t, isinstance(prob.residual, CondensedResidual))
+    # the problem's own class (frf.FRFProblem): this module sits above frf, not beside it
+    return type(prob)(prob.model, harmonics, n_t, isinstance(prob.residual, CondensedResidual))
 
 
 #: Richer levels checked at the peak (H' and H'' = richer(H')): three levels give the
@@ -43,12 +43,11 @@ def check_problem(prob, harmonics):
 CHECK_LEVELS = 2
 
 
-def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> list:
+def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS, *, tol_rel: float) -> list:
     """[(H', amplitude, omega), ...] of ``result``'s peak re-solved at up to ``levels``
     successively richer sets (:func:`accuracy.richer`, capped at ``limit``; empty when
-    the limit leaves no richer set). RuntimeError when the first richer set finds no peak."""
-    from .frf import TOL_REL
-
+    the limit leaves no richer set). RuntimeError when the first richer set finds no peak.
+    ``tol_rel``: the Newton tolerance relative to the problem's reference size."""
     prob = result.problem
     out, hs = [], prob.basis.harmonics
     om = np.asarray(result.omega)
@@ -60,7 +59,7 @@ def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) ->
         hs = nxt
         rich = check_problem(prob, hs)
         xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
-        tol = TOL_REL * max(rich.reference(result.peak_omega), 1e-300)
+        tol = tol_rel * max(rich.reference(result.peak_omega), 1e-300)
         try:
             if result.peak_interior:
                 _, w, a, _ = acc.peak_at(rich, rich.amplitude, xs, om, i, tol, 1e-6 * abs(om[i]))
@@ -77,7 +76,8 @@ def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) ->
     return out
 
 
-def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS) -> dict:
+def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS, *,
+                     tol_rel: float) -> dict:
     """The ``truncation_error`` record (:func:`accuracy.estimate`) of ``result``'s peak,
     checked at up to ``levels`` richer sets. A check that fails or finds no richer set
     within ``limit`` gives a record with null estimates and a ``note`` saying why."""
@@ -90,7 +90,7 @@ def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVE
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": "no peak to check"}
     try:
-        checks = check_peak(result, limit, levels)
+        checks = check_peak(result, limit, levels, tol_rel=tol_rel)
     except RuntimeError as err:
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": f"check failed: {err}"}
@@ -104,8 +104,8 @@ def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVE
     return out
 
 
-def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
-                    limit: int = MAX_HARMONIC, **kwargs):
+def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
+                    limit: int = MAX_HARMONIC, *, tol_rel: float, **kwargs):
     """Forced-response curve whose peak amplitude's estimated truncation error is below
     ``accuracy`` (relative), raising H per curve.
 
@@ -113,8 +113,10 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
     is checked at richer sets (:func:`truncation_error`); while the estimate e exceeds
     ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
     observed order, else :data:`accuracy.ASSUMED_ORDER`), at most RAISE_MAX H, at least
-    the first check's H, at most the highest H whose checks still fit within ``limit``. Other keyword arguments
-    go to :func:`frf.compute_frf`.
+    the first check's H, at most the highest H whose checks still fit within ``limit``.
+    ``curve(model, harmonics, omega_range, truncation_check=False, **kwargs)`` traces one
+    curve (:func:`frf.compute_frf`, which passes itself: this module sits above frf);
+    other keyword arguments go to it.
 
     Returns
     -------
@@ -125,11 +127,9 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
 
     Raises
     ------
-    ValueError (bad accuracy), frf.FRFError when the first curve fails (a later curve
-    that fails ends the run with the previous result, said in its status).
+    ValueError (bad accuracy), frf.FRFError (a RuntimeError) when the first curve fails
+    (a later curve that fails ends the run with the previous result, said in its status).
     """
-    from .frf import FRFError, compute_frf
-
     tol = acc.check_accuracy(accuracy)
     hs = parse_harmonics(harmonics)
     odd = all(h % 2 for h in hs)
@@ -140,8 +140,8 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
     levels, seq, best = [], [], None
     while True:
         try:
-            res = compute_frf(model, hs, omega_range, truncation_check=False, **kwargs)
-        except FRFError as err:
+            res = curve(model, hs, omega_range, truncation_check=False, **kwargs)
+        except RuntimeError as err:
             if best is None:
                 raise
             best.status += (f"; warning: the curve at H = {hs[-1]} failed ({err}), the result at "
@@ -150,7 +150,7 @@ def frf_to_accuracy(model, accuracy: float, omega_range, harmonics="3",
         best = res
         evaluations += res.evaluations
         seq.append(hs[-1])
-        rec = truncation_error(res, limit)
+        rec = truncation_error(res, limit, tol_rel=tol_rel)
         res.truncation_error = rec
         res.extra["truncation_warning"] = acc.warning(rec)
         levels.append((hs[-1], res.peak_amplitude, res.peak_omega))

@@ -222,19 +222,18 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
     """
     import zipfile
 
+    from contact_core.fileio import open_npz
+
     path = Path(path)
     try:
-        with open(path, "rb") as fh:
-            magic = fh.read(4)
-    except OSError as err:
-        raise ValueError(f"cannot read model file {path}: {err.strerror or err}") from None
-    if magic != b"PK\x03\x04":  # every .npz is a zip archive
-        raise ValueError(f"{path}: not a numpy .npz archive (numpy.savez writes one)")
-    try:
-        with np.load(path, allow_pickle=False) as data:
+        with open_npz(path, "model file") as data:
             arrays = {k: data[k] for k in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
-        raise ValueError(f"cannot read model file {path} (a numpy .npz archive): {err}") from None
+    except OSError as err:
+        raise ValueError(f"cannot read model file {path}: {err.strerror}" if err.strerror else str(err)) from None
+    except (ValueError, EOFError, zipfile.BadZipFile) as err:
+        msg = str(err)
+        raise ValueError(msg if str(path) in msg else
+                         f"cannot read model file {path} (a numpy .npz archive): {msg}") from None
     if not arrays:
         raise ValueError(f"{path}: an empty .npz archive")
     try:
@@ -298,7 +297,9 @@ def load_elements(path) -> list[ForceElement]:
 
     path = Path(path)
     try:
-        spec = tomllib.loads(path.read_text())
+        from contact_core.fileio import read_text_bounded
+
+        spec = tomllib.loads(read_text_bounded(path, what="elements file"))
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
         raise ValueError(f"cannot read elements file {path} (TOML): {err}") from None
     parse(ElementsFile, spec, str(path))   # tables, keys, types, ranges (elements_model)

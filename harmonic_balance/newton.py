@@ -60,7 +60,7 @@ class NewtonResult:
 
 
 def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
-           min_alpha: float = None, lm: bool = True) -> NewtonResult:
+           min_alpha: float = None, lm: bool = True, value=None) -> NewtonResult:
     """Solve R(x) = 0 to |R|_2 <= tol, or until Newton's step is below round-off.
 
     The second test (|dx|_2 <= STEP_RTOL max(|x|_2, x_norm)) ends the iteration when
@@ -78,6 +78,9 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
     min_alpha : float, smallest line-search factor (default MIN_ALPHA)
     lm : bool, fall back to Levenberg-Marquardt when the line search fails (False:
         fail at once, e.g. in a continuation corrector, which then takes a smaller step)
+    value : callable x -> R, optional
+        R alone, the same numbers as ``fun(x)[0]`` at less cost: the line search's
+        trial points (:func:`line_search`); None: ``fun``.
 
     Returns
     -------
@@ -107,7 +110,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
             x = x + dx  # the last (tiny) step, so a smooth residual keeps quadratic accuracy
             R, J = fun(x)
             return NewtonResult(x, R, J, it + 1)
-        step = line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha)
+        step = line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha, value)
         if step is None and _at_noise_floor(fun, x, R, J, nr, tol, x_norm):
             return NewtonResult(x, R, J, it)
         if step is None:
@@ -146,18 +149,22 @@ def _at_noise_floor(fun, x, R, J, nr, tol, x_norm=0.0) -> bool:
     return bool(np.linalg.norm(R2 - R) >= 0.5 * nr and np.linalg.norm(J @ d) <= 0.1 * nr)
 
 
-def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA):
+def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA, value=None):
     """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < min_alpha.
 
-    Also the sparse ring solver's (:mod:`.bladed_disk.ring_solve`): ``J`` is whatever
-    ``fun`` returns, dense or sparse.
+    ``value`` (x -> R, the same numbers as ``fun(x)[0]``): the trial points are judged by
+    R alone and only the accepted one gets its Jacobian (``fun``), so a rejected trial
+    costs no Jacobian. Also the sparse ring solver's (:mod:`.bladed_disk.ring_solve`):
+    ``J`` is whatever ``fun`` returns, dense or sparse.
     """
     alpha = 1.0
     while alpha >= min_alpha:
         xt = x + alpha * dx
-        Rt, Jt = fun(xt)
+        Rt, Jt = (value(xt), None) if value is not None else fun(xt)
         nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
         if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
+            if Jt is None:
+                Rt, Jt = fun(xt)
             return xt, Rt, Jt, nt
         alpha *= 0.5
     return None

@@ -12,13 +12,15 @@ error of each row is against an independent reference:
   the energy the FMU dissipates per cycle at P communication steps a cycle;
 * hb: time integration (``harmonic_balance.timeint.march``, 1024 steps a period,
   tol 1e-10) of the single-DOF Jenkins model at one frequency near resonance,
-  against the harmonic-balance amplitude there, over H and over AFT samples; then
-  whole curves of the model classes (:mod:`.hb_classes`: single-DOF soft and stiff,
+  against the harmonic-balance amplitude there, over H and over AFT samples; the
+  cost of a whole curve against H (:mod:`.hb_cost`: the 5-mass chain and UPD-24, CPU
+  time per curve and per point, the refined peak; no error); then whole curves of
+  the model classes (:mod:`.hb_classes`: single-DOF soft and stiff,
   3- and 5-mass friction chains, UPD-24, with pyHarm and NLvib when given), their
   first-harmonic peak against a dense reference (:mod:`.hb_reference`).
 
 ``time_s`` is the command's wall time, interpreter start and imports included
-(hb: the solver's own time, which the CLI reports). Rows carry ``default: True``
+(hb: the solver's own time, which the CLI reports; the cost rows: process time). Rows carry ``default: True``
 where the setting is the tool's default. The blade-damper stage joins STAGES
 when it lands: a function ``(quick, work, log) -> list[Row]``.
 """
@@ -184,10 +186,13 @@ def _ti_reference(log) -> float:
 
 def hb(quick: bool, work: Path, log=print, models=None) -> list[Row]:
     """Harmonic balance: harmonics and AFT samples against the error vs time integration (default H 1, auto),
-    then the model classes with their peers (:mod:`.hb_classes`; ``models``: its ModelOptions)."""
-    from . import hb_classes
+    the cost of a curve against H (:mod:`.hb_cost`), then the model classes with their peers
+    (:mod:`.hb_classes`; ``models``: its ModelOptions)."""
+    from . import hb_classes, hb_cost
 
     rows = _hb_settings(quick, log)
+    log("  hb cost against H (CPU time of a whole curve):")
+    rows += hb_cost.run(quick, lambda s: log("  " + s))
     log("  hb model classes (peak error against dense references):")
     log("  " + hb_classes.HEAD)
     return rows + hb_classes.run(quick, work, lambda s: log("  " + s), models)

@@ -7,7 +7,8 @@ Each subcommand lives in its own module of this package and exposes
 
 Exit codes: 0 success, 2 bad input (``ValueError``, ``OSError``: a clear
 message on stderr, nothing written), 3 a solver that did not converge
-(``RuntimeError``), 130 interrupted (Ctrl-C: one line saying where).
+(``RuntimeError``), 130 interrupted (Ctrl-C: one line saying where), 143 terminated
+(SIGTERM: handled as Ctrl-C, so temporary folders are removed on the way out).
 Warnings (numpy's overflow, a library's note) print as one line each, once per
 message, however often their cause repeats.
 """
@@ -118,8 +119,37 @@ def _one_line_warnings(command: str) -> None:
     warnings.showwarning = show
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is, so that cleanup (finally, with) runs as for Ctrl-C."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated("terminated (SIGTERM)")
+
+
+def _sigterm_as_interrupt():
+    """Install :func:`_on_sigterm` (main thread only); return the handler to restore, or None."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _on_sigterm)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the ``damper`` command; return the process exit code."""
+    import signal
+
+    previous = _sigterm_as_interrupt()
+    try:
+        return _main(argv)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None) -> int:
     command = "damper"
     _blas_threads_as_set()
     try:
@@ -128,7 +158,13 @@ def main(argv: list[str] | None = None) -> int:
         command = args.command
         _one_line_warnings(command)
         try:
-            return int(args.func(args) or 0)
+            from contact_core.fileio import guard_inputs
+
+            from .common import check_outputs
+
+            check_outputs(args)
+            with guard_inputs():
+                return int(args.func(args) or 0)
         except (ValueError, OSError) as err:
             print(f"damper {command}: error: {_text(err)}", file=sys.stderr)
             return 2
@@ -137,6 +173,10 @@ def main(argv: list[str] | None = None) -> int:
             return 3
     except KeyboardInterrupt as err:
         where = getattr(err, "message", "")
+        if isinstance(err, Terminated) or isinstance(err.__context__, Terminated):  # (re-raised with a where)
+            text = where.replace("interrupted", "terminated (SIGTERM)", 1) if where else "terminated (SIGTERM)"
+            print(f"damper {command}: {text}", file=sys.stderr)
+            return 143
         print(f"damper {command}: {where or 'interrupted'}", file=sys.stderr)
         return 130
 

@@ -36,7 +36,7 @@ def register(sub) -> None:
     g.add_argument("--pyharm", metavar="PYTHON", help="a Python interpreter with pyHarm (pip install pyharm-os)")
     g.add_argument("--nlvib", metavar="DIR", help="an NLvib folder (github.com/maltekrack/NLvib), run by Octave")
     g.add_argument("--octave", metavar="EXE", help="GNU Octave for NLvib (default: octave on PATH)")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, out_folder=True)
 
 
 def run(args) -> int:

@@ -1,5 +1,19 @@
 """Helpers shared by the subcommands: JSON output, all-or-nothing file writes, output paths
-checked before any work."""
+checked before any work.
+
+Outputs and inputs: :func:`check_outputs` runs for every subcommand before its work
+(``damper.cli.main``). The options that name outputs are the ones of :data:`OUTPUTS`
+(a subcommand whose ``--out`` is a result folder sets ``out_folder=True`` in its
+parser's defaults); every other option value that names an existing file is an input.
+An output file that is one of the inputs, whatever the spelling (symlinks, ``./``, hard
+links: compared by device and inode), is refused, as is an output that exists and is
+not a regular file (``/dev/null``, a FIFO, a socket: writing through a temporary file
+and a rename would replace it). A result folder (``run --out``, ``sweep --out``) that
+holds one of the inputs is refused too: the command writes that folder's files as its
+own. A figure folder (``--plot``) may hold inputs: its files have fixed ``.png`` names,
+and while the command runs no input it read is ever replaced
+(:func:`contact_core.fileio.guard_inputs`).
+"""
 from __future__ import annotations
 
 import json
@@ -9,7 +23,16 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_core.fileio import atomic_write  # noqa: F401  (re-exported for subcommands)
+from contact_core.fileio import (
+    atomic_write,  # noqa: F401  (re-exported for subcommands)
+    check_writable_target,
+)
+
+#: Option destinations that name outputs: dest -> (flag, "file" or "folder").
+OUTPUTS = {"output": ("-o", "file"), "out": ("--out", "file"), "normal_curve": ("--normal-curve", "file"),
+           "plot": ("--plot", "figures")}
+#: Positional arguments that name input files (named as they are in messages, without --).
+POSITIONAL = ("scene", "ssp")
 
 
 def to_jsonable(obj):
@@ -70,3 +93,58 @@ def check_out_dir(path, flag: str) -> None:
             raise ValueError(f"{flag} {path}: cannot write in this folder (permission denied)")
         return
     _writable_parent(path, flag)
+
+
+def _inputs(args) -> list[tuple[str, Path]]:
+    """(option, path) of every option value that names an existing file and is not an output."""
+    found = []
+    for dest, value in vars(args).items():
+        if dest in OUTPUTS or dest in ("func", "command"):
+            continue
+        for v in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(v, (str, os.PathLike)) and str(v) and os.path.isfile(v):
+                found.append((dest if dest in POSITIONAL else "--" + dest.replace("_", "-"), Path(v)))
+    return found
+
+
+def _same(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def _inside(folder: Path, path: Path) -> bool:
+    try:
+        folder, path = folder.resolve(), path.resolve()
+    except OSError:
+        return False
+    return folder in path.parents
+
+
+def check_outputs(args) -> None:
+    """Refuse, before any work, an output that is one of the inputs or not a regular file (module docstring)."""
+    inputs = _inputs(args)
+    for dest, (flag, kind) in OUTPUTS.items():
+        value = getattr(args, dest, None)
+        if value is None or isinstance(value, bool):
+            continue
+        out = Path(value)
+        if dest == "out" and getattr(args, "out_folder", False):
+            kind = "folder"
+        if kind == "file":
+            try:
+                check_writable_target(out)
+            except IsADirectoryError:
+                continue            # check_out_file says it in the command's words
+            except OSError as err:
+                raise ValueError(f"{flag} {out}: {str(err).split(': ', 1)[-1]}") from None
+            for name, path in inputs:
+                if _same(out, path):
+                    raise ValueError(f"{flag} {out} is the input {name} {path}: it would be overwritten; "
+                                     "give another output name")
+        elif kind == "folder":
+            for name, path in inputs:
+                if _inside(out, path):
+                    raise ValueError(f"{flag} {out} holds the input {name} {path}: the result folder is the "
+                                     "command's own; give another folder")

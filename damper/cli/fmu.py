@@ -98,8 +98,7 @@ def check_numbers(args) -> None:
 
 def _run_element(args, source, n_ref) -> int:
     """The 1D friction element FMU (inputs u, N)."""
-    from pathlib import Path
-
+    from contact_core.fileio import read_text_bounded
     from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_build import build_fmu
 
@@ -115,7 +114,7 @@ def _run_element(args, source, n_ref) -> int:
                    + (", flat beyond its end: gross slip" if curve.tail == "flat" else "") + ")")
     path = build_fmu(curve.u, curve.T, n_ref, args.output, fmi_version=args.fmi_version,
                      fit=args.fit, description=description, tail=curve.tail,
-                     curve_json=Path(args.curve).read_text())
+                     curve_json=read_text_bounded(args.curve, what="curve file"))
     return _report(args, path, "element", source, curve, error, n_ref, None)
 
 
@@ -126,8 +125,7 @@ SAME_LOAD_RTOL = 1e-6
 
 def _normal_law(args, n_ref: float):
     """(p, N, text of the source file or None, description) of --normal / --k-n."""
-    from pathlib import Path
-
+    from contact_core.fileio import read_text_bounded
     from fmu_src.fmu_point import penalty_table
 
     if args.k_n is not None:
@@ -145,13 +143,13 @@ def _normal_law(args, n_ref: float):
         raise ValueError(f"{args.curve} was computed at N = {n_ref:g} N but {args.normal} up to "
                          f"{normal.load:g} N: pass --preload N to say at which normal load the "
                          "contact starts (the slip limits scale with N(p) / N_ref)")
-    return normal.approach, normal.N, Path(args.normal).read_text(), f"normal curve {args.normal}"
+    return normal.approach, normal.N, read_text_bounded(args.normal, what="normal-curve file"), \
+        f"normal curve {args.normal}"
 
 
 def _run_point(args, source, n_ref) -> int:
     """The 3D contact point FMU (inputs u_x, u_y, p)."""
-    from pathlib import Path
-
+    from contact_core.fileio import read_text_bounded
     from fmu_src.curve_fit import reduce_virgin_curve
     from fmu_src.fmu_point import build_point_fmu
 
@@ -164,7 +162,7 @@ def _run_point(args, source, n_ref) -> int:
     description = (f"3D contact point: 2D Masing/Iwan element from the virgin curve {args.curve} "
                    f"({curve.u.size} points, N_ref = {n_ref:g} N) and the normal law of the {law}; "
                    f"start at N = {preload:g} N")
-    resources = {"curve.json": Path(args.curve).read_text()}
+    resources = {"curve.json": read_text_bounded(args.curve, what="curve file")}
     if normal_text is not None:
         resources["normal.json"] = normal_text
     path = build_point_fmu(curve.u, curve.T, n_ref, p, N, args.output, fmi_version=args.fmi_version,

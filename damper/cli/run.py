@@ -42,7 +42,7 @@ def register(subparsers) -> None:
     p.add_argument("--no-cache", action="store_true",
                    help="neither read nor write the cache folder (results stay in memory for this run)")
     add_cache_options(p)
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, out_folder=True)
 
 
 def run(args) -> int:

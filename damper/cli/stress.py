@@ -25,7 +25,7 @@ def register(sub) -> None:
     p.add_argument("--case", action="append", help="only the cases whose name contains this text (repeatable)")
     p.add_argument("--out", default="out/stress", help="folder for stress.json and stress.md")
     p.add_argument("--json", action="store_true", help="print one JSON object with `cases`")
-    p.set_defaults(func=run)
+    p.set_defaults(func=run, out_folder=True)
 
 
 def run(args) -> int:

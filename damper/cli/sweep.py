@@ -58,7 +58,7 @@ def register(subparsers) -> None:
                    help="stop at the first variant that fails (default: run every variant, report failures "
                    "in the table's error column and exit with code 3)")
     add_cache_options(p)
-    p.set_defaults(func=run, specs=None)
+    p.set_defaults(func=run, specs=None, out_folder=True)
 
 
 def specs_from(items) -> list[tuple[str, list]]:

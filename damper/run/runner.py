@@ -19,6 +19,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from contact_core.fileio import MAX_TEXT_FILE_BYTES, read_bounded
 from damper.cache import Store
 from damper.cli.common import atomic_write, dumps
 from damper.provenance import code_version, git_revision, record
@@ -74,8 +75,9 @@ def plan_scene(scene, store: Store, force=(), out: Path | None = None, kinds=KIN
     previous = {}
     if out is not None and (Path(out) / "run.json").is_file():
         try:
-            previous = json.loads((Path(out) / "run.json").read_text()).get("keys", {})
-        except (OSError, ValueError):
+            text = read_bounded(Path(out) / "run.json", MAX_TEXT_FILE_BYTES, protect=False)
+            previous = json.loads(text).get("keys", {})
+        except (OSError, ValueError, AttributeError):   # unreadable or not an object: no reasons
             previous = {}
     return build_plan(scene.data, kinds, store, force=force, previous=previous)
 

@@ -13,6 +13,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from contact_core.fileio import MAX_ARRAY_FILE_BYTES, MAX_TEXT_FILE_BYTES, read_bounded, read_text_bounded
+
 from . import checks, schema
 from .lines import key_lines, line_of
 
@@ -68,9 +70,10 @@ def read_scene_text(path: str | Path) -> str:
     """The text of a scene file; SceneError naming the file if it cannot be read as text."""
     path = Path(path)
     try:
-        return path.read_text()
-    except OSError as err:
-        raise SceneError(str(path), [("", None, f"cannot read the scene: {err.strerror or err}")]) from None
+        return read_text_bounded(path, what="scene")
+    except (OSError, ValueError) as err:
+        text = getattr(err, "strerror", None) or str(err).replace(f"scene {path} ", "")
+        raise SceneError(str(path), [("", None, f"cannot read the scene: {text}")]) from None
     except UnicodeDecodeError:
         raise SceneError(str(path), [("", None, "not a text file (a scene is TOML)")]) from None
 
@@ -164,9 +167,9 @@ def _check_structure(data: dict, problems: list, base: Path) -> None:
     if s["model"] == "matrices" and "matrices" in s:
         path = (base / s["matrices"]).resolve()
         try:
-            s["matrices_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
-        except OSError as err:
-            problems.append((("structure", "matrices"), f"cannot read {path}: {err.strerror}"))
+            s["matrices_sha256"] = hashlib.sha256(read_bounded(path, MAX_ARRAY_FILE_BYTES, "file")).hexdigest()
+        except (OSError, ValueError) as err:
+            problems.append((("structure", "matrices"), f"cannot read {path}: {getattr(err, 'strerror', None) or err}"))
         s["matrices"] = str(path)
         if "element_dofs" in s and len(s["element_dofs"]) not in (1, 2):
             problems.append((("structure", "element_dofs"), "must be [a] (to the ground) or [a, b]"))
@@ -301,9 +304,9 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
     if "config" in u:
         path = (base / u["config"]).resolve()
         try:
-            u["config_sha256"] = hashlib.sha256(path.read_bytes()).hexdigest()
-        except OSError as err:
-            problems.append((("upd", "config"), f"cannot read {path}: {err.strerror}"))
+            u["config_sha256"] = hashlib.sha256(read_bounded(path, MAX_TEXT_FILE_BYTES, "file")).hexdigest()
+        except (OSError, ValueError) as err:
+            problems.append((("upd", "config"), f"cannot read {path}: {getattr(err, 'strerror', None) or err}"))
         u["config"] = str(path)
 
 

@@ -401,6 +401,6 @@ def _typed() -> list[InputCase]:
 
 
 def all_cases() -> list[InputCase]:
-    """Every input case, grouped by subcommand."""
+    """Every input case, grouped by subcommand (the files themselves: :mod:`.file_cases`)."""
     return (_cli() + _normal() + _tangential() + _loop() + _fmu() + _frf() + _backbone() + _upd() + _system() + _run()
             + _sweep() + _cache_and_rest() + _duties() + _typed())

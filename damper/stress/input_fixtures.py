@@ -197,6 +197,34 @@ def upd_files() -> dict[str, str | bytes]:
             "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
 
 
+def _forged_sizes(blob: bytes, size: int) -> bytes:
+    """A zip archive whose members declare ``size`` bytes unpacked (local and central headers)."""
+    out = bytearray(blob)
+    for sig, offset in ((b"PK\x03\x04", 22), (b"PK\x01\x02", 24)):
+        at = out.find(sig)
+        while at >= 0:
+            out[at + offset:at + offset + 4] = size.to_bytes(4, "little")
+            at = out.find(sig, at + 4)
+    return bytes(out)
+
+
+def forged_archives() -> dict[str, bytes]:
+    """Forged archives: members declaring 4 GiB (an SSP, a model .npz), an SSP of 5000
+    members, Matrix Market headers declaring a 1e8 x 1e8 matrix and 1e12 entries."""
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("resources/system.json", '{"kind": "damper-ring"}')
+    many = io.BytesIO()
+    with zipfile.ZipFile(many, "w") as zf:
+        for i in range(5000):
+            zf.writestr(f"m{i}", b"")
+    mtx = b"%%MatrixMarket matrix coordinate real general\n100000000 100000000 1\n1 1 1.0\n"
+    return {"bomb.ssp": _forged_sizes(buf.getvalue(), 2**32 - 16), "many.ssp": many.getvalue(),
+            "m_bomb.npz": _forged_sizes(matrices()["m_good.npz"], 2**32 - 16), "big_M.mtx": mtx, "big_K.mtx": mtx,
+            "upd_bigmtx.toml": b'[blade]\nM = "big_M.mtx"\nK = "big_K.mtx"\n',
+            "big_nnz.mtx": b"%%MatrixMarket matrix coordinate real general\n1000 1000 1000000000000\n1 1 1.0\n"}
+
+
 def typed_files() -> dict[str, str | bytes]:
     """Files well-formed as JSON / TOML whose content the typed models refuse: booleans or
     strings as numbers, lists of the wrong length, unknown keys, a curve above its own
@@ -261,7 +289,8 @@ def archives() -> dict[str, bytes]:
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
-    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives()):
+    for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives(),
+                  forged_archives()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):

@@ -1,6 +1,6 @@
 """The input stage of ``damper stress``: every bad input refused cleanly, nothing lost.
 
-Each case of :mod:`.input_cases` runs in a forked child (:mod:`.forkrun`) in a folder
+Each case of :mod:`.input_cases` and :mod:`.file_cases` runs in a forked child (:mod:`.forkrun`) in a folder
 of its own, with a time limit, and is classified:
 
 * ``clear_error``: exit code 2 or 3, no traceback, the last line of standard error is
@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 from . import forkrun, input_fixtures
+from .file_cases import cases as file_cases
 from .input_cases import InputCase, all_cases
 
 #: Lines of standard error that are not the message: argparse's usage, progress, plan.
@@ -85,7 +86,33 @@ def swap_entries(case_dir: Path) -> None:
         ent[-1].write_bytes(ent[0].read_bytes())
 
 
-MUTATE = {"add_user_file": add_user_file, "truncate_entries": truncate_entries, "swap_entries": swap_entries}
+def fifo_entries(case_dir: Path) -> None:
+    """Replace every cache entry by a FIFO of the same name (a read would block forever)."""
+    for p in _entries(case_dir):
+        p.unlink()
+        os.mkfifo(p)
+
+
+def fifo(case_dir: Path, name: str) -> None:
+    os.mkfifo(case_dir / name)
+
+
+def symlink(case_dir: Path, target: str, name: str) -> None:
+    (case_dir / name).symlink_to(target)
+
+
+def hardlink(case_dir: Path, target: str, name: str) -> None:
+    os.link(case_dir / target, case_dir / name)
+
+
+def sparse(case_dir: Path, name: str, size: str) -> None:
+    """A file of ``size`` bytes that takes no disk (a hole)."""
+    with open(case_dir / name, "wb") as fh:
+        fh.truncate(int(size))
+
+
+MUTATE = {"add_user_file": add_user_file, "truncate_entries": truncate_entries, "swap_entries": swap_entries,
+          "fifo_entries": fifo_entries, "fifo": fifo, "symlink": symlink, "hardlink": hardlink, "sparse": sparse}
 
 
 def check(name: str, case_dir: Path, r: forkrun.Finished) -> str:
@@ -156,7 +183,8 @@ def run_case(case: InputCase, fx: Path, work: Path, index: int) -> dict:
         if p.code != 0:
             return _row(case, "crash", f"the set-up command failed (exit {p.code}): {p.stderr[-200:]}", t0, fill)
     if case.mutate:
-        MUTATE[case.mutate](case_dir)
+        what, *mutate_args = case.mutate.split(":")
+        MUTATE[what](case_dir, *mutate_args)
     keep = {k: (case_dir / k).read_bytes() for k in case.keep if (case_dir / k).is_file()}
     before, fx_before = snapshot(case_dir), snapshot(fx)
     r = forkrun.run(fill(case.argv), case_dir, case.timeout, env, interrupt_on=case.interrupt_on)
@@ -177,7 +205,7 @@ def _row(case: InputCase, outcome: str, message: str, t0: float, fill=None) -> d
 
 def run(log=print, match=None) -> list[dict]:
     """Run every input case (``match``: only those whose name contains one of these texts)."""
-    cases = [c for c in all_cases() if not match or any(m in f"{c.group}: {c.name}" for m in match)]
+    cases = [c for c in all_cases() + file_cases() if not match or any(m in f"{c.group}: {c.name}" for m in match)]
     if not cases:
         return []
     forkrun.preload()

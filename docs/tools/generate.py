@@ -126,28 +126,54 @@ def more_pages(docs: Path) -> None:
     _write(docs / "_generated" / "more.md", text)
 
 
+#: Modules whose upper-case constants with a ``#:`` reason are the bounds of limits.md:
+#: the sizes a user types, and the input files' caps.
+LIMIT_MODULES = ("damper/limits.py", "contact_core/fileio.py")
+
+
 def limits_page(docs: Path) -> None:
-    """``_generated/limits.md``: every constant of ``damper/limits.py`` with its ``#:`` reason."""
+    """``_generated/limits.md``: every constant of :data:`LIMIT_MODULES` with its ``#:`` reason."""
+    rows = []
+    for module in LIMIT_MODULES:
+        rows += _limit_rows((docs.parent / module).read_text())
+    text = "| constant | bound | what it bounds, and why |\n|---|---|---|\n" + "\n".join(rows) + "\n"
+    _write(docs / "_generated" / "limits.md", text)
+
+
+def _limit_rows(src: str) -> list[str]:
+    """Table rows of the numeric upper-case constants of one module's source with their ``#:`` comments."""
     import ast
 
-    src = (docs.parent / "damper" / "limits.py").read_text()
     lines = src.splitlines()
     rows = []
     for node in ast.parse(src).body:
-        if not (isinstance(node, ast.Assign) and len(node.targets) == 1
-                and isinstance(node.targets[0], ast.Name) and node.targets[0].id.isupper()):
+        if not (isinstance(node, ast.Assign) and len(node.targets) == 1 and isinstance(node.targets[0], ast.Name)
+                and node.targets[0].id.isupper() and not node.targets[0].id.startswith("_")):
             continue
         k, why = node.lineno - 2, []
         while k >= 0 and lines[k].lstrip().startswith("#:"):
             why.insert(0, lines[k].lstrip()[2:].strip())
             k -= 1
-        value = ast.literal_eval(node.value)
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            continue   # a message text (e.g. RING_BLADES_WHY), not a bound
+        value = _number(node.value)
+        if value is None:
+            continue   # a message text (e.g. RING_BLADES_WHY) or an object, not a bound
         shown = f"{value:g}" if isinstance(value, float) else f"{value:,}".replace(",", " ")
+        if node.targets[0].id.endswith("_BYTES") and value >= 2**20:
+            shown += f" ({value / 2**30:g} GiB)" if value >= 2**30 else f" ({value / 2**20:g} MiB)"
         rows.append(f"| `{node.targets[0].id}` | {shown} | {' '.join(why)} |")
-    text = "| constant | bound | what it bounds, and why |\n|---|---|---|\n" + "\n".join(rows) + "\n"
-    _write(docs / "_generated" / "limits.md", text)
+    return rows
+
+
+def _number(node):
+    """The int or float value of a constant expression of numbers (``16 * 2**20``), else None."""
+    import ast
+
+    allowed = (ast.Expression, ast.Constant, ast.BinOp, ast.UnaryOp, ast.operator, ast.unaryop)
+    tree = ast.Expression(node)
+    if not all(isinstance(n, allowed) for n in ast.walk(tree)):
+        return None
+    value = eval(compile(tree, "<limit>", "eval"), {"__builtins__": {}})  # numbers and operators only
+    return value if isinstance(value, (int, float)) and not isinstance(value, bool) else None
 
 
 def formats_page(docs: Path) -> None:

@@ -92,10 +92,13 @@ static double root(tpoly *p, const double *U, int d, double target, double lo, d
  * phase rounding eps h t, times k_t, was ~1e-10 of residual noise at 1e6 k). With
  * C(k) = int_0^L cos k tau, S(k) = int_0^L sin k tau (trig scratch of 2K + 2 nb,
  * K = 2 hmax + 1). On a slipping interval (s = 0, every slider at its limit) F = c does
- * not depend on U: no dc (its sliders' anchors), no q loop. */
-static void interval_integrals(size_t nb, const int32_t *ord, const int8_t *kind, const double *U,
-                           double a, double L, double c, double s, const double *dc, double u_a,
-                           double *trig, size_t K, double *Fh, double *dFh)
+ * not depend on U: no dc (its sliders' anchors), no q loop. The Jacobian's entries are
+ * taken per pair of harmonics (p, q): the four integrals A, B, Cc, D below depend on the
+ * orders alone and serve the four (cos, sin) x (cos, sin) entries, so the O(nb^2) loop
+ * reads them once per pair, not once per entry. */
+static void interval_integrals(size_t n_h, const int32_t *harm, const double *U, double a,
+                               double L, double c, double s, const double *dc, double u_a,
+                               double *trig, size_t K, size_t nb, double *Fh, double *dFh)
 {
     /* a slipping interval needs orders up to hmax only (no products of two harmonics) */
     const size_t kn = s == 0.0 ? (K + 1) / 2 : K;
@@ -104,45 +107,58 @@ static void interval_integrals(size_t nb, const int32_t *ord, const int8_t *kind
         trig[k] = k ? sin((double)k * L) / (double)k : L;
         trig[K + k] = k ? 2.0 * h * h / (double)k : 0.0;
     }
-    /* cos, sin of (order x a) per coefficient, once (scratch after the 2K above) */
-    double *ca = trig + 2 * K, *sa = ca + nb;
-    for (size_t q = 0; q < nb; ++q) {
-        ca[q] = cos(ord[q] * a);
-        sa[q] = sin(ord[q] * a);
+    /* cos, sin of (order x a) per harmonic, once (scratch after the 2K above) */
+    double *ca = trig + 2 * K, *sa = ca + n_h;
+    for (size_t k = 0; k < n_h; ++k) {
+        ca[k] = cos(harm[k] * a);
+        sa[k] = sin(harm[k] * a);
     }
 #define C_(k) trig[(size_t)abs(k)]
 #define S_(k) ((k) < 0 ? -trig[K + (size_t)(-(k))] : trig[K + (size_t)(k)])
     const double Fa = c + s * u_a;
-    for (size_t pp = 0; pp < nb; ++pp) {
-        const int32_t op = ord[pp];
-        const double cp = ca[pp], sp = sa[pp], wp = op == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
-        const double ipsi = kind[pp] ? sp * C_(op) + cp * S_(op) : cp * C_(op) - sp * S_(op);
-        double acc = Fa * ipsi;
-        if (s == 0.0) {
-            Fh[pp] += wp * acc;
-            continue;
-        }
-        for (size_t q = 0; q < nb; ++q) {
-            const int32_t oq = ord[q];
-            if (oq == 0) {   /* the mean does not vary over the interval */
-                dFh[pp * nb + q] += wp * ipsi * (dc[q] + s);
-                continue;
+    for (size_t kp = 0, pc = 0; kp < n_h; ++kp) {
+        const int32_t op = harm[kp];
+        const double cp = ca[kp], sp = sa[kp], wp = op == 0 ? 1.0 / TWO_PI : 2.0 / TWO_PI;
+        const size_t ps = pc + 1;   /* the sine row (none for the mean) */
+        const double ipc = cp * C_(op) - sp * S_(op), ips = sp * C_(op) + cp * S_(op);
+        double acc_c = Fa * ipc, acc_s = Fa * ips;
+        if (s != 0.0) {
+            double *rc = dFh + pc * nb, *rs = dFh + ps * nb;
+            for (size_t kq = 0, q = 0; kq < n_h; ++kq) {
+                const int32_t oq = harm[kq];
+                if (oq == 0) {   /* the mean does not vary over the interval */
+                    rc[q] += wp * ipc * (dc[q] + s);
+                    if (op) rs[q] += wp * ips * (dc[q] + s);
+                    ++q;
+                    continue;
+                }
+                const double cq = ca[kq], sq = sa[kq];
+                const double A = 0.5 * (C_(op - oq) + C_(op + oq)) - C_(op);     /* cos p (cos q - 1) */
+                const double B = 0.5 * (S_(oq + op) + S_(oq - op));              /* cos p sin q */
+                const double Cc = 0.5 * (S_(op + oq) + S_(op - oq)) - S_(op);    /* sin p (cos q - 1) */
+                const double D = 0.5 * (C_(op - oq) - C_(op + oq));              /* sin p sin q */
+                const double cc = cp * cq, cs = cp * sq, sc = sp * cq, ss = sp * sq;
+                /* int psi_p(a + tau) (phi_q(a + tau) - phi_q(a)), p and q cos or sin */
+                const double Icc = cc * A - cs * B - sc * Cc + ss * D;
+                const double Ics = cs * A + cc * B - ss * Cc - sc * D;
+                acc_c += s * Icc * U[q];
+                rc[q] += wp * (s * Icc + ipc * (dc[q] + s * cq));
+                acc_c += s * Ics * U[q + 1];
+                rc[q + 1] += wp * (s * Ics + ipc * (dc[q + 1] + s * sq));
+                if (op) {
+                    const double Isc = sc * A - ss * B + cc * Cc - cs * D;
+                    const double Iss = ss * A + sc * B + cs * Cc + cc * D;
+                    acc_s += s * Isc * U[q];
+                    rs[q] += wp * (s * Isc + ips * (dc[q] + s * cq));
+                    acc_s += s * Iss * U[q + 1];
+                    rs[q + 1] += wp * (s * Iss + ips * (dc[q + 1] + s * sq));
+                }
+                q += 2;
             }
-            const double cq = ca[q], sq = sa[q];
-            const double A = 0.5 * (C_(op - oq) + C_(op + oq)) - C_(op);     /* cos p (cos q - 1) */
-            const double B = 0.5 * (S_(oq + op) + S_(oq - op));              /* cos p sin q */
-            const double Cc = 0.5 * (S_(op + oq) + S_(op - oq)) - S_(op);    /* sin p (cos q - 1) */
-            const double D = 0.5 * (C_(op - oq) - C_(op + oq));              /* sin p sin q */
-            double I;   /* int psi_p(a + tau) (phi_q(a + tau) - phi_q(a)) */
-            if (!kind[pp] && !kind[q]) I = cp * cq * A - cp * sq * B - sp * cq * Cc + sp * sq * D;
-            else if (!kind[pp]) I = cp * sq * A + cp * cq * B - sp * sq * Cc - sp * cq * D;
-            else if (!kind[q]) I = sp * cq * A - sp * sq * B + cp * cq * Cc - cp * sq * D;
-            else I = sp * sq * A + sp * cq * B + cp * sq * Cc + cp * cq * D;
-            const double phia = kind[q] ? sq : cq;
-            acc += s * I * U[q];
-            dFh[pp * nb + q] += wp * (s * I + ipsi * (dc[q] + s * phia));
         }
-        Fh[pp] += wp * acc;
+        Fh[pc] += wp * acc_c;
+        if (op) Fh[ps] += wp * acc_s;
+        pc += op ? 2 : 1;
     }
 #undef S_
 #undef C_
@@ -326,7 +342,7 @@ iwan_status iwan_periodic_fourier(const iwan_model *model, size_t n_h, const int
             dc[q] = v;
         }
         const double u_a = sl[i] != 0.0 ? eval_u(&p, U, a, 0) : 0.0;
-        interval_integrals(nb, ord, kind, U, a, b - a, ic[i], sl[i], dc, u_a, trig, K, Fh, dFh);
+        interval_integrals(n_h, harm, U, a, b - a, ic[i], sl[i], dc, u_a, trig, K, nb, Fh, dFh);
     }
     *n_ext_out = ne;
     if (W_cycle) *W_cycle = W;

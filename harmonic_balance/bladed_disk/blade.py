@@ -180,11 +180,14 @@ def load_blade(section: dict, base: Path | None = None) -> Blade:
 
 
 def _read_npz(path: Path) -> dict:
+    from contact_core.fileio import open_npz
+
     try:
-        with np.load(path, allow_pickle=False) as z:
+        with open_npz(path, "blade file") as z:
             data = {k: z[k] for k in z.files}
     except (OSError, ValueError) as err:
-        raise ValueError(f"blade file {path}: cannot read ({err})") from None
+        msg = getattr(err, "strerror", None) or str(err)
+        raise ValueError(msg if str(path) in msg else f"blade file {path}: cannot read ({msg})") from None
     unknown = set(data) - set(MATRICES) - set(ROLES)
     if unknown:
         raise ValueError(f"blade file {path}: unknown arrays {sorted(unknown)} "
@@ -199,10 +202,15 @@ def _read_npz(path: Path) -> dict:
 def _read_mtx(path: Path, key: str) -> np.ndarray:
     import scipy.io
 
+    from contact_core.fileio import check_matrix_market
+
     try:
+        check_matrix_market(path, dense=True, what=f"blade {key} =")
         A = scipy.io.mmread(str(path))
     except (OSError, ValueError) as err:
-        raise ValueError(f"blade {key} = {path}: cannot read Matrix Market ({err})") from None
+        msg = getattr(err, "strerror", None) or str(err)
+        raise ValueError(msg if str(path) in msg else
+                         f"blade {key} = {path}: cannot read Matrix Market ({msg})") from None
     return A.toarray() if hasattr(A, "toarray") else np.asarray(A)
 
 

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from contact_core.fileformat import parse
+from contact_core.fileio import read_text_bounded
 
 from .blade import MATRICES, Blade, load_blade
 from .config_model import UPDFile
@@ -191,9 +192,9 @@ def load_config(path=None) -> UPDConfig:
     if path is not None:
         path = Path(path)
         try:
-            user = tomllib.loads(path.read_text())
+            user = tomllib.loads(read_text_bounded(path, what="config"))
         except OSError as err:
-            raise ValueError(f"cannot read config {path}: {err.strerror or err}") from None
+            raise ValueError(f"cannot read config {path}: {err.strerror}" if err.strerror else str(err)) from None
         except (UnicodeDecodeError, tomllib.TOMLDecodeError) as err:
             raise ValueError(f"cannot read config {path} (TOML): {err}") from None
         for sec, table in user.items():   # unknown sections and keys: UPDFile refuses them

@@ -208,8 +208,16 @@ class SectorHB:
 
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True):
         """R (size,), dR/dx (size, size), dR/domega (size,)."""
-        self.evaluations += 1
+        last, self._last_value = getattr(self, "_last_value", None), None
+        if not (last is not None and last[1] == omega and np.array_equal(last[0], x)):
+            self.evaluations += 1   # the Jacobian after value() at this point is no new one
         return self.residual(x, omega, jac)
+
+    def value(self, x: np.ndarray, omega: float) -> np.ndarray:
+        """R (size,) alone (``FullResidual.value``: a line search's trial point)."""
+        self.evaluations += 1
+        self._last_value = (x.copy(), omega)
+        return self.residual.value(x, omega)
 
     # ------------------------------------------------------------ starts
     def static_guess(self) -> np.ndarray:

@@ -165,7 +165,7 @@ def sweep(hb: SectorHB, omegas, x0: np.ndarray | None = None) -> list:
 def _trace(hb: SectorHB, x0, w0: float, w1: float, lam_step: float):
     """Branch from (x0, w0) to w1 [rad/s] by continuation (module docstring), or SolverError."""
     try:
-        return continuation(hb.__call__, x0, w0, w1, _tol(hb), ds_max=DS_MAX,
+        return continuation(hb, x0, w0, w1, _tol(hb), ds_max=DS_MAX,
                             tolerance=UPD_TOL, lam_step=lam_step, rtol=TOL_REL,
                             max_points=MAX_POINTS)
     except ContinuationError as err:
@@ -215,7 +215,7 @@ def _refine(hb, branch, curve) -> None:
     if not 0 < i < len(branch.x) - 1:
         return
     try:
-        x, w, a, _ = refine_max(hb.__call__, branch, i, lambda x, lam: hb.amplitude_h1(x),
+        x, w, a, _ = refine_max(hb, branch, i, lambda x, lam: hb.amplitude_h1(x),
                                 _tol(hb), PEAK_XTOL * branch.lam[i])
     except RuntimeError as err:
         curve.extra["peak_refined"] = False
