@@ -296,8 +296,12 @@ class Store:
         self.hits += 1
         return arrays, head["meta"]
 
-    def put(self, key: str, arrays: dict, meta: dict, stage: str | None = None) -> Path:
-        """Store ``arrays`` (name -> ndarray) and ``meta`` (JSON-able) under ``key`` (of ``stage``)."""
+    def put(self, key: str, arrays: dict, meta: dict, stage: str | None = None, evict: bool = True) -> Path:
+        """Store ``arrays`` (name -> ndarray) and ``meta`` (JSON-able) under ``key`` (of ``stage``).
+
+        ``evict=False`` leaves the size limit to a later :meth:`evict`: a batch of many small
+        entries (each eviction check lists and stats the whole folder).
+        """
         if "meta" in arrays:
             raise ValueError("'meta' is reserved for the entry's JSON object")
         head = {"schema": ENTRY_SCHEMA, "key": key, "stage": stage, "meta": meta}
@@ -318,11 +322,17 @@ class Store:
                                "keeping new results in memory for this run only")
             else:
                 self.writes += 1
-                self._evict(keep=path)
+                if evict:
+                    self._evict(keep=path)
                 return path
         self._mem[key] = buf.getvalue()
         self.writes += 1
         return path
+
+    def evict(self) -> None:
+        """Drop least recently used entries until the folder fits the size limit."""
+        if not self.memory and not self.readonly:
+            self._evict(keep=None)
 
     def delete(self, key: str) -> bool:
         """Remove the entry of ``key``; whether there was one."""

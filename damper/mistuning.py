@@ -3,13 +3,16 @@
 A study draws every mistuning pattern first (``harmonic_balance.bladed_disk.mistuning``:
 seeded per sample, so a resumed or extended study draws the same patterns) and refuses
 a bad one before any work. The tuned sector's peak on the band is the reference (the
-sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). Each
-sample is one task: the full ring's forced response (``ring_hb`` / ``ring_solve``, or
-the linear ring) and every blade's peak; its result is stored in the shared cache
+sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). A
+sample is the full ring's forced response (``ring_hb`` / ``ring_solve``, or the linear
+ring) and every blade's peak; a task is a chunk of samples solved with one
+:class:`SampleModel` (:func:`run_chunk`). Each sample's result is stored in the shared cache
 (:class:`damper.cache.Store`) under a key of the model, the solver settings, the
 pattern and the code version, so an interrupted study computes only the samples it has
 not stored. A sample whose solve fails is reported with its message (not cached: a
-later run tries it again), the study goes on.
+later run tries it again), the study goes on. ``until_ci`` stops the study after the
+first chunk (in index order) at which the 0.95 quantile's interval
+(:mod:`damper.mistuning_stats`) is narrow enough.
 
 Symbols: N_b blades; a_j the peak first-harmonic amplitude of blade j's response DOF;
 amplification = max_j a_j / a_tuned; sigma_f the standard deviation of the blade
@@ -34,6 +37,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from damper import mistuning_stats
 from damper.cache import Store, make_key
 from damper.provenance import code_version
 
@@ -47,6 +51,12 @@ QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 #: docstring; a blade's frequency scatters by sigma_f).
 BAND_MARGIN, BAND_SIGMAS = 0.02, 3.0
 DAMPERS = ("nonlinear", "free", "stuck")
+#: Chunks: a worker solves a chunk of samples with one model (:class:`SampleModel`).
+#: About CHUNKS_PER_WORKER chunks per worker balance the load (a chunk's samples differ
+#: in cost) while each worker builds its model a few times only; MAX_CHUNK bounds the work
+#: an interruption loses. With ``until_ci`` the chunks have CHUNK_UNTIL_CI samples and the
+#: interval is checked after each, in index order.
+CHUNKS_PER_WORKER, MAX_CHUNK, CHUNK_UNTIL_CI = 4, 100, 20
 
 
 class AllSamplesFailed(RuntimeError):
@@ -81,6 +91,7 @@ class Study:
     harmonics: int = 7
     band_hz: list | None = None
     points: int = 41
+    until_ci: float | None = None
 
     def load(self):
         """The validated UPD config with ``blades`` / ``engine_order`` applied (ValueError)."""
@@ -110,6 +121,13 @@ class Study:
                           "balance solve of the whole ring (~0.2 s at 24 blades, H = 7)")
         if self.blades is not None:
             limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
+        if self.until_ci is not None:
+            if self.factors is not None:
+                raise ValueError("--until-ci needs random samples (--std/--samples), not --factors")
+            if not (isinstance(self.until_ci, (int, float)) and np.isfinite(self.until_ci)
+                    and self.until_ci > 0):
+                raise ValueError(f"until-ci half-width must be finite and > 0, got {self.until_ci}"
+                                 " (the amplification's 0.95 quantile to +- this, e.g. 0.01)")
         if self.factors is None:
             limits.check_size("samples", self.samples, 1, limits.MAX_MISTUNING_SAMPLES,
                               "each sample is a ring curve (~20 s CPU at 24 blades, H = 7)")
@@ -204,45 +222,90 @@ def sample_key(study: Study, fp: str, band: list, kappa) -> str:
                     [float(k) for k in kappa], code_version(MODULES))
 
 
-def run_sample(task: dict) -> dict:
-    """One sample (runs in a Dask worker or in this process): the cached result, or the
-    ring's per-blade peaks computed and stored; a failed solve is returned as ``error``."""
+class SampleModel:
+    """What the samples of one chunk share, built once in the worker: the sector, the
+    band's grid, and the linear ring family (:class:`LinearRingFamily`, the tuned matrices)
+    or the tuned sector's harmonic balance (the starts of every ring solve)."""
+
+    def __init__(self, study: Study, band, f_tuned: float):
+        from harmonic_balance.bladed_disk.mistuning import LinearRingFamily
+        from harmonic_balance.bladed_disk.sector import Sector
+
+        self.study, self.f_tuned = study, f_tuned
+        self.sector = Sector(study.load())
+        self.om = 2 * np.pi * np.linspace(band[0], band[1], study.points)
+        self.family = (LinearRingFamily(self.sector, study.damper, study.f0)
+                       if study.damper != "nonlinear" else None)
+        self.tuned = None       # the tuned SectorHB, from the first ring (its H, CF, F0, mu, n_t)
+
+
+def run_chunk(task: dict) -> dict:
+    """A chunk of samples (runs in a Dask worker or in this process) with one
+    :class:`SampleModel`: each sample's cached result, or its ring's per-blade peaks
+    computed and stored; a failed solve is that sample's ``error``.
+
+    ``task``: ``study``, ``band_hz``, ``tuned_frequency_hz``, ``folder``, ``max_bytes``
+    and ``items`` (each ``index``, ``kappa``, ``key``). Returns ``results`` (in the
+    items' order) and the chunk's ``cpu_s`` (this process's CPU time) and ``wall_s``.
+    """
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    c0, t0 = time.process_time(), time.perf_counter()
     store = Store(task["folder"], task["max_bytes"])
-    hit = store.get(task["key"])
-    if hit is not None:
-        return hit[1]["data"] | {"cached": True, "index": task["index"]}
+    model, results = None, []
+    for item in task["items"]:
+        hit = store.get(item["key"])
+        if hit is not None:
+            results.append(hit[1]["data"] | {"cached": True, "index": item["index"]})
+            continue
+        if model is None:   # a chunk read wholly from the cache builds nothing
+            model = SampleModel(Study(**task["study"]), task["band_hz"], task["tuned_frequency_hz"])
+        results.append(_run_one(model, store, item))
+    if model is not None:
+        store.evict()       # once per chunk: each check lists the whole cache folder
+    return {"results": results, "cpu_s": time.process_time() - c0, "wall_s": time.perf_counter() - t0}
+
+
+def _run_one(model: SampleModel, store: Store, item: dict) -> dict:
+    """One sample of a chunk: solved and stored, or its error (not stored)."""
     t0 = time.perf_counter()
     try:
-        out = _solve_sample(Study(**task["study"]), task["kappa"], task["band_hz"],
-                            task["tuned_frequency_hz"])
+        out = _solve_sample(model, item["kappa"])
     except (RuntimeError, ValueError, ArithmeticError, np.linalg.LinAlgError) as err:
         # a diverged solve (the C core refuses a non-finite iterate: a ValueError); the
-        # model itself was checked by the study's tuned reference before any sample
-        return {"index": task["index"], "error": f"{type(err).__name__}: {err}", "cached": False,
+        # model itself was checked by the study's tuned reference before any sample.
+        model.tuned = None   # rebuilt for the next sample: nothing of a failed solve carries over
+        return {"index": item["index"], "error": f"{type(err).__name__}: {err}", "cached": False,
                 "time_s": time.perf_counter() - t0}
-    out |= {"index": task["index"], "error": None, "time_s": time.perf_counter() - t0}
-    store.put(task["key"], {}, {"data": out})
+    out |= {"index": item["index"], "error": None, "time_s": time.perf_counter() - t0}
+    store.put(item["key"], {}, {"data": out}, evict=False)
     return out | {"cached": False}
 
 
-def _solve_sample(study: Study, kappa, band, f_tuned) -> dict:
+def run_sample(task: dict) -> dict:
+    """One sample as a chunk of one (``task`` holds ``index``, ``kappa``, ``key`` besides the
+    chunk's settings); its result row."""
+    item = {k: task[k] for k in ("index", "kappa", "key")}
+    return run_chunk({k: v for k, v in task.items() if k not in item} | {"items": [item]})["results"][0]
+
+
+def _solve_sample(model: SampleModel, kappa) -> dict:
     """Per-blade peaks [m] and frequencies [Hz] of one pattern (raises on solver failure)."""
-    from harmonic_balance.bladed_disk.mistuning import LinearRing
+    from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
     from harmonic_balance.bladed_disk.ring_solve import ring_frf
-    from harmonic_balance.bladed_disk.sector import Sector
 
-    sector = Sector(study.load())
-    om = 2 * np.pi * np.linspace(band[0], band[1], study.points)
-    if study.damper != "nonlinear":
-        lin = LinearRing(sector, kappa, study.damper, study.f0)
+    study, om = model.study, model.om
+    if model.family is not None:
+        lin = model.family.ring(kappa)
         peaks, w = lin.peaks(om)
         _inside(w[peaks.argmax()], om)
         return {"peak_per_blade": peaks.tolist(), "peak_frequency_per_blade_hz": (w / 2 / np.pi).tolist(),
                 "evaluations": lin.solves, "truncated": []}
-    ring = MistunedRingHB(sector, kappa, study.harmonics, cf=study.cf, f0=study.f0)
-    c = ring_frf(ring, om, start_omega=2 * np.pi * f_tuned)
+    ring = MistunedRingHB(model.sector, kappa, study.harmonics, cf=study.cf, f0=study.f0)
+    if model.tuned is None:   # as RingSolver builds it: the ring's H, loads, mu and time grid
+        model.tuned = SectorHB(ring.sector, ring.H, cf=ring.cf, f0=ring.f0, mu=ring.mu,
+                               n_t=ring.basis.n_t)
+    c = ring_frf(ring, om, model.tuned, start_omega=2 * np.pi * model.f_tuned)
     _inside(c.peak_omega, om)
     return {"peak_per_blade": c.peak_per_blade.tolist(),
             "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
@@ -258,29 +321,86 @@ def _inside(w: float, om: np.ndarray) -> None:
 
 def run_study(study: Study, store: Store, scheduler: str | None = None, workers: int | None = None,
               serial: bool = False, echo=print) -> dict:
-    """Run (or resume) the study; the JSON-able summary (module docstring)."""
+    """Run (or resume) the study in chunks; the JSON-able summary (module docstring)."""
     t0 = time.perf_counter()
     study.check()
     cfg = study.load()
     kappas = study.patterns(cfg.blades)           # every bad pattern refused before any work
     from damper.tasks import executor
 
-    submit, gather, close = executor(scheduler, workers, serial)  # an unreachable scheduler: now
+    info = {}
+    submit, gather, close = executor(scheduler, workers, serial, info)  # an unreachable scheduler: now
     try:
         ref = tuned_reference(study, cfg)
         fp = fingerprint(cfg)
-        tasks = [{"study": asdict(study), "index": i, "kappa": k.tolist(), "band_hz": ref["band_hz"],
-                  "tuned_frequency_hz": ref["tuned_frequency_hz"], "folder": str(store.folder),
-                  "max_bytes": store.max_bytes, "key": sample_key(study, fp, ref["band_hz"], k)}
+        common = {"study": asdict(study), "band_hz": ref["band_hz"], "folder": str(store.folder),
+                  "tuned_frequency_hz": ref["tuned_frequency_hz"], "max_bytes": store.max_bytes}
+        items = [{"index": i, "kappa": k.tolist(), "key": sample_key(study, fp, ref["band_hz"], k)}
                  for i, k in enumerate(kappas)]
-        done = sum(store.contains(t["key"]) for t in tasks)
+        done = sum(store.contains(t["key"]) for t in items)
+        n_workers = info.get("workers", 1)
         where = ("this process" if serial else scheduler
-                 or f"a local Dask cluster ({workers or os.cpu_count()} workers)")
-        echo(f"mistuning: {len(tasks)} samples of {cfg.blades} blades, {done} in the cache, on {where}")
-        results = gather([submit(run_sample, t) for t in tasks])
+                 or f"a local Dask cluster ({n_workers} workers)")
+        size = chunk_size(len(items), n_workers, study.until_ci)
+        echo(f"mistuning: {len(items)} samples of {cfg.blades} blades, {done} in the cache, on {where}, "
+             f"in chunks of {size}" + (f", until the 0.95 quantile is known to +-{study.until_ci:g}"
+                                       if study.until_ci else ""))
+        run = _run_chunks(common, items, size, submit, gather, 1 if serial else 2 * n_workers,
+                          study.until_ci, ref["tuned_peak"], echo)
     finally:
         close()
-    return summarize(study, cfg, ref, kappas, results, time.perf_counter() - t0)
+    n = len(run["results"])
+    run["efficiency"] |= {"workers": n_workers}
+    e = run["efficiency"]
+    e["efficiency"] = e["cpu_s"] / (n_workers * max(e["wall_s"], 1e-9))   # (a study read from the cache: ~0)
+    out = summarize(study, cfg, ref, kappas[:n], run["results"], time.perf_counter() - t0)
+    out["efficiency"] = run["efficiency"]
+    if study.until_ci is not None:
+        out["until_ci"] = run["until_ci"]
+    return out
+
+
+def chunk_size(n_samples: int, n_workers: int, until_ci: float | None) -> int:
+    """Samples per chunk: :data:`CHUNK_UNTIL_CI` when the study stops on its interval (the
+    stopping sample count then does not depend on the workers), else about
+    :data:`CHUNKS_PER_WORKER` chunks per worker (load balance) of at most :data:`MAX_CHUNK`."""
+    if until_ci is not None:
+        return min(CHUNK_UNTIL_CI, n_samples)
+    return max(1, min(MAX_CHUNK, -(-n_samples // (CHUNKS_PER_WORKER * n_workers))))
+
+
+def _run_chunks(common, items, size, submit, gather, window, until_ci, tuned_peak, echo) -> dict:
+    """The chunks in index order, at most ``window`` in flight; with ``until_ci``, stops
+    after the first chunk whose prefix of samples gives the 0.95 quantile's interval a
+    half-width <= until_ci. Returns the prefix's ``results``, ``efficiency`` (the chunks'
+    CPU time and the wall time of this phase) and ``until_ci``."""
+    from collections import deque
+
+    from damper.mistuning_stats import quantile_half_width
+
+    chunks = [items[i:i + size] for i in range(0, len(items), size)]
+    t0, cpu, results, gathered = time.perf_counter(), 0.0, [], 0
+    pending, nxt, half = deque(), 0, float("inf")
+    while pending or nxt < len(chunks):
+        while nxt < len(chunks) and len(pending) < (window if until_ci else len(chunks)):
+            pending.append(submit(run_chunk, common | {"items": chunks[nxt]}))
+            nxt += 1
+        r = gather([pending.popleft()])[0]
+        cpu, gathered = cpu + r["cpu_s"], gathered + 1
+        results += r["results"]
+        if until_ci is None:
+            continue
+        amp = [max(s["peak_per_blade"]) / tuned_peak for s in results if s.get("error") is None]
+        half = quantile_half_width(amp, 0.95) if amp else float("inf")
+        if half <= until_ci:
+            echo(f"mistuning: the 0.95 quantile's interval half-width {half:.4g} <= {until_ci:g} "
+                 f"after {len(results)} samples")
+            break
+    wall = time.perf_counter() - t0
+    return {"results": results,
+            "efficiency": {"cpu_s": cpu, "wall_s": wall, "chunks": gathered, "chunk_size": size},
+            "until_ci": {"half_width_target": until_ci, "half_width": None if half == float("inf") else half,
+                         "samples_used": len(results), "reached": half <= (until_ci or 0.0)}}
 
 
 def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> dict:
@@ -316,10 +436,11 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
     if amp.size == 0:
         raise AllSamplesFailed(f"every sample failed; the first: {samples[0]['error']}",
                                out | {"max_amplification": None, "mean_amplification": None,
-                                      "std_amplification": None, "quantiles": None})
+                                      "std_amplification": None, "quantiles": None, "statistics": None})
     return out | {"max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
                   "std_amplification": float(amp.std()),
-                  "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES}}
+                  "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
+                  "statistics": mistuning_stats.summary(amp)}
 
 
 def plot_study(out: dict, folder) -> dict:
@@ -339,9 +460,10 @@ def plot_study(out: dict, folder) -> dict:
     amp = np.array([s["amplification"] for s in ok])
     folder = Path(folder)
     fig, ax = plt.subplots(figsize=(6, 4))
-    ax.hist(amp, bins=max(5, min(40, amp.size // 4)), color="C0", alpha=0.8)
+    counts, edges, _ = ax.hist(amp, bins=max(5, min(40, amp.size // 4)), color="C0", alpha=0.8)
     ax.axvline(1.0, color="k", lw=1, label="tuned")
     ax.axvline(out["whitehead_bound"], color="C3", ls="--", lw=1, label="(1 + sqrt(N_b)) / 2")
+    _plot_statistics(ax, out["statistics"], amp.size * (edges[1] - edges[0]), edges)
     ax.set_xlabel("amplification factor (worst blade / tuned peak)")
     ax.set_ylabel("samples")
     ax.set_title(f"{len(ok)} samples, N_b = {out['blades']}, damper {out['damper']}")
@@ -365,3 +487,22 @@ def plot_study(out: dict, folder) -> dict:
     paths["blades"] = str(_save(fig, folder / "mistuning_blades.png"))
     plt.close(fig)
     return paths
+
+
+def _plot_statistics(ax, st: dict, per_density: float, edges) -> None:
+    """The best fitted density (scaled to the histogram's counts) and the 0.95 quantile
+    with its interval (shaded) on the histogram's axes."""
+    from scipy import stats
+
+    fit = st.get("fit")
+    if fit and fit["best"]:
+        f = fit["fits"][fit["best"]]
+        x = np.linspace(edges[0], edges[-1], 300)
+        pdf = getattr(stats, f["family"]).pdf(x, *f["params"].values())
+        ax.plot(x, per_density * pdf, color="C1", lw=1.5,
+                label=f"{f['family']} fit (KS D {f['ks_distance']:.3f})")
+    q = next((q for q in st["quantiles"] if q["q"] == 0.95), None)
+    if q is not None:
+        ax.axvline(q["value"], color="C2", lw=1, label="0.95 quantile")
+        if q["low"] is not None and q["high"] is not None:
+            ax.axvspan(q["low"], q["high"], color="C2", alpha=0.2, label="its 95 % interval")

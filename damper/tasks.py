@@ -33,13 +33,18 @@ def _ignore_sigint_plugin():
     return IgnoreSigint()
 
 
-def executor(scheduler, workers, serial):
+def executor(scheduler, workers, serial, info: dict | None = None):
     """(submit, gather, close) for a Dask client, or plain calls for ``serial``.
+
+    ``info``, when given, receives ``workers``: the number of processes that run tasks
+    (1 for ``serial``; the cluster's workers when connected).
 
     Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
     be reached within :data:`CONNECT_TIMEOUT` seconds.
     """
+    info = {} if info is None else info
     if serial:
+        info["workers"] = 1
         return (lambda f, *a: f(*a)), (lambda fs: fs), (lambda: None)
     import dask
     from dask.distributed import Client, LocalCluster
@@ -51,6 +56,7 @@ def executor(scheduler, workers, serial):
             raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
                           "or give the right --scheduler address (tcp://host:8786)") from None
         cluster = scratch = None
+        info["workers"] = max(1, len(client.scheduler_info().get("workers", {})))
     else:
         n = workers or os.cpu_count() or 1
         scratch = tempfile.mkdtemp(prefix="damper_workers_")
@@ -60,6 +66,7 @@ def executor(scheduler, workers, serial):
                                        silence_logs=logging.CRITICAL, local_directory=scratch,
                                        env={"TMPDIR": scratch})
             client = Client(cluster)
+            info["workers"] = n
             # A terminal's Ctrl-C reaches the whole process group: this process alone handles it
             # (one line, exit 130) and closes the cluster; each worker would print a traceback.
             client.register_plugin(_ignore_sigint_plugin(), name="damper-ignore-sigint")

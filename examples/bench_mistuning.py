@@ -10,17 +10,19 @@ Rows:
 * ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
   cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
   time: why the solver factors the mistuned Jacobian instead.
-* ``throughput``: a Monte Carlo study (``damper.mistuning``, N_b = 24, std 0.02) on a
-  Dask local cluster of 1 and 2 workers, fresh caches: wall time and samples per
-  minute; the traced memory peak of one sample (tracemalloc, a separate run). With
-  ``--quick`` the samples run in this process (``workers = 0``, the serial executor):
-  the quick mode starts no Dask cluster (the documentation build runs it).
+* ``throughput``: a Monte Carlo study (``damper.mistuning``, N_b = 24, std 0.02, the
+  friction damper or ``--damper free|stuck``) on a Dask local cluster of 1 and 2 workers
+  (``--workers``), fresh caches: wall time, samples per minute, the chunks' CPU time and
+  the parallel efficiency CPU / (workers x wall); the traced memory peak of one sample
+  (tracemalloc, a separate run). With ``--quick`` (and no ``--workers``) 2 samples run
+  in this process (``workers = 0``, the serial executor): the quick mode starts no Dask
+  cluster (the documentation build runs it).
 
 Times are CPU (process_time) where one process works, wall time for the clusters: the
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling precond throughput] [--samples 8] [--quick]
+        [--rows scaling precond throughput] [--samples 8] [--quick] [--workers 1 2] [--damper free]
 """
 from __future__ import annotations
 
@@ -109,24 +111,32 @@ def precond_rows(stds, nb=24) -> list:
     return rows
 
 
-def throughput_rows(samples: int, workers=(1, 2)) -> list:
+def throughput_rows(samples: int, workers=(1, 2), damper: str = "nonlinear") -> list:
     """Monte Carlo rows; ``workers`` are Dask local-cluster sizes, 0 is this process
-    (serial executor, no cluster)."""
+    (serial executor, no cluster). Each row: wall time, the chunks' CPU time and the
+    parallel efficiency CPU / (workers x wall) of the study's sample phase."""
     from damper.cache import Store
     from damper.mistuning import Study, run_sample, run_study
 
     rows = []
-    study = Study(std=0.02, samples=samples, seed=1)
+    study = Study(std=0.02, samples=samples, seed=1, damper=damper)
     for n in workers:
         with tempfile.TemporaryDirectory() as tmp:
+            load0 = os.getloadavg()[0]
             t0 = time.perf_counter()
             out = run_study(study, Store(tmp), workers=n or None, serial=n == 0, echo=lambda t: None)
             wall = time.perf_counter() - t0
         ok = [s for s in out["samples"] if s["error"] is None]
-        rows.append({"case": "Monte Carlo", "blades": out["blades"], "workers": n, "samples": samples,
-                     "failed": out["failed"], "wall_s": wall, "samples_per_min": 60 * samples / wall,
+        e = out["efficiency"]
+        rows.append({"case": "Monte Carlo", "blades": out["blades"], "damper": damper, "workers": n,
+                     "samples": samples, "failed": out["failed"], "wall_s": wall,
+                     "samples_per_min": 60 * samples / wall, "chunks": e["chunks"],
+                     "chunk_size": e["chunk_size"], "sample_phase_wall_s": e["wall_s"],
+                     "cpu_s": e["cpu_s"], "cpu_per_sample_s": e["cpu_s"] / samples,
+                     "efficiency": e["efficiency"],
                      "sample_s_median": float(np.median([s["time_s"] for s in ok])),
-                     "max_amplification": out["max_amplification"], "load_avg": os.getloadavg()[0]})
+                     "max_amplification": out["max_amplification"],
+                     "load_avg_before": load0, "load_avg_after": os.getloadavg()[0]})
         print(_fmt(rows[-1]), flush=True)
     # memory of one sample (tracemalloc traces numpy's buffers; a separate, untimed run)
     from damper.mistuning import fingerprint, sample_key, tuned_reference
@@ -157,6 +167,11 @@ def main(argv=None) -> int:
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
                    choices=("scaling", "precond", "throughput"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
+    p.add_argument("--workers", type=int, nargs="+",
+                   help="Dask local-cluster sizes of the throughput rows (0: this process; "
+                   "default 1 2, --quick 0)")
+    p.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
+                   help="the throughput rows' damper (free/stuck: the cheap linear limits)")
     p.add_argument("--quick", action="store_true",
                    help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
     a = p.parse_args(argv)
@@ -168,7 +183,8 @@ def main(argv=None) -> int:
     if "precond" in a.rows:
         rows += precond_rows((0.02,) if a.quick else (0.002, 0.005, 0.02), nb=8 if a.quick else 24)
     if "throughput" in a.rows:
-        rows += throughput_rows(2 if a.quick else a.samples, (0,) if a.quick else (1, 2))
+        workers = a.workers or ((0,) if a.quick else (1, 2))
+        rows += throughput_rows(a.samples if a.workers or not a.quick else 2, workers, a.damper)
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "bench_mistuning.json").write_text(json.dumps(rows, indent=1, default=str) + "\n")
     print(f"table in {a.out / 'bench_mistuning.json'}")

@@ -79,6 +79,9 @@ def _mistuning(s) -> None:
     p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                    help="band [Hz] (default: around the tuned peak, widened with the scatter)")
     p.add_argument("--points", type=int, default=41, help="frequency points per ring curve")
+    p.add_argument("--until-ci", type=float, metavar="W",
+                   help="stop when the amplification's 0.95 quantile is known to +-W (its 95 %% "
+                   "interval's half-width); --samples is then the most to run (default 2000)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=int, help="local Dask cluster workers (default: cores)")
     p.add_argument("--serial", action="store_true", help="no Dask: the samples in this process")
@@ -105,13 +108,15 @@ def run_mistuning(args) -> int:
         limits.check_workers("--workers", args.workers)
     check_out_dir(args.plot, "--plot")
     draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
+    if args.until_ci is not None and args.factors is None:
+        draw.setdefault("samples", UNTIL_CI_SAMPLES)
     if args.factors is not None and draw:
         raise ValueError("give --factors or --std/--samples/--seed, not both")
     study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
                   **draw, kind=args.kind,
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
                   cf=args.cf, f0=args.f0, harmonics=args.harmonics,
-                  band_hz=args.band, points=args.points)
+                  band_hz=args.band, points=args.points, until_ci=args.until_ci)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     try:
         out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
@@ -132,12 +137,47 @@ def run_mistuning(args) -> int:
         print_json(out)
         return 0
     _print_samples(out)
-    q = out["quantiles"]
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
-          f"max {out['max_amplification']:.4f}, mean {out['mean_amplification']:.4f}, median {q['0.5']:.4f}, "
-          f"95 % {q['0.95']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); {out['failed']} failed, "
-          f"{out['cached']} from the cache, {out['time_s']:.1f} s")
+          f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
+          f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
+    for line in statistics_lines(out):
+        print(line)
     return 0
+
+
+#: Most samples of an --until-ci study without --samples.
+UNTIL_CI_SAMPLES = 2000
+
+
+def _ci(d: dict) -> str:
+    lo, hi = ("-" if d[k] is None else f"{d[k]:.4f}" for k in ("low", "high"))
+    return f"[{lo}, {hi}]"
+
+
+def statistics_lines(out: dict) -> list:
+    """The printed statistics: mean and quantiles with their 95 % intervals, the fit, the
+    stopping rule, the parallel efficiency."""
+    st = out["statistics"]
+    lines = [f"amplification over {st['n']} samples (95 % intervals): mean {st['mean']['value']:.4f} "
+             f"{_ci(st['mean'])}"]
+    lines += [f"  quantile {q['q']:<4g} {q['value']:.4f} {_ci(q)}" for q in st["quantiles"]]
+    fit = st["fit"]
+    if fit and fit["best"]:
+        f = fit["fits"][fit["best"]]
+        p = f["params"]
+        lines.append(f"  fit {f['family']}: c {p['c']:.4g}, loc {p['loc']:.5g}, scale {p['scale']:.4g}; "
+                     f"KS distance {f['ks_distance']:.4f} (p {f['ks_pvalue']:.2g}); 0.95 quantile "
+                     f"{f['quantiles']['0.95']:.4f}")
+    if "until_ci" in out:
+        u = out["until_ci"]
+        lines.append(f"  --until-ci {u['half_width_target']:g}: " + (
+            f"reached after {u['samples_used']} samples" if u["reached"] else
+            f"not reached after {u['samples_used']} samples (half-width "
+            f"{'unbounded' if u['half_width'] is None else format(u['half_width'], '.4g')}; give more --samples)"))
+    e = out["efficiency"]
+    lines.append(f"parallel efficiency {e['efficiency']:.2f}: {e['cpu_s']:.1f} s CPU in {e['chunks']} "
+                 f"chunks of {e['chunk_size']} on {e['workers']} worker(s) in {e['wall_s']:.1f} s")
+    return lines
 
 
 def _print_samples(out: dict) -> None:

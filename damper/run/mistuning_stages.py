@@ -18,7 +18,7 @@ class Mistuning(Kind):
     """Per-blade peaks of the mistuned ring over samples, amplification statistics."""
 
     name = "mistuning"
-    modules = ("harmonic_balance", "fmu_src", "damper.mistuning")
+    modules = ("harmonic_balance", "fmu_src", "damper.mistuning", "damper.mistuning_stats")
 
     def instances(self, data):
         if "mistuning" not in data:
@@ -45,10 +45,26 @@ class Mistuning(Kind):
         o = result.data
         return [f"{len(o['samples'])} samples of {o['blades']} blades ({o['failed']} failed): amplification "
                 f"max {o['max_amplification']:.4f}, median {o['quantiles']['0.5']:.4f} over the tuned peak "
-                f"{o['tuned_peak']:.4e} m at {o['tuned_frequency_hz']:.2f} Hz"]
+                f"{o['tuned_peak']:.4e} m at {o['tuned_frequency_hz']:.2f} Hz"] + _ci_lines(o)
 
     def scalars(self, stage, result):
         o = result.data
         return {"max_amplification": o["max_amplification"], "mean_amplification": o["mean_amplification"],
                 "q95_amplification": o["quantiles"]["0.95"], "tuned_peak_m": o["tuned_peak"],
-                "failed_samples": o["failed"]}
+                "failed_samples": o["failed"]} | {f"q95_amplification_{k}": v for k, v in _q95(o).items()
+                                                  if k in ("low", "high") and v is not None}
+
+
+def _q95(o: dict) -> dict:
+    return next(q for q in o["statistics"]["quantiles"] if q["q"] == 0.95)
+
+
+def _ci_lines(o: dict) -> list:
+    """The 0.95 quantile's interval and the --until-ci outcome."""
+    q = _q95(o)
+    line = (f"0.95 quantile {q['value']:.4f}, 95 % interval " + (
+        f"[{q['low']:.4f}, {q['high']:.4f}]" if q["half_width"] is not None else "not bounded by so few samples"))
+    if "until_ci" in o:
+        u = o["until_ci"]
+        line += f"; until_ci {u['half_width_target']:g} " + ("reached" if u["reached"] else "not reached")
+    return [line]

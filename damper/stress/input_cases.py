@@ -266,6 +266,9 @@ def _upd() -> list[InputCase]:
         ("mistuning unreachable scheduler", "mistuning --scheduler tcp://127.0.0.1:9 --samples 2"),
         ("mistuning workers and serial", "mistuning --workers 2 --serial"),
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
+        ("mistuning until-ci 0", "mistuning --until-ci 0"), ("mistuning until-ci nan", "mistuning --until-ci nan"),
+        ("mistuning until-ci inf", "mistuning --until-ci inf"),
+        ("mistuning until-ci with factors", "mistuning --blades 4 --engine-order 1 --factors 1 1 1 1 --until-ci 0.01"),
     ], "upd")
 
 

@@ -35,6 +35,11 @@ def _run(argv, capsys, code=0):
     (["--factors", "1", "1", "1", "1", "--std", "0.1"], "not both"),
     (["--scheduler", "tcp://127.0.0.1:9"], "cannot reach the Dask scheduler"),
     (["--workers", "2", "--serial"], "give one of"),
+    (["--until-ci", "0"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "-0.01"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "nan"], "until-ci half-width must be finite and > 0"),
+    (["--until-ci", "inf"], "until-ci half-width must be finite and > 0"),
+    (["--factors", "1", "1", "1", "1", "--until-ci", "0.01"], "needs random samples"),
 ])
 def test_refused_input_exit_2_nothing_written(tmp_path, capsys, monkeypatch, extra, message):
     monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 1)   # the unreachable scheduler: 1 s
@@ -71,10 +76,10 @@ def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
     assert first["cached"] == 0 and first["failed"] == 0
     solve, third = mt._solve_sample, draw_factors(4, 0.02, 3, 2).tolist()
 
-    def failing(study, kappa, band, f):
+    def failing(model, kappa):
         if kappa == third:
             raise RuntimeError("ring harmonic balance failed (test)")
-        return solve(study, kappa, band, f)
+        return solve(model, kappa)
 
     monkeypatch.setattr(mt, "_solve_sample", failing)
     again = _run(args + ["--samples", "3"], capsys)
@@ -90,7 +95,7 @@ def test_resume_and_a_failing_sample(tmp_path, capsys, monkeypatch):
 def test_every_sample_failing_prints_the_object_with_the_errors_and_exits_3(tmp_path, capsys, monkeypatch):
     import damper.mistuning as mt
 
-    def failing(study, kappa, band, f):
+    def failing(model, kappa):
         raise RuntimeError("ring harmonic balance failed (test)")
 
     monkeypatch.setattr(mt, "_solve_sample", failing)
@@ -100,6 +105,7 @@ def test_every_sample_failing_prints_the_object_with_the_errors_and_exits_3(tmp_
     out = json.loads(cap.out)
     assert code == 3 and "every sample failed" in cap.err.splitlines()[-1]
     assert out["failed"] == 2 and out["max_amplification"] is None and out["quantiles"] is None
+    assert out["statistics"] is None
     assert all("failed (test)" in s["error"] and s["amplification"] is None for s in out["samples"])
 
 
