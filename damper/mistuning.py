@@ -46,6 +46,9 @@ QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 #: docstring; a blade's frequency scatters by sigma_f).
 BAND_MARGIN, BAND_SIGMAS = 0.02, 3.0
 DAMPERS = ("nonlinear", "free", "stuck")
+#: Ring solvers: ``fast`` (``ring_fast``: adaptive continuation, Hermite peaks) and
+#: ``full`` (``ring_solve``: every point of the grid solved; the reference).
+SOLVERS = ("fast", "full")
 
 
 @dataclass
@@ -71,6 +74,7 @@ class Study:
     harmonics: int = 7
     band_hz: list | None = None
     points: int = 41
+    solver: str = "fast"
 
     def load(self):
         """The validated UPD config with ``blades`` / ``engine_order`` applied (ValueError)."""
@@ -90,6 +94,8 @@ class Study:
 
         if self.damper not in DAMPERS:
             raise ValueError(f"damper must be one of {DAMPERS}, got {self.damper!r}")
+        if self.solver not in SOLVERS:
+            raise ValueError(f"solver must be one of {SOLVERS}, got {self.solver!r}")
         for name in ("cf", "f0"):
             v = getattr(self, name)
             if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
@@ -179,7 +185,7 @@ def tuned_reference(study: Study, cfg) -> dict:
 def sample_key(study: Study, fp: str, band: list, kappa) -> str:
     """Cache key of one sample: model, solver settings, band, pattern, code version."""
     settings = {k: v for k, v in asdict(study).items()
-                if k in ("damper", "cf", "f0", "harmonics", "points")}
+                if k in ("damper", "cf", "f0", "harmonics", "points", "solver")}
     return make_key("mistuning_sample", VERSION, fp, settings, [float(b) for b in band],
                     [float(k) for k in kappa], code_version(MODULES))
 
@@ -209,6 +215,7 @@ def run_sample(task: dict) -> dict:
 def _solve_sample(study: Study, kappa, band, f_tuned) -> dict:
     """Per-blade peaks [m] and frequencies [Hz] of one pattern (raises on solver failure)."""
     from harmonic_balance.bladed_disk.mistuning import LinearRing
+    from harmonic_balance.bladed_disk.ring_fast import fast_ring_frf
     from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
     from harmonic_balance.bladed_disk.ring_solve import ring_frf
     from harmonic_balance.bladed_disk.sector import Sector
@@ -222,7 +229,10 @@ def _solve_sample(study: Study, kappa, band, f_tuned) -> dict:
         return {"peak_per_blade": peaks.tolist(), "peak_frequency_per_blade_hz": (w / 2 / np.pi).tolist(),
                 "evaluations": lin.solves, "truncated": []}
     ring = MistunedRingHB(sector, kappa, study.harmonics, cf=study.cf, f0=study.f0)
-    c = ring_frf(ring, om, start_omega=2 * np.pi * f_tuned)
+    if study.solver == "fast":
+        c = fast_ring_frf(ring, (om[0], om[-1]), start_omega=2 * np.pi * f_tuned)
+    else:
+        c = ring_frf(ring, om, start_omega=2 * np.pi * f_tuned)
     _inside(c.peak_omega, om)
     return {"peak_per_blade": c.peak_per_blade.tolist(),
             "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
@@ -290,7 +300,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "kind": study.kind, "distribution": study.distribution,
             "std": None if study.factors is not None else study.std, "seed": study.seed,
             "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
-            "band_hz": ref["band_hz"], "points": study.points,
+            "band_hz": ref["band_hz"], "points": study.points, "solver": study.solver,
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),

@@ -73,7 +73,11 @@ def _mistuning(s) -> None:
     p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H")
     p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                    help="band [Hz] (default: around the tuned peak, widened with the scatter)")
-    p.add_argument("--points", type=int, default=41, help="frequency points per ring curve")
+    p.add_argument("--points", type=int, default=41,
+                   help="frequency points per ring curve (--solver full)")
+    p.add_argument("--solver", choices=("fast", "full"), default="fast",
+                   help="fast: adaptive continuation with Hermite peaks (default); full: the "
+                   "fixed grid with every point solved (the reference)")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=int, help="local Dask cluster workers (default: cores)")
     p.add_argument("--serial", action="store_true", help="no Dask: the samples in this process")
@@ -106,7 +110,7 @@ def run_mistuning(args) -> int:
                   **draw, kind=args.kind,
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
                   cf=args.cf, f0=args.f0, harmonics=args.harmonics,
-                  band_hz=args.band, points=args.points)
+                  band_hz=args.band, points=args.points, solver=args.solver)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     try:
         out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)

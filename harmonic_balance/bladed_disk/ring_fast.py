@@ -54,6 +54,9 @@ PREDICTOR_ERR = 0.01
 STEP_START, STEP_MIN, STEP_MAX = 1.0 / 40, 1.0 / 2000, 1.0 / 8
 #: Largest growth of the step from one point to the next.
 STEP_GROW = 2.0
+#: A blade's Hermite peak above the polished largest by more than this is polished too
+#: (else capped at it): Hermite's error at the continuation's steps is ~1e-5.
+HERMITE_RTOL = 1e-4
 #: Secant iterations of the peak polish.
 POLISH_ITER = 8
 
@@ -153,9 +156,12 @@ class FastRingSolver:
         return self.factor.solve_near(J, -Rw)
 
     def start(self, omega: float):
-        """(x, dx/domega) at omega from the reference's start (tuned map, homotopy)."""
-        x = self.ref.start(omega)
-        return self.solve(omega, x, 40)
+        """(x, dx/domega) at omega from the mapped tuned solution, else from the
+        reference's start (scatter homotopy, stuck guess)."""
+        try:
+            return self.restart(omega)
+        except (NewtonError, SolverError):
+            return self.solve(omega, self.ref.start(omega), 40)
 
     def restart(self, omega: float):
         """(x, dx/domega) at omega from the mapped tuned solution (past a kink)."""
@@ -308,7 +314,7 @@ def fast_ring_frf(ring: MistunedRingHB, band, tuned: SectorHB | None = None,
                           f"{w[0] / 2 / np.pi:.6g}-{w[-1] / 2 / np.pi:.6g} Hz: the sweep "
                           f"{'; '.join(errors)}")
     if polish:
-        _polish(solver, c, dA)
+        _polish_largest(solver, c, dA)
     c.evaluations, c.newton_iterations = ring.evaluations - e0, solver.iterations
     c.extra |= {"factorizations": solver.factor.factorizations,
                 "refinements": solver.factor.refinements,
@@ -317,43 +323,61 @@ def fast_ring_frf(ring: MistunedRingHB, band, tuned: SectorHB | None = None,
     return c
 
 
-def _polish(solver: FastRingSolver, c: RingCurve, dA: np.ndarray) -> None:
-    """Worst blade's peak by the secant method on da_j/domega = 0 from its Hermite
-    estimate (module docstring); values met raise the per-blade peaks."""
+def _polish_largest(solver: FastRingSolver, c: RingCurve, dA: np.ndarray) -> None:
+    """Polish the largest Hermite peak; again any other blade's that still exceeds the
+    polished largest by more than :data:`HERMITE_RTOL`; the others are capped at it
+    (an interpolant's overshoot), as the reference caps its parabolas."""
+    done, best = set(), -np.inf
+    while True:
+        rest = [j for j in np.argsort(-c.peak_per_blade) if j not in done]
+        if not rest or (done and c.peak_per_blade[rest[0]] <= best * (1 + HERMITE_RTOL)):
+            break
+        c.worst = int(rest[0])
+        c.peak, c.peak_omega = float(c.peak_per_blade[c.worst]), float(c.peak_omega_per_blade[c.worst])
+        val, wk, xk = _polish(solver, c, dA)
+        done.add(c.worst)
+        if val > best:
+            best, w_best, x_best = val, wk, xk
+    c.peak_per_blade = np.minimum(c.peak_per_blade, best)
+    c.worst = int(c.peak_per_blade.argmax())
+    c.peak, c.peak_omega, c.peak_x = float(best), w_best, x_best
+
+
+def _polish(solver: FastRingSolver, c: RingCurve, dA: np.ndarray):
+    """Blade ``c.worst``'s peak by a bracketed secant method on da_j/domega = 0 from its
+    Hermite estimate (module docstring); values met raise the per-blade peaks.
+    Returns the polished (peak [m], omega, x)."""
     w, j = c.omega, c.worst
     if c.peak_omega <= w[0] or c.peak_omega >= w[-1]:
-        c.peak_x = c.x[int(np.argmin(np.abs(w - c.peak_omega)))]
-        return
+        k = int(np.argmin(np.abs(w - c.peak_omega)))
+        return float(c.amplitude[k, j]), float(w[k]), c.x[k]
     br = Branch(solver.ring)
     i = int(np.clip(np.searchsorted(w, c.peak_omega), 1, w.size - 1))
-    lo, hi = w[i - 1], w[i]
-    pts = [(lo, dA[i - 1, j]), (hi, dA[i, j])]
-    wk = c.peak_omega
-    met = []
+    (lo, glo), (hi, ghi) = (w[i - 1], dA[i - 1, j]), (w[i], dA[i, j])
+    wk, met, side = c.peak_omega, [], 0
     for _ in range(POLISH_ITER):
         k = int(np.argmin(np.abs(w - wk)))
-        x0, xp = c.x[k], c.extra["tangents"][k]
         try:
-            x, xpk = solver.solve(wk, x0 + (wk - w[k]) * xp, 40)
+            x, xp = solver.solve(wk, c.x[k] + (wk - w[k]) * c.extra["tangents"][k], 40)
         except NewtonError as err:
             raise SolverError(f"peak refinement near {wk / 2 / np.pi:.6g} Hz failed ({err}); "
                               "use a finer continuation") from None
-        a, da = br.amplitude(x, xpk)
+        a, da = br.amplitude(x, xp)
         met.append((wk, x, a))
-        pts.append((wk, da[j]))
-        # secant on da_j/domega through the two iterates closest to the root
-        (w1, g1), (w2, g2) = sorted(pts, key=lambda p: abs(p[1]))[:2]
-        if g1 == g2:
+        g = da[j]
+        # Illinois (bracketed secant) on da_j/domega = 0: keep g(lo) > 0 > g(hi)
+        if g > 0:
+            lo, glo = wk, g
+            ghi, side = (0.5 * ghi if side == 1 else ghi), 1
+        else:
+            hi, ghi = wk, g
+            glo, side = (0.5 * glo if side == -1 else glo), -1
+        if hi - lo <= PEAK_XTOL * wk or not (glo > 0 > ghi):
             break
-        wn = float(np.clip(w1 - g1 * (w1 - w2) / (g1 - g2), lo, hi))
-        if abs(wn - wk) <= PEAK_XTOL * wk:
-            break
-        wk = wn
+        wk = lo + (hi - lo) * glo / (glo - ghi)
     wk, xk, ak = max(met, key=lambda m: m[2][j])
-    c.peak, c.peak_omega, c.peak_x = float(ak[j]), wk, xk
-    c.peak_per_blade[j], c.peak_omega_per_blade[j] = c.peak, wk
+    c.peak_per_blade[j], c.peak_omega_per_blade[j] = float(ak[j]), wk
     for wm, _, am in met:
         up = am > c.peak_per_blade
         c.peak_per_blade[up], c.peak_omega_per_blade[up] = am[up], wm
-    c.worst = int(c.peak_per_blade.argmax())
-    c.peak = float(c.peak_per_blade[c.worst])
+    return float(ak[j]), wk, xk
