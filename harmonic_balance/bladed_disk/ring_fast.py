@@ -10,16 +10,20 @@ The same residual (R1) of :mod:`.ring_hb` and the same tolerance as :mod:`.ring_
   converged point reuses the last step's factors with iterative refinement.
 * **Adaptive continuation in frequency** instead of a fixed grid plus bisection: from
   the tuned peak along both flanks, each step predicted along the tangent
-  dx/domega = -J^-1 dR/domega (one more preconditioned solve at the converged point),
+  dx/domega = -J^-1 dR/domega (one more solve at the converged point, on the factors
+  of the last Newton step refined iteratively),
   its length set from the predictor's error (the amplitudes' change beyond the
   tangent, :data:`PREDICTOR_ERR`: steps of a fraction of a peak's width where the
   amplitudes bend, long steps on the flanks) and from Newton's iterations.
 * **Per-blade peaks by cubic Hermite interpolation** of every blade's amplitude a_j and
   its exact slope da_j/domega (from the tangent) between the continuation points:
   O(h^4) accurate, with no further solve. The largest of them (the worst blade, the
-  amplification) is then polished by the secant method on da_j/domega = 0, each
-  iterate a converged solve, to :data:`~.solve.PEAK_XTOL`; every blade's value met on
-  the way raises its peak where larger (as the reference's refinement does).
+  amplification) is then polished by a bracketed secant method (Illinois) on
+  da_j/domega = 0, each iterate a converged solve, to :data:`~.solve.PEAK_XTOL`
+  (the slope is only piecewise smooth -- friction -- so the root stays bracketed);
+  every blade's value met on the way raises its peak where larger, a blade whose
+  Hermite peak still exceeds the polished one by :data:`HERMITE_RTOL` is polished
+  too, the others are capped at it (as the reference's refinement does).
 
 A flank whose step fails at the smallest step length is retried once from the mapped
 tuned solution and else ends there (``extra["truncated"]``), with the same rule as the
