@@ -244,6 +244,14 @@ def _upd() -> list[InputCase]:
         ("mistuning unreachable scheduler", "mistuning --scheduler tcp://127.0.0.1:9 --samples 2"),
         ("mistuning workers and serial", "mistuning --workers 2 --serial"),
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
+        ("mistuning solver bogus", "mistuning --solver bogus"),
+        ("mistuning worst with friction", "mistuning --worst --std 0.02"),
+        ("mistuning worst bound 0.9", "mistuning --worst --damper free --bound 0.9"),
+        ("mistuning worst bound nan", "mistuning --worst --damper free --bound nan"),
+        ("mistuning bound without worst", "mistuning --bound 0.1"),
+        ("mistuning worst with factors", "mistuning --worst --damper free --blades 4 --engine-order 1 "
+         "--factors 1 1 1 1"),
+        ("mistuning worst --out a folder", "mistuning --worst --damper free --out {fx}"),
     ], "upd")
 
 
