@@ -14,8 +14,9 @@ import numpy as np
 
 #: Band margin beyond the factors' reach (fraction of the tuned peak's frequency).
 BAND_MARGIN = 0.02
-#: Grid points of the band (each blade-0 peak: the grid's maximum refined by Brent).
-GRID = 201
+#: Grid points of the band (each blade-0 peak: the grid's maximum refined by Brent, on the
+#: modal form: a grid point costs a sum over the modes, no solve).
+GRID = 2001
 #: Largest bound: factors stay within 0.25 .. 1.75.
 MAX_BOUND = 0.75
 

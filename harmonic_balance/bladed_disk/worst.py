@@ -11,7 +11,8 @@ Peak of blade 0 (response DOF r, ring (M2) of :mod:`.mistuning`)::
     a(kappa) = max_omega |u_r(omega, kappa)|,   Z(omega, kappa) u = F,
     Z = K_tuned + sum_i (kappa_i - 1) K0_i - omega^2 M + i omega C
 
-on the band's grid, then Brent's search between the neighbours of the grid maximum.
+on the band's grid, then Brent's search between the neighbours of the grid maximum, both
+on the ring's complex modes (one eigendecomposition per pattern).
 Its gradient by the envelope theorem (omega* stationary) and one adjoint solve
 (Z is complex symmetric: Z^T = Z)::
 
@@ -63,27 +64,44 @@ class LinearPeak:
         self.r = sector.response
         self.evaluations = 0
 
-    def _Z(self, kappa, w):
+    def _K(self, kappa) -> np.ndarray:
         K = self.K.copy()
         for i, k in enumerate(kappa):
             s = slice(self.n * i, self.n * (i + 1))
             K[s, s] += (k - 1.0) * self.K0
-        return K - w * w * self.M + 1j * w * self.C
+        return K
 
-    def amplitude(self, kappa, w) -> float:
-        return float(abs(np.linalg.solve(self._Z(kappa, w), self.F)[self.r]))
+    def _Z(self, kappa, w):
+        return self._K(kappa) - w * w * self.M + 1j * w * self.C
+
+    def modal(self, kappa):
+        """Poles lambda (2n,) and residues c (2n,) of u_r(omega) = sum_k c_k / (i omega -
+        lambda_k): the first-order form A z' = B z + [F, 0], A = [[C, M], [M, 0]],
+        B = [[-K, 0], [0, M]] (as :func:`.sector.modal_response`), one eigendecomposition
+        per pattern, so a peak search costs no further solve."""
+        n = self.M.shape[0]
+        Z0 = np.zeros((n, n))
+        A = np.block([[self.C, self.M], [self.M, Z0]])
+        B = np.block([[-self._K(kappa), Z0], [Z0, self.M]])
+        lam, V = np.linalg.eig(np.linalg.solve(A, B))
+        g = np.linalg.solve(V, np.linalg.solve(A, np.concatenate([self.F, np.zeros(n)])))
+        return lam, V[self.r] * g
 
     def peak(self, kappa) -> tuple[float, float]:
-        """(a [m], omega* [rad/s]) of blade 0 (grid, then Brent)."""
+        """(a [m], omega* [rad/s]) of blade 0: the largest of the band's grid, then Brent's
+        search between its neighbours, both on the modal form."""
         kappa = check_factors(kappa, self.nb)
         self.evaluations += 1
-        Z = np.array([self._Z(kappa, w) for w in self.omegas])
-        A = np.abs(np.linalg.solve(Z, np.broadcast_to(self.F, (len(self.omegas), self.F.size))
-                                   [..., None])[:, self.r, 0])
+        lam, c = self.modal(kappa)
+
+        def amp(w):
+            return np.abs((c / (1j * np.asarray(w, dtype=float)[..., None] - lam)).sum(axis=-1))
+
+        A = amp(self.omegas)
         i = int(A.argmax())
         if not 0 < i < A.size - 1:
             return float(A[i]), float(self.omegas[i])
-        res = minimize_scalar(lambda w: -self.amplitude(kappa, w),
+        res = minimize_scalar(lambda w: -float(amp(w)),
                               bounds=(self.omegas[i - 1], self.omegas[i + 1]), method="bounded",
                               options={"xatol": PEAK_XTOL * self.omegas[i]})
         return (-float(res.fun), float(res.x)) if -res.fun > A[i] else (float(A[i]), float(self.omegas[i]))
