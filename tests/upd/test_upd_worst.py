@@ -15,7 +15,7 @@ from harmonic_balance.bladed_disk.worst import LinearPeak, worst_pattern
 #: Adjoint gradient against central differences (step 1e-6: the differences' truncation
 #: and the peak search's 1e-10 frequency tolerance leave ~1e-5).
 GRAD_RTOL = 1e-4
-#: The issue's requirement: the search within 1 % of an independent optimizer.
+#: The required agreement of the search with an independent optimizer.
 DE_RTOL = 0.01
 BOUND = 0.06   # 3 std at std 0.02
 
