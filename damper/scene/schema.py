@@ -198,7 +198,9 @@ MISTUNING = {
     "f0": Field("float", "EO force amplitude [N] (default: the UPD model's)", gt=0),
     "harmonics": Field("int", "highest harmonic", default=7, ge=1),
     "band": Field("list[float]", "[low, high] band [Hz] (default: around the tuned peak)", gt=0),
-    "points": Field("int", "frequency points per ring curve", default=41, ge=3),
+    "points": Field("int", "frequency points per ring curve (solver full)", default=41, ge=3),
+    "solver": Field("str", "fast (adaptive continuation, Hermite peaks) or full (every grid "
+                    "point solved: the reference)", default="fast", choices=("fast", "full")),
 }
 
 TOP = {
