@@ -1,16 +1,15 @@
 """Mistuning study of a UPD bladed disk: Monte Carlo samples as cached tasks on Dask.
 
 A study draws every mistuning pattern first (``harmonic_balance.bladed_disk.mistuning``:
-seeded per sample, so a resumed or extended study draws the same patterns) and refuses a
-bad one before any work. The tuned sector's peak on the band is the reference (the
+seeded per sample, so a resumed or extended study draws the same patterns) and refuses
+a bad one before any work. The tuned sector's peak on the band is the reference (the
 sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). Each
-sample is one task: the full ring's forced response (``ring_hb`` solved by
-``ring_fast``, or by ``ring_solve`` with ``solver = "full"``; or the linear ring) and
-every blade's peak; its result is stored in the shared cache
-(:class:`damper.cache.Store`) under a key of the model, the solver settings, the pattern
-and the code version, so an interrupted study computes only the samples it has not
-stored. A sample whose solve fails is reported with its message (not cached: a later run
-tries it again), the study goes on.
+sample is one task: the full ring's forced response (``ring_hb`` / ``ring_fast`` | ``ring_solve``, or
+the linear ring) and every blade's peak; its result is stored in the shared cache
+(:class:`damper.cache.Store`) under a key of the model, the solver settings, the
+pattern and the code version, so an interrupted study computes only the samples it has
+not stored. A sample whose solve fails is reported with its message (not cached: a
+later run tries it again), the study goes on.
 
 Symbols: N_b blades; a_j the peak first-harmonic amplitude of blade j's response DOF;
 amplification = max_j a_j / a_tuned; sigma_f the standard deviation of the blade
