@@ -17,7 +17,7 @@ to round-off (``tests/upd/test_upd_ring_fast.py``):
 
 SuperLU is the default: its solutions are bit-for-bit the same in every process, so a
 study on Dask workers equals the serial one exactly. PARDISO, chosen with
-``DAMPER_SOLVER=pardiso``, is faster (a UPD-24 sample ~30 % less CPU time) and agrees to
+``DAMPER_SOLVER=pardiso``, is faster (20 % less CPU time a UPD-24 sample, 43 % at 48 blades) and agrees to
 round-off in each solve, but its last bits differ between a Dask worker and a serial
 run (its kernels depend on more than the thread count), and Newton's iterates and the
 per-blade peaks then differ in the ~8th digit.
