@@ -4,9 +4,9 @@ A study draws every mistuning pattern first (``harmonic_balance.bladed_disk.mist
 seeded per sample, so a resumed or extended study draws the same patterns) and refuses
 a bad one before any work. The tuned sector's peak on the band is the reference (the
 sector's harmonic balance, or its linear limit for ``damper = "free" | "stuck"``). A
-sample is the full ring's forced response (``ring_hb`` / ``ring_solve``, or the linear
-ring) and every blade's peak; a task is a chunk of samples solved with one
-:class:`SampleModel` (:func:`run_chunk`). Each sample's result is stored in the shared cache
+sample is the full ring's forced response (``ring_hb`` with ``ring_fast`` or
+``ring_solve``, or the linear ring) and every blade's peak; a task is a chunk of samples
+solved with one :class:`SampleModel` (:func:`run_chunk`). Each sample's result is stored in the shared cache
 (:class:`damper.cache.Store`) under a key of the model, the solver settings, the
 pattern and the code version, so an interrupted study computes only the samples it has
 not stored. A sample whose solve fails is reported with its message (not cached: a
@@ -66,6 +66,9 @@ class AllSamplesFailed(RuntimeError):
     def __init__(self, message: str, summary: dict):
         super().__init__(message)
         self.summary = summary
+#: Ring solvers: ``fast`` (``ring_fast``: adaptive continuation, Hermite peaks) and
+#: ``full`` (``ring_solve``: every point of the grid solved; the reference).
+SOLVERS = ("fast", "full")
 
 
 @dataclass
@@ -92,6 +95,7 @@ class Study:
     band_hz: list | None = None
     points: int = 41
     until_ci: float | None = None
+    solver: str = "fast"
 
     def load(self):
         """The validated UPD config with ``blades`` / ``engine_order`` applied (ValueError)."""
@@ -111,6 +115,8 @@ class Study:
 
         if self.damper not in DAMPERS:
             raise ValueError(f"damper must be one of {DAMPERS}, got {self.damper!r}")
+        if self.solver not in SOLVERS:
+            raise ValueError(f"solver must be one of {SOLVERS}, got {self.solver!r}")
         for name in ("cf", "f0"):
             v = getattr(self, name)
             if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
@@ -217,7 +223,7 @@ def default_band(f_low: float, f_high: float, margin: float) -> list:
 def sample_key(study: Study, fp: str, band: list, kappa) -> str:
     """Cache key of one sample: model, solver settings, band, pattern, code version."""
     settings = {k: v for k, v in asdict(study).items()
-                if k in ("damper", "cf", "f0", "harmonics", "points")}
+                if k in ("damper", "cf", "f0", "harmonics", "points", "solver")}
     return make_key("mistuning_sample", VERSION, fp, settings, [float(b) for b in band],
                     [float(k) for k in kappa], code_version(MODULES))
 
@@ -291,6 +297,7 @@ def run_sample(task: dict) -> dict:
 def _solve_sample(model: SampleModel, kappa) -> dict:
     """Per-blade peaks [m] and frequencies [Hz] of one pattern (raises on solver failure)."""
     from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.ring_fast import fast_ring_frf
     from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
     from harmonic_balance.bladed_disk.ring_solve import ring_frf
 
@@ -305,7 +312,11 @@ def _solve_sample(model: SampleModel, kappa) -> dict:
     if model.tuned is None:   # as RingSolver builds it: the ring's H, loads, mu and time grid
         model.tuned = SectorHB(ring.sector, ring.H, cf=ring.cf, f0=ring.f0, mu=ring.mu,
                                n_t=ring.basis.n_t)
-    c = ring_frf(ring, om, model.tuned, start_omega=2 * np.pi * model.f_tuned)
+    start = 2 * np.pi * model.f_tuned
+    if study.solver == "fast":
+        c = fast_ring_frf(ring, (om[0], om[-1]), model.tuned, start_omega=start)
+    else:
+        c = ring_frf(ring, om, model.tuned, start_omega=start)
     _inside(c.peak_omega, om)
     return {"peak_per_blade": c.peak_per_blade.tolist(),
             "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
@@ -428,7 +439,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "kind": study.kind, "distribution": study.distribution,
             "std": None if study.factors is not None else study.std, "seed": study.seed,
             "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
-            "band_hz": ref["band_hz"], "points": study.points,
+            "band_hz": ref["band_hz"], "points": study.points, "solver": study.solver,
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),

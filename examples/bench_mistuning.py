@@ -6,7 +6,9 @@ Rows:
 * ``scaling``: one ring curve (41 points, H = 7, CF/F0 = 4, one std-0.02 pattern) of
   N_b = 4, 8, 24, 48 blades at the same interblade phase (EO = N_b / 4, so the tuned
   sector is the same) against the tuned sector's curve on the same grid: CPU time,
-  evaluations, Newton iterations, one sparse LU of the ring Jacobian, its non-zeros.
+  evaluations, Newton iterations, one sparse LU of the ring Jacobian, its non-zeros; the
+  same curve by the fast solver (``ring_fast``): CPU time, speed-up, evaluations, and its
+  per-blade peaks and amplification against the full solver's.
 * ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
   cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
   time: why the solver factors the mistuned Jacobian instead.
@@ -41,6 +43,7 @@ from scipy.sparse.linalg import LinearOperator, gmres, splu
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.mistuning import draw_factors
+from harmonic_balance.bladed_disk.ring_fast import fast_ring_frf
 from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
 from harmonic_balance.bladed_disk.ring_solve import RingSolver, ring_frf
 from harmonic_balance.bladed_disk.sector import Sector
@@ -76,12 +79,21 @@ def scaling_rows(blades) -> list:
         c0 = time.process_time()
         c = ring_frf(ring, om, tuned, start_omega=ct.peak_omega)
         t_ring = time.process_time() - c0
+        fast = MistunedRingHB(sector, ring.kappa, H)
+        c0 = time.process_time()
+        cf = fast_ring_frf(fast, (om[0], om[-1]), tuned, start_omega=ct.peak_omega)
+        t_fast = time.process_time() - c0
         J = ring(c.peak_x, c.peak_omega)[1].tocsc()
         rows.append({"case": "ring curve", "blades": nb, "unknowns": ring.size, "jacobian_nnz": J.nnz,
                      "sector_cpu_s": t_sector, "ring_cpu_s": t_ring, "ratio_ring_sector": t_ring / t_sector,
                      "ring_cpu_per_blade_s": t_ring / nb, "evaluations": c.evaluations,
                      "newton_iterations": c.newton_iterations, "lu_ms": lu_ms(J),
-                     "amplification": c.peak / ct.peak_amplitude, "truncated": c.extra["truncated"]})
+                     "amplification": c.peak / ct.peak_amplitude, "truncated": c.extra["truncated"],
+                     "fast_cpu_s": t_fast, "fast_speedup": t_ring / t_fast,
+                     "fast_evaluations": cf.evaluations, "fast_points": cf.extra["points"],
+                     "fast_amplification_rel_diff": cf.peak / c.peak - 1,
+                     "fast_peak_per_blade_max_rel_diff": float(np.abs(cf.peak_per_blade / c.peak_per_blade
+                                                                      - 1).max())})
         print(_fmt(rows[-1]), flush=True)
     return rows
 

@@ -78,10 +78,18 @@ def _mistuning(s) -> None:
     p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H")
     p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                    help="band [Hz] (default: around the tuned peak, widened with the scatter)")
-    p.add_argument("--points", type=int, default=41, help="frequency points per ring curve")
+    p.add_argument("--points", type=int, default=41,
+                   help="frequency points per ring curve (--solver full)")
     p.add_argument("--until-ci", type=float, metavar="W",
                    help="stop when the amplification's 0.95 quantile is known to +-W (its 95 %% "
                    "interval's half-width); --samples is then the most to run (default 2000)")
+    p.add_argument("--solver", choices=("fast", "full"), default="fast",
+                   help="fast: adaptive continuation with Hermite peaks (default); full: the "
+                   "fixed grid with every point solved (the reference)")
+    p.add_argument("--worst", action="store_true",
+                   help="search the worst pattern within 1 +- --bound (linear ring: --damper free|stuck)")
+    p.add_argument("--bound", type=float, help="half-width B of the --worst box (default 3 --std)")
+    p.add_argument("--out", metavar="FILE", help="with --worst: also write its JSON to FILE")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=int, help="local Dask cluster workers (default: cores)")
     p.add_argument("--serial", action="store_true", help="no Dask: the samples in this process")
@@ -116,7 +124,11 @@ def run_mistuning(args) -> int:
                   **draw, kind=args.kind,
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
                   cf=args.cf, f0=args.f0, harmonics=args.harmonics,
-                  band_hz=args.band, points=args.points, until_ci=args.until_ci)
+                  band_hz=args.band, points=args.points, until_ci=args.until_ci, solver=args.solver)
+    if args.worst or args.bound is not None or args.out is not None:
+        if args.until_ci is not None:
+            raise ValueError("--until-ci goes with a random study, not with --worst")
+        return _run_worst(args, study)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     try:
         out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
@@ -185,6 +197,42 @@ def _print_samples(out: dict) -> None:
         print(f"sample {s['index']:4d}: " + (f"amplification {s['amplification']:.4f}, worst blade "
               f"{s['worst_blade']} at {s['frequency_hz']:.2f} Hz" if s["error"] is None
               else f"failed: {s['error']}"))
+
+
+def _run_worst(args, study) -> int:
+    """``--worst``: the worst pattern of the linear ring, printed (and written to --out)."""
+    import json
+    from pathlib import Path
+
+    from damper.mistuning_worst import check_worst, run_worst
+
+    from .common import atomic_write, print_json
+
+    if not args.worst:
+        raise ValueError("--bound and --out go with --worst")
+    if args.plot or args.scheduler or args.workers:
+        raise ValueError("--worst runs in this process and draws no plots: drop --plot, "
+                         "--scheduler, --workers")
+    study.check()
+    check_worst(study, args.bound)
+    if args.out is not None:
+        out_path = Path(args.out)
+        if out_path.is_dir() or not out_path.parent.is_dir():
+            raise ValueError(f"--out {args.out}: give a file in an existing folder")
+    out = run_worst(study, args.bound)
+    if args.out is not None:
+        atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"worst pattern within 1 +- {out['bound']:.4g} ({out['damper']} damper, {out['blades']} "
+          f"blades): amplification {out['amplification']:.4f} (Whitehead bound "
+          f"{out['whitehead_bound']:.3f}) at {out['frequency_hz']:.2f} Hz on blade 0")
+    print("factors: " + " ".join(f"{k:.5f}" for k in out["factors"]))
+    if not out["converged"]:
+        print(f"note: the best start's optimizer did not converge ({out['message']}); the best "
+              "pattern found is shown")
+    return 0
 
 
 def _common(p) -> None:

@@ -201,9 +201,11 @@ MISTUNING = {
     "f0": Field("float", "EO force amplitude [N] (default: the UPD model's)", gt=0),
     "harmonics": Field("int", "highest harmonic", default=7, ge=1),
     "band": Field("list[float]", "[low, high] band [Hz] (default: around the tuned peak)", gt=0),
-    "points": Field("int", "frequency points per ring curve", default=41, ge=3),
+    "points": Field("int", "frequency points per ring curve (solver full)", default=41, ge=3),
     "until_ci": Field("float", "stop when the amplification's 0.95 quantile is known to +- this (its "
                       "95 % interval's half-width); samples is then the most to run", gt=0),
+    "solver": Field("str", "fast (adaptive continuation, Hermite peaks) or full (every grid "
+                    "point solved: the reference)", default="fast", choices=("fast", "full")),
 }
 
 TOP = {

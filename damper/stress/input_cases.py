@@ -269,6 +269,14 @@ def _upd() -> list[InputCase]:
         ("mistuning until-ci 0", "mistuning --until-ci 0"), ("mistuning until-ci nan", "mistuning --until-ci nan"),
         ("mistuning until-ci inf", "mistuning --until-ci inf"),
         ("mistuning until-ci with factors", "mistuning --blades 4 --engine-order 1 --factors 1 1 1 1 --until-ci 0.01"),
+        ("mistuning solver bogus", "mistuning --solver bogus"),
+        ("mistuning worst with friction", "mistuning --worst --std 0.02"),
+        ("mistuning worst bound 0.9", "mistuning --worst --damper free --bound 0.9"),
+        ("mistuning worst bound nan", "mistuning --worst --damper free --bound nan"),
+        ("mistuning bound without worst", "mistuning --bound 0.1"),
+        ("mistuning worst with factors", "mistuning --worst --damper free --blades 4 --engine-order 1 "
+         "--factors 1 1 1 1"),
+        ("mistuning worst --out a folder", "mistuning --worst --damper free --out {fx}"),
     ], "upd")
 
 

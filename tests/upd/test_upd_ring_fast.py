@@ -1,0 +1,124 @@
+"""Fast mistuned-ring solver (``ring_fast``) against the full-grid reference (``ring_solve``),
+the linear ring (dampers sliding) and the tuned sector; the ring LU back ends."""
+import numpy as np
+import pytest
+from scipy.optimize import minimize_scalar
+
+from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.mistuning import LinearRing
+from harmonic_balance.bladed_disk.ring_fast import fast_ring_frf, hermite_peaks
+from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
+from harmonic_balance.bladed_disk.ring_lu import PardisoFactor, SuperLUFactor
+from harmonic_balance.bladed_disk.ring_solve import RingSolver, ring_frf
+from harmonic_balance.bladed_disk.sector import Sector
+from harmonic_balance.bladed_disk.solve import frf
+
+#: Per-blade peaks against the reference: the required accuracy (the fast solver's
+#: non-worst blades come from cubic Hermite interpolation between continuation points).
+PEAK_RTOL = 1e-3
+#: The worst blade's peak (the amplification): both solvers locate its frequency to
+#: PEAK_XTOL = 1e-6 relative, so the amplitudes agree to ~1e-9; 1e-6 leaves margin.
+WORST_RTOL = 1e-6
+#: The same linear system factored by two LU codes (round-off of a 420-unknown solve).
+LU_RTOL = 1e-9
+PATTERN = (1.02, 0.985, 1.0, 0.995)
+
+
+@pytest.fixture(scope="module")
+def sector4():
+    """Four blades, EO 1: UPD-24's interblade phase on a ring of 4."""
+    return Sector(load_config().with_values(disk__blades=4, disk__engine_order=1))
+
+
+def exact_blade_peaks(ring, omegas, tuned, start):
+    """Reference per-blade peaks: the full solver's grid, then Brent's search of every
+    blade's own amplitude between the grid neighbours of its grid maximum."""
+    c = ring_frf(ring, omegas, tuned, start_omega=start, refine=False)
+    solver = RingSolver(ring, tuned)
+    peaks = np.empty(ring.blades)
+    for j in range(ring.blades):
+        i = int(c.amplitude[:, j].argmax())
+        assert 0 < i < c.omega.size - 1, "a blade's peak at the band's end: widen the band"
+        res = minimize_scalar(lambda w, j=j: -ring.amplitudes(solver.at(w, c.omega, c.x))[j],
+                              bounds=(c.omega[i - 1], c.omega[i + 1]), method="bounded",
+                              options={"xatol": 1e-7 * c.omega[i]})
+        peaks[j] = -res.fun
+    return peaks
+
+
+def test_fast_ring_equals_full_ring_with_friction(sector4):
+    """Friction damper (CF/F0 = 4), a mistuned four-blade ring at H = 3: every blade's
+    peak equals the reference's exactly refined one to PEAK_RTOL, the worst to WORST_RTOL."""
+    H = 3
+    tuned = SectorHB(sector4, H)
+    om = 2 * np.pi * np.linspace(430.0, 485.0, 56)
+    t = frf(tuned, om)
+    ring = MistunedRingHB(sector4, PATTERN, H)
+    ref = exact_blade_peaks(ring, om, tuned, t.peak_omega)
+    c = fast_ring_frf(ring, (om[0], om[-1]), tuned, start_omega=t.peak_omega)
+    assert not c.extra["truncated"]
+    assert np.abs(c.peak_per_blade / ref - 1).max() < PEAK_RTOL
+    assert c.peak == pytest.approx(ref.max(), rel=WORST_RTOL)
+    assert c.worst == int(ref.argmax())
+    # the converged points solve the ring's residual to the reference's tolerance
+    tol = RingSolver(ring, tuned).tol
+    for w, x in zip(c.omega[::5], c.x[::5]):
+        assert np.linalg.norm(ring(x, w, jac=False)) <= tol
+
+
+def test_fast_ring_sliding_limit_equals_linear_ring(sector4):
+    """Friction that carries nothing (mu = 0), the normal load never lost (CF/F0 = 120):
+    the fast HB's per-blade peaks equal those of the linear mistuned ring with the
+    dampers sliding (an independent sparse solve per frequency)."""
+    H, f0, cf, state, mu = 3, 1.0, 120.0, "sliding", 0.0
+    om = 2 * np.pi * np.linspace(380.0, 520.0, 141)
+    lin = LinearRing(sector4, PATTERN, state, f0)
+    ref, wref = lin.peaks(om)
+    band = (wref.min() * 0.97, wref.max() * 1.03)
+    ring = MistunedRingHB(sector4, PATTERN, H, cf=cf, f0=f0, mu=mu)
+    tuned = SectorHB(sector4, H, cf=cf, f0=f0, mu=mu)
+    c = fast_ring_frf(ring, band, tuned, start_omega=float(np.median(wref)))
+    assert np.abs(c.peak_per_blade / ref - 1).max() < PEAK_RTOL
+    assert c.peak == pytest.approx(ref.max(), rel=WORST_RTOL)
+
+
+def test_fast_ring_without_mistuning_is_the_tuned_sector(sector4):
+    """kappa = 1: every blade's peak is the tuned sector's (its continuation's refined peak)."""
+    H = 3
+    tuned = SectorHB(sector4, H)
+    om = 2 * np.pi * np.linspace(430.0, 470.0, 41)
+    t = frf(tuned, om)
+    c = fast_ring_frf(MistunedRingHB(sector4, np.ones(4), H), (om[0], om[-1]), tuned,
+                      start_omega=t.peak_omega)
+    assert c.peak_per_blade == pytest.approx(np.full(4, t.peak_amplitude), rel=WORST_RTOL)
+
+
+def test_hermite_peaks_of_a_cubic_are_exact():
+    """The interpolant of a cubic's values and slopes is the cubic: its maximum exactly."""
+    w = np.array([0.0, 0.7, 1.5, 2.0])
+    a = lambda x: 1.0 + x - 0.9 * x**2 + 0.1 * x**3  # noqa: E731
+    da = lambda x: 1.0 - 1.8 * x + 0.3 * x**2  # noqa: E731
+    x_max = (1.8 - np.sqrt(1.8**2 - 1.2)) / 0.6
+    pk, wk = hermite_peaks(w, a(w)[:, None], da(w)[:, None])
+    assert wk[0] == pytest.approx(x_max, rel=1e-12) and pk[0] == pytest.approx(a(x_max), rel=1e-12)
+
+
+def test_ring_lu_backends_solve_the_same_system(sector4):
+    """PARDISO (pattern analysed once, refactored for a second Jacobian) and SuperLU."""
+    try:
+        pard = PardisoFactor()
+    except (ImportError, OSError):
+        pytest.skip("pypardiso is not installed")
+    ring = MistunedRingHB(sector4, PATTERN, 5)
+    rng = np.random.default_rng(20261127)
+    for f in (440.0, 455.0):
+        w = 2 * np.pi * f
+        x = ring.stuck_guess(w)
+        R, J, _ = ring(x, w)
+        slu = SuperLUFactor()
+        slu.factor(J)
+        pard.factor(J)
+        b = rng.standard_normal(ring.size)
+        y1, y2 = slu.solve(b), pard.solve(b)
+        assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
