@@ -212,9 +212,9 @@ def summary_lines(summary, hz: bool = False) -> list[str]:
     ex = rec.get("extrapolated")
     if ex:
         w = ex["peak_omega"]
-        at = (f"{_num(None if w is None else w / (2 * math.pi))} Hz" if hz
-              else f"omega = {_num(w)} rad/s")
-        lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m at {at}")
+        at = ("" if w is None or not math.isfinite(w) else   # frequency not extrapolated
+              f" at {_num(w / (2 * math.pi))} Hz" if hz else f" at omega = {_num(w)} rad/s")
+        lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m{at}")
     a = summary.get("accuracy")
     if a:
         lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
