@@ -6,7 +6,7 @@ Every blade is equivalent -- rotating a pattern by one blade rotates the respons
 advances its phase by phi -- so the search maximizes blade 0's peak, a smooth function
 of kappa wherever its peak frequency is unique.
 
-Peak of blade 0 (response DOF r, ring (M2) of :mod:`.mistuning`)::
+Peak of blade 0 (response DOF r, ring (M2) of :mod:`harmonic_balance.bladed_disk.mistuning`)::
 
     a(kappa) = max_omega |u_r(omega, kappa)|,   Z(omega, kappa) u = F,
     Z = K_tuned + sum_i (kappa_i - 1) K0_i - omega^2 M + i omega C
