@@ -9,7 +9,9 @@ the curve and of the check; then per accuracy target the H the engine chose, the
 estimate, the true error and the total time.
 
 Run: ``python -m damper.bench.hb_accuracy [--quick] [--only frf|upd] [--json]``
-(``make docs-accuracy`` records it for docs/method/accuracy.md).
+(``make docs-accuracy`` records it for docs/method/accuracy.md). ``damper bench --stage hb``
+adds the same rows to its report (:func:`bench_rows`; with ``--quick``, the soft single-DOF
+model only: :data:`BENCH_QUICK_MODELS`).
 """
 from __future__ import annotations
 
@@ -19,6 +21,8 @@ import sys
 import time
 
 import numpy as np
+
+from .common import Row, self_peak_mb
 
 #: Harmonics of the reference peak: ~(7 / 61)^1.7 = 2.5 % of the H = 7 error is left.
 REFERENCE_H = 61
@@ -31,6 +35,9 @@ HS = (3, 7, 15)
 TOLS = (1e-2, 1e-3)
 #: Centrifugal loads [N] of the UPD-24 rows (F0 = 30 N).
 UPD_CF = (60.0, 120.0, 600.0)
+#: Models of ``damper bench --quick``'s accuracy rows: one whose reference costs a second,
+#: so the bench's smoke run stays short.
+BENCH_QUICK_MODELS = ("sdof soft",)
 
 
 def _frf_cases(quick: bool):
@@ -54,12 +61,14 @@ def _frf_reference(result, H_ref: int) -> float:
                        1e-6 * result.peak_omega)[2]
 
 
-def frf_rows(quick: bool = False) -> list[dict]:
-    """Rows of the chain models: per H and per accuracy target."""
+def frf_rows(quick: bool = False, names: tuple[str, ...] | None = None) -> list[dict]:
+    """Rows of the chain models: per H and per accuracy target (``names``: only these models)."""
     from harmonic_balance.frf import compute_frf
 
     rows = []
     for case in _frf_cases(quick):
+        if names is not None and case.name not in names:
+            continue
         model, ref = case.model(), None
         for H in HS[:2] if quick else HS:
             t0 = time.perf_counter()
@@ -67,14 +76,15 @@ def frf_rows(quick: bool = False) -> list[dict]:
             dt = time.perf_counter() - t0
             if ref is None:
                 ref = _frf_reference(r, REFERENCE_H)
-            rows.append(_row(case.name, f"H {H}", r.peak_amplitude, r.truncation_error, ref, dt))
+            rows.append(_row(case.name, f"H {H}", r.peak_amplitude, r.truncation_error, ref, dt, H))
         slow = case.name.startswith("chain5")   # converges like H^-0.5 up to H ~ 20: no 1e-3
         for tol in TOLS[:1] if quick or slow else TOLS:
             t0 = time.perf_counter()
             r = compute_frf(model, 3, case.band, stability="off", accuracy=tol,
                             max_harmonic=REFERENCE_H)
-            rows.append(_row(case.name, f"tol {tol:g} -> H {r.problem.basis.H}", r.peak_amplitude,
-                             r.truncation_error, ref, time.perf_counter() - t0))
+            H = r.problem.basis.H
+            rows.append(_row(case.name, f"tol {tol:g} -> H {H}", r.peak_amplitude, r.truncation_error, ref,
+                             time.perf_counter() - t0, H, tol))
     return rows
 
 
@@ -105,12 +115,12 @@ def upd_rows(quick: bool = False) -> list[dict]:
                 ref = acc.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs, om,
                                   int(np.argmax(c.amplitude)), 1e-10 * max(hb.f0, hb.cf),
                                   1e-6 * c.peak_omega)[2]
-            rows.append(_row(name, f"H {H}", c.peak_amplitude, rec, ref, dt))
+            rows.append(_row(name, f"H {H}", c.peak_amplitude, rec, ref, dt, H))
         for tol in TOLS[:1]:   # 1e-3 needs H ~ 35-40 on UPD-24: minutes per curve
             t0 = time.perf_counter()
             hb, c, rec = frf_to_accuracy(sector, om, tol, 7, cf=cf, f0=30.0)
             rows.append(_row(name, f"tol {tol:g} -> H {hb.H}", c.peak_amplitude, rec, ref,
-                             time.perf_counter() - t0))
+                             time.perf_counter() - t0, hb.H, tol))
     return rows
 
 
@@ -118,10 +128,11 @@ def upd_rows(quick: bool = False) -> list[dict]:
 ECHO = None
 
 
-def _row(model, setting, amp, rec, ref, dt) -> dict:
+def _row(model, setting, amp, rec, ref, dt, H, target=None) -> dict:
     est = (rec or {}).get("peak_amplitude_rel")
     true = abs(amp - ref) / abs(ref)
-    row = {"model": model, "setting": setting, "peak_amplitude": amp, "estimate": est,
+    row = {"model": model, "setting": setting, "H": int(H), "target": target, "peak_amplitude": amp,
+           "reference_amplitude": float(ref), "estimate": est,
            "true_error": true, "ratio": est / true if est is not None and true > 0 else None,
            "order": (rec or {}).get("order_observed"), "check_time_s": (rec or {}).get("time_s"),
            "time_s": dt}
@@ -130,17 +141,46 @@ def _row(model, setting, amp, rec, ref, dt) -> dict:
     return row
 
 
-def print_table(rows, out=sys.stdout, header: bool = True) -> None:
-    if header:
-        print(f"{'model':24s} {'setting':18s} {'peak':>12s} {'estimate':>9s} {'true':>9s} "
-              f"{'ratio':>6s} {'check s':>8s} {'total s':>8s}", file=out)
+def bench_rows(quick: bool, log=print) -> list[Row]:
+    """The rows of ``damper bench --stage hb``: every model of :func:`frf_rows` and
+    :func:`upd_rows` (``quick``: :data:`BENCH_QUICK_MODELS` at the quick H and target).
+
+    A row's ``case`` is ``"accuracy <model>"`` (``"accuracy <model> target"`` for an
+    accuracy target), ``size`` the H used, ``error`` the true error against the reference
+    peak, ``time_s`` the wall time of the curve and its check (of a target: every curve and
+    check it took); the rest of :func:`frf_rows`'s row rides along (``estimate``, ``ratio``,
+    ``setting``, ``target``...).
+    """
+    log(table_lines([])[0])
+    rows = frf_rows(True, BENCH_QUICK_MODELS) if quick else frf_rows(False) + upd_rows(False)
+    out = []
     for r in rows:
-        def pct(v):
-            return "-" if v is None else f"{100 * v:.3g}%"
-        print(f"{r['model']:24s} {r['setting']:18s} {r['peak_amplitude']:12.6g} {pct(r['estimate']):>9s} "
-              f"{pct(r['true_error']):>9s} {'-' if r['ratio'] is None else format(r['ratio'], '.2f'):>6s} "
-              f"{'-' if r['check_time_s'] is None else format(r['check_time_s'], '.2f'):>8s} "
-              f"{r['time_s']:8.2f}", file=out, flush=True)
+        log(table_lines([r])[1])
+        case = f"accuracy {r['model']}" + (" target" if r["target"] is not None else "")
+        out.append(Row(case, r["H"], r["true_error"], r["time_s"], self_peak_mb(), False,
+                       {k: v for k, v in r.items() if k not in ("H", "true_error", "time_s")}
+                       | {"true_error": r["true_error"], "clock": "wall"}))
+    return out
+
+
+def table_lines(rows) -> list[str]:
+    """The plain-text table of accuracy rows (dicts of :func:`frf_rows`): a header, a line per row."""
+    def pct(v):
+        return "-" if v is None else f"{100 * v:.3g}%"
+
+    lines = [f"{'model':24s} {'setting':18s} {'peak':>12s} {'estimate':>9s} {'true':>9s} "
+             f"{'ratio':>6s} {'check s':>8s} {'total s':>8s}"]
+    for r in rows:
+        lines.append(f"{r['model']:24s} {r['setting']:18s} {r['peak_amplitude']:12.6g} {pct(r['estimate']):>9s} "
+                     f"{pct(r['true_error']):>9s} {'-' if r['ratio'] is None else format(r['ratio'], '.2f'):>6s} "
+                     f"{'-' if r['check_time_s'] is None else format(r['check_time_s'], '.2f'):>8s} "
+                     f"{r['time_s']:8.2f}")
+    return lines
+
+
+def print_table(rows, out=sys.stdout, header: bool = True) -> None:
+    lines = table_lines(rows)
+    print("\n".join(lines if header else lines[1:]), file=out, flush=True)
 
 
 def main(argv=None) -> int:

@@ -2,7 +2,9 @@
 
 Each plot puts the error against its reference on the x axis and the time on
 the y axis (both logarithmic), one point per row labelled with its size; cold
-runs are circles, cached runs squares, the tool's default setting a star.
+runs are circles, cached runs squares, the tool's default setting a star. The hb
+stage's accuracy rows (:mod:`.hb_accuracy`) also get a table of the truncation-error
+estimate beside the true error.
 """
 from __future__ import annotations
 
@@ -47,7 +49,7 @@ def _plot(stage: str, rows: list[dict]) -> str:
             style = ("s" if cached else "o") if "tool" in pts[0] else ("s--" if cached else "o-")
             ax.plot(x, y, style, label=f"{case}{' (cached)' if cached else ''}")
             for r, xi, yi in zip(pts, x, y):
-                ax.annotate(r.get("model") or f"{r['size']:g}", (xi, yi), fontsize=7, xytext=(3, 3),
+                ax.annotate(r["model"] if "tool" in r else f"{r['size']:g}", (xi, yi), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
                 if r.get("default"):
                     ax.plot(xi, yi, "*", ms=16, mfc="none", mec="k")
@@ -74,20 +76,40 @@ def _fmt(v) -> str:
     return html.escape(str(v))
 
 
-def _split(rows: list[dict]) -> tuple[list[dict], list[dict]]:
-    """(the stage's own rows, the model-class rows of damper.bench.hb_classes)."""
-    return [r for r in rows if "tool" not in r], [r for r in rows if "tool" in r]
+def _split(rows: list[dict]) -> tuple[list[dict], list[dict], list[dict]]:
+    """(the stage's own rows, the accuracy rows of damper.bench.hb_accuracy, the model-class
+    rows of damper.bench.hb_classes)."""
+    acc = [r for r in rows if "estimate" in r and "tool" not in r]
+    return ([r for r in rows if "tool" not in r and "estimate" not in r], acc,
+            [r for r in rows if "tool" in r])
+
+
+#: Columns of the accuracy rows' HTML and Markdown tables: (heading, key, format).
+ACCURACY_COLUMNS = (("model", "model", "s"), ("H or target", "setting", "s"), ("peak", "peak_amplitude", ".6g"),
+                    ("estimate", "estimate", ".2e"), ("true error", "true_error", ".2e"),
+                    ("ratio", "ratio", ".2f"), ("check [s]", "check_time_s", ".2f"), ("total [s]", "time_s", ".2f"))
+ACCURACY_CAPTION = ("accuracy: the truncation-error estimate of the peak amplitude against the true error "
+                    "(against the peak re-solved with many more harmonics); ratio = estimate / true error; "
+                    "total: the curve and its check (of a target: every curve and check it took)")
+
+
+def _cells(r: dict) -> list[str]:
+    return ["-" if r.get(k) is None else format(r[k], f) for _, k, f in ACCURACY_COLUMNS]
 
 
 def table_text(stage: str, rows: list[dict]) -> str:
     """Plain-text table of one stage (case, size, error, time, memory, cached), then its
     model-class rows (hb_classes.table)."""
-    own, models = _split(rows)
+    own, acc, models = _split(rows)
     lines = [f"== {stage}", f"{'case':26s} {'size':>8s} {'error':>10s} {'time_s':>8s} {'memory_mb':>9s} cached"]
     for r in own:
         err = "-" if r["error"] is None else f"{r['error']:.2e}"
         lines.append(f"{r['case']:26s} {r['size']:8g} {err:>10s} {r['time_s']:8.2f} {r['memory_mb']:9.0f} "
                      f"{'yes' if r['cached'] else 'no'}{'  (default)' if r.get('default') else ''}")
+    if acc:
+        from .hb_accuracy import table_lines
+
+        lines += [ACCURACY_CAPTION + ":", *table_lines(acc)]
     if models:
         from .hb_classes import table
 
@@ -119,6 +141,12 @@ def write(out: Path, result: dict) -> tuple[Path, Path]:
                          f"<td>{_fmt(r['error'])}</td><td>{_fmt(r['time_s'])}</td><td>{_fmt(r['memory_mb'])}</td>"
                          f"<td>{'yes' if r['cached'] else 'no'}</td><td>{'*' if r.get('default') else ''}</td></tr>")
         parts.append("</table>")
+        acc = _split(rows)[1]
+        if acc:
+            parts.append(f"<p>{html.escape(ACCURACY_CAPTION)}.</p><table><tr>"
+                         + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in ACCURACY_COLUMNS) + "</tr>")
+            parts += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in _cells(r)) + "</tr>" for r in acc]
+            parts.append("</table>")
     parts.append("</body></html>")
     j = atomic_write(out / "bench.json", json.dumps(result, indent=1) + "\n")
     h = atomic_write(out / "bench.html", "\n".join(parts))
@@ -135,13 +163,17 @@ def markdown(result: dict) -> str:
         size_label, err_label = LEGEND.get(stage, ("size", "error"))
         out += [f"**{stage}** (size: {size_label}; error: {err_label})", "",
                 "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
-        own, models = _split(rows)
+        own, acc, models = _split(rows)
         for r in own:
             err = "-" if r["error"] is None else f"{r['error']:.2e}"
             star = " (default)" if r.get("default") else ""
             out.append(f"| {r['case']}{star} | {r['size']:g} | {err} | {r['time_s']:.2f} | {r['memory_mb']:.0f} | "
                        f"{'yes' if r['cached'] else 'no'} |")
         out.append("")
+        if acc:
+            out += [f"**{stage}: {ACCURACY_CAPTION}**", "",
+                    "| " + " | ".join(h for h, _, _ in ACCURACY_COLUMNS) + " |", "|" + "---|" * len(ACCURACY_COLUMNS),
+                    *("| " + " | ".join(_cells(r)) + " |" for r in acc), ""]
         if models:
             from .hb_classes import markdown as model_markdown
 

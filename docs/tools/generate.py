@@ -16,7 +16,8 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
   (``damper.formats``); the schema files are copied into the site's ``schemas/``;
 * ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
   of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
-  (``make docs-accuracy``);
+  (``make docs-accuracy``), and ``accuracy_plots.md`` with its figures of error against
+  time, one per model class (``accuracy_<class>.png``, drawn by ``docs/tools/plots.py``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
   ``docs/data/stress.json`` (written by ``make docs-bench`` and ``make docs-stress``:
   ``docs/tools/record.py`` around ``damper bench --json`` / ``damper stress --json``).
@@ -29,6 +30,7 @@ import json
 import pkgutil
 from pathlib import Path
 
+import plots
 import tables
 
 #: The packages of the API reference, bottom layer first, with a one-line role each.
@@ -270,3 +272,4 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "stress", tables.stress)
     data_page(docs, "accuracy", tables.accuracy)
     data_page(docs, "accuracy_upd", tables.accuracy)
+    plots.accuracy_plots(docs)

@@ -99,7 +99,7 @@ def validation(data: dict) -> str:
 
 
 def bench(data: dict) -> str:
-    from damper.bench.report import LEGEND
+    from damper.bench.report import ACCURACY_CAPTION, ACCURACY_COLUMNS, LEGEND
 
     res = data.get("result", {})
     out = [stamp_text(data, "bench"), ""]
@@ -109,11 +109,17 @@ def bench(data: dict) -> str:
         size, err = LEGEND.get(stage, ("size", "error"))
         out += [f"## {stage}", "", f"Size: {size}. Error: {err}.", "",
                 "| case | size | error | time [s] | memory [MB] | cached |", "|---|---|---|---|---|---|"]
-        for r in (r for r in rows if "tool" not in r):
+        for r in (r for r in rows if "tool" not in r and "estimate" not in r):
             case = r["case"] + (" (default)" if r.get("default") else "")
             out.append(f"| {_cell(case)} | {_g(r['size'])} | {_g(r['error'])} | {_g(r['time_s'])} | "
                        f"{_g(r['memory_mb'], 4)} | {_g(bool(r.get('cached')))} |")
         out.append("")
+        acc = [r for r in rows if "estimate" in r and "tool" not in r]   # damper.bench.hb_accuracy
+        if acc:
+            out += [ACCURACY_CAPTION[0].upper() + ACCURACY_CAPTION[1:] + ".", "",
+                    "| " + " | ".join(h for h, _, _ in ACCURACY_COLUMNS) + " |", "|" + "---|" * len(ACCURACY_COLUMNS)]
+            out += ["| " + " | ".join(_cell(r.get(k)) for _, k, _ in ACCURACY_COLUMNS) + " |" for r in acc]
+            out.append("")
         models = [r for r in rows if "tool" in r]   # whole curves of the model classes, with peers
         if models:
             from damper.bench.hb_classes import markdown

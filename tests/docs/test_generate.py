@@ -42,3 +42,33 @@ def test_a_page_no_index_names_goes_to_more(tmp_path):
     _generate().more_pages(tmp_path)
     more = (tmp_path / "_generated" / "more.md").read_text()
     assert "\nnew_stage\n" in more and "\n../notes\n" in more and "mistuning" not in more
+
+
+def _plots():
+    spec = importlib.util.spec_from_file_location("plots", DOCS / "tools" / "plots.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: The eight bytes every PNG file starts with.
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def test_accuracy_figures_one_per_model_class_from_the_recorded_data(tmp_path):
+    (tmp_path / "data").mkdir()
+    for name in ("accuracy", "accuracy_upd"):
+        shutil.copy(DOCS / "data" / f"{name}.json", tmp_path / "data")
+    plots = _plots()
+    plots.accuracy_plots(tmp_path)
+    md = (tmp_path / "_generated" / "accuracy_plots.md").read_text()
+    for stem, _, _ in plots.CLASSES:
+        png = tmp_path / "_generated" / f"accuracy_{stem}.png"
+        assert png.read_bytes()[:8] == PNG_SIGNATURE
+        assert f"{{figure}} /_generated/accuracy_{stem}.png" in md
+
+
+def test_accuracy_figures_without_data_say_how_to_record_it(tmp_path):
+    _plots().accuracy_plots(tmp_path)
+    assert "make docs-accuracy" in (tmp_path / "_generated" / "accuracy_plots.md").read_text()
+    assert not list((tmp_path / "_generated").glob("*.png"))

@@ -1,0 +1,75 @@
+"""The hb stage's accuracy rows (damper.bench.hb_accuracy.bench_rows): per model, H and
+accuracy target the engine's truncation-error estimate beside the true error, and the
+report's tables that show both."""
+import json
+
+import pytest
+
+from damper.bench import hb_accuracy, report
+from harmonic_balance.bench_models import sdof
+from harmonic_balance.frf import compute_frf
+
+#: The row's peak and the engine's are the same computation: equal to round-off.
+SAME_PEAK_RTOL = 1e-12
+#: Round-off of the relative error recomputed from the row's two peaks.
+ERROR_RTOL = 1e-9
+
+
+@pytest.fixture(scope="module")
+def quick_rows():
+    lines = []
+    rows = [r.as_dict() for r in hb_accuracy.bench_rows(True, lines.append)]
+    return rows, lines
+
+
+def test_quick_accuracy_rows_cover_each_h_and_target(quick_rows):
+    rows, lines = quick_rows
+    models = {r["model"] for r in rows}
+    assert models == set(hb_accuracy.BENCH_QUICK_MODELS)
+    for model in models:
+        mine = [r for r in rows if r["model"] == model]
+        assert sorted(r["size"] for r in mine if r["target"] is None) == list(hb_accuracy.HS[:2])
+        assert [r["target"] for r in mine if r["target"] is not None] == list(hb_accuracy.TOLS[:1])
+    assert lines[0] == hb_accuracy.table_lines([])[0] and len(lines) == 1 + len(rows)
+    json.dumps(rows)   # the bench JSON holds them as they are
+
+
+def test_accuracy_row_error_is_its_peak_against_the_reference(quick_rows):
+    for r in quick_rows[0]:
+        assert r["case"] == f"accuracy {r['model']}" + (" target" if r["target"] is not None else "")
+        assert r["error"] == r["true_error"] > 0
+        assert r["error"] == pytest.approx(abs(r["peak_amplitude"] / r["reference_amplitude"] - 1), rel=ERROR_RTOL)
+        assert r["ratio"] == pytest.approx(r["estimate"] / r["true_error"])
+        assert r["time_s"] > 0 and r["memory_mb"] > 0
+
+
+def test_accuracy_row_peak_is_the_engines_peak_at_that_h(quick_rows):
+    case = sdof(1.0)
+    r = next(r for r in quick_rows[0] if r["model"] == case.name and r["size"] == 3 and r["target"] is None)
+    ref = compute_frf(case.model(), 3, case.band, stability="off")
+    assert r["peak_amplitude"] == pytest.approx(ref.peak_amplitude, rel=SAME_PEAK_RTOL)
+
+
+def test_more_harmonics_bring_the_peak_closer_to_the_reference(quick_rows):
+    """Truncation error falls with H (the reference is the same peak at REFERENCE_H)."""
+    for model in hb_accuracy.BENCH_QUICK_MODELS:
+        err = {r["size"]: r["error"] for r in quick_rows[0] if r["model"] == model and r["target"] is None}
+        assert err[3] > err[7]
+
+
+def test_an_accuracy_target_met_by_its_estimate_is_met_in_truth(quick_rows):
+    for r in (r for r in quick_rows[0] if r["target"] is not None):
+        assert r["estimate"] <= r["target"] and r["true_error"] <= r["target"]
+
+
+def test_report_shows_estimate_and_true_error_of_accuracy_rows(quick_rows, tmp_path):
+    rows = quick_rows[0]
+    stamp = {"date_utc": "2026-01-01T00:00:00Z", "revision": "abc", "cores": 2, "machine": "x86_64",
+             "load_average": [1.0, 1.0, 1.0], "sparse_solvers": ["scipy"]}
+    _, html = report.write(tmp_path, {"stamp": stamp, "quick": True, "stages": {"hb": rows}})
+    page = html.read_text()
+    assert page.count("<th>true error</th>") == 1 and page.count("data:image/png;base64,") == 1
+    text = report.table_text("hb", rows)
+    md = (tmp_path / "bench.md").read_text()
+    for r in rows:
+        assert r["setting"] in text and f"| {r['estimate']:.2e} | {r['true_error']:.2e} |" in md
