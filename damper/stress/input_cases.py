@@ -250,6 +250,8 @@ def _upd() -> list[InputCase]:
         ("optimize points 1e6", "optimize --points 1000000"), ("optimize grid 1e6", "optimize --grid 1000000"),
         ("optimize harmonics 1000", "optimize --harmonics 1000"),
         ("optimize workers 0", "optimize --workers 0"), ("optimize workers 10000", "optimize --workers 10000"),
+        ("optimize accuracy 0.5", "optimize --accuracy 0.5"),
+        ("optimize accuracy 1e-7", "optimize --accuracy 1e-7"),
         ("no action", ""),
         ("mistuning std -0.01", "mistuning --std=-0.01"), ("mistuning std nan", "mistuning --std nan"),
         ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
