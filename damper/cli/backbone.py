@@ -15,7 +15,10 @@ amplitude [m]); start it small (the start is the stuck linear mode).
 JSON output (SI): ``modal_amplitude``, ``omega`` [rad/s], ``xi`` [1/s] (the
 artificial negative damping), ``damping_ratio`` (xi / (2 omega)), ``amplitude``
 (peak |x| of the response DOF) per point, ``points``, ``newton_iterations``,
-``status``. A backbone that stops early prints its points and exits with code 3.
+``status``, and ``truncation_error``: a few points re-solved with about 1.5 H harmonics
+(``method``, ``H_used``, ``H_check``, ``omega_rel`` and ``damping_ratio_rel``, the
+largest estimated relative errors, ``points``), with ``truncation_warning`` above 1 %.
+A backbone that stops early prints its points and exits with code 3.
 """
 from __future__ import annotations
 
@@ -43,6 +46,7 @@ def register(subparsers) -> None:
 def run(args) -> int:
     from damper import limits
     from harmonic_balance.epmc import EPMCError, compute_backbone
+    from harmonic_balance.epmc_accuracy import truncation_error, warning
 
     from .common import atomic_write, check_out_file, dumps, print_json
     from .frf import build_model, check_model_arguments, check_samples
@@ -63,16 +67,30 @@ def run(args) -> int:
     except EPMCError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         raise RuntimeError(f"{err} ({err.result.a.size} points kept)") from None
-    _emit(args, bb.summary(), print_json, atomic_write, dumps)
+    s = bb.summary()
+    s["truncation_error"] = truncation_error(model, args.harmonics, bb, args.samples, args.mode,
+                                             limits.MAX_HARMONICS)
+    s["truncation_warning"] = warning(s["truncation_error"])
+    _emit(args, s, print_json, atomic_write, dumps)
     return 0
 
 
 def _emit(args, s, print_json, atomic_write, dumps):
     if args.out:
         atomic_write(args.out, dumps(s, indent=1) + "\n")
+    import sys
+
+    from harmonic_balance.epmc_accuracy import summary_lines
+
+    lines = summary_lines(s.get("truncation_error"))
     if args.json:
         print_json(s)
+        for line in lines:  # the warning stays visible beside the JSON
+            if line.startswith("warning"):
+                print(line, file=sys.stderr)
         return
     print(f"{s['points']} points, {s['newton_iterations']} Newton iterations, status: {s['status']}")
     for a, w, d in list(zip(s["modal_amplitude"], s["omega"], s["damping_ratio"]))[:: max(1, s["points"] // 10)]:
         print(f"a = {a:.4g}  omega = {w:.6g} rad/s  damping ratio = {d:.4g}")
+    for line in lines:
+        print(line)
