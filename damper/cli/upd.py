@@ -152,12 +152,16 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
+        if out.get("truncation_warning"):
+            print(out["truncation_warning"], file=sys.stderr)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
           f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
           f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
     for line in statistics_lines(out):
+        print(line)
+    for line in _accuracy_lines(out):
         print(line)
     return 0
 
