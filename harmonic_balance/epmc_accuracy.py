@@ -10,17 +10,21 @@ and of the damping ratio D, scaled for the error left at H' with the assumed ord
 
     e_H = |v_H - v_H'| / |v_H'| / (1 - (H / H')^p),   v = omega or D.
 
-A few Newton solves at H', no second backbone.
+A few Newton solves at H', no second backbone. :func:`backbone_to_accuracy` raises H
+per backbone until the larger of the two estimates is below a requested accuracy, as
+:func:`.frf_accuracy.frf_to_accuracy` does for a forced response.
 """
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
 
 from . import accuracy as acc
-from .epmc import TOL, Backbone, EPMCProblem
-from .fourier import FourierBasis
+from .epmc import TOL, Backbone, EPMCError, EPMCProblem, compute_backbone
+from .fourier import FourierBasis, parse_harmonics
+from .frf_accuracy import H_MARGIN, RAISE_MAX, _curve_limit, _harmonic_set
 from .model import Model
 from .newton import NewtonError, newton
 
@@ -116,5 +120,60 @@ def summary_lines(record: dict | None) -> list[str]:
     lines = [f"truncation error (estimate, H = {record['H_used']} checked at H = {record['H_check']} "
              f"at {len(record['points'])} amplitudes, order {record['order']:.2g} assumed): "
              f"frequency {pct(record['omega_rel'])}, damping ratio {pct(record['damping_ratio_rel'])}"]
+    a = record.get("accuracy")
+    if a:
+        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
+                     f"tried {a['H_sequence']}")
+        if a.get("message"):
+            lines.append(f"warning: {a['message']}")
     w = warning(record)
-    return lines + ([w] if w else [])
+    return lines + ([w] if w and not (a and a["met"]) else [])
+
+
+def _worst(rec: dict):
+    vals = [rec.get(k) for k in ("omega_rel", "damping_ratio_rel") if rec.get(k) is not None]
+    return max(vals) if vals else None
+
+
+def backbone_to_accuracy(model: Model, harmonics, a_range, accuracy: float, n_t: int = 0,
+                         mode: int = 0, limit: int = MAX_HARMONIC) -> tuple[Backbone, dict]:
+    """(backbone, record) whose larger estimate (omega or damping ratio) is below
+    ``accuracy`` (relative), raising H per backbone from ``harmonics`` (its kind kept):
+    H_next = H (e / accuracy)^(1/p) H_MARGIN, at most RAISE_MAX H, at least the check's
+    H, at most the highest H whose check fits within ``limit``. The record carries
+    ``accuracy``: target, met, H_sequence, message (why not met, or None).
+
+    Raises
+    ------
+    ValueError (bad accuracy); EPMCError when the first backbone stops early (a later one
+    that does ends the run with the previous backbone and a message).
+    """
+    tol = acc.check_accuracy(accuracy)
+    hs = parse_harmonics(harmonics)
+    odd, top, seq, best, message = all(h % 2 for h in hs), _curve_limit(hs, limit), [], None, None
+    while True:
+        try:
+            bb = compute_backbone(model, hs, a_range, n_t=n_t, mode=mode)
+        except EPMCError as err:
+            if best is None:
+                raise
+            message = f"the backbone at H = {hs[-1]} stopped ({err}); H = {seq[-1]} kept"
+            break
+        rec = truncation_error(model, hs, bb, n_t, mode, limit)
+        best = (bb, rec)
+        seq.append(hs[-1])
+        e = _worst(rec)
+        if e is not None and e <= tol:
+            break
+        if e is None or hs[-1] >= top:
+            why = rec.get("note") or f"H = {hs[-1]} is the highest whose check fits the limit H <= {limit}"
+            message = (f"accuracy {tol:g} not reached: {why}; the estimate is "
+                       f"{'unknown' if e is None else f'{100 * e:.3g} %'} at H = {hs[-1]}")
+            break
+        want = min(hs[-1] * (e / tol) ** (1.0 / acc.ASSUMED_ORDER) * H_MARGIN, RAISE_MAX * hs[-1])
+        hs = _harmonic_set(min(max(int(math.ceil(want)), rec["H_check"]), top), odd, 0 in hs)
+    bb, rec = best
+    e = _worst(rec)
+    rec["accuracy"] = {"target": tol, "met": e is not None and e <= tol, "H_sequence": seq,
+                       "message": message}
+    return bb, rec

@@ -225,6 +225,7 @@ def _backbone() -> list[InputCase]:
         ("amplitude nan", f"{SDOF} --amplitude nan 1"), ("harmonics 100000", f"{SDOF} {a} --harmonics 100000"),
         ("samples -1", f"{SDOF} {a} --samples=-1"), ("mode -1", f"{SDOF} {a} --mode=-1"),
         ("mode 5 of one DOF", f"{SDOF} {a} --mode 5"),
+        ("accuracy 0.5", f"{SDOF} {a} --accuracy 0.5"), ("accuracy 1e-7", f"{SDOF} {a} --accuracy 1e-7"),
         ("npz M = -I", "--model {fx}/m_negM.npz --elements {fx}/el_good.toml " + a),
         ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
         ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),

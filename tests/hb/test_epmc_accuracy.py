@@ -7,7 +7,7 @@ from scipy.interpolate import CubicSpline
 
 from damper.cli import main
 from harmonic_balance.epmc import compute_backbone
-from harmonic_balance.epmc_accuracy import truncation_error
+from harmonic_balance.epmc_accuracy import backbone_to_accuracy, truncation_error
 from harmonic_balance.model import sdof_model
 
 #: The goal for an error estimate: within a factor 3 of the true error (measured 0.5-2.2
@@ -54,3 +54,21 @@ def test_backbone_summary_prints_the_estimate(capsys):
     assert main([*CLI, "--contact-stiffness", "1", "--harmonics", "odd:7"]) == 0
     text = capsys.readouterr().out
     assert "truncation error (estimate, H = 7 checked at H = 11" in text and "warning" not in text
+
+
+@pytest.mark.parametrize("target", [1e-3, 1e-4])
+def test_backbone_accuracy_raises_h_until_the_true_error_is_below_the_target(reference, target):
+    bb, rec = backbone_to_accuracy(SDOF, "1", (1e-3, 10), target)
+    a = rec["accuracy"]
+    assert a["met"] and a["message"] is None and a["H_sequence"][-1] == rec["H_used"]
+    assert max(rec["omega_rel"], rec["damping_ratio_rel"]) <= target
+    for name, spline in (("omega", reference[0]), ("damping_ratio", reference[1])):
+        true = max(abs(p[name] / spline(np.log10(p["modal_amplitude"])) - 1) for p in rec["points"])
+        assert true <= target
+
+
+@pytest.mark.parametrize("tol", ["0.5", "1e-7", "nan"])
+def test_backbone_refuses_an_accuracy_outside_its_range(capsys, tol):
+    assert main([*CLI, "--contact-stiffness", "1", "--accuracy", tol]) == 2
+    cap = capsys.readouterr()
+    assert "--accuracy" in cap.err and cap.out == ""
