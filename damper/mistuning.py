@@ -193,9 +193,12 @@ def tuned_reference(study: Study, cfg) -> dict:
     sector = Sector(cfg)
     search = study.band_hz or cfg["load.band_hz"]
     om = 2 * np.pi * np.linspace(search[0], search[1], max(study.points, 41))
+    rec = None  # a linear limit has no harmonic truncation
     if study.damper == "nonlinear":
-        c = frf(SectorHB(sector, study.harmonics, cf=study.cf, f0=study.f0), om)
+        hb = SectorHB(sector, study.harmonics, cf=study.cf, f0=study.f0)
+        c = frf(hb, om)
         w, a = c.peak_omega, c.peak_amplitude
+        rec = _tuned_truncation(hb, c)
     else:
         w, a = tuned_linear_peak(sector, om, study.damper, study.f0)
     margin = BAND_MARGIN + BAND_SIGMAS * study.sigma_f()
@@ -206,7 +209,19 @@ def tuned_reference(study: Study, cfg) -> dict:
         hi = f_t if study.damper != "nonlinear" else max(
             f_t, tuned_linear_peak(sector, om, "stuck", study.f0)[0] / (2 * np.pi))
         band = default_band(f_t, hi, margin)
-    return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band}
+    return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band,
+            "truncation_error": rec}
+
+
+def _tuned_truncation(hb, curve) -> dict:
+    """Truncation-error estimate of the tuned sector's peak at the study's H (the
+    reference every amplification divides by): how accurate that H is for a peak."""
+    from damper import limits
+    from harmonic_balance.bladed_disk.accuracy import truncation_error
+
+    rec = truncation_error(hb, curve, limits.MAX_UPD_HARMONICS)
+    rec["at"] = "the tuned sector's peak (the study's reference)"
+    return rec
 
 
 def default_band(f_low: float, f_high: float, margin: float) -> list:
@@ -416,6 +431,7 @@ def _run_chunks(common, items, size, submit, gather, window, until_ci, tuned_pea
 
 def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> dict:
     """The study's JSON: tuned reference, samples, statistics."""
+    from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.mistuning import frequency_factors, whitehead_bound
 
     a_t = ref["tuned_peak"]
@@ -441,6 +457,8 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
             "band_hz": ref["band_hz"], "points": study.points, "solver": study.solver,
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
+            "truncation_error": ref.get("truncation_error"),
+            "truncation_warning": warning(ref.get("truncation_error")),
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),
             "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}

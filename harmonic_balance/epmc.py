@@ -58,6 +58,9 @@ class Backbone:
     amplitude: np.ndarray
     newton_iterations: int
     status: str = "complete"
+    #: (n, N + 2) the solved unknowns (X~, omega, xi) per point (:class:`EPMCProblem`), for
+    #: re-solving a point with more harmonics (:mod:`.epmc_accuracy`); not in the summary.
+    y: np.ndarray | None = None
 
     def summary(self) -> dict:
         return {"modal_amplitude": self.a.tolist(), "omega": self.omega.tolist(),
@@ -155,7 +158,7 @@ def compute_backbone(model: Model, harmonics, a_range, n_t: int = 0, mode: int =
     xi = Y[:, -1] if len(Y) else np.zeros(0)
     amp = np.array([prob.amplitude(y, l) for y, l in zip(br.x, lam)])
     bb = Backbone(10.0**lam, w, xi, xi / (2.0 * np.where(w > 0, w, np.nan)), amp,
-                  int(sum(br.iterations)), status)
+                  int(sum(br.iterations)), status, Y)
     if status != "complete":
         raise EPMCError(status, bb)
     return bb

@@ -43,7 +43,12 @@ def register(sub) -> None:
     _common(o)
     o.add_argument("--cf-range", type=float, nargs=2, default=(30.0, 3000.0), metavar=("LO", "HI"))
     o.add_argument("--points", type=int, default=20, help="number of CF values (log-spaced)")
-    o.add_argument("--harmonics", type=int, default=7)
+    o.add_argument("--harmonics", type=int, default=7, help="highest harmonic H of the load sweep "
+                   "(with --accuracy the first one tried)")
+    o.add_argument("--accuracy", type=float, metavar="TOL",
+                   help="relative accuracy of the optimum's peak amplitude, in (1e-6, 0.5): its curve is "
+                   "raised in H until the estimate is below TOL, and the sweep re-run at that H "
+                   "(default: the fixed --harmonics, the optimum's estimate reported)")
     o.add_argument("--grid", type=int, default=40, help="frequency points per curve")
     o.add_argument("--workers", type=int, default=2,
                    help="processes for the load grid (results do not depend on it)")
@@ -147,12 +152,16 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
+        if out.get("truncation_warning"):
+            print(out["truncation_warning"], file=sys.stderr)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
           f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
           f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
     for line in statistics_lines(out):
+        print(line)
+    for line in _accuracy_lines(out):
         print(line)
     return 0
 
@@ -332,7 +341,8 @@ def run_frf(args) -> int:
 
 
 def _accuracy_lines(out) -> list[str]:
-    """The truncation-error lines of a ``upd frf`` result (frequencies in Hz)."""
+    """The truncation-error lines of a ``upd frf`` or ``upd optimize`` result (frequencies
+    in Hz)."""
     from harmonic_balance.frf_accuracy import summary_lines
 
     rec = out.get("truncation_error")
@@ -414,6 +424,7 @@ def _check_optimize(args) -> None:
     limits.check_size("--grid", args.grid, 3, limits.MAX_UPD_GRID,
                       "each frequency point is a harmonic-balance solve of the sector")
     limits.check_workers("--workers", args.workers)
+    check_accuracy_option(args.accuracy)
     check_out_dir(args.plot, "--plot")
 
 
@@ -439,6 +450,7 @@ def _optimum_truncation(sector, out, args) -> dict:
 
 def run_optimize(args) -> int:
     import sys
+    import time
 
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.optimize import optimal_load
@@ -447,9 +459,18 @@ def run_optimize(args) -> int:
 
     _check_optimize(args)
     sector = _sector(args)
-    out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
-                       workers=args.workers)
-    out["truncation_error"] = _optimum_truncation(sector, out, args)
+    if args.accuracy is None:
+        out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
+                           workers=args.workers)
+        out["truncation_error"] = _optimum_truncation(sector, out, args)
+    else:
+        from damper import limits
+        from harmonic_balance.bladed_disk.accuracy import optimal_load_to_accuracy
+
+        t0 = time.perf_counter()
+        out = optimal_load_to_accuracy(sector, args.cf_range, args.accuracy, args.points,
+                                       args.harmonics, args.grid, args.workers, limits.MAX_UPD_HARMONICS)
+        out["time_s"] = time.perf_counter() - t0  # both sweeps and the curves that chose H
     out["truncation_warning"] = warning(out["truncation_error"])
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     if args.plot:
@@ -458,7 +479,7 @@ def run_optimize(args) -> int:
         print_json(out)
     else:
         print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
-              f"({out['method']}, {out['time_s']:.1f} s)")
+              f"({out['method']}, H = {out['harmonics']}, {out['time_s']:.1f} s)")
         band = out.get("optimum_band_cf")
         if band:  # the minimum is flat: the CF range a design can use
             print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")

@@ -37,8 +37,10 @@ class Backbone(Kind):
                       products=("backbone",), extra={"matrices": s.get("matrices")})]
 
     def compute(self, stage, inputs, ctx):
+        from damper import limits
         from fmu_src.element import IwanElement
         from harmonic_balance.epmc import EPMCError, compute_backbone
+        from harmonic_balance.epmc_accuracy import truncation_error, warning
 
         p, bb = stage.params, stage.params["backbone"]
         if bb["element"] == "contact":
@@ -56,6 +58,9 @@ class Backbone(Kind):
         except EPMCError as err:
             raise RuntimeError(f"{err} ({err.result.a.size} points kept)") from None
         summary = result.summary()
+        summary["truncation_error"] = truncation_error(model, str(bb["harmonics"]), result, bb["samples"],
+                                                       bb["mode"], limits.MAX_HARMONICS)
+        summary["truncation_warning"] = warning(summary["truncation_error"])
         with tempfile.TemporaryDirectory() as tmp:
             plot_backbone(summary, Path(tmp) / "backbone.png")
             files = collect_files(Path(tmp))
@@ -65,12 +70,15 @@ class Backbone(Kind):
         return {"backbone": "result.json"}
 
     def lines(self, stage, result):
+        from harmonic_balance.epmc_accuracy import summary_lines
+
         s = result.data
         w, d = np.asarray(s["omega"]), np.asarray(s["damping_ratio"])
         i = int(np.nanargmax(d)) if d.size else 0
         return [f"{s['points']} points, {s['newton_iterations']} Newton iterations, status: {s['status']}",
                 f"   frequency {w[0] / (2 * np.pi):.1f} Hz (stuck) -> {w[-1] / (2 * np.pi):.1f} Hz; "
-                f"largest damping ratio {d[i]:.4g} at modal amplitude {s['modal_amplitude'][i]:.4g}"]
+                f"largest damping ratio {d[i]:.4g} at modal amplitude {s['modal_amplitude'][i]:.4g}"] + [
+                    f"   {line}" for line in summary_lines(s.get("truncation_error"))]
 
     def scalars(self, stage, result):
         s = result.data

@@ -119,3 +119,53 @@ def frf_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = MA
     rec["accuracy"] = {"target": tol, "met": e is not None and e <= tol, "H_sequence": seq,
                        "levels": [list(lv) for lv in levels], "message": rec.get("message")}
     return best
+
+
+def optimal_load_to_accuracy(sector, cf_range, accuracy: float, points: int = 20, H: int = 7,
+                             grid: int = 40, workers: int = 1, limit: int = MAX_HARMONIC,
+                             f0=None) -> dict:
+    """Optimal-load curve (:func:`.optimize.optimal_load`) whose optimum's peak has an
+    estimated truncation error below ``accuracy`` (relative).
+
+    The load sweep runs at ``H``; the curve at its optimum CF is raised to the accuracy by
+    :func:`frf_to_accuracy` (from ``H``), which chooses H_acc. When H_acc > H the sweep runs
+    again at H_acc (the optimum CF moves with H: the minimum is flat) and the new
+    optimum's peak is checked at H_acc. Costs one sweep when ``H`` already meets the
+    accuracy, two sweeps and a few sector curves otherwise.
+
+    Returns
+    -------
+    dict of :func:`.optimize.optimal_load` at the H used (``harmonics``), with
+    ``truncation_error`` (the optimum's record, ``at`` = "the optimum CF") carrying
+    ``accuracy``: target, met, sweep_harmonics (H of each sweep), H_sequence and levels
+    (the curves that chose H_acc at the first optimum), message (why not met, or None).
+
+    Raises
+    ------
+    ValueError (bad accuracy or range); SolverError when the first optimum's curve fails.
+    """
+    from .optimize import optimal_load
+
+    tol = acc.check_accuracy(accuracy)
+    lo, hi = sector.cfg["load.band_hz"]
+    omegas = 2 * np.pi * np.linspace(lo, hi, grid)
+    out = optimal_load(sector, cf_range, points, H, grid=grid, f0=f0, workers=workers)
+    _, _, rec = frf_to_accuracy(sector, omegas, tol, H, limit, cf=out["optimum_cf"], f0=f0)
+    chosen, sweeps = rec["accuracy"], [H]
+    if rec["H_used"] != H:
+        sweeps.append(rec["H_used"])
+        out = optimal_load(sector, cf_range, points, rec["H_used"], grid=grid, f0=f0, workers=workers)
+        hb = SectorHB(sector, rec["H_used"], cf=out["optimum_cf"], f0=f0)
+        rec = truncation_error(hb, frf(hb, omegas), limit)
+    e = rec.get("peak_amplitude_rel")
+    met = e is not None and e <= tol
+    message = chosen["message"]
+    if message is None and not met:  # the optimum moved with H, and its peak converges slower there
+        message = (f"accuracy {tol:g} not reached at the new optimum: the estimate is "
+                   f"{'unknown' if e is None else f'{100 * e:.3g} %'} at H = {rec['H_used']}")
+    rec["at"] = "the optimum CF"
+    rec["accuracy"] = {"target": tol, "met": met, "sweep_harmonics": sweeps,
+                       "H_sequence": chosen["H_sequence"], "levels": chosen["levels"],
+                       "message": message}
+    out["truncation_error"] = rec
+    return out

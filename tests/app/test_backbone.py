@@ -69,6 +69,8 @@ def test_only_backbone_runs_no_contact_fe_element_or_frf_stage(tmp_path):
     d = np.asarray(bb["damping_ratio"])
     assert d[0] == pytest.approx(_stuck_damping_ratio(), rel=DAMPING_RTOL)
     assert d.max() > 10 * d[0] and d[-1] < d.max()           # friction damping rises and falls
+    te = bb["truncation_error"]   # the estimate re-solves points with more harmonics
+    assert te["H_check"] > te["H_used"] and len(te["points"]) >= 2 and te["omega_rel"] is not None
     assert (tmp_path / "out" / "backbone" / "backbone.png").stat().st_size > 0
     again = run_scene(scene, store, tmp_path / "out", **QUIET)
     assert again.computed == []
