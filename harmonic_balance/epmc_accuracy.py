@@ -150,6 +150,8 @@ def backbone_to_accuracy(model: Model, harmonics, a_range, accuracy: float, n_t:
     """
     tol = acc.check_accuracy(accuracy)
     hs = parse_harmonics(harmonics)
+    if hs[-1] < acc.MIN_START_HARMONIC:   # the check from H = 1 is not yet in its steady range
+        hs = _harmonic_set(acc.MIN_START_HARMONIC, all(h % 2 for h in hs), 0 in hs)
     odd, top, seq, best, message = all(h % 2 for h in hs), _curve_limit(hs, limit), [], None, None
     while True:
         try:

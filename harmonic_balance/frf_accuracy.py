@@ -109,7 +109,8 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
     """Forced-response curve whose peak amplitude's estimated truncation error is below
     ``accuracy`` (relative), raising H per curve.
 
-    Starts at ``harmonics`` (its kind, odd or all, is kept); after each curve the peak
+    Starts at ``harmonics`` (its kind, odd or all, is kept; at least
+    :data:`accuracy.MIN_START_HARMONIC`); after each curve the peak
     is checked at richer sets (:func:`truncation_error`); while the estimate e exceeds
     ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
     observed order, else :data:`accuracy.ASSUMED_ORDER`), at most RAISE_MAX H, at least
@@ -133,6 +134,8 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
     tol = acc.check_accuracy(accuracy)
     hs = parse_harmonics(harmonics)
     odd = all(h % 2 for h in hs)
+    if hs[-1] < acc.MIN_START_HARMONIC:
+        hs = _harmonic_set(acc.MIN_START_HARMONIC, odd, 0 in hs)
     top = _curve_limit(hs, limit)
     import time
 

@@ -85,6 +85,7 @@ def frf_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = MA
     ValueError (bad accuracy); the first curve's StartError / SolverError.
     """
     tol = acc.check_accuracy(accuracy)
+    H = max(int(H), acc.MIN_START_HARMONIC)   # from H = 1 the check is not yet in its steady range
     top = limit
     while top > H and acc.richer(tuple(range(top + 1)))[-1] > limit:
         top -= 1
@@ -147,6 +148,7 @@ def optimal_load_to_accuracy(sector, cf_range, accuracy: float, points: int = 20
     from .optimize import optimal_load
 
     tol = acc.check_accuracy(accuracy)
+    H = max(int(H), acc.MIN_START_HARMONIC)   # as frf_to_accuracy: the sweep starts there too
     lo, hi = sector.cfg["load.band_hz"]
     omegas = 2 * np.pi * np.linspace(lo, hi, grid)
     out = optimal_load(sector, cf_range, points, H, grid=grid, f0=f0, workers=workers)
