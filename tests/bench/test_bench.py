@@ -39,7 +39,7 @@ def test_bench_quick_report(tmp_path, capsys):
     hb = {r["size"]: r["error"] for r in stages["hb"] if r["case"] == "harmonics"}
     assert hb[1] > hb[3] > hb[7] and hb[7] < 2e-4
     assert any(r.get("default") for r in stages["hb"])
-    # the accuracy rows (tests/bench/test_hb_accuracy.py checks their numbers)
+    # the accuracy rows (tests/bench/test_bench_accuracy.py checks their numbers)
     acc = [r for r in stages["hb"] if r["case"].startswith("accuracy ")]
     assert acc and all(r["estimate"] is not None and r["error"] > 0 for r in acc)
     assert out["stamp"]["cores"] >= 1 and "numpy" in out["stamp"]["versions"]
