@@ -68,6 +68,10 @@ def main(argv: list[str]) -> int:
     run = json.loads(run_path.read_text())
     table = json.loads(table_path.read_text()) if table_path.exists() else {"records": []}
     now, listed = keys(run["records"]), keys(table["records"])
+    if listed and not now:   # a run that collected or passed nothing checks nothing
+        print(f"validation check: the run in {run_path} recorded no reference check "
+              f"({len(listed)} in the table): did the tests run?", file=sys.stderr)
+        return 1
     passed = set(run.get("passed_tests", []))
     missing = sorted(now - listed)
     stale = sorted(k for k in listed - now if k[0] in passed)

@@ -65,3 +65,9 @@ def test_missing_and_stale_checks_fail(tmp_path):
     code, err = run_check(tmp_path, [record("peak [m]", 2e-6)], [record("omega [rad/s]", 2e-6)])
     assert code == 1
     assert "not in the validation table" in err and "no longer checked" in err
+
+
+def test_a_run_without_any_reference_check_fails(tmp_path):
+    # a suite that stopped at collection records nothing: that is no pass
+    code, err = run_check(tmp_path, [], [record("peak [m]", 2e-6)])
+    assert code == 1 and "recorded no reference check" in err
