@@ -1,12 +1,12 @@
 """Truncation error of a backbone (:mod:`.epmc`): a few points re-solved with more harmonics.
 
-Method (docs/method/accuracy.md, as for a forced response's peak, :mod:`.accuracy`): at
+Method (docs/method/accuracy.md, as for a forced response's peak, :mod:`harmonic_balance.accuracy`): at
 CHECK_POINTS modal amplitudes of the backbone (the largest damping ratio, where the
 contacts slip most, the middle of the range in log a and its end) the point's unknowns
-(X~, omega, xi) are padded with zeros to the richer set H' (:func:`.accuracy.richer`,
+(X~, omega, xi) are padded with zeros to the richer set H' (:func:`harmonic_balance.accuracy.richer`,
 about 1.5 H) and corrected by Newton at the same amplitude a. The differences of omega
 and of the damping ratio D, scaled for the error left at H' with the assumed order p
-(:data:`.accuracy.ASSUMED_ORDER`), estimate the relative truncation error at H::
+(:data:`harmonic_balance.accuracy.ASSUMED_ORDER`), estimate the relative truncation error at H::
 
     e_H = |v_H - v_H'| / |v_H'| / (1 - (H / H')^p),   v = omega or D.
 
