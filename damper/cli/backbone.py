@@ -54,9 +54,8 @@ def run(args) -> int:
     from harmonic_balance.epmc import EPMCError, compute_backbone
     from harmonic_balance.epmc_accuracy import backbone_to_accuracy, truncation_error, warning
 
-    from .common import atomic_write, check_out_file, dumps, print_json
+    from .common import atomic_write, check_accuracy_option, check_out_file, dumps, print_json
     from .frf import build_model, check_model_arguments, check_samples
-    from .upd import check_accuracy_option
 
     check_model_arguments(args)
     limits.check_harmonics("--harmonics", args.harmonics)

@@ -60,6 +60,17 @@ def print_json(obj) -> None:
     sys.stdout.write(dumps(obj) + "\n")
 
 
+def check_accuracy_option(tol) -> None:
+    """``--accuracy`` unset or inside :data:`harmonic_balance.accuracy.ACCURACY_RANGE`
+    (open interval)."""
+    from harmonic_balance.accuracy import ACCURACY_RANGE
+
+    lo, hi = ACCURACY_RANGE
+    if tol is not None and not lo < tol < hi:
+        raise ValueError(f"--accuracy must be a relative tolerance in ({lo:g}, {hi:g}) on the peak "
+                         f"amplitude, got {tol:g}")
+
+
 def _writable_parent(path: Path, flag: str) -> None:
     """The nearest existing folder above ``path`` must be a folder this user can write."""
     probe = path.parent

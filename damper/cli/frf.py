@@ -235,12 +235,9 @@ DEFAULT_ACCURACY, DEFAULT_START = 1e-2, "3"
 def check_accuracy_arguments(args) -> None:
     """``--accuracy`` inside (1e-6, 0.5); without it and without ``--harmonics`` the default
     accuracy and start (the arguments are filled in)."""
-    from harmonic_balance.accuracy import ACCURACY_RANGE
+    from .common import check_accuracy_option
 
-    lo, hi = ACCURACY_RANGE
-    if args.accuracy is not None and not lo < args.accuracy < hi:
-        raise ValueError(f"--accuracy must be a relative tolerance in ({lo:g}, {hi:g}) on the peak "
-                         f"amplitude, got {args.accuracy:g}")
+    check_accuracy_option(args.accuracy)
     if args.accuracy is None and args.harmonics is None:
         args.accuracy = DEFAULT_ACCURACY
     if args.harmonics is None:

@@ -282,7 +282,7 @@ def _check_frf(args) -> None:
     """Every option of ``upd frf``, before the model (or its contacts) is built."""
     from damper import limits
 
-    from .common import check_out_dir
+    from .common import check_accuracy_option, check_out_dir
 
     if args.band is not None:
         limits.check_omega_range("--band", *args.band, unit="Hz", scale=2 * np.pi)
@@ -298,16 +298,6 @@ def _check_frf(args) -> None:
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
     check_out_dir(args.plot, "--plot")
-
-
-def check_accuracy_option(tol) -> None:
-    """``--accuracy`` unset or inside (1e-6, 0.5)."""
-    from harmonic_balance.accuracy import ACCURACY_RANGE
-
-    lo, hi = ACCURACY_RANGE
-    if tol is not None and not lo < tol < hi:
-        raise ValueError(f"--accuracy must be a relative tolerance in ({lo:g}, {hi:g}) on the peak "
-                         f"amplitude, got {tol:g}")
 
 
 def run_frf(args) -> int:
@@ -412,7 +402,7 @@ def _check_optimize(args) -> None:
     """Every option of ``upd optimize``, before the model (or its contacts) is built."""
     from damper import limits
 
-    from .common import check_out_dir
+    from .common import check_accuracy_option, check_out_dir
 
     lo, hi = args.cf_range
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
