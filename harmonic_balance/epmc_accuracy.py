@@ -24,7 +24,7 @@ import numpy as np
 from . import accuracy as acc
 from .epmc import TOL, Backbone, EPMCError, EPMCProblem, compute_backbone
 from .fourier import FourierBasis, parse_harmonics
-from .frf_accuracy import H_MARGIN, RAISE_MAX, _curve_limit, _harmonic_set
+from .frf_accuracy import H_MARGIN, RAISE_MAX, _curve_limit, _harmonic_set, accuracy_lines
 from .model import Model
 from .newton import NewtonError, newton
 
@@ -121,11 +121,7 @@ def summary_lines(record: dict | None) -> list[str]:
              f"at {len(record['points'])} amplitudes, order {record['order']:.2g} assumed): "
              f"frequency {pct(record['omega_rel'])}, damping ratio {pct(record['damping_ratio_rel'])}"]
     a = record.get("accuracy")
-    if a:
-        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
-                     f"tried {a['H_sequence']}")
-        if a.get("message"):
-            lines.append(f"warning: {a['message']}")
+    lines += accuracy_lines(a)
     w = warning(record)
     return lines + ([w] if w and not (a and a["met"]) else [])
 

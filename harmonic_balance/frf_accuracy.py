@@ -219,14 +219,20 @@ def summary_lines(summary, hz: bool = False) -> list[str]:
               f" at {_num(w / (2 * math.pi))} Hz" if hz else f" at omega = {_num(w)} rad/s")
         lines.append(f"extrapolated in H: peak amplitude {_num(ex['peak_amplitude'])} m{at}")
     a = summary.get("accuracy")
-    if a:
-        lines.append(f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
-                     f"tried {a['H_sequence']}")
-        if a.get("message"):
-            lines.append(f"warning: {a['message']}")
+    lines += accuracy_lines(a)
     if summary.get("truncation_warning") and not (a and a["met"]):
         lines.append(summary["truncation_warning"])
     return lines
+
+
+def accuracy_lines(a: dict | None) -> list[str]:
+    """Text lines of a run to an accuracy (its ``accuracy`` record: target, met,
+    H_sequence, message), for forced responses and backbones alike."""
+    if not a:
+        return []
+    lines = [f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
+             f"tried {a['H_sequence']}"]
+    return lines + ([f"warning: {a['message']}"] if a.get("message") else [])
 
 
 def _num(v, fmt=".9g") -> str:
