@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from processes import gone_after_kill
 
 from contact_core.fileio import atomic_write
 from damper.cache import TAG_NAME, NotACacheError, Store, is_cache_folder
@@ -279,16 +280,7 @@ def test_the_fork_runner_detects_a_traceback_and_a_hang(tmp_path, monkeypatch):
     monkeypatch.setattr(loop, "run", lambda args: (pid_file.write_text(str(os.getpid())), time.sleep(60)))
     r = forkrun.run(["loop", "--curve", "x.json", "--amplitude", "1"], tmp_path / "a", 3.0)
     # the time limit ended it (no exit code), and the hung child is gone, not waited on
-    assert r.code is None and not _running(int(pid_file.read_text()))
-
-
-def _running(pid: int) -> bool:
-    """Is process ``pid`` still there (a zombie, dead but not reaped, is not running)?"""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except FileNotFoundError:
-        return False
-    return state not in ("Z", "X")
+    assert r.code is None and gone_after_kill(int(pid_file.read_text()))
 
 
 def test_scene_problems_found_before_any_work_name_their_key_and_line(tmp_path):
