@@ -19,12 +19,17 @@ Rows:
   (tracemalloc, a separate run). With ``--quick`` (and no ``--workers``) 2 samples run
   in this process (``workers = 0``, the serial executor): the quick mode starts no Dask
   cluster (the documentation build runs it).
+* ``confidence``: the 0.95 quantile's 95 % interval from ``--confidence-samples`` damper-free
+  samples (default 1000; UPD-24, std 0.02, seed 1) against the 0.95 quantile of an
+  independent study four times as large (seed 2), in this process
+  (``examples/mistuning_confidence.py``, which also plots it): whether it is inside.
 
 Times are CPU (process_time) where one process works, wall time for the clusters: the
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling precond throughput] [--samples 8] [--quick] [--workers 1 2] [--damper free]
+        [--rows scaling precond throughput confidence] [--samples 8] [--quick] [--workers 1 2]
+        [--damper free] [--confidence-samples 1000]
 """
 from __future__ import annotations
 
@@ -169,6 +174,23 @@ def throughput_rows(samples: int, workers=(1, 2), damper: str = "nonlinear") -> 
     return rows
 
 
+def confidence_rows(n: int, blades: int | None) -> list:
+    """The ``confidence`` row (``examples/mistuning_confidence.py`` on a fresh cache)."""
+    import importlib.util
+
+    from damper.cache import Store
+
+    spec = importlib.util.spec_from_file_location("mistuning_confidence",
+                                                  Path(__file__).with_name("mistuning_confidence.py"))
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    with tempfile.TemporaryDirectory() as tmp:
+        row = conf.confidence_row(n, "free", Store(tmp), blades)[0]
+    for line in conf.row_lines(row):
+        print(line, flush=True)
+    return [row]
+
+
 def _fmt(row: dict) -> str:
     return "  ".join(f"{k}={v:.4g}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items())
 
@@ -177,7 +199,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
-                   choices=("scaling", "precond", "throughput"))
+                   choices=("scaling", "precond", "throughput", "confidence"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
     p.add_argument("--workers", type=int, nargs="+",
                    help="Dask local-cluster sizes of the throughput rows (0: this process; "
@@ -186,7 +208,11 @@ def main(argv=None) -> int:
                    help="the throughput rows' damper (free/stuck: the cheap linear limits)")
     p.add_argument("--quick", action="store_true",
                    help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
+    p.add_argument("--confidence-samples", type=int, default=1000,
+                   help="samples of the confidence row's first study (>= 72; the second: 4x)")
     a = p.parse_args(argv)
+    if a.confidence_samples < 72:
+        p.error("--confidence-samples must be >= 72 (the 0.95 quantile's interval needs them)")
     if a.samples < 1:
         p.error("--samples must be >= 1")
     rows = []
@@ -197,6 +223,8 @@ def main(argv=None) -> int:
     if "throughput" in a.rows:
         workers = a.workers or ((0,) if a.quick else (1, 2))
         rows += throughput_rows(a.samples if a.workers or not a.quick else 2, workers, a.damper)
+    if "confidence" in a.rows:
+        rows += confidence_rows(80 if a.quick else a.confidence_samples, 8 if a.quick else None)
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "bench_mistuning.json").write_text(json.dumps(rows, indent=1, default=str) + "\n")
     print(f"table in {a.out / 'bench_mistuning.json'}")

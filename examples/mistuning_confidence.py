@@ -81,6 +81,45 @@ def plot(a: np.ndarray, b: np.ndarray, q: dict, ref: float, path: Path) -> None:
     plt.close(fig)
 
 
+def confidence_row(n: int, damper: str, store: Store, blades: int | None = None) -> dict:
+    """The comparison of the module docstring: a study of ``n`` samples (seed 1) and an
+    independent one of 4 ``n`` (seed 2); the row (JSON-able) and the two samples."""
+    small = study(n, SEEDS[0], damper, store, blades)
+    large = study(4 * n, SEEDS[1], damper, store, blades)
+    x, y = amplifications(small), amplifications(large)
+    q, ref = quantile_ci(x, 0.95), float(np.quantile(y, 0.95))
+    fits = {k: o["statistics"]["fit"] for k, o in (("small", small), ("large", large))}
+    row = {"case": "confidence", "damper": damper, "std": STD, "blades": small["blades"],
+           "n_small": int(x.size), "n_large": int(y.size), "q95_small": q["value"],
+           "q95_low": q["low"], "q95_high": q["high"], "coverage": q["coverage"], "q95_large": ref,
+           "contained": bool(q["low"] <= ref <= q["high"]),
+           "q95_large_interval": quantile_ci(y, 0.95),
+           "fit_best": {k: f and f["best"] for k, f in fits.items()},
+           "fit_q95": {k: f and f["best"] and f["fits"][f["best"]]["quantiles"]["0.95"] for k, f in fits.items()},
+           "until_ci_samples": {f"{w:g}": until_ci_samples(y, w) for w in (0.05, 0.02, 0.01, 0.005)},
+           "cpu_s": {"small": small["cpu_s"], "large": large["cpu_s"]},
+           "cpu_per_sample_s": (small["cpu_s"] + large["cpu_s"]) / (x.size + y.size),
+           "efficiency": {"small": small["efficiency"], "large": large["efficiency"]}}
+    return row, x, y
+
+
+def row_lines(row: dict) -> list:
+    """The printed comparison."""
+    ok = row["contained"]
+    return [f"{row['damper']} damper, std {STD}, {row['blades']} blades",
+            f"0.95 quantile of {row['n_small']} samples: {row['q95_small']:.4f}, 95 % interval "
+            f"[{row['q95_low']:.4f}, {row['q95_high']:.4f}] (coverage {row['coverage']:.4f})",
+            f"0.95 quantile of {row['n_large']} independent samples: {row['q95_large']:.4f} -> "
+            + ("inside the interval" if ok else
+               "outside the interval (a 95 % interval misses about one pair in 20, more when the "
+               "large study's own estimate scatters)"),
+            f"fitted {row['fit_best']['small']} 0.95 quantile (small study): {row['fit_q95']['small']}",
+            "samples --until-ci would need (large study's sequence): "
+            + ", ".join(f"+-{w}: {m}" for w, m in row["until_ci_samples"].items()),
+            f"CPU: {row['cpu_s']['small']:.1f} s and {row['cpu_s']['large']:.1f} s "
+            f"({row['cpu_per_sample_s']:.3f} s a sample)"]
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/mt_confidence"))
@@ -94,35 +133,13 @@ def main(argv=None) -> int:
     if n < 72:
         p.error("--samples must be >= 72 (the 0.95 quantile's two-sided interval needs them)")
     with tempfile.TemporaryDirectory() as tmp:
-        store = Store(a.cache_dir or tmp)
-        small = study(n, SEEDS[0], a.damper, store, blades)
-        large = study(4 * n, SEEDS[1], a.damper, store, blades)
-    x, y = amplifications(small), amplifications(large)
-    q, ref = quantile_ci(x, 0.95), float(np.quantile(y, 0.95))
-    fits = {k: o["statistics"]["fit"] for k, o in (("small", small), ("large", large))}
-    row = {"damper": a.damper, "std": STD, "blades": small["blades"], "n_small": int(x.size),
-           "n_large": int(y.size), "q95_small": q["value"], "q95_low": q["low"], "q95_high": q["high"],
-           "coverage": q["coverage"], "q95_large": ref, "contained": bool(q["low"] <= ref <= q["high"]),
-           "q95_large_interval": quantile_ci(y, 0.95),
-           "fit_best": {k: f and f["best"] for k, f in fits.items()},
-           "fit_q95": {k: f and f["best"] and f["fits"][f["best"]]["quantiles"]["0.95"] for k, f in fits.items()},
-           "until_ci_samples": {f"{w:g}": until_ci_samples(y, w) for w in (0.05, 0.02, 0.01, 0.005)},
-           "cpu_s": {"small": small["cpu_s"], "large": large["cpu_s"]},
-           "efficiency": {"small": small["efficiency"], "large": large["efficiency"]}}
-    print(f"{a.damper} damper, std {STD}, {row['blades']} blades")
-    print(f"0.95 quantile of {x.size} samples: {q['value']:.4f}, 95 % interval [{q['low']:.4f}, "
-          f"{q['high']:.4f}] (coverage {q['coverage']:.4f})")
-    print(f"0.95 quantile of {y.size} independent samples: {ref:.4f} -> "
-          + ("inside the interval" if row["contained"] else
-             "outside the interval (a 95 % interval misses about one pair in 20, more when the "
-             "large study's own estimate scatters)"))
-    print(f"fitted {row['fit_best']['small']} 0.95 quantile (small study): {row['fit_q95']['small']}")
-    print("samples --until-ci would need (large study's sequence): "
-          + ", ".join(f"+-{w}: {m}" for w, m in row["until_ci_samples"].items()))
-    print(f"CPU: {small['cpu_s']:.1f} s and {large['cpu_s']:.1f} s")
+        row, x, y = confidence_row(n, a.damper, Store(a.cache_dir or tmp), blades)
+    for line in row_lines(row):
+        print(line)
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "mistuning_confidence.json").write_text(json.dumps(row, indent=1) + "\n")
-    plot(x, y, q, ref, a.out / "mistuning_confidence.png")
+    q = {"low": row["q95_low"], "high": row["q95_high"]}
+    plot(x, y, q, row["q95_large"], a.out / "mistuning_confidence.png")
     return 0   # a miss is a possible outcome of a 95 % interval, reported, not an error
 
 
