@@ -20,7 +20,7 @@ Rows:
   in this process (``workers = 0``, the serial executor): the quick mode starts no Dask
   cluster (the documentation build runs it).
 * ``confidence``: the 0.95 quantile's 95 % interval from ``--confidence-samples`` damper-free
-  samples (default 1000; UPD-24, std 0.02, seed 1) against the 0.95 quantile of an
+  samples (default 1000; UPD-24 or ``--confidence-blades``, std 0.02, seed 1) against the 0.95 quantile of an
   independent study four times as large (seed 2), in this process
   (``examples/mistuning_confidence.py``, which also plots it): whether it is inside.
 
@@ -29,7 +29,7 @@ machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
         [--rows scaling precond throughput confidence] [--samples 8] [--quick] [--workers 1 2]
-        [--damper free] [--confidence-samples 1000]
+        [--damper free] [--confidence-samples 1000] [--confidence-blades 8]
 """
 from __future__ import annotations
 
@@ -210,6 +210,8 @@ def main(argv=None) -> int:
                    help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
     p.add_argument("--confidence-samples", type=int, default=1000,
                    help="samples of the confidence row's first study (>= 72; the second: 4x)")
+    p.add_argument("--confidence-blades", type=int,
+                   help="N_b of the confidence row (EO = N_b / 4; default UPD-24's 24)")
     a = p.parse_args(argv)
     if a.confidence_samples < 72:
         p.error("--confidence-samples must be >= 72 (the 0.95 quantile's interval needs them)")
@@ -224,7 +226,8 @@ def main(argv=None) -> int:
         workers = a.workers or ((0,) if a.quick else (1, 2))
         rows += throughput_rows(a.samples if a.workers or not a.quick else 2, workers, a.damper)
     if "confidence" in a.rows:
-        rows += confidence_rows(80 if a.quick else a.confidence_samples, 8 if a.quick else None)
+        rows += confidence_rows(80 if a.quick else a.confidence_samples,
+                                8 if a.quick else a.confidence_blades)
     a.out.mkdir(parents=True, exist_ok=True)
     (a.out / "bench_mistuning.json").write_text(json.dumps(rows, indent=1, default=str) + "\n")
     print(f"table in {a.out / 'bench_mistuning.json'}")

@@ -92,8 +92,12 @@ def _mistuning(s) -> None:
                    help="fast: adaptive continuation with Hermite peaks (default); full: the "
                    "fixed grid with every point solved (the reference)")
     p.add_argument("--worst", action="store_true",
-                   help="search the worst pattern within 1 +- --bound (linear ring: --damper free|stuck)")
+                   help="search the worst pattern within 1 +- --bound (the friction damper, or the linear "
+                   "ring with --damper free|stuck)")
     p.add_argument("--bound", type=float, help="half-width B of the --worst box (default 3 --std)")
+    p.add_argument("--max-evaluations", type=int, metavar="N",
+                   help="with --worst and the friction damper: ring curves per start at most "
+                   "(default 25)")
     p.add_argument("--out", metavar="FILE", help="with --worst: also write its JSON to FILE")
     p.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786)")
     p.add_argument("--workers", type=int, help="local Dask cluster workers (default: cores)")
@@ -130,7 +134,7 @@ def run_mistuning(args) -> int:
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
                   cf=args.cf, f0=args.f0, harmonics=args.harmonics,
                   band_hz=args.band, points=args.points, until_ci=args.until_ci, solver=args.solver)
-    if args.worst or args.bound is not None or args.out is not None:
+    if args.worst or args.bound is not None or args.out is not None or args.max_evaluations is not None:
         if args.until_ci is not None:
             raise ValueError("--until-ci goes with a random study, not with --worst")
         return _run_worst(args, study)
@@ -166,6 +170,8 @@ def run_mistuning(args) -> int:
     return 0
 
 
+#: Most ring curves per start of a friction --worst search.
+MAX_EVALUATIONS_CLI = 1000
 #: Most samples of an --until-ci study without --samples.
 UNTIL_CI_SAMPLES = 2000
 
@@ -209,7 +215,7 @@ def _print_samples(out: dict) -> None:
 
 
 def _run_worst(args, study) -> int:
-    """``--worst``: the worst pattern of the linear ring, printed (and written to --out)."""
+    """``--worst``: the worst pattern, printed (and written to --out)."""
     import json
     from pathlib import Path
 
@@ -218,7 +224,17 @@ def _run_worst(args, study) -> int:
     from .common import atomic_write, print_json
 
     if not args.worst:
-        raise ValueError("--bound and --out go with --worst")
+        raise ValueError("--bound, --out and --max-evaluations go with --worst")
+    friction = {}
+    if args.max_evaluations is not None:
+        if study.damper != "nonlinear":
+            raise ValueError("--max-evaluations limits the friction damper's search (ring curves "
+                             "per start): drop it with --damper free|stuck")
+        from damper import limits
+
+        limits.check_size("--max-evaluations", args.max_evaluations, 1, MAX_EVALUATIONS_CLI,
+                          "each evaluation is a ring curve (~5 s CPU at 24 blades, H = 7)")
+        friction["max_evaluations"] = args.max_evaluations
     if args.plot or args.scheduler or args.workers:
         raise ValueError("--worst runs in this process and draws no plots: drop --plot, "
                          "--scheduler, --workers")
@@ -228,20 +244,41 @@ def _run_worst(args, study) -> int:
         out_path = Path(args.out)
         if out_path.is_dir() or not out_path.parent.is_dir():
             raise ValueError(f"--out {args.out}: give a file in an existing folder")
-    out = run_worst(study, args.bound)
+    out = run_worst(study, args.bound, **friction)
     if args.out is not None:
         atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
     if args.json:
         print_json(out)
         return 0
-    print(f"worst pattern within 1 +- {out['bound']:.4g} ({out['damper']} damper, {out['blades']} "
-          f"blades): amplification {out['amplification']:.4f} (Whitehead bound "
-          f"{out['whitehead_bound']:.3f}) at {out['frequency_hz']:.2f} Hz on blade 0")
-    print("factors: " + " ".join(f"{k:.5f}" for k in out["factors"]))
-    if not out["converged"]:
-        print(f"note: the best start's optimizer did not converge ({out['message']}); the best "
-              "pattern found is shown")
+    for line in worst_lines(out):
+        print(line)
     return 0
+
+
+def worst_lines(out: dict) -> list:
+    """The printed worst pattern: amplification, factors, convergence, the time-integration
+    check (friction damper)."""
+    lines = [f"worst pattern within 1 +- {out['bound']:.4g} ({out['damper']} damper, {out['blades']} "
+             f"blades): amplification {out['amplification']:.4f} (Whitehead bound "
+             f"{out['whitehead_bound']:.3f}, linear disks) at {out['frequency_hz']:.2f} Hz on blade "
+             f"{out['worst_blade']}",
+             "factors: " + " ".join(f"{k:.5f}" for k in out["factors"])]
+    if out["damper"] == "nonlinear":
+        lines += [f"  start {s['label']}: " + ("no pattern solved" if s["amplification"] is None else
+                  f"amplification {s['amplification']:.4f}") + f", {s['evaluations']} ring curves, "
+                  f"{s['message']}" for s in out["starts"]]
+    if not out["converged"]:
+        lines.append(f"note: the best start's optimizer did not converge ({out['message']}); the best "
+                     "pattern found is shown")
+    c = out.get("timeint_check")
+    if c:
+        lines.append(f"time integration at {out['frequency_hz']:.2f} Hz: blade {out['worst_blade']} "
+                     f"{c['timeint_amplitude']:.5e} m, {100 * c['rel_diff']:+.2f} % from the HB peak "
+                     f"(H = {out['harmonics']}; " + ("within 1 %" if c["within_1_percent"] else "not within 1 %")
+                     + (f"; HB at H = {c['check_harmonics']}: {100 * c['rel_diff_check']:+.2f} %"
+                        if c["rel_diff_check"] is not None else "")
+                     + f"; {c['periods']} periods" + ("" if c["settled"] else ", not settled") + ")")
+    return lines
 
 
 def _common(p) -> None:

@@ -70,7 +70,9 @@ def test_cli_worst_prints_and_writes_the_pattern(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("extra, message", [
-    (["--worst", "--std", "0.02"], "--damper free or --damper stuck"),
+    (["--worst", "--std", "0.02", "--max-evaluations", "0"], "--max-evaluations must be >= 1"),
+    (["--worst", "--damper", "free", "--max-evaluations", "5"], "drop it with --damper free|stuck"),
+    (["--max-evaluations", "5"], "go with --worst"),
     (["--worst", "--damper", "free", "--bound", "0.9"], "--bound <= 0.75"),
     (["--bound", "0.1"], "go with --worst"),
 ])
