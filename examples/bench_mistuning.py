@@ -19,6 +19,13 @@ Rows:
   (tracemalloc, a separate run). With ``--quick`` (and no ``--workers``) 2 samples run
   in this process (``workers = 0``, the serial executor): the quick mode starts no Dask
   cluster (the documentation build runs it).
+* ``worst``: the worst pattern of the linear ring (damper free, std 0.02, factors within
+  1 +- 0.06; ``damper upd mistuning --worst``'s search) against the largest amplification
+  of ``--worst-samples`` uniform random patterns at the same std (a study, every blade's
+  peak by the ring's own peak search), Whitehead's bound (1 + sqrt(N_b)) / 2, and, for
+  N_b <= 6, scipy's differential evolution on the same peak (no gradients): whether it is
+  above, below and within 1 %. N_b from ``--worst-blades`` (default 6 and 24; EO = N_b / 4,
+  at least 1).
 * ``confidence``: the 0.95 quantile's 95 % interval from ``--confidence-samples`` damper-free
   samples (default 1000; UPD-24 or ``--confidence-blades``, std 0.02, seed 1) against the 0.95 quantile of an
   independent study four times as large (seed 2), in this process
@@ -28,8 +35,9 @@ Times are CPU (process_time) where one process works, wall time for the clusters
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling precond throughput confidence] [--samples 8] [--quick] [--workers 1 2]
-        [--damper free] [--confidence-samples 1000] [--confidence-blades 8]
+        [--rows scaling precond throughput worst confidence] [--samples 8] [--quick] [--workers 1 2]
+        [--damper free] [--worst-blades 6 24] [--worst-samples 1000]
+        [--confidence-samples 1000] [--confidence-blades 8]
 """
 from __future__ import annotations
 
@@ -174,6 +182,46 @@ def throughput_rows(samples: int, workers=(1, 2), damper: str = "nonlinear") -> 
     return rows
 
 
+def worst_rows(blades, samples: int) -> list:
+    """The ``worst`` rows (module docstring)."""
+    from scipy.optimize import differential_evolution
+
+    from damper.cache import Store
+    from damper.mistuning import Study, run_study
+    from damper.mistuning_worst import _linear_search
+    from harmonic_balance.bladed_disk.mistuning import whitehead_bound
+
+    std, b, rows = 0.02, 0.06, []
+    for nb in blades:
+        eo = max(1, nb // 4)
+        study = Study(blades=nb, engine_order=eo, std=std, damper="free", seed=1)
+        c0 = time.process_time()
+        r, peak, (_, a_t), _ = _linear_search(study, b, 32)
+        t_worst = time.process_time() - c0
+        c0 = time.process_time()
+        with tempfile.TemporaryDirectory() as tmp:
+            mc = run_study(Study(blades=nb, engine_order=eo, std=std, damper="free", seed=3, samples=samples,
+                                 distribution="uniform"), Store(tmp), serial=True, echo=lambda t: None)
+        t_mc = time.process_time() - c0
+        row = {"case": "worst pattern, linear", "blades": nb, "damper": "free", "std": std, "bound": b,
+               "amplification": r["peak"] / a_t, "worst_cpu_s": t_worst, "evaluations": r["evaluations"],
+               "random_samples": samples - mc["failed"], "random_max": mc["max_amplification"],
+               "random_cpu_s": t_mc, "whitehead_bound": whitehead_bound(nb)}
+        row["above_random"] = row["amplification"] > row["random_max"]
+        row["below_whitehead"] = row["amplification"] < row["whitehead_bound"]
+        if nb <= 6:
+            c0 = time.process_time()
+            de = differential_evolution(lambda k, p=peak: -p.peak(k)[0], [(1 - b, 1 + b)] * nb,
+                                        seed=20261127, tol=1e-7, popsize=10, polish=True)
+            row |= {"de_amplification": -de.fun / a_t, "de_cpu_s": time.process_time() - c0,
+                    "de_evaluations": int(de.nfev)}
+            row["rel_diff_de"] = row["amplification"] / row["de_amplification"] - 1
+            row["within_1pct_of_de"] = abs(row["rel_diff_de"]) <= 0.01
+        rows.append(row)
+        print(_fmt(row), flush=True)
+    return rows
+
+
 def confidence_rows(n: int, blades: int | None) -> list:
     """The ``confidence`` row (``examples/mistuning_confidence.py`` on a fresh cache)."""
     import importlib.util
@@ -199,7 +247,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
-                   choices=("scaling", "precond", "throughput", "confidence"))
+                   choices=("scaling", "precond", "throughput", "worst", "confidence"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
     p.add_argument("--workers", type=int, nargs="+",
                    help="Dask local-cluster sizes of the throughput rows (0: this process; "
@@ -208,6 +256,10 @@ def main(argv=None) -> int:
                    help="the throughput rows' damper (free/stuck: the cheap linear limits)")
     p.add_argument("--quick", action="store_true",
                    help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
+    p.add_argument("--worst-blades", type=int, nargs="+", default=[6, 24],
+                   help="N_b of the worst rows (differential evolution for N_b <= 6)")
+    p.add_argument("--worst-samples", type=int, default=1000,
+                   help="random patterns the worst rows compare with")
     p.add_argument("--confidence-samples", type=int, default=1000,
                    help="samples of the confidence row's first study (>= 72; the second: 4x)")
     p.add_argument("--confidence-blades", type=int,
@@ -225,6 +277,8 @@ def main(argv=None) -> int:
     if "throughput" in a.rows:
         workers = a.workers or ((0,) if a.quick else (1, 2))
         rows += throughput_rows(a.samples if a.workers or not a.quick else 2, workers, a.damper)
+    if "worst" in a.rows:
+        rows += worst_rows([4] if a.quick else a.worst_blades, 20 if a.quick else a.worst_samples)
     if "confidence" in a.rows:
         rows += confidence_rows(80 if a.quick else a.confidence_samples,
                                 8 if a.quick else a.confidence_blades)
