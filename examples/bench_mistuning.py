@@ -26,6 +26,11 @@ Rows:
   N_b <= 6, scipy's differential evolution on the same peak (no gradients): whether it is
   above, below and within 1 %. N_b from ``--worst-blades`` (default 6 and 24; EO = N_b / 4,
   at least 1).
+* ``worst_friction``: the worst pattern with the friction damper (``damper upd mistuning
+  --worst``, std 0.02, H = 7, ``--worst-evaluations`` ring curves per start) on
+  ``--worst-friction-blades`` (default 24): its amplification, each start's, and the ring's
+  time integration at the worst blade's peak against the HB peak (and against the HB at
+  H = 15 there).
 * ``confidence``: the 0.95 quantile's 95 % interval from ``--confidence-samples`` damper-free
   samples (default 1000; UPD-24 or ``--confidence-blades``, std 0.02, seed 1) against the 0.95 quantile of an
   independent study four times as large (seed 2), in this process
@@ -35,8 +40,9 @@ Times are CPU (process_time) where one process works, wall time for the clusters
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling precond throughput worst confidence] [--samples 8] [--quick] [--workers 1 2]
+        [--rows scaling precond throughput worst worst_friction confidence] [--samples 8] [--quick] [--workers 1 2]
         [--damper free] [--worst-blades 6 24] [--worst-samples 1000]
+        [--worst-friction-blades 24] [--worst-evaluations 25]
         [--confidence-samples 1000] [--confidence-blades 8]
 """
 from __future__ import annotations
@@ -222,6 +228,31 @@ def worst_rows(blades, samples: int) -> list:
     return rows
 
 
+def worst_friction_rows(blades, evaluations: int) -> list:
+    """The ``worst_friction`` rows (module docstring)."""
+    from damper.mistuning import Study
+    from damper.mistuning_worst import run_worst_friction
+
+    rows = []
+    for nb in blades:
+        c0 = time.process_time()
+        out = run_worst_friction(Study(blades=nb, engine_order=max(1, nb // 4), std=0.02),
+                                 max_evaluations=evaluations)
+        c = out["timeint_check"]
+        rows.append({"case": "worst pattern, friction", "blades": nb, "std": 0.02, "bound": out["bound"],
+                     "harmonics": out["harmonics"], "amplification": out["amplification"],
+                     "frequency_hz": out["frequency_hz"], "worst_blade": out["worst_blade"],
+                     "starts": {s["label"]: s["amplification"] for s in out["starts"]},
+                     "converged": out["converged"], "message": out["message"],
+                     "evaluations": out["evaluations"], "failures": len(out["failures"]),
+                     "timeint_rel_diff": c["rel_diff"], "timeint_within_1pct": c["within_1_percent"],
+                     "timeint_rel_diff_h15": c["rel_diff_check"], "timeint_periods": c["periods"],
+                     "whitehead_bound": out["whitehead_bound"], "factors": out["factors"],
+                     "cpu_s": time.process_time() - c0, "wall_s": out["time_s"]})
+        print(_fmt(rows[-1]), flush=True)
+    return rows
+
+
 def confidence_rows(n: int, blades: int | None) -> list:
     """The ``confidence`` row (``examples/mistuning_confidence.py`` on a fresh cache)."""
     import importlib.util
@@ -247,7 +278,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
-                   choices=("scaling", "precond", "throughput", "worst", "confidence"))
+                   choices=("scaling", "precond", "throughput", "worst", "worst_friction", "confidence"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
     p.add_argument("--workers", type=int, nargs="+",
                    help="Dask local-cluster sizes of the throughput rows (0: this process; "
@@ -260,6 +291,10 @@ def main(argv=None) -> int:
                    help="N_b of the worst rows (differential evolution for N_b <= 6)")
     p.add_argument("--worst-samples", type=int, default=1000,
                    help="random patterns the worst rows compare with")
+    p.add_argument("--worst-friction-blades", type=int, nargs="+", default=[24],
+                   help="N_b of the worst_friction rows")
+    p.add_argument("--worst-evaluations", type=int, default=25,
+                   help="ring curves per start of the worst_friction rows")
     p.add_argument("--confidence-samples", type=int, default=1000,
                    help="samples of the confidence row's first study (>= 72; the second: 4x)")
     p.add_argument("--confidence-blades", type=int,
@@ -279,6 +314,9 @@ def main(argv=None) -> int:
         rows += throughput_rows(a.samples if a.workers or not a.quick else 2, workers, a.damper)
     if "worst" in a.rows:
         rows += worst_rows([4] if a.quick else a.worst_blades, 20 if a.quick else a.worst_samples)
+    if "worst_friction" in a.rows:
+        rows += worst_friction_rows([4] if a.quick else a.worst_friction_blades,
+                                    2 if a.quick else a.worst_evaluations)
     if "confidence" in a.rows:
         rows += confidence_rows(80 if a.quick else a.confidence_samples,
                                 8 if a.quick else a.confidence_blades)
