@@ -15,7 +15,9 @@ Rows:
 * ``throughput``: a Monte Carlo study (``damper.mistuning``, N_b = 24, std 0.02, the
   friction damper or ``--damper free|stuck``) on a Dask local cluster of 1 and 2 workers
   (``--workers``), fresh caches: wall time, samples per minute, the chunks' CPU time and
-  the parallel efficiency CPU / (workers x wall); the traced memory peak of one sample
+  the parallel efficiency CPU / (workers x wall), and with a serial run in the same list
+  (``--workers 0 1 2``) the speed-up of each cluster over it (serial wall / cluster wall of
+  the sample phase) and that over the workers; the traced memory peak of one sample
   (tracemalloc, a separate run). With ``--quick`` (and no ``--workers``) 2 samples run
   in this process (``workers = 0``, the serial executor): the quick mode starts no Dask
   cluster (the documentation build runs it).
@@ -105,7 +107,8 @@ def scaling_rows(blades) -> list:
         J = ring(c.peak_x, c.peak_omega)[1].tocsc()
         rows.append({"case": "ring curve", "blades": nb, "unknowns": ring.size, "jacobian_nnz": J.nnz,
                      "sector_cpu_s": t_sector, "ring_cpu_s": t_ring, "ratio_ring_sector": t_ring / t_sector,
-                     "ring_cpu_per_blade_s": t_ring / nb, "evaluations": c.evaluations,
+                     "ring_cpu_per_blade_s": t_ring / nb, "fast_cpu_per_blade_s": t_fast / nb,
+                     "evaluations": c.evaluations,
                      "newton_iterations": c.newton_iterations, "lu_ms": lu_ms(J),
                      "amplification": c.peak / ct.peak_amplitude, "truncated": c.extra["truncated"],
                      "fast_cpu_s": t_fast, "fast_speedup": t_ring / t_fast,
@@ -168,6 +171,10 @@ def throughput_rows(samples: int, workers=(1, 2), damper: str = "nonlinear") -> 
                      "sample_s_median": float(np.median([s["time_s"] for s in ok])),
                      "max_amplification": out["max_amplification"],
                      "load_avg_before": load0, "load_avg_after": os.getloadavg()[0]})
+        serial = next((r for r in rows if r.get("workers") == 0), None)
+        if serial is not None and n > 0:   # against the serial run of the same study
+            rows[-1]["speedup_vs_serial"] = serial["sample_phase_wall_s"] / e["wall_s"]
+            rows[-1]["efficiency_vs_serial"] = rows[-1]["speedup_vs_serial"] / n
         print(_fmt(rows[-1]), flush=True)
     # memory of one sample (tracemalloc traces numpy's buffers; a separate, untimed run)
     from damper.mistuning import fingerprint, sample_key, tuned_reference
