@@ -138,6 +138,20 @@ def check_peak(result, steps_per_period: int = CHECK_STEPS) -> dict:
             "steps_per_period": hb.steps_per_period, "time_s": time.perf_counter() - t0}
 
 
+def annotate(result, check: bool = False):
+    """A refined curve's ``extra["stuck_links"]`` (at its peak) and, when ``check``, its
+    ``extra["steady_state"]`` (:func:`check_peak`) and ``extra["steady_state_warning"]``;
+    in place, returns ``result``. The check's time is added to ``result.time_s``."""
+    prob, x = getattr(result, "problem", None), getattr(result, "peak_solution", None)
+    if prob is not None and x is not None:
+        result.extra["stuck_links"] = stuck_links(prob, x)
+    if check:
+        rec = result.extra["steady_state"] = check_peak(result)
+        result.extra["steady_state_warning"] = warning(rec)
+        result.time_s += rec.get("time_s", 0.0)
+    return result
+
+
 def warning(record: dict | None) -> str | None:
     """The summary's warning line when the HB peak is not the state a start from rest reaches."""
     if not record or not record.get("states_differ"):
