@@ -35,7 +35,7 @@ def test_start_from_rest_settles_at_another_stuck_mean_than_the_hb_convention():
     assert abs(rec["hb_state_drift"]) < HB_STATE_KEPT
     assert abs(rec["mean_from_hb_state"] - rec["hb_mean"]) < HB_STATE_KEPT
     # ... and the start from rest, having slipped once, ends on another mean
-    assert rec["states_differ"] and rec["states_rel"] > 10 * SAME_STATE_TOL
+    assert rec["states_differ"] and rec["states_rel"] > SAME_STATE_TOL
     assert rec["mean_from_rest"] > rec["hb_mean"] + 0.05
     assert r.extra["steady_state_warning"].startswith("warning:")
     assert any("two steady states" in line for line in summary_lines(rec))
