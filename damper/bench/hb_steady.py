@@ -3,7 +3,7 @@
 For every model of the hb stage's model classes (:mod:`.hb_classes`; the two sweep
 directions of a model share one row): the first-harmonic peak of the dense high-H
 reference (:mod:`.hb_reference`: the converged harmonic balance) against the peak of
-the time integration from rest (:func:`harmonic_balance.timeint.steady_curve`: every
+the time integration from rest (:func:`harmonic_balance.timeint.march_curve`: every
 link virgin, at the reference's peak frequency and +-TI_REL of it, the first harmonic
 through a parabola; its step error from 256 against 512 steps a period), their
 difference, and whether the two are different steady states: the curve at the case's
@@ -29,6 +29,9 @@ from .common import Row, self_peak_mb
 #: Frequencies of the time integration around the reference peak: +- this fraction
 #: (as the UPD-24 reference's ring check, hb_reference.UPD_TI_REL).
 TI_REL = 2e-3
+#: Time steps per period of the time integration (raised for stability by timeint); its
+#: step error is the change from half as many.
+TI_STEPS = 512
 #: Settling tolerance of the curve's time integrations (timeint's extrapolated
 #: distance to steady state), well below the differences the rows measure.
 TI_TOL = 1e-7
@@ -55,13 +58,19 @@ def models(quick: bool) -> list[str]:
 
 
 def _ti_peak(model, omega: float) -> dict:
-    """Time-integration first-harmonic peak near ``omega`` (parabola through three frequencies)."""
-    from harmonic_balance.timeint import steady_curve
+    """Time-integration first-harmonic peak near ``omega`` (parabola through three
+    frequencies) at 512 steps a period, with its step error against 256."""
+    from harmonic_balance.timeint import march_curve
 
     w = omega * np.array([1.0 - TI_REL, 1.0, 1.0 + TI_REL])
-    a, a1, err, fine = steady_curve(model, w, tol=TI_TOL)
+    coarse = march_curve(model, w, TI_STEPS // 2, tol=TI_TOL)
+    fine = march_curve(model, w, 2 * coarse.steps_per_period, tol=TI_TOL)
+    if not (coarse.converged.all() and fine.converged.all()):
+        raise RuntimeError(f"time integration did not reach steady state near omega = {omega:g}")
+    a1 = fine.amplitude_h1
     c2, c1, c0 = np.polyfit(w - omega, a1, 2)
     peak, at = (c0 - c1 * c1 / (4 * c2), omega - c1 / (2 * c2)) if c2 < 0 else (a1.max(), w[np.argmax(a1)])
+    err = np.abs(a1 / coarse.amplitude_h1 - 1.0)
     return {"amplitude": float(peak), "omega": float(at), "step_error": float(err.max()),
             "steps_per_period": int(fine.steps_per_period), "periods": int(fine.periods.max())}
 
@@ -99,8 +108,9 @@ def model_row(key: str, log=print) -> dict:
         row.update(ti_peak=ti["amplitude"], ti_omega=ti["omega"], ti_error=ti["step_error"],
                    states_differ=chk.get("states_differ"),
                    check={k: chk.get(k) for k in ("omega", "hb_amplitude", "from_rest", "from_hb_state",
-                                                  "states_rel", "stuck_links", "note")},
-                   how=f"timeint.steady_curve at {ti['steps_per_period']} steps a period, "
+                                                  "states_rel", "hb_mean", "mean_from_rest",
+                                                  "mean_from_hb_state", "stuck_links", "note")},
+                   how=f"timeint.march_curve at {ti['steps_per_period']} steps a period, "
                        f"+-{TI_REL:g} of the reference peak; state check at H = {case.harmonics}")
     d = row["hb_peak"] / row["ti_peak"] - 1.0 if row.get("ti_peak") else None
     allowed = (row["hb_error"] or 0.0) + (row["ti_error"] or 0.0) + TI_PEAK_TOL
