@@ -139,3 +139,18 @@ def test_shifted_stuck_jacobian_matches_finite_differences():
         e[j] = 1e-7
         Jfd[:, j] = (res(x + e, w, jac=False) - res(x - e, w, jac=False)) / 2e-7
     assert np.abs(J - Jfd).max() <= FD_RTOL * np.abs(J).max()
+
+
+def test_cli_check_steady_state_reports_both_time_integrations(capsys):
+    import json
+
+    from damper.cli import main
+
+    argv = ["frf", "--model", "sdof", "--harmonics", "5", "--omega", "0.9", "1.2", "--stability", "off"]
+    assert main(argv + ["--check-steady-state", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    rec = out["steady_state"]
+    assert rec["states_differ"] is False and out["steady_state_warning"] is None
+    assert rec["from_rest"] > 0 and rec["from_hb_state"] > 0 and out["stuck_links"] == []
+    assert main(argv + ["--check-steady-state"]) == 0
+    assert "steady state (time integration at the peak): from rest" in capsys.readouterr().out
