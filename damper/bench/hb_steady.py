@@ -136,8 +136,8 @@ HEAD = (f"{'model':22s} {'HB peak':>12s} {'at omega':>10s} {'H':>3s} {'TI peak':
         f"{'HB/TI-1':>9s} {'HB err':>8s} {'TI err':>8s} {'states':>9s}  note")
 
 
-def _pct(v, fmt=".2g") -> str:
-    return "-" if v is None else f"{100 * v:+{fmt}}%"
+def _pct(v, fmt=".2g", sign="+") -> str:
+    return "-" if v is None else f"{100 * v:{sign}{fmt}}%"
 
 
 def line(r: dict) -> str:
@@ -147,8 +147,8 @@ def line(r: dict) -> str:
     return (f"{r['model']:22s} {r['hb_peak']:12.6g} {r['hb_omega']:10.6g} {r.get('hb_H') or '-':>3} "
             f"{'-' if r.get('ti_peak') is None else format(r['ti_peak'], '12.6g'):>12s} "
             f"{'-' if r.get('ti_omega') is None else format(r['ti_omega'], '10.6g'):>10s} "
-            f"{_pct(r.get('difference')):>9s} {_pct(r.get('hb_error'), '.1g'):>8s} "
-            f"{_pct(r.get('ti_error'), '.1g'):>8s} {flag:>9s}  {note}")
+            f"{_pct(r.get('difference')):>9s} {_pct(r.get('hb_error'), '.1g', ''):>8s} "
+            f"{_pct(r.get('ti_error'), '.1g', ''):>8s} {flag:>9s}  {note}")
 
 
 def table_lines(rows: list[dict]) -> list[str]:
@@ -170,6 +170,6 @@ def markdown(rows: list[dict]) -> list[str]:
         flag = {None: "-", True: "different", False: "same"}[r.get("states_differ")]
         out.append(f"| {r['model']} | {r['hb_peak']:.6g} | {r['hb_omega']:.6g} | {r.get('hb_H') or '-'} | "
                    f"{num(r.get('ti_peak'), '.6g')} | {num(r.get('ti_omega'), '.6g')} | "
-                   f"{_pct(r.get('difference'))} | {_pct(r.get('hb_error'), '.1g')} | "
-                   f"{_pct(r.get('ti_error'), '.1g')} | {flag} |")
+                   f"{_pct(r.get('difference'))} | {_pct(r.get('hb_error'), '.1g', '')} | "
+                   f"{_pct(r.get('ti_error'), '.1g', '')} | {flag} |")
     return out
