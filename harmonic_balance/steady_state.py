@@ -84,10 +84,9 @@ def hb_period(basis, X: np.ndarray, omega: float, samples: int):
     -------
     x : (samples, n) array at t = j T / samples [m]; v0 : (n,) array [m/s]
     """
-    th = 2.0 * np.pi * np.arange(samples) / samples
-    cols = [np.ones(samples) if h == 0 else f(h * th) for h in basis.harmonics
-            for f in ((np.cos,) if h == 0 else (np.cos, np.sin))]
-    E = np.column_stack(cols)
+    from .fourier import FourierBasis
+
+    E = FourierBasis(basis.harmonics, samples).E   # the same coefficient order as basis
     return E @ X, omega * (E[0] @ (basis.dtheta @ X))
 
 
