@@ -4,7 +4,8 @@ Each plot puts the error against its reference on the x axis and the time on
 the y axis (both logarithmic), one point per row labelled with its size; cold
 runs are circles, cached runs squares, the tool's default setting a star. The hb
 stage's accuracy rows (:mod:`.hb_accuracy`) also get a table of the truncation-error
-estimate beside the true error.
+estimate beside the true error, its rows of HB against time integration
+(:mod:`.hb_steady`) a table of the two peaks and the steady-state flag.
 """
 from __future__ import annotations
 
@@ -110,6 +111,11 @@ def table_text(stage: str, rows: list[dict]) -> str:
         from .hb_accuracy import table_lines
 
         lines += [ACCURACY_CAPTION + ":", *table_lines(acc)]
+    steady = [r for r in own if "states_differ" in r]
+    if steady:
+        from .hb_steady import table_lines as steady_lines
+
+        lines += ["harmonic balance against time integration (which steady state):", *steady_lines(steady)]
     if models:
         from .hb_classes import table
 
@@ -174,6 +180,12 @@ def markdown(result: dict) -> str:
             out += [f"**{stage}: {ACCURACY_CAPTION}**", "",
                     "| " + " | ".join(h for h, _, _ in ACCURACY_COLUMNS) + " |", "|" + "---|" * len(ACCURACY_COLUMNS),
                     *("| " + " | ".join(_cells(r)) + " |" for r in acc), ""]
+        steady = [r for r in own if "states_differ" in r]
+        if steady:
+            from .hb_steady import markdown as steady_markdown
+
+            out += [f"**{stage}: harmonic balance against time integration (which steady state)**", "",
+                    *steady_markdown(steady), ""]
         if models:
             from .hb_classes import markdown as model_markdown
 
