@@ -106,6 +106,8 @@ docs-accuracy: $(STAMP) cbuild
 	  $(PY) -m damper.bench.hb_accuracy --only frf --json
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy_upd.json -- \
 	  $(PY) -m damper.bench.hb_accuracy --only upd --json
+	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy_contact.json -- \
+	  $(PY) -m damper.bench.hb_accuracy --only contact --json
 docs-stress: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/stress.json -- $(VENV)/bin/damper stress --json --out out/stress
 

@@ -21,7 +21,7 @@ Each row also says whether it meets the goals of the estimate and of the default
   within 1 %, "warned" when it is not but its estimate exceeds 1 % (the command prints the
   warning), "FAIL" otherwise.
 
-Run: ``python -m damper.bench.hb_accuracy [--quick] [--only frf|upd] [--json]``
+Run: ``python -m damper.bench.hb_accuracy [--quick] [--only frf|contact|upd] [--json]``
 (``make docs-accuracy`` records it for docs/method/accuracy.md). ``damper bench --stage hb``
 adds the same rows to its report (:func:`bench_rows`; with ``--quick``, the soft single-DOF
 model only: :data:`BENCH_QUICK_MODELS`).
@@ -69,9 +69,14 @@ BENCH_QUICK_MODELS = ("sdof soft",)
 def _frf_cases(quick: bool):
     from harmonic_balance import bench_models as bm
 
-    cases = [bm.sdof(1.0), bm.sdof(1e4), bm.chain3(1.0, 20.0), bm.chain3(2.0, 200.0), bm.chain5(),
-             bm.contact_point()]
+    cases = [bm.sdof(1.0), bm.sdof(1e4), bm.chain3(1.0, 20.0), bm.chain3(2.0, 200.0), bm.chain5()]
     return cases[:3] if quick else cases
+
+
+def _contact_cases():
+    from harmonic_balance import bench_models as bm
+
+    return [bm.contact_point()]
 
 
 def _frf_reference(result, H_ref: int) -> float:
@@ -88,12 +93,13 @@ def _frf_reference(result, H_ref: int) -> float:
                        1e-6 * result.peak_omega)[2]
 
 
-def frf_rows(quick: bool = False, names: tuple[str, ...] | None = None) -> list[dict]:
-    """Rows of the chain models: per H and per accuracy target (``names``: only these models)."""
+def frf_rows(quick: bool = False, names: tuple[str, ...] | None = None, contact: bool = False) -> list[dict]:
+    """Rows of the chain models (``contact``: of the 3D contact point instead): per H and
+    per accuracy target (``names``: only these models)."""
     from harmonic_balance.frf import compute_frf
 
     rows = []
-    for case in _frf_cases(quick):
+    for case in _contact_cases() if contact else _frf_cases(quick):
         if names is not None and case.name not in names:
             continue
         model, ref = case.model(), None
@@ -203,7 +209,8 @@ def bench_rows(quick: bool, log=print) -> list[Row]:
     ``setting``, ``target``...).
     """
     log(table_lines([])[0])
-    rows = frf_rows(True, BENCH_QUICK_MODELS) if quick else frf_rows(False) + upd_rows(False)
+    rows = (frf_rows(True, BENCH_QUICK_MODELS) if quick else
+            frf_rows(False) + frf_rows(False, contact=True) + upd_rows(False))
     out = []
     for r in rows:
         log(table_lines([r])[1])
@@ -252,7 +259,8 @@ def print_table(rows, out=sys.stdout, header: bool = True) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="fewer models and settings")
-    ap.add_argument("--only", choices=("frf", "upd"), help="one model class")
+    ap.add_argument("--only", choices=("frf", "contact", "upd"),
+                    help="one model class (frf: the Jenkins chains; contact: the 3D contact point)")
     ap.add_argument("--json", action="store_true",
                     help="print the rows as one JSON object on stdout (the table on stderr)")
     a = ap.parse_args(argv)
@@ -262,6 +270,8 @@ def main(argv=None) -> int:
     rows = []
     if a.only in (None, "frf"):
         rows += frf_rows(a.quick)
+    if a.only in (None, "contact") and not a.quick:
+        rows += frf_rows(a.quick, contact=True)
     if a.only in (None, "upd"):
         rows += upd_rows(a.quick)
     if not a.json:

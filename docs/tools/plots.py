@@ -18,7 +18,7 @@ CLASSES = (("sdof", "single-DOF Jenkins oscillator", "sdof"),
            ("upd24", "UPD-24 sector, F0 = 30 N", "UPD-24"),
            ("contact", "mass on a 3D contact point with lift-off", "contact3d"))
 #: The recorded data files the figures are drawn from.
-SOURCES = ("accuracy", "accuracy_upd")
+SOURCES = ("accuracy", "accuracy_upd", "accuracy_contact")
 #: Where a zero error would sit on the logarithmic axis (never reached by recorded rows).
 FLOOR = 1e-12
 
