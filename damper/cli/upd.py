@@ -8,6 +8,7 @@ Examples::
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
+    damper upd mistuning --accuracy 0.01 --samples 20 --json   # H chosen on the tuned sector
 """
 from __future__ import annotations
 
