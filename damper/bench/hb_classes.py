@@ -150,7 +150,8 @@ def run_ours(name: str, work: Path, case=None) -> dict:
     engine = j.get("peak_interior") and j.get("peak_amplitude_h1") is not None
     pa, pw, _ = curve_peak(w, a1)
     return {**out, "points": j["points"], "evaluations": j.get("residual_evaluations"),
-            "time_s": j.get("time_s"), "status": j.get("status", ""),
+            "time_s": j.get("time_s"), "check_s": (j.get("truncation_error") or {}).get("time_s"),
+            "status": j.get("status", ""),
             "complete": r.code == 0, "gaps": "restart" in j.get("status", ""),
             "peak_amplitude": j["peak_amplitude_h1"] if engine else pa,
             "peak_omega": j["peak_omega"] if engine else pw, "peak_refined": bool(engine),

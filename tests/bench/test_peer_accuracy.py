@@ -20,7 +20,8 @@ def test_scan_stops_at_the_first_h_within_one_percent_and_rows_give_the_time_rat
 
     def fake_ours(name, work, case=None):
         H = case.harmonics
-        return {"complete": True, "peak_amplitude": _peak(H, ours_c), "time_s": 0.1 * H, "cpu_s": 0.1 * H}
+        return {"complete": True, "peak_amplitude": _peak(H, ours_c), "time_s": 0.1 * H, "cpu_s": 0.1 * H,
+                "check_s": 0.05 * H}
 
     def fake_peer(kind, case, path, work, settings, octave=None, timeout=600.0):
         H = case.harmonics
@@ -38,6 +39,7 @@ def test_scan_stops_at_the_first_h_within_one_percent_and_rows_give_the_time_rat
     e = peer_accuracy.row(case.name, "pyHarm", case, ours, peer).extra
     assert e["speedup_cpu_1pct"] == pytest.approx(0.3 * 11 / (0.1 * 3))
     assert e["speedup_1pct"] == pytest.approx(0.2 * 11 / (0.1 * 3))
+    assert e["speedup_curve_1pct"] == pytest.approx(0.2 * 11 / (0.05 * 3))   # our curve without its check
 
 
 def test_a_peer_that_never_reaches_one_percent_has_no_ratio(monkeypatch, tmp_path):
