@@ -88,10 +88,14 @@ def _split(rows: list[dict]) -> tuple[list[dict], list[dict], list[dict]]:
 #: Columns of the accuracy rows' HTML and Markdown tables: (heading, key, format).
 ACCURACY_COLUMNS = (("model", "model", "s"), ("H or target", "setting", "s"), ("peak", "peak_amplitude", ".6g"),
                     ("estimate", "estimate", ".2e"), ("true error", "true_error", ".2e"),
-                    ("ratio", "ratio", ".2f"), ("check [s]", "check_time_s", ".2f"), ("total [s]", "time_s", ".2f"))
+                    ("ratio", "ratio", ".2f"), ("check [s]", "check_time_s", ".2f"), ("total [s]", "time_s", ".2f"),
+                    ("flags", "flags", "s"))
 ACCURACY_CAPTION = ("accuracy: the truncation-error estimate of the peak amplitude against the true error "
                     "(against the peak re-solved with many more harmonics); ratio = estimate / true error; "
-                    "total: the curve and its check (of a target: every curve and check it took)")
+                    "total: the curve and its check (of a target: every curve and check it took); "
+                    "flags: R ratio outside [1/3, 3], T true error above the target (t: the engine said "
+                    "not met, the harmonic limit), D! a default more than 1 % off without a warning, "
+                    "D~ with one")
 
 
 def _cells(r: dict) -> list[str]:

@@ -273,6 +273,9 @@ def _upd() -> list[InputCase]:
         ("mistuning until-ci inf", "mistuning --until-ci inf"),
         ("mistuning until-ci with factors", "mistuning --blades 4 --engine-order 1 --factors 1 1 1 1 --until-ci 0.01"),
         ("mistuning solver bogus", "mistuning --solver bogus"),
+        ("mistuning accuracy 0.6", "mistuning --accuracy 0.6"),
+        ("mistuning accuracy 1e-7", "mistuning --accuracy 1e-7"),
+        ("mistuning accuracy with a linear damper", "mistuning --damper free --accuracy 0.01"),
         ("mistuning worst with friction", "mistuning --worst --std 0.02"),
         ("mistuning worst bound 0.9", "mistuning --worst --damper free --bound 0.9"),
         ("mistuning worst bound nan", "mistuning --worst --damper free --bound nan"),
@@ -311,7 +314,8 @@ def _run() -> list[InputCase]:
         "s_elcontact.toml", "s_fmi.toml", "s_body.toml", "s_both.toml", "s_nu.toml", "s_type.toml", "s_dofs.toml",
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
         "s_empty.toml", "s_binary.toml", "s_bbmode.toml", "s_bbamp.toml", "s_updpoints.toml", "s_updharm.toml",
-        "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml")]
+        "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
+        "s_mtacc.toml", "s_mtacclin.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),
