@@ -42,8 +42,9 @@ class _Residual:
     ``T_e[r_e] dF_e Q_e[:, r_e]`` by products over the local index, O(n_b^2) per
     element, added into the (size, size) matrix, instead of dense products of the whole
     (size, sum n_b m_e) operators, O(n_b^3 n m) (at H = 31 on a 5-DOF chain with three
-    links, 80 % of a curve's time; :class:`_LocalMap`). When every element is
-    conservative, Q is T's transpose (a view).
+    links, 80 % of a curve's time; :class:`_LocalMap`); a link (one local displacement,
+    no neighbour) adds dF_e times (T Q)_ij straight into the strided view of each of its
+    DOF pairs (i, j). When every element is conservative, Q is T's transpose (a view).
     """
 
     def __init__(self, model: Model, basis: FourierBasis, dofs):
@@ -74,20 +75,27 @@ class _Residual:
              for el in self.elements]) if self.elements else np.zeros(0)
 
     def _local_maps(self):
-        """Each element's :class:`_LocalMap`, grouped by the rows they act on (the blocks of
-        a group are summed before the one scatter into the Jacobian)."""
+        """Each element's :class:`_LocalMap`; those without a direct path grouped by the rows
+        they act on (the blocks of a group are summed before the one scatter into the
+        Jacobian)."""
         pos = {int(d): i for i, d in enumerate(self.dofs)}
         maps = [_LocalMap(el.kinematics, self.basis, [pos[d] for d in el.kinematics.dofs], self.m)
                 for el in self.elements]
         groups = {}
         for k, lm in enumerate(maps):
-            groups.setdefault(lm.rows.tobytes(), (lm.rows, []))[1].append(k)
+            if lm.pairs is None:
+                groups.setdefault(lm.rows.tobytes(), (lm.rows, []))[1].append(k)
         self._local = maps
         self._groups = [(np.ix_(rows, rows), ks) for rows, ks in groups.values()]
 
     def _assemble(self, res) -> np.ndarray:
         """dF_nl/dx (size, size) = sum_e T_e dF_e Q_e, element by element on its rows."""
         dF = np.zeros((self.size, self.size))
+        nb = self.basis.nb
+        J4 = dF.reshape(nb, self.m, nb, self.m)
+        for lm, r in zip(self._local, res):
+            if lm.pairs is not None:
+                lm.add_direct(J4, r.dF)
         for ix, ks in self._groups:
             B = self._local[ks[0]].block(res[ks[0]].dF)
             for k in ks[1:]:
@@ -244,6 +252,13 @@ class _LocalMap:
         nb = basis.nb
         self.rows = (np.arange(nb)[:, None] * n_dofs + np.asarray(pos)[None, :]).ravel()
         self.Q, self.T, self.Qn, self.Tn = kin.Q, kin.T, kin.Q_next, kin.T_next
+        # one local displacement, no neighbour (a friction link): the block is dF times
+        # (T Q)[i, j] on DOF pair (i, j), added in place by add_direct
+        self.pairs = None
+        if not kin.cyclic and kin.m == 1:
+            TQ = kin.T @ kin.Q
+            self.pairs = [(pi, pj, float(TQ[i, j])) for i, pi in enumerate(pos)
+                          for j, pj in enumerate(pos) if TQ[i, j] != 0.0]
         if kin.cyclic:
             # harmonic h > 0 holds the coefficient pair (cos, sin) at (c, c + 1): the
             # pairs are every other coefficient from the first non-mean one
@@ -263,6 +278,17 @@ class _LocalMap:
         Z[ic] = c * zc - s * zs
         Z[isn] = s * zc + c * Z[isn]
         return Z
+
+    def add_direct(self, J4: np.ndarray, dF: np.ndarray) -> None:
+        """J += T_e dF Q_e for a map with ``pairs``, on J viewed as (n_b, n_dofs, n_b, n_dofs):
+        n_b^2 adds per DOF pair, no block formed and no index arrays."""
+        for pi, pj, c in self.pairs:
+            if c == 1.0:
+                J4[:, pi, :, pj] += dF
+            elif c == -1.0:
+                J4[:, pi, :, pj] -= dF
+            else:
+                J4[:, pi, :, pj] += c * dF
 
     def block(self, dF: np.ndarray) -> np.ndarray:
         """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m)."""
