@@ -266,6 +266,7 @@ class _LocalMap:
             self._cos, self._sin = slice(first, None, 2), slice(first + 1, None, 2)
             hphi = np.array([h for h in basis.harmonics if h > 0], dtype=float) * kin.phase
             self._c, self._s = np.cos(hphi), np.sin(hphi)
+            self._QQ, self._TT = np.vstack([self.Q, self.Qn]), np.hstack([self.T, self.Tn])
 
     def _phase(self, Z: np.ndarray, axis: int) -> np.ndarray:
         """``sum_b P[b, c] Z[.., b, ..]`` along ``axis`` (harmonic coefficients), in place."""
@@ -291,17 +292,26 @@ class _LocalMap:
                 J4[:, pi, :, pj] += c * dF
 
     def block(self, dF: np.ndarray) -> np.ndarray:
-        """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m)."""
+        """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m).
+
+        With a neighbour, dF (I (x) Q + P (x) Q_next) = [dF, dF P] [Q; Q_next] (P rotates
+        the m-sized columns, before Q_next widens them to d) and T_e Y = [T, T_next]
+        [Y; P^T Y]; the products over the local index are one matrix product each, the
+        left one batched over the row harmonics so that B comes out in its final layout."""
         m, d = self.Q.shape
         nb = dF.shape[0] // m
-        flat = dF.reshape(-1, m)
-        Y = (flat @ self.Q).reshape(nb, m, nb, d)          # dF (I (x) Q)
-        if self.Qn is not None:
-            Y += self._phase((flat @ self.Qn).reshape(nb, m, nb, d), 2)
-        B = np.tensordot(self.T, Y, axes=([1], [1])).transpose(1, 0, 2, 3)
-        if self.Tn is not None:
-            B += self._phase(np.tensordot(self.Tn, Y, axes=([1], [1])).transpose(1, 0, 2, 3), 0)
-        return B.reshape(nb * d, nb * d)
+        if self.Qn is None:
+            Y = dF.reshape(-1, m) @ self.Q                                  # dF (I (x) Q)
+            return np.matmul(self.T, Y.reshape(nb, m, nb * d)).reshape(nb * d, nb * d)
+        Z = np.empty((nb, m, nb, 2 * m))
+        Z[..., :m] = dF.reshape(nb, m, nb, m)
+        Z[..., m:] = Z[..., :m]
+        self._phase(Z[..., m:], 2)
+        Y = (Z.reshape(-1, 2 * m) @ self._QQ).reshape(nb, m, nb, d)
+        W = np.empty((nb, 2 * m, nb, d))
+        W[:, :m], W[:, m:] = Y, Y
+        self._phase(W[:, m:], 0)
+        return np.matmul(self._TT, W.reshape(nb, 2 * m, nb * d)).reshape(nb * d, nb * d)
 
 
 def _mean_mask(basis: FourierBasis, m: int) -> np.ndarray:
