@@ -3,7 +3,8 @@
  * by its own Fourier coefficients (iwan.h: iwan_periodic_fourier).
  *
  * u(theta) = sum_h a_h cos(h theta) + b_h sin(h theta) (+ a_0). Its extrema are the
- * zeros of u' (sign scan on n_scan points, then Newton safeguarded by bisection); the
+ * zeros of u' (sign scan on n_scan points, u' and u'' there by one FFT when n_scan is a
+ * power of two, then Newton safeguarded by bisection); the
  * loop between them is iwan_periodic_branches (the play operator itself): on interval
  * i, F = c_i + s_i u. Each interval end (a slider reaching its limit) is located in
  * theta (u is monotone between extrema) and the Fourier integrals of c_i + s_i u(theta)
@@ -11,7 +12,11 @@
  * absolute theta in the arguments loses eps |theta| h of phase, which a stiff slider
  * turns into residual noise). The Jacobian: F is continuous at every interval end and
  * u' = 0 at the extrema, so no boundary terms: dF_p/dU_q = w_p sum_i int psi_p (s_i
- * phi_q + dc_i/dU_q), dc_i/dU = -sum_e A[i][e] phi(theta_e).
+ * phi_q + dc_i/dU_q), dc_i/dU = -sum_e A[i][e] phi(theta_e). The first sum is the
+ * transform of the piecewise-constant stiffness s(theta) against products of two
+ * harmonics, Toeplitz plus Hankel in the orders (built once from its 2 hmax + 1 Fourier
+ * coefficients), the second one outer product per extremum that anchors stuck sliders:
+ * O(nb^2) per call, not per interval.
  */
 #include "iwan_internal.h"
 
