@@ -333,11 +333,28 @@ class FullResidual(_Residual):
         self._pairs = tuple(np.array([p[j] for p in pairs], dtype=int if j < 2 else float)
                             for j in range(3))
         self._f = self.Fext.ravel()
-        # the dense operators of the module docstring (Hill's method, tests); the
+        # the dense operators of the module docstring (_K, _M, _C: Hill's method, tests),
+        # formed when first read, in a dict that copies (with_elements) share; the
         # residual itself applies them per harmonic (_linear_terms)
-        self._K = np.kron(np.eye(basis.nb), lin.K)
-        self._M = np.kron(np.diag(self._h2), lin.M)
-        self._C = np.kron(basis.dtheta, lin.C)
+        self._dense = {}
+
+    @property
+    def _K(self) -> np.ndarray:
+        return self._dense_operator("K", lambda: np.kron(np.eye(self.basis.nb), self.model.linear.K))
+
+    @property
+    def _M(self) -> np.ndarray:
+        return self._dense_operator("M", lambda: np.kron(np.diag(self._h2), self.model.linear.M))
+
+    @property
+    def _C(self) -> np.ndarray:
+        return self._dense_operator("C", lambda: np.kron(self.basis.dtheta, self.model.linear.C))
+
+    def _dense_operator(self, name: str, build) -> np.ndarray:
+        """The (size, size) operator ``name`` (K, M, C of the module docstring), built once."""
+        if name not in self._dense:
+            self._dense[name] = build()
+        return self._dense[name]
 
     def _linear_terms(self, X: np.ndarray, omega: float):
         """A(omega) x and dA/domega x on the harmonics X (n_b, n), per harmonic:
