@@ -266,19 +266,21 @@ class _LocalMap:
             self._cos, self._sin = slice(first, None, 2), slice(first + 1, None, 2)
             hphi = np.array([h for h in basis.harmonics if h > 0], dtype=float) * kin.phase
             self._c, self._s = np.cos(hphi), np.sin(hphi)
-            self._QQ, self._TT = np.vstack([self.Q, self.Qn]), np.hstack([self.T, self.Tn])
+            self._rot = self._rotation(nb, kin.m)
 
-    def _phase(self, Z: np.ndarray, axis: int) -> np.ndarray:
-        """``sum_b P[b, c] Z[.., b, ..]`` along ``axis`` (harmonic coefficients), in place."""
-        shape = [1] * Z.ndim
-        shape[axis] = -1
-        c, s = self._c.reshape(shape), self._s.reshape(shape)
-        ic = (slice(None),) * axis + (self._cos,)
-        isn = (slice(None),) * axis + (self._sin,)
-        zc, zs = Z[ic].copy(), Z[isn]
-        Z[ic] = c * zc - s * zs
-        Z[isn] = s * zc + c * Z[isn]
-        return Z
+    def _rotation(self, nb: int, m: int):
+        """The phase P on a coefficient-major axis of n_b m entries (coefficient c, local j
+        at c m + j) as gathers: ``(P^T z)[r] = wa[r] z[ia[r]] + wb[r] z[ib[r]]`` (the cos
+        entry of harmonic h takes c_h cos - s_h sin, the sin entry s_h cos + c_h sin, the
+        mean itself), so that it runs on contiguous rows and columns."""
+        ia, ib = np.arange(nb), np.arange(nb)
+        wa, wb = np.ones(nb), np.zeros(nb)
+        ic, isn = np.arange(nb)[self._cos], np.arange(nb)[self._sin]
+        ib[ic], wa[ic], wb[ic] = isn, self._c, -self._s
+        ia[isn], wa[isn], wb[isn] = ic, self._s, self._c
+        j = np.arange(m)
+        return ((ia[:, None] * m + j).ravel(), (ib[:, None] * m + j).ravel(),
+                np.repeat(wa, m), np.repeat(wb, m))
 
     def add_direct(self, J4: np.ndarray, dF: np.ndarray) -> None:
         """J += T_e dF Q_e for a map with ``pairs``, on J viewed as (n_b, n_dofs, n_b, n_dofs):
@@ -294,24 +296,23 @@ class _LocalMap:
     def block(self, dF: np.ndarray) -> np.ndarray:
         """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m).
 
-        With a neighbour, dF (I (x) Q + P (x) Q_next) = [dF, dF P] [Q; Q_next] (P rotates
-        the m-sized columns, before Q_next widens them to d) and T_e Y = [T, T_next]
-        [Y; P^T Y]; the products over the local index are one matrix product each, the
-        left one batched over the row harmonics so that B comes out in its final layout."""
+        With a neighbour, dF (I (x) Q + P (x) Q_next) = dF (I (x) Q) + (dF (P (x) I)) (I (x)
+        Q_next) and T_e Y = (I (x) T) Y + (I (x) T_next) (P^T (x) I) Y: the phase acts on
+        the m-sized local index, by gathers of whole columns and rows (:meth:`_rotation`),
+        and the products over the local index are matrix products, the left ones batched
+        over the row harmonics so that B comes out in its final layout."""
         m, d = self.Q.shape
         nb = dF.shape[0] // m
-        if self.Qn is None:
-            Y = dF.reshape(-1, m) @ self.Q                                  # dF (I (x) Q)
-            return np.matmul(self.T, Y.reshape(nb, m, nb * d)).reshape(nb * d, nb * d)
-        Z = np.empty((nb, m, nb, 2 * m))
-        Z[..., :m] = dF.reshape(nb, m, nb, m)
-        Z[..., m:] = Z[..., :m]
-        self._phase(Z[..., m:], 2)
-        Y = (Z.reshape(-1, 2 * m) @ self._QQ).reshape(nb, m, nb, d)
-        W = np.empty((nb, 2 * m, nb, d))
-        W[:, :m], W[:, m:] = Y, Y
-        self._phase(W[:, m:], 0)
-        return np.matmul(self._TT, W.reshape(nb, 2 * m, nb * d)).reshape(nb * d, nb * d)
+        Y = dF.reshape(-1, m) @ self.Q                                      # dF (I (x) Q)
+        if self.Qn is not None:
+            ia, ib, wa, wb = self._rot
+            Y += (dF[:, ia] * wa + dF[:, ib] * wb).reshape(-1, m) @ self.Qn
+        Y = Y.reshape(nb, m, nb * d)
+        B = np.matmul(self.T, Y)
+        if self.Tn is not None:
+            Y2 = Y.reshape(nb * m, nb * d)
+            B += np.matmul(self.Tn, (Y2[ia] * wa[:, None] + Y2[ib] * wb[:, None]).reshape(nb, m, nb * d))
+        return B.reshape(nb * d, nb * d)
 
 
 def _mean_mask(basis: FourierBasis, m: int) -> np.ndarray:
