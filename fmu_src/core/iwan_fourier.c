@@ -48,10 +48,9 @@ static void rot_table(tpoly *p, double t)
     }
 }
 
-/* d-th derivative (0 .. 3) of u at t. */
-static double eval_u(tpoly *p, const double *U, double t, int d)
+/* d-th derivative (0 .. 3) of u at the t of the last rot_table(p, t). */
+static double sum_u(const tpoly *p, const double *U, int d)
 {
-    rot_table(p, t);
     double v = 0.0;
     size_t q = 0;
     for (size_t k = 0; k < p->n_h; ++k) {
@@ -71,6 +70,13 @@ static double eval_u(tpoly *p, const double *U, double t, int d)
     return v;
 }
 
+/* d-th derivative (0 .. 3) of u at t. */
+static double eval_u(tpoly *p, const double *U, double t, int d)
+{
+    rot_table(p, t);
+    return sum_u(p, U, d);
+}
+
 /* Root of u^(d)(t) - target in [lo, hi] (values of opposite sign at the ends, f_lo at
  * lo): Newton with the derivative, bisection when it leaves the bracket. */
 static double root(tpoly *p, const double *U, int d, double target, double lo, double hi,
@@ -81,7 +87,7 @@ static double root(tpoly *p, const double *U, int d, double target, double lo, d
         const double f = eval_u(p, U, x, d) - target;
         if (fabs(f) <= ftol) return x;
         if ((f > 0.0) == (f_lo > 0.0)) { lo = x; f_lo = f; } else { hi = x; }
-        const double df = eval_u(p, U, x, d + 1);
+        const double df = sum_u(p, U, d + 1);   /* the same x: the same table */
         double xn = x - f / df;
         if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
         if (fabs(xn - x) <= 4.0 * DBL_EPSILON * fabs(x) || hi - lo <= 4.0 * DBL_EPSILON * hi) return xn;
