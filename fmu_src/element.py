@@ -453,9 +453,8 @@ class IwanElement:
         mean alone), and their Jacobian: (Fh (n_b,), dFh (n_b, n_b), W [J], extrema found;
         0 for a constant input, then Fh and dFh are zero). ``n_scan`` > 2 max(harmonics):
         the points of u' scanned for its sign changes."""
-        h = np.ascontiguousarray(harmonics, dtype=np.int32)
+        h, nb = _harmonic_orders(harmonics)
         U = _vec(U, "U")
-        nb = int(np.sum(np.where(h == 0, 1, 2)))
         if U.size != nb:
             raise IwanInputError(f"U must have {nb} coefficients for harmonics {tuple(h)}, got {U.size}")
         Fh, dFh = np.empty(nb), np.empty((nb, nb))
@@ -473,3 +472,18 @@ class IwanElement:
         F = np.empty_like(u)
         F[order] = self.series(np.abs(u)[order], None if N is None else float(N)).F
         return np.sign(u) * F
+
+
+#: The orders of periodic_fourier's harmonic sets met so far (a basis passes the same
+#: tuple at every call): (int32 array, n_b), so a call converts none.
+_ORDERS: dict = {}
+
+
+def _harmonic_orders(harmonics):
+    """(int32 C array of the orders, n_b) of a harmonic set, kept per tuple."""
+    key = tuple(int(k) for k in harmonics) if not isinstance(harmonics, tuple) else harmonics
+    got = _ORDERS.get(key)
+    if got is None:
+        h = np.ascontiguousarray(key, dtype=np.int32)
+        got = _ORDERS[key] = (h, int(np.sum(np.where(h == 0, 1, 2))))
+    return got

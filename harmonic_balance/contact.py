@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .aft import FrictionLink, _project_rows
+from .aft import FrictionLink
 from .forces import ForceElement, LinearElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
@@ -166,13 +166,16 @@ class ContactElement(ForceElement):
             s, W = self._evaluate_plane(U, basis, p, f, dF, D)
         elif m == 2:
             s = E @ U[:, 0]
-            Ft, dFs, dFp, W = self.friction.periodic_jac(
+            # the C core returns the Jacobian's non-zero rows alone (the samples in
+            # contact), packed: D dF over those samples, no test for zero rows
+            Ft, rows, dFs, dFp, W = self.friction.periodic_jac_rows(
                 s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
                 max_periods=self.max_periods, tol=self.tol)
             f[:, 0] = Ft
-            if jac:   # rows of zeros (slipping, resp. stuck samples) skipped
-                dF[0::2, 0::2] = _project_rows(D, dFs)
-                dF[0::2, 1::2] = _project_rows(D, dFp)
+            if jac:
+                Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
+                dF[0::2, 0::2] = Dr @ dFs
+                dF[0::2, 1::2] = Dr @ dFp
         F = D @ f
         dw, C = None, self._local_damping_cached()
         if C is not None:
