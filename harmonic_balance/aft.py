@@ -235,10 +235,11 @@ STUCK_RTOL = 1e-12
 
 
 def _stuck_harmonics(Fh, U, k0) -> bool:
-    """:func:`_stuck` on an exact loop's harmonics (the mean first): F - k0 u is constant
-    when its other harmonics vanish, to STUCK_RTOL of the loop's size (no samples)."""
-    dev = np.abs(Fh[1:] - k0 * U[1:]).max(initial=0.0)
-    return bool(dev <= STUCK_RTOL * (k0 * np.abs(U[1:]).max(initial=0.0) + np.abs(Fh).max() + 1e-300))
+    """:func:`_stuck` on an exact loop's harmonics: F = k0 u when every harmonic of
+    F - k0 u vanishes, the mean included (a stuck line shifted by a static load past the
+    slip limits is the C core's loop, kept), to STUCK_RTOL of the loop's size (no samples)."""
+    dev = np.abs(Fh - k0 * U).max()
+    return bool(dev <= STUCK_RTOL * (k0 * np.abs(U).max() + np.abs(Fh).max() + 1e-300))
 
 
 def _stuck(F, u, k0) -> bool:
