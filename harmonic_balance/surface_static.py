@@ -193,6 +193,10 @@ def preload(surface, force: float, eccentricity: float = 0.0,
         raise ValueError(f"the normal force must be positive and finite, got {force!r}: "
                          "a surface without normal load falls out of contact")
     loads = {"approach": float(force)}
+    half = float(np.max(np.abs(surface.contact.grid.x)))
+    if not (np.isfinite(eccentricity) and abs(eccentricity) < half):
+        raise ValueError(f"eccentricity {eccentricity!r} m lies outside the face (|e| < {half:g} m): "
+                         "the surface would tip over and lose contact")
     if "rotation" in surface.inputs:
         loads["rotation"] = float(force) * float(eccentricity)
     elif eccentricity:
