@@ -14,7 +14,8 @@ Symbols (SI units)::
     m_i     full-model weight of node i (``grid.mult``); W = diag(m)
     C_d     (n, n) combined compliance in direction d = x, y, z [m/N]
     K_d     = C_d^-1, the stiffness of both bodies on the surface nodes [N/m]
-    w       (3 n,) relative displacements of the node pairs, node-major
+    d       DOFs per node: 3 (slips x, y and the closing), 2 in a planar model
+    w       (d n,) relative displacements of the node pairs, node-major
             [w_0x, w_0y, w_0z, w_1x, ...]: tangential displacement of body 1
             over body 2 (x, y) and the closing of the gap (z) [m]
     q       (r,) rigid relative motion of the distant faces: approach [m],
@@ -31,7 +32,7 @@ A = blockdiag_d(W K_d) (symmetric: W C_d is, by reciprocity). Its forces are the
 nodal contact forces f = K_d (R_d q - w_d) (eq. A.23 in flexibility form: the
 closing w = R q - C f) and, on q, the full-model resultants R^T W f.
 
-Contact at node i (one ContactElement on [w_ix, w_iy, w_iz])::
+Contact at node i (one ContactElement on [w_ix, w_iy, w_iz]; [w_ix, w_iz] planar)::
 
     N_i = m_i k_n,i max(w_iz - h_i, 0)                                   (S2)
     f_t,i = 2D Jenkins slider, stiffness m_i k_t,i, slip force mu N_i      (S3)
@@ -66,9 +67,6 @@ PENALTY = 1e4
 #: fewer than MIN cannot carry a stick/slip pattern (contact_core.tangential_run),
 #: more than MAX makes the dense node stiffness (3 n)^2 too large for the dynamics.
 MIN_NODES, MAX_NODES = 5, 41
-#: Names of the rigid inputs q, by position (the rotation only on a flat face).
-INPUTS_FLAT = ("approach", "rotation", "tangential_x", "tangential_y")
-INPUTS = ("approach", "tangential_x", "tangential_y")
 
 
 def check_nodes(nodes_per_side: int) -> int:
@@ -87,13 +85,15 @@ class Surface:
     Attributes
     ----------
     contact : CondensedContact
-        The condensed pair (needs Czz, Cxx and Cyy).
-    K : ndarray, shape (3 n + r, 3 n + r)
+        The condensed pair.
+    K : ndarray, shape (d n + r, d n + r)
         Stiffness on x = [w; q] [N/m, N, N m] (S1).
     elements : list of ContactElement
-        One per node, on DOFs (3 i, 3 i + 1, 3 i + 2), weighted by m_i (S2, S3).
+        One per node, on DOFs (d i, ..., d i + d - 1), weighted by m_i (S2, S3).
     inputs : tuple of str
-        Names of the r rigid inputs, DOFs 3 n ... 3 n + r - 1.
+        Names of the r rigid inputs, DOFs d n ... d n + r - 1.
+    tangents : tuple of str
+        The slip directions kept: ("x", "y") (d = 3), or ("x",) (d = 2: a planar model).
     mu : float
         Friction coefficient.
     penalty : float
@@ -104,6 +104,7 @@ class Surface:
     K: np.ndarray
     elements: list
     inputs: tuple
+    tangents: tuple
     mu: float
     penalty: float
 
@@ -113,59 +114,83 @@ class Surface:
         return self.contact.n
 
     @property
+    def d(self) -> int:
+        """DOFs per node: the slips, then the closing."""
+        return len(self.tangents) + 1
+
+    @property
+    def n_w(self) -> int:
+        """Number of node DOFs, d n."""
+        return self.d * self.n
+
+    @property
     def n_dof(self) -> int:
-        """Number of DOFs, 3 n + r."""
+        """Number of DOFs, d n + r."""
         return self.K.shape[0]
 
     def input_dof(self, name: str) -> int:
         """DOF index of a rigid input by name (``inputs``)."""
         if name not in self.inputs:
             raise ValueError(f"this surface has no input {name!r}; it has {list(self.inputs)}")
-        return 3 * self.n + self.inputs.index(name)
+        return self.n_w + self.inputs.index(name)
 
     def normal_forces(self, x: np.ndarray) -> np.ndarray:
         """Nodal compressive forces f (n,) of the modelled part at DOFs x [N] (S2 / m_i)."""
-        p = x[2:3 * self.n:3] - self.contact.grid.h
+        p = x[self.d - 1:self.n_w:self.d] - self.contact.grid.h
         return np.array([el.k_n for el in self.elements]) / self.contact.grid.mult * np.maximum(p, 0.0)
 
 
-def rigid_map(cc) -> np.ndarray:
-    """R (3 n, r): relative node displacement per unit rigid input (node-major rows)."""
-    n, rz = cc.n, cc.rigid.shape[1]
-    R = np.zeros((3 * n, rz + 2))
-    R[2::3, :rz] = cc.rigid          # approach (and rotation): the closing of the gap
-    R[0::3, rz] = 1.0                # tangential x
-    R[1::3, rz + 1] = 1.0            # tangential y
+def _check_tangents(tangents) -> tuple:
+    tangents = tuple(tangents)
+    if tangents not in (("x", "y"), ("x",)):
+        raise ValueError(f"tangents must be ('x', 'y') or ('x',), got {tangents!r}")
+    return tangents
+
+
+def rigid_map(cc, tangents=("x", "y")) -> np.ndarray:
+    """R (d n, r): relative node displacement per unit rigid input (node-major rows)."""
+    tangents = _check_tangents(tangents)
+    d, n, rz = len(tangents) + 1, cc.n, cc.rigid.shape[1]
+    R = np.zeros((d * n, rz + len(tangents)))
+    R[d - 1::d, :rz] = cc.rigid          # approach (and rotation): the closing of the gap
+    for k in range(len(tangents)):
+        R[k::d, rz + k] = 1.0            # tangential translations
     return R
 
 
-def node_stiffness(cc) -> np.ndarray:
-    """A = blockdiag_d(W C_d^-1) on w, node-major, shape (3 n, 3 n) [N/m] (S1)."""
-    blocks = (cc.Cxx, cc.Cyy, cc.Czz)
+def node_stiffness(cc, tangents=("x", "y")) -> np.ndarray:
+    """A = blockdiag_d(W C_d^-1) on w, node-major, shape (d n, d n) [N/m] (S1)."""
+    tangents = _check_tangents(tangents)
+    blocks = [cc.Cxx, cc.Cyy][:len(tangents)] + [cc.Czz]
     if any(C is None for C in blocks):
-        raise ValueError("a contact surface needs the compliances in z, x and y "
-                         "(condense with directions ('z', 'x', 'y'))")
-    n, W = cc.n, np.asarray(cc.grid.mult, float)
-    A = np.zeros((3 * n, 3 * n))
-    for d, C in enumerate(blocks):
+        need = ", ".join(("z",) + tangents)
+        raise ValueError(f"a contact surface needs the compliances in {need} "
+                         f"(condense with directions {('z',) + tangents})")
+    d, n, W = len(blocks), cc.n, np.asarray(cc.grid.mult, float)
+    A = np.zeros((d * n, d * n))
+    for k, C in enumerate(blocks):
         Kd = W[:, None] * np.linalg.inv(C)
-        A[d::3, d::3] = 0.5 * (Kd + Kd.T)   # symmetric by reciprocity; drop round-off
+        A[k::d, k::d] = 0.5 * (Kd + Kd.T)   # symmetric by reciprocity; drop round-off
     return A
 
 
-def build(cc, mu: float, penalty: float = PENALTY, beta_c: float = 0.0) -> Surface:
+def build(cc, mu: float, penalty: float = PENALTY, beta_c: float = 0.0,
+          tangents=("x", "y")) -> Surface:
     """The surface model piece of a condensed pair.
 
     Parameters
     ----------
     cc : CondensedContact
-        Condensed with directions ("z", "x", "y").
+        Condensed with directions ("z", "x", "y") (("z", "x") for tangents ("x",)).
     mu : float
         Friction coefficient (>= 0).
     penalty : float
         Contact penalty relative to each node's own body stiffness (> 1).
     beta_c : float
         Contact damping [s] of every node (ContactElement C3).
+    tangents : ("x", "y") or ("x",)
+        Slip directions kept: both (3D contact points, 2D Coulomb friction) or x only
+        (a planar model: 2 DOFs per node, 1D Coulomb friction).
 
     Returns
     -------
@@ -175,18 +200,21 @@ def build(cc, mu: float, penalty: float = PENALTY, beta_c: float = 0.0) -> Surfa
         raise ValueError(f"friction coefficient mu must be finite and >= 0, got {mu!r}")
     if not (np.isfinite(penalty) and penalty > 1):
         raise ValueError(f"penalty must be finite and > 1, got {penalty!r}")
-    A = node_stiffness(cc)
-    R = rigid_map(cc)
+    tangents = _check_tangents(tangents)
+    A = node_stiffness(cc, tangents)
+    R = rigid_map(cc, tangents)
     AR = A @ R
     K = np.block([[A, -AR], [-AR.T, R.T @ AR]])
     W = np.asarray(cc.grid.mult, float)
     k_n = penalty / np.diag(cc.Czz)
-    k_t = penalty / np.minimum(np.diag(cc.Cxx), np.diag(cc.Cyy))  # one isotropic slider
-    elements = []
+    diag_t = np.diag(cc.Cxx) if tangents == ("x",) else np.minimum(np.diag(cc.Cxx), np.diag(cc.Cyy))
+    k_t = penalty / diag_t                       # one isotropic slider per node
+    d, elements = len(tangents) + 1, []
     for i in range(cc.n):
-        kin = Kinematics([3 * i, 3 * i + 1, 3 * i + 2], np.eye(3))
+        kin = Kinematics(list(range(d * i, d * i + d)), np.eye(d))
         elements.append(ContactElement.jenkins(kin, W[i] * k_n[i], W[i] * k_t[i], mu,
                                                preload=-float(cc.grid.h[i]), beta_c=beta_c,
                                                name=f"surface node {i}"))
-    inputs = INPUTS_FLAT if cc.rigid.shape[1] == 2 else INPUTS
-    return Surface(cc, 0.5 * (K + K.T), elements, inputs, float(mu), float(penalty))
+    rot = ("rotation",) if cc.rigid.shape[1] == 2 else ()
+    inputs = ("approach",) + rot + tuple(f"tangential_{t}" for t in tangents)
+    return Surface(cc, 0.5 * (K + K.T), elements, inputs, tangents, float(mu), float(penalty))

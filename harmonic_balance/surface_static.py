@@ -46,26 +46,37 @@ class SurfaceState:
         return SurfaceState(self.x.copy(), [s.copy() for s in self.friction], dict(self.loads))
 
 
+def _slider(el):
+    """The element's friction law in its slip dimension (2D for two tangents, else 1D)."""
+    return el.friction2d if el.friction2d is not None else el.friction
+
+
 def initial_state(surface) -> SurfaceState:
     """Unloaded, open surface: x = 0, virgin sliders at N = 0."""
     return SurfaceState(np.zeros(surface.n_dof),
-                        [el.friction2d.initial_state(0.0) for el in surface.elements])
+                        [_slider(el).initial_state(0.0) for el in surface.elements])
 
 
 def contact_forces(surface, state: SurfaceState, x: np.ndarray, jac: bool = True):
     """f_c (n_dof,) and its tangent (n_dof, n_dof) reached from ``state`` (trial, not committed)."""
     f = np.zeros(surface.n_dof)
     J = np.zeros((surface.n_dof, surface.n_dof)) if jac else None
+    m = surface.d
     for i, el in enumerate(surface.elements):
-        d = slice(3 * i, 3 * i + 3)
+        d = slice(m * i, m * i + m)
         w = x[d]
-        p = el.preload + w[2]
+        p = el.preload + w[-1]
         on = p > 0.0
-        out = el.friction2d.eval(state.friction[i], w[:2] - el.slip_ref, el.k_n * p)
-        f[d] = (out.F[0], out.F[1], el.k_n * p if on else 0.0)
+        if m == 3:
+            out = el.friction2d.eval(state.friction[i], w[:2] - el.slip_ref, el.k_n * p)
+            Ft, Kt, dFdN = out.F, out.K, out.dFdN
+        else:
+            out = el.friction.eval(state.friction[i], w[0] - el.slip_ref, el.k_n * p)
+            Ft, Kt, dFdN = np.array([out.F]), np.array([[out.kt]]), np.array([out.dFdN])
+        f[d] = np.append(Ft, el.k_n * p if on else 0.0)
         if jac:
-            J[d, d] = np.block([[out.K, (out.dFdN * el.k_n)[:, None]],
-                                [np.zeros((1, 2)), np.array([[el.k_n if on else 0.0]])]])
+            J[d, d] = np.block([[Kt, (dFdN * el.k_n)[:, None]],
+                                [np.zeros((1, m - 1)), np.array([[el.k_n if on else 0.0]])]])
     return f, J
 
 
@@ -74,9 +85,11 @@ def commit(surface, state: SurfaceState, x: np.ndarray, loads: dict) -> SurfaceS
     new = state.copy()
     new.x = x.copy()
     new.loads = dict(loads)
+    m = surface.d
     for i, el in enumerate(surface.elements):
-        w = x[3 * i:3 * i + 3]
-        el.friction2d.step(new.friction[i], w[:2] - el.slip_ref, el.k_n * (el.preload + w[2]))
+        w = x[m * i:m * i + m]
+        slip = w[:2] - el.slip_ref if m == 3 else w[0] - el.slip_ref
+        _slider(el).step(new.friction[i], slip, el.k_n * (el.preload + w[-1]))
     return new
 
 
@@ -204,9 +217,9 @@ def preload(surface, force: float, eccentricity: float = 0.0,
     state = initial_state(surface)
     x = state.x.copy()
     k_n = np.array([el.k_n for el in surface.elements])
-    x[2:3 * surface.n:3] = surface.contact.grid.h + force / k_n.sum()
+    x[surface.d - 1:surface.n_w:surface.d] = surface.contact.grid.h + force / k_n.sum()
     x[surface.input_dof("approach")] = surface.contact.grid.h.max()
-    pres = {"tangential_x": tangential[0], "tangential_y": tangential[1]}
+    pres = {f"tangential_{t}": u for t, u in zip(surface.tangents, tangential)}
     state = step(surface, state, pres, loads, guess=x)
     if not np.any(surface.normal_forces(state.x) > 0):
         raise RuntimeError("the contact surface lost contact at every node: raise the normal load")
@@ -232,11 +245,11 @@ def tangential_path(surface, state: SurfaceState, u_points, direction: str = "x"
     """
     name = f"tangential_{direction}"
     k = surface.input_dof(name)
-    other = "tangential_y" if direction == "x" else "tangential_x"
-    hold = state.x[surface.input_dof(other)]
+    held = {f"tangential_{t}": state.x[surface.input_dof(f"tangential_{t}")]
+            for t in surface.tangents if t != direction}
     u, T, W = [], [], []
     for v in np.asarray(u_points, float):
-        state = step(surface, state, {name: v, other: hold}, state.loads)
+        state = step(surface, state, {name: v} | held, state.loads)
         u.append(v)
         T.append(float((surface.K @ state.x)[k]))
         W.append(sum(s.W for s in state.friction))
@@ -273,9 +286,9 @@ def stuck_stiffness(surface, state: SurfaceState, direction: str = "x") -> float
     The Schur complement of the stuck system on the tangential input: the bodies'
     stiffness on [w_d; u] plus each node in contact's slider stiffness on w_d.
     """
-    d = "xy".index(direction)
-    n = surface.n
-    rows = np.concatenate([np.arange(d, 3 * n, 3), [surface.input_dof(f"tangential_{direction}")]])
+    d, n = surface.tangents.index(direction), surface.n
+    rows = np.concatenate([np.arange(d, surface.n_w, surface.d),
+                           [surface.input_dof(f"tangential_{direction}")]])
     Kd = surface.K[np.ix_(rows, rows)].copy()
     on = surface.normal_forces(state.x) > 0
     Kd[np.arange(n)[on], np.arange(n)[on]] += np.array([el.k_t for el in surface.elements])[on]

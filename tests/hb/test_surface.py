@@ -151,5 +151,22 @@ def test_surface_without_a_holding_normal_load_is_refused(condensed, force, e, m
 
 def test_surface_needs_all_three_compliances(condensed, tmp_path):
     cc = condense(CASES["flat"][0], directions=("z", "x"), cache=tmp_path)
-    with pytest.raises(ValueError, match="compliances in z, x and y"):
+    with pytest.raises(ValueError, match="compliances in z, x, y"):
         sf.build(cc, MU)
+    assert sf.build(cc, MU, tangents=("x",)).d == 2   # a planar surface needs z and x only
+
+
+def test_planar_surface_gives_the_loop_of_the_3d_surface(condensed):
+    """x and y are decoupled (like materials), so dropping y changes nothing under an x load
+    but the slider penalty (1 / min(C_xx,ii, C_yy,ii) in 3D, 1 / C_xx,ii planar): within
+    the penalty's own effect, 1 / PENALTY."""
+    cc = condensed("flat")
+    core = TangentialProblem(cc, normal.solve_force(cc, 500.0, ECCENTRIC["e6"]).f, MU)
+    a = 0.7 * core.gross_slip_displacement(core.initial_state())
+    loops = []
+    for tangents in (("x", "y"), ("x",)):
+        surface = sf.build(cc, MU, tangents=tangents)
+        state = ss.preload(surface, 500.0, ECCENTRIC["e6"])
+        loops.append(ss.hysteresis_loop(surface, state, a, steps=10)[0])
+    tol = 1.0 / sf.PENALTY
+    assert np.allclose(loops[1].T, loops[0].T, rtol=tol, atol=tol * np.abs(loops[0].T).max())
