@@ -37,7 +37,7 @@ def register(sub) -> None:
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
-    _contacts(f)
+    _contacts(f, surface=True)
     f.set_defaults(func=run_frf)
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     _common(o)
@@ -249,10 +249,17 @@ def _common(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
-def _contacts(p) -> None:
-    p.add_argument("--contacts", choices=("toml", "geometry"), default="toml",
+def _contacts(p, surface: bool = False) -> None:
+    p.add_argument("--contacts", choices=("toml", "geometry") + (("surface",) if surface else ()),
+                   default="toml",
                    help="contact laws: the TOML's Jenkins points, or computed by contact_core "
-                   "from the [geometry] section (damper.upd_geometry; cached)")
+                   "from the [geometry] section (damper.upd_geometry; cached)"
+                   + ("; surface: the damper's faces as contact surfaces of many 3D points on the "
+                      "condensed FE bodies (damper.upd_surface; slower)" if surface else ""))
+    if surface:
+        p.add_argument("--surface-nodes", type=int, default=5, metavar="N",
+                       help="with --contacts surface: contact-zone nodes per side of each face "
+                       "(5 .. 41; default 5)")
 
 
 def _sector(args):
@@ -298,6 +305,21 @@ def _check_frf(args) -> None:
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
     check_out_dir(args.plot, "--plot")
+    _check_surface(args)
+
+
+def _check_surface(args) -> None:
+    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run."""
+    from harmonic_balance.surface import check_nodes
+
+    if args.contacts != "surface":
+        return
+    check_nodes(args.surface_nodes)
+    if args.damper != "nonlinear":
+        raise ValueError(f"--contacts surface with --damper {args.damper}: the linear limits use the "
+                         "point model; drop --contacts surface or use --damper nonlinear")
+    if args.accuracy is not None:
+        raise ValueError("--contacts surface runs at the fixed --harmonics: drop --accuracy")
 
 
 def run_frf(args) -> int:
@@ -315,6 +337,7 @@ def run_frf(args) -> int:
     else:
         out = _frf_linear(sector, args, omegas)
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
+    out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -368,7 +391,11 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
 
-    if args.accuracy is None:
+    if args.contacts == "surface":
+        hb = _surface_hb(sector, args)
+        c = frf(hb, omegas)
+        rec = None
+    elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
         rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
@@ -380,6 +407,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
                                      limits.MAX_UPD_HARMONICS, cf=args.cf, f0=args.f0)
         c.time_s = time.perf_counter() - t0
     summ = hb.contact_summary(c.peak_x)
+    if args.contacts == "surface":
+        summ = _surface_summary(hb, summ)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
@@ -387,7 +416,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
             "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
-            "static_normal_load": hb.static["N"].tolist(),
+            "static_normal_load": _static_loads(hb),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
             "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
@@ -395,6 +424,47 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "truncation_warning": warning(rec)}
     if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
         out["warning"] = c.extra["warning"]
+    return out
+
+
+def _surface_hb(sector, args):
+    """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
+    from damper.cache import Store
+    from damper.upd_surface import build_surfaces
+    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+
+    surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
+    hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)
+    args.surface_report = {face: {"nodes": s.n, "dofs": s.n_w, "nodes_per_side": args.surface_nodes}
+                           for face, s in surfaces.items()}
+    return hb
+
+
+def _static_loads(hb) -> list:
+    """Prestress normal load per contact point [N]; with surfaces, per face (sum over its nodes)."""
+    N = hb.static["N"]
+    if not hasattr(hb, "surfaces"):
+        return N.tolist()
+    names = [e.name for e in hb.points]
+    return [float(sum(n for n, name in zip(N, names) if name.startswith(f"{face} node")))
+            for face in hb.surfaces]
+
+
+def _surface_summary(hb, summ: dict) -> dict:
+    """Per face (the sums over its nodes): mean and range of N [N], share of nodes ever
+    lifted off, friction energy per cycle [J]; refuses a damper that left both faces."""
+    out = {"names": [], "normal_load_mean": [], "normal_load_range": [], "lift_off": [],
+           "friction_energy": []}
+    for face in hb.surfaces:
+        idx = [i for i, name in enumerate(summ["names"]) if name.startswith(f"{face} node")]
+        out["names"].append(face)
+        out["normal_load_mean"].append(sum(summ["normal_load_mean"][i] for i in idx))
+        out["normal_load_range"].append(sum(summ["normal_load_range"][i] for i in idx))
+        out["lift_off"].append(float(np.mean([summ["lift_off"][i] for i in idx])))
+        out["friction_energy"].append(sum(summ["friction_energy"][i] for i in idx))
+    if max(out["normal_load_mean"]) <= 0.0:
+        raise RuntimeError("the damper lost contact on both faces at the peak (no node carries a "
+                           "load): raise --cf or lower --f0")
     return out
 
 

@@ -1,0 +1,51 @@
+"""Contact surfaces of the underplatform damper from its geometry (``damper upd frf --contacts surface``).
+
+The damper's cylinder line and flat face as contact surfaces
+(:mod:`harmonic_balance.surface`, planar; the sector model
+:class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`): the bodies,
+materials and potential contact zones are those of ``--contacts geometry``
+(:func:`damper.upd_geometry.contact_specs`), condensed by ``contact_core`` with the
+user's node count per side (``--surface-nodes``) and kept in the application's store.
+
+Symbols: N nodes per side of each face's contact-zone grid; mu friction coefficient.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+
+def build_surfaces(cfg, nodes_per_side: int, cf: float | None = None, store=None) -> dict:
+    """Planar contact surfaces {"left": cylinder, "flat": flat face} of a UPD config.
+
+    Parameters
+    ----------
+    cfg : UPDConfig
+        With a [geometry] section.
+    nodes_per_side : int
+        Contact-zone nodes per side of each face (``surface.check_nodes`` bounds).
+    cf : float, optional
+        The run's centrifugal load [N] (sizes the cylinder's potential zone as for
+        ``--contacts geometry``).
+    store : damper.cache.Store, optional
+        Cache of the condensation (None: none).
+
+    Raises
+    ------
+    ValueError
+        A node count outside its bound, or a geometry contact_core refuses.
+    """
+    from contact_core.condense import condense
+    from harmonic_balance.surface import build, check_nodes
+
+    from .upd_geometry import contact_specs, geometry_params
+
+    nodes = check_nodes(nodes_per_side)
+    p = geometry_params(cfg, cf)
+    specs = contact_specs(p)
+    out = {}
+    for face in ("left", "flat"):
+        spec, model, _ = specs[face]
+        cc = condense(replace(spec, grid=nodes, model=model), directions=("z", "x"),
+                      cache=store if store is not None else False)
+        out[face] = build(cc, p["mu"], tangents=("x",))
+    return out
