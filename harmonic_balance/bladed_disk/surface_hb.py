@@ -95,11 +95,27 @@ def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c:
         Qn[n_w:, n_w:] = Gn[:, used]
     kin = Kinematics(dofs, Q, Q_next=Qn, phase=phi if cyclic else 0.0)
     els = [LinearElement(kin, surface.K, beta_c * surface.K if beta_c else None, name=f"{name} bodies")]
+    els += node_contacts(surface, offset, name)
+    return els
+
+
+def node_contacts(surface, offset: int, name: str) -> list:
+    """The surface's node ContactElements on model DOFs offset ... offset + d n - 1."""
+    els = []
     for i, el in enumerate(surface.elements):
         node = Kinematics(offset + np.arange(surface.d * i, surface.d * (i + 1)), np.eye(surface.d))
         contact = type(el)(node, el.k_n, el.friction, preload=el.preload, name=f"{name} node {i}")
         els.append(contact)
     return els
+
+
+def linear_part(surface, offset: int, G, n_model: int) -> np.ndarray:
+    """T^T K T (n_model, n_model) of a surface without a neighbour: [w; q] = T x, exact in
+    every harmonic (no phase), so it joins the linear structure."""
+    T = np.zeros((surface.n_dof, n_model))
+    T[:surface.n_w, offset:offset + surface.n_w] = np.eye(surface.n_w)
+    T[surface.n_w:, :G.shape[1]] = G
+    return T.T @ surface.K @ T
 
 
 class SurfaceSectorHB(SectorHB):
@@ -133,18 +149,29 @@ class SurfaceSectorHB(SectorHB):
         offset = n
         for face, surf in self.surfaces.items():
             G, G_next = face_inputs(sec, face)
-            els += surface_elements(surf, offset, G, G_next, list(sec.blade.right), sec.cfg.phi,
-                                    sec.beta_c, face)
+            if np.any(G_next != 0.0):   # the flat: its inputs use blade j+1 (phase phi)
+                els += surface_elements(surf, offset, G, G_next, list(sec.blade.right), sec.cfg.phi,
+                                        sec.beta_c, face)
+            else:                       # the cylinder: linear structure (cheaper, exact)
+                Ks = linear_part(surf, offset, G, n + n_w)
+                pad[2] += Ks
+                pad[1] += sec.beta_c * Ks
+                els += node_contacts(surf, offset, face)
             offset += surf.n_w
         f_static, f_eo = np.zeros(n + n_w), np.zeros(n + n_w, dtype=complex)
         f_static[sec.y_d], f_eo[sec.forced] = self.cf, self.f0
         return Model(LinearModel(M=pad[0], C=pad[1], K=pad[2]), els, {0: f_static, 1: f_eo}, sec.response)
 
     def stuck_guess(self, omega: float) -> np.ndarray:
-        """The point model's stuck response on the sector DOFs, the node DOFs at their statics."""
-        x = self.static_guess().reshape(self.nb, self.ndof)
-        x[:, :self.sector.n_dof] = SectorHB.stuck_guess(self, omega).reshape(self.nb, -1)[:, :self.sector.n_dof]
-        return x.ravel()
+        """Prestress mean + the linear response with every node stuck (a Newton start).
+
+        One Newton step from the prestress state without vibration: there every node in
+        contact is stuck, so the Jacobian is the stuck linear system (surfaces included)
+        and the step is its response to the EO force.
+        """
+        x0 = self.static_guess()
+        R, J, _ = self.residual(x0, omega, True)
+        return x0 - np.linalg.solve(J, R)
 
     def _eo_forcing(self) -> np.ndarray:
         f = np.zeros(self.ndof, dtype=complex)
