@@ -394,7 +394,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     if args.contacts == "surface":
         hb = _surface_hb(sector, args)
         c = frf(hb, omegas)
-        rec = None
+        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
     elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
