@@ -76,21 +76,6 @@ def test_surface_sector_solves_one_frequency_with_its_energy_balanced(surfaces):
     assert hb.amplitude_h1(x) > 0.0
 
 
-@pytest.mark.slow
-def test_cli_frf_with_contact_surfaces(tmp_path, capsys, monkeypatch):
-    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
-    argv = ["upd", "frf", "--contacts", "surface", "--surface-nodes", str(NODES), "--cf", "300",
-            "--harmonics", "3", "--points", "8", "--band", "440", "500", "--json"]
-    assert main(argv) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert out["contact_points"] == ["left", "flat"]
-    assert out["peak_amplitude"] > 0
-    assert abs(out["energy_per_cycle_at_peak"]["imbalance"]) < TOL_REL
-    N = 300.0 / (2 * np.cos(np.radians(45.0)))
-    assert out["static_normal_load"] == pytest.approx([N, N], rel=STATIC_RTOL)
-    assert out["contact_surfaces"]["flat"]["nodes_per_side"] == NODES
-
-
 @pytest.mark.parametrize("extra, words", [
     (["--surface-nodes", "3"], "surface nodes per side"),
     (["--surface-nodes", "99"], "surface nodes per side"),
