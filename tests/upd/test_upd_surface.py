@@ -3,7 +3,6 @@
 The coarsest surfaces (5 nodes per side) keep the condensation and the HB small; the
 store is shared by the module so contact_core condenses once.
 """
-import json
 
 import numpy as np
 import pytest
