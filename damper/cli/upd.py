@@ -38,7 +38,7 @@ def register(sub) -> None:
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
-    _contacts(f)
+    _contacts(f, surface=True)
     f.set_defaults(func=run_frf)
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     _common(o)
@@ -261,10 +261,17 @@ def _common(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
-def _contacts(p) -> None:
-    p.add_argument("--contacts", choices=("toml", "geometry"), default="toml",
+def _contacts(p, surface: bool = False) -> None:
+    p.add_argument("--contacts", choices=("toml", "geometry") + (("surface",) if surface else ()),
+                   default="toml",
                    help="contact laws: the TOML's Jenkins points, or computed by contact_core "
-                   "from the [geometry] section (damper.upd_geometry; cached)")
+                   "from the [geometry] section (damper.upd_geometry; cached)"
+                   + ("; surface: the damper's faces as contact surfaces of many 3D points on the "
+                      "condensed FE bodies (damper.upd_surface; slower)" if surface else ""))
+    if surface:
+        p.add_argument("--surface-nodes", type=int, default=5, metavar="N",
+                       help="with --contacts surface: contact-zone nodes per side of each face "
+                       "(5 .. 41; default 5)")
 
 
 def _sector(args):
@@ -310,6 +317,9 @@ def _check_frf(args) -> None:
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
     check_out_dir(args.plot, "--plot")
+    from damper.upd_surface import check_options
+
+    check_options(args)
 
 
 def run_frf(args) -> int:
@@ -327,6 +337,7 @@ def run_frf(args) -> int:
     else:
         out = _frf_linear(sector, args, omegas)
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
+    out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -336,6 +347,8 @@ def run_frf(args) -> int:
               f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
         if "warning" in out:
             print(f"warning: {out['warning']}")
+        if out.get("zone_edge_warning"):
+            print(out["zone_edge_warning"])
     for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
@@ -375,12 +388,19 @@ def _frf_linear(sector, args, omegas) -> dict:
 
 def _frf_nonlinear(sector, args, omegas) -> dict:
     from damper import limits
+    from damper.upd_surface import static_loads
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import frf_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
 
-    if args.accuracy is None:
+    if args.contacts == "surface":
+        from damper.upd_surface import sector_hb
+
+        hb = sector_hb(sector, args)
+        c = frf(hb, omegas)
+        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
         rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
@@ -392,14 +412,19 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
                                      limits.MAX_UPD_HARMONICS, cf=args.cf, f0=args.f0)
         c.time_s = time.perf_counter() - t0
     summ = hb.contact_summary(c.peak_x)
+    if args.contacts == "surface":
+        from damper.upd_surface import face_summary
+
+        summ = face_summary(hb, summ)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
             "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
+            "zone_edge_warning": summ.get("warning_zone_edge"),
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
-            "static_normal_load": hb.static["N"].tolist(),
+            "static_normal_load": static_loads(hb),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
             "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
