@@ -296,7 +296,8 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
     for kind, (path, why) in kinds.items():   # then each tool at its own H for 1 %
         if not why:
             rows += [_clean(r) for r in peer_accuracy.run(case_names(quick, opts), kind, path, work,
-                                                          PEER_SETTINGS, octave, PEER_TIMEOUT_S, log)]
+                                                          PEER_SETTINGS, run_ours, octave, PEER_TIMEOUT_S,
+                                                          log)]
     return rows
 
 

@@ -37,12 +37,11 @@ def _error(peak, ref: dict) -> float | None:
     return abs(peak / ref["amplitude"] - 1.0)
 
 
-def scan_ours(case, work: Path, ref: dict, log=print) -> dict:
+def scan_ours(case, work: Path, ref: dict, run_ours, log=print) -> dict:
     """Our curves at SCAN until the peak is within TARGET_REL: the last curve's numbers
     with ``H``, ``error`` and ``scan`` (H, error, time_s, cpu_s of each curve tried);
-    ``H`` None when no H of SCAN got there."""
-    from .hb_classes import run_ours
-
+    ``H`` None when no H of SCAN got there. ``run_ours(name, work, case)`` runs one curve
+    (:func:`.hb_classes.run_ours`, passed in: that module calls this one)."""
     tried = []
     for H in SCAN:
         o = run_ours(case.name, work, replace(case, harmonics=H))
@@ -102,9 +101,10 @@ def _curve_ratio(peer: dict, ours: dict) -> float | None:
     return peer["time_s"] / (t - c) if peer.get("time_s") and t and t > c else None
 
 
-def run(names, kind: str, path: str, work: Path, settings: dict, octave=None, timeout: float = 600.0,
-        log=print) -> list[Row]:
-    """The rows of :func:`row` for the named bench cases that have a stored reference."""
+def run(names, kind: str, path: str, work: Path, settings: dict, run_ours, octave=None,
+        timeout: float = 600.0, log=print) -> list[Row]:
+    """The rows of :func:`row` for the named bench cases that have a stored reference
+    (``run_ours`` as in :func:`scan_ours`)."""
     from harmonic_balance.bench_models import by_name
 
     from .hb_reference import load as load_reference
@@ -120,7 +120,7 @@ def run(names, kind: str, path: str, work: Path, settings: dict, octave=None, ti
         sub = work / f"{name.replace(' ', '_').replace('=', '')}_1pct"
         sub.mkdir(parents=True, exist_ok=True)
         log(f"  {name}: each tool at its own H for {100 * TARGET_REL:g} %")
-        ours = scan_ours(case, sub, ref, log)
+        ours = scan_ours(case, sub, ref, run_ours, log)
         peer = scan_peer(kind, case, path, sub, settings, ref, octave, timeout, log)
         rows.append(row(name, tool, case, ours, peer))
         e = rows[-1].extra

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from damper.bench import hb_classes, peer_accuracy, peers
+from damper.bench import peer_accuracy, peers
 from harmonic_balance.bench_models import sdof
 
 REF = {"amplitude": 1.0}
@@ -29,10 +29,9 @@ def test_scan_stops_at_the_first_h_within_one_percent_and_rows_give_the_time_rat
         return {"complete": True, "omega": [0.9, 1.0, 1.1], "a1": [0.5 * a, a, 0.5 * a],
                 "time_s": 0.2 * H, "cpu_s": 0.3 * H, "wall_s": 0.2 * H, "status": "complete"}
 
-    monkeypatch.setattr(hb_classes, "run_ours", fake_ours)
     monkeypatch.setattr(peers, "run", fake_peer)
     case = sdof(1.0)
-    ours = peer_accuracy.scan_ours(case, Path(tmp_path), REF, log=lambda s: None)
+    ours = peer_accuracy.scan_ours(case, Path(tmp_path), REF, fake_ours, log=lambda s: None)
     peer = peer_accuracy.scan_peer("pyharm", case, "python", Path(tmp_path), {}, REF, log=lambda s: None)
     assert ours["H"] == 3 and [t["H"] for t in ours["scan"]] == [1, 3]
     assert peer["H"] == 11 and peer["error"] == pytest.approx(peer_c / 121)
