@@ -166,16 +166,18 @@ class ContactElement(ForceElement):
             s, W = self._evaluate_plane(U, basis, p, f, dF, D)
         elif m == 2:
             s = E @ U[:, 0]
-            # the C core returns the Jacobian's non-zero rows alone (the samples in
-            # contact), packed: D dF over those samples, no test for zero rows
-            Ft, rows, dFs, dFp, W = self.friction.periodic_jac_rows(
-                s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
-                max_periods=self.max_periods, tol=self.tol)
+            # the C core returns the Jacobian as sparse terms in the samples (each row:
+            # its own sample, where a slider stuck, a re-contact step's ends), so D dF
+            # is a weighted transform plus a few outer products, not a product over
+            # every sample in contact; dF/dU_p = dF/dN k_n (N = k_n p)
+            Ft, dX, dN, row, col, cX, cN, W = self.friction.periodic_jac_terms(
+                s - self.slip_ref, N=self.k_n * p, with_N=jac, max_periods=self.max_periods,
+                tol=self.tol)
             f[:, 0] = Ft
             if jac:
-                Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
-                dF[0::2, 0::2] = Dr @ dFs
-                dF[0::2, 1::2] = Dr @ dFp
+                dF[0::2, 0::2], dF[0::2, 1::2] = basis.project_terms(
+                    np.column_stack([dX, self.k_n * dN]), row, col,
+                    np.column_stack([cX, self.k_n * cN]))
         F = D @ f
         dw, C = None, self._local_damping_cached()
         if C is not None:
