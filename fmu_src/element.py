@@ -450,7 +450,8 @@ class IwanElement:
                                             float(tol), ct.byref(p)),
                "IwanElement.periodic_jac_terms")
         r = k.value
-        return (F, dX, dXN, row[:r].astype(np.intp), col[:r].astype(np.intp), cX[:r], cXN[:r],
+        # size_t -> intp without a copy (indices < n): numpy indexes and counts with intp
+        return (F, dX, dXN, row[:r].view(np.intp), col[:r].view(np.intp), cX[:r], cXN[:r],
                 w.value)
 
     def periodic_branches(self, u_ext):
