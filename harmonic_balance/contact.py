@@ -22,7 +22,11 @@ Friction with N varying in time (C2) is evaluated by the C core's periodic path
 element's state recurs (closure to ``tol`` of the force range, ``max_periods`` at
 most, else ``IwanNotConvergedError``); with N constant over the period the loop is
 exact in one pass. It returns dF/dU_s and dF/dU_p exactly, including the
-dependence of each sticking slider on N where it stuck and of the re-contact point.
+dependence of each sticking slider on N where it stuck and of the re-contact point,
+either as the rows of the samples in contact or as sparse terms in the samples (a
+diagonal plus the few samples where sliders stuck: ``periodic_jac_terms``), whose
+projection onto the harmonics takes one FFT (``FourierBasis.project_terms``) instead
+of a product over the samples; :data:`TERMS_MIN_WORK` chooses the cheaper.
 With two tangents the 2D loop (``IwanElement2D.periodic_jac``: each slider marched on
 its own from the same start convention; on a line it is the 1D loop) gives
 d(f_x, f_y)/d(U_sx, U_sy, U_p) exactly, by sensitivities carried through the march.
