@@ -65,8 +65,9 @@ MAX_PERIODS = 400
 #: Work (n_b^2 n_t multiply-adds) of the product D dF/dU over the samples above which a
 #: one-tangent contact's Jacobian is projected from the C core's sparse terms instead
 #: (an FFT of the diagonal, a few anchor columns: ~80 us of fixed cost, then about
-#: n_t log n_t). Measured per contact evaluation on UPD-24 (CF 120 N, F0 30 N): H 15,
-#: n_t 512 (0.49e6): product 207 us, terms 230 us; H 21, n_t 1024 (1.9e6): 600 us
+#: n_t log n_t). Measured per contact evaluation on UPD-24 (CF 120 N, F0 30 N): H 7,
+#: n_t 256 (0.06e6): product 100 us, terms 155 us; H 15, n_t 512 (0.49e6): 210 us
+#: both; H 17, n_t 1024 (1.25e6): 435-490 us against 270-310 us; H 21 (1.9e6): 600 us
 #: against 330 us.
 TERMS_MIN_WORK = 1.0e6
 #: Condition number above which the static stiffness counts as singular (a floating
