@@ -4,6 +4,7 @@ import pytest
 from hbcases import SEED, sdof, two_dof
 
 from fmu_src.element import IwanElement
+from harmonic_balance import contact
 from harmonic_balance.aft import FrictionLink, aft_link
 from harmonic_balance.contact import ContactElement, frictionless_statics
 from harmonic_balance.forces import LinearElement, harmonic_work
@@ -118,9 +119,12 @@ def test_cyclic_spring_gives_the_harmonic_coupling_stiffness():
     assert np.abs(J - np.diag(expect)).max() < ROUND * kc
 
 
+@pytest.mark.parametrize("projection", ["product over rows", "sparse terms"])
 @pytest.mark.parametrize("kind", sorted(FRICTIONS))
 @pytest.mark.parametrize("draw", range(3))
-def test_contact_jacobian_matches_finite_differences(kind, draw):
+def test_contact_jacobian_matches_finite_differences(kind, draw, projection, monkeypatch):
+    """Both projections of the sampled Jacobian (contact.TERMS_MIN_WORK chooses)."""
+    monkeypatch.setattr(contact, "TERMS_MIN_WORK", np.inf if projection == "product over rows" else 0.0)
     el = plane_contact(FRICTIONS[kind](), preload=0.2, slip_ref=0.03, beta_c=0.01)
     b = FourierBasis("all:5")
     U = np.random.default_rng(SEED + draw).normal(scale=0.15, size=(b.nb, 2))
