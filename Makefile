@@ -100,12 +100,14 @@ docs-bench-peers: $(STAMP) cbuild
 	@test -n "$(PYHARM)" -a -n "$(NLVIB)" || { echo "give PYHARM=python-with-pyharm NLVIB=nlvib-folder"; exit 2; }
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/bench_peers.json -- \
 	  $(VENV)/bin/damper bench --stage hb --pyharm $(PYHARM) --nlvib $(NLVIB) --json --out out/bench_peers
-# docs-accuracy: the truncation-error estimate against the true error (about 30 minutes).
+# docs-accuracy: the truncation-error estimate against the true error (about 50 minutes).
 docs-accuracy: $(STAMP) cbuild
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy.json -- \
 	  $(PY) -m damper.bench.hb_accuracy --only frf --json
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy_upd.json -- \
 	  $(PY) -m damper.bench.hb_accuracy --only upd --json
+	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy_contact.json -- \
+	  $(PY) -m damper.bench.hb_accuracy --only contact --json
 docs-stress: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/stress.json -- $(VENV)/bin/damper stress --json --out out/stress
 

@@ -231,12 +231,13 @@ class Sphere(Body):
                              f"{spec.radius:.3g} m: lower --p-design")
 
     def check_load(self, spec, force):
-        a = hertz.sphere(force, spec.radius, spec.Estar)["a"]
-        if a > MAX_CONTACT_SHARE * spec.radius * (1.0 + 1e-9):
-            a_max = MAX_CONTACT_SHARE * spec.radius
-            f_max = 4.0 * spec.Estar * a_max**3 / (3.0 * spec.radius)
+        a_max = MAX_CONTACT_SHARE * spec.radius
+        f_max = 4.0 * spec.Estar * a_max**3 / (3.0 * spec.radius)   # Hertz: a^3 = 3 F R / (4 E*)
+        if force > f_max * (1.0 + 3e-9):
+            # a from the ratio to f_max: finite for any finite force (a^3 = 3FR/4E* overflows)
+            a = a_max * (force / f_max) ** (1.0 / 3.0)
             raise ValueError(f"a force of {force:.4g} N gives a Hertz contact radius of {a:.3g} m, "
-                             f"{100 * a / spec.radius:.0f} % of the sphere radius {spec.radius:.3g} m: "
+                             f"{100 * a / spec.radius:.3g} % of the sphere radius {spec.radius:.3g} m: "
                              f"beyond what the contact model represents (a <= {MAX_CONTACT_SHARE:g} R); "
                              f"use a force of at most {f_max:.4g} N for this sphere, or a larger radius")
 

@@ -13,6 +13,8 @@ Symmetry (quarter model for sphere and cylinder, half model for the flat face):
 * z (normal) load, even in x and y: u_x = 0 on x = 0, u_y = 0 on y = 0.
 * x (tangential) load: u_x even in x, so u_y, u_z odd in x -> u_y = u_z = 0 on
   x = 0; even in y -> u_y = 0 on y = 0.
+* y (tangential) load: u_y even in y, so u_x, u_z odd in y -> u_x = u_z = 0 on
+  y = 0; even in x -> u_x = 0 on x = 0.
 
 The rigid motion of a distant face carries the unloaded body with it, so the
 closing of the gap per unit approach is 1 at every contact node, and per unit
@@ -32,7 +34,7 @@ from .condensed import CondensedContact, ContactGrid
 from .spec import ContactSpec
 
 _SOURCES = ("mesh.py", "bodies.py", "assembly.py", "condense.py", "spec.py", "linsolve.py")
-DIRECTIONS = ("z", "x")
+DIRECTIONS = ("z", "x", "y")
 
 
 def code_version() -> str:
@@ -46,10 +48,11 @@ def code_version() -> str:
 def _fixed_dofs(body: mesh.BodyMesh, direction: str, symmetry: str) -> np.ndarray:
     """Clamped DOFs (distant face) plus the symmetry conditions of the load direction."""
     fixed = [3 * body.distant + c for c in range(3)]
-    fixed.append(3 * body.sym_y0 + 1)
+    on_y0 = (0, 2) if direction == "y" else (1,)     # components odd in y (module docstring)
+    fixed += [3 * body.sym_y0 + c for c in on_y0]
     if symmetry == "quarter":
-        comps = (0,) if direction == "z" else (1, 2)
-        fixed += [3 * body.sym_x0 + c for c in comps]
+        on_x0 = (1, 2) if direction == "x" else (0,)  # components odd in x
+        fixed += [3 * body.sym_x0 + c for c in on_x0]
     return np.unique(np.concatenate(fixed))
 
 
@@ -164,9 +167,11 @@ def _assemble_result(arrays: dict, meta: dict) -> CondensedContact:
                        h=arrays["h"], copies=arrays["copies"])
     z = (arrays["Czz_1"], arrays["Czz_2"])
     x = (arrays["Cxx_1"], arrays["Cxx_2"]) if "Cxx_1" in arrays else None
+    y = (arrays["Cyy_1"], arrays["Cyy_2"]) if "Cyy_1" in arrays else None
     return CondensedContact(grid=grid, Czz=z[0] + z[1], rigid=arrays["rigid"], Czz_bodies=z,
                             Cxx=None if x is None else x[0] + x[1], Cxx_bodies=x, meta=meta,
-                            probe_x=arrays.get("probe_x"), probe_C1=arrays.get("probe_C1"))
+                            probe_x=arrays.get("probe_x"), probe_C1=arrays.get("probe_C1"),
+                            Cyy=None if y is None else y[0] + y[1], Cyy_bodies=y)
 
 
 def direction_key(spec: ContactSpec, direction: str) -> str:
@@ -181,8 +186,10 @@ def condense(spec: ContactSpec, directions=("z",), cache=None, progress=None) ->
     Parameters
     ----------
     spec : ContactSpec
-    directions : sequence of {"z", "x"}
-        Compliance blocks to compute; "z" is always included (the normal solve).
+    directions : sequence of {"z", "x", "y"}
+        Compliance blocks to compute; "z" is always included (the normal solve);
+        "y" (the second tangential direction) is needed by the contact surface of
+        the harmonic balance only.
     cache : None, False, str, Path or a ``cache.CondensationCache``
         None: the default cache folder (``DAMPER_CACHE_DIR`` or ``.damper_cache``);
         False: no cache; a folder: a DiskCache there; an object with
@@ -205,7 +212,7 @@ def condense(spec: ContactSpec, directions=("z",), cache=None, progress=None) ->
     """
     bad = set(directions) - set(DIRECTIONS)
     if bad:
-        raise ValueError(f"unknown direction(s) {sorted(bad)}; use 'z' and/or 'x'")
+        raise ValueError(f"unknown direction(s) {sorted(bad)}; use 'z', 'x' and/or 'y'")
     directions = tuple(d for d in DIRECTIONS if d in set(directions) | {"z"})
     store = resolve(cache)
     keys = {d: direction_key(spec, d) for d in directions}
@@ -214,7 +221,7 @@ def condense(spec: ContactSpec, directions=("z",), cache=None, progress=None) ->
     load_time = time.perf_counter() - t0
     missing = tuple(d for d in directions if found[d] is None)
     arrays, meta = {}, None
-    for d in directions:                     # cached blocks first (DIRECTIONS order: z, x)
+    for d in directions:                     # cached blocks first (DIRECTIONS order: z, x, y)
         if found[d] is not None:
             arrays.update(found[d][0])
             meta = meta or found[d][1]

@@ -99,6 +99,9 @@ class CondensedContact:
         displacement of the surfaces at i per unit opposite x forces at j.
     Cxx_bodies : tuple of ndarray or None
         ``(C1, C2)`` tangential compliances, or None.
+    Cyy, Cyy_bodies : ndarray (n, n) and tuple, or None
+        The same for the second tangential direction y (symmetry conditions of a
+        y load, u_y even in y), or None if not requested.
     meta : dict
         Geometry, materials, grid, symmetry, mesh sizes, timings per stage
         [s], cache key and hit.
@@ -118,6 +121,8 @@ class CondensedContact:
     meta: dict = field(default_factory=dict)
     probe_x: np.ndarray | None = None
     probe_C1: np.ndarray | None = None
+    Cyy: np.ndarray | None = None
+    Cyy_bodies: tuple | None = None
 
     @property
     def n(self) -> int:

@@ -33,7 +33,7 @@ import hashlib
 import json
 import os
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -76,7 +76,9 @@ class Study:
     """What a mistuning study computes (SI units; frequencies in Hz).
 
     ``factors`` (one pattern, N_b values) replaces the random draw; ``kind`` says whether
-    they (or the drawn ones) are stiffness or frequency factors.
+    they (or the drawn ones) are stiffness or frequency factors. ``accuracy`` (relative, on
+    the peak amplitude) chooses H on the tuned sector (from ``harmonics``, by the truncation
+    estimate of :mod:`harmonic_balance.bladed_disk.accuracy`); every sample then runs at that H.
     """
 
     config: str | None = None
@@ -96,6 +98,7 @@ class Study:
     points: int = 41
     until_ci: float | None = None
     solver: str = "fast"
+    accuracy: float | None = None
 
     def load(self):
         """The validated UPD config with ``blades`` / ``engine_order`` applied (ValueError)."""
@@ -115,6 +118,13 @@ class Study:
 
         if self.damper not in DAMPERS:
             raise ValueError(f"damper must be one of {DAMPERS}, got {self.damper!r}")
+        if self.accuracy is not None:
+            from harmonic_balance.accuracy import check_accuracy
+
+            check_accuracy(self.accuracy)
+            if self.damper != "nonlinear":
+                raise ValueError(f"accuracy goes with the nonlinear damper: the linear limit "
+                                 f"{self.damper!r} has no harmonic truncation (drop the accuracy)")
         if self.solver not in SOLVERS:
             raise ValueError(f"solver must be one of {SOLVERS}, got {self.solver!r}")
         for name in ("cf", "f0"):
@@ -184,7 +194,9 @@ def fingerprint(cfg) -> str:
 
 
 def tuned_reference(study: Study, cfg) -> dict:
-    """Tuned sector's peak [m] and frequency [Hz] and the study's band [Hz] and grid size."""
+    """Tuned sector's peak [m] and frequency [Hz], the study's band [Hz], the harmonics of
+    every sample (``harmonics``: the study's, or the H its ``accuracy`` chose on the tuned
+    sector) and the tuned peak's truncation estimate (None for a linear limit)."""
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.mistuning import tuned_linear_peak
     from harmonic_balance.bladed_disk.sector import Sector
@@ -193,8 +205,11 @@ def tuned_reference(study: Study, cfg) -> dict:
     sector = Sector(cfg)
     search = study.band_hz or cfg["load.band_hz"]
     om = 2 * np.pi * np.linspace(search[0], search[1], max(study.points, 41))
-    rec = None  # a linear limit has no harmonic truncation
-    if study.damper == "nonlinear":
+    rec, H = None, study.harmonics  # a linear limit has no harmonic truncation
+    if study.damper == "nonlinear" and study.accuracy is not None:
+        hb, c, rec = _tuned_to_accuracy(study, sector, om)
+        w, a, H = c.peak_omega, c.peak_amplitude, hb.H
+    elif study.damper == "nonlinear":
         hb = SectorHB(sector, study.harmonics, cf=study.cf, f0=study.f0)
         c = frf(hb, om)
         w, a = c.peak_omega, c.peak_amplitude
@@ -210,7 +225,7 @@ def tuned_reference(study: Study, cfg) -> dict:
             f_t, tuned_linear_peak(sector, om, "stuck", study.f0)[0] / (2 * np.pi))
         band = default_band(f_t, hi, margin)
     return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band,
-            "truncation_error": rec}
+            "harmonics": int(H), "truncation_error": rec}
 
 
 def _tuned_truncation(hb, curve) -> dict:
@@ -222,6 +237,20 @@ def _tuned_truncation(hb, curve) -> dict:
     rec = truncation_error(hb, curve, limits.MAX_UPD_HARMONICS)
     rec["at"] = "the tuned sector's peak (the study's reference)"
     return rec
+
+
+def _tuned_to_accuracy(study: Study, sector, om):
+    """(hb, curve, record) of the tuned sector raised in H from the study's ``harmonics``
+    until its peak's estimate is below ``accuracy`` (:func:`frf_to_accuracy`): the H every
+    sample then uses. The ring's peaks converge in H like the sector's (the same contacts),
+    and the amplification divides by the tuned peak at the same H."""
+    from damper import limits
+    from harmonic_balance.bladed_disk.accuracy import frf_to_accuracy
+
+    hb, c, rec = frf_to_accuracy(sector, om, study.accuracy, study.harmonics,
+                                 limits.MAX_UPD_HARMONICS, cf=study.cf, f0=study.f0)
+    rec["at"] = "the tuned sector's peak (the study's reference; its H used for every sample)"
+    return hb, c, rec
 
 
 def default_band(f_low: float, f_high: float, margin: float) -> list:
@@ -358,6 +387,10 @@ def run_study(study: Study, store: Store, scheduler: str | None = None, workers:
     submit, gather, close = executor(scheduler, workers, serial, info)  # an unreachable scheduler: now
     try:
         ref = tuned_reference(study, cfg)
+        if study.accuracy is not None:   # H chosen for the accuracy: every sample at it
+            echo(f"mistuning: H = {ref['harmonics']} for the accuracy {study.accuracy:g} (tuned "
+                 f"sector, harmonics tried {ref['truncation_error']['accuracy']['H_sequence']})")
+            study = replace(study, harmonics=ref["harmonics"])
         fp = fingerprint(cfg)
         common = {"study": asdict(study), "band_hz": ref["band_hz"], "folder": str(store.folder),
                   "tuned_frequency_hz": ref["tuned_frequency_hz"], "max_bytes": store.max_bytes}
@@ -454,7 +487,8 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
     out = {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
             "kind": study.kind, "distribution": study.distribution,
             "std": None if study.factors is not None else study.std, "seed": study.seed,
-            "harmonics": study.harmonics, "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
+            "harmonics": study.harmonics, "accuracy": study.accuracy,
+            "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0,
             "band_hz": ref["band_hz"], "points": study.points, "solver": study.solver,
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "truncation_error": ref.get("truncation_error"),

@@ -123,13 +123,14 @@ def run_worst_friction(study, bound: float | None = None, linear_starts: int = L
     rng = np.random.default_rng([int(study.seed), 31, 1])
     starts += [(f"random {i}", 1.0 + b * rng.uniform(-1.0, 1.0, cfg.blades)) for i in range(random_starts)]
     band = 2 * np.pi * np.asarray(ref["band_hz"])
-    peak = FrictionPeak(sector, band, study.harmonics, cf=study.cf, f0=study.f0,
+    H = ref["harmonics"]   # the study's, or the H its accuracy chose on the tuned sector
+    peak = FrictionPeak(sector, band, H, cf=study.cf, f0=study.f0,
                         start_omega=2 * np.pi * ref["tuned_frequency_hz"], solver=study.solver,
                         points=study.points)
     r = worst_friction_pattern(peak, b, starts, ref["tuned_peak"], max_evaluations)
     a_t = ref["tuned_peak"]
     out = {"blades": cfg.blades, "engine_order": cfg.engine_order, "damper": study.damper,
-           "bound": b, "std": study.std, "band_hz": ref["band_hz"], "harmonics": study.harmonics,
+           "bound": b, "std": study.std, "band_hz": ref["band_hz"], "harmonics": H,
            "cf": study.cf or cfg.cf, "f0": study.f0 or cfg.f0, "solver": study.solver,
            "factors": r["kappa"].tolist(), "frequency_factors": frequency_factors(r["kappa"]).tolist(),
            "worst_blade": r["blade"], "peak": r["peak"], "frequency_hz": r["omega"] / (2 * np.pi),

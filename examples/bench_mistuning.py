@@ -9,6 +9,11 @@ Rows:
   evaluations, Newton iterations, one sparse LU of the ring Jacobian, its non-zeros; the
   same curve by the fast solver (``ring_fast``): CPU time, speed-up, evaluations, and its
   per-blade peaks and amplification against the full solver's.
+* ``band``: UPD-24 samples (``--samples``, std 0.02, seed 1) on the study's default band
+  (the tuned friction-damped peak up to the stuck ring's, with margins) by the fast
+  solver and by the full solver on 41 and on 401 points: CPU time, evaluations, and
+  the per-blade peaks' and amplification's largest differences against the 401-point
+  full solver (the band's narrow resonance near the stuck peak needs that grid).
 * ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
   cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
   time: why the solver factors the mistuned Jacobian instead.
@@ -42,8 +47,8 @@ Times are CPU (process_time) where one process works, wall time for the clusters
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling precond throughput worst worst_friction confidence] [--samples 8] [--quick] [--workers 1 2]
-        [--damper free] [--worst-blades 6 24] [--worst-samples 1000]
+        [--rows scaling band precond throughput worst worst_friction confidence] [--samples 8] [--quick]
+        [--workers 1 2] [--damper free] [--worst-blades 6 24] [--worst-samples 1000]
         [--worst-friction-blades 24] [--worst-evaluations 25]
         [--confidence-samples 1000] [--confidence-blades 8]
 """
@@ -117,6 +122,41 @@ def scaling_rows(blades) -> list:
                      "fast_peak_per_blade_max_rel_diff": float(np.abs(cf.peak_per_blade / c.peak_per_blade
                                                                       - 1).max())})
         print(_fmt(rows[-1]), flush=True)
+    return rows
+
+
+def band_rows(samples: int) -> list:
+    """Fast against full (41 and 401 points) on UPD-24's default study band."""
+    from damper.mistuning import SampleModel, Study, tuned_reference
+
+    study = Study(std=0.02, samples=samples, seed=1)
+    ref = tuned_reference(study, study.load())
+    model = SampleModel(study, ref["band_hz"], ref["tuned_frequency_hz"])
+    lo, hi = model.om[0], model.om[-1]
+    start = 2 * np.pi * ref["tuned_frequency_hz"]
+    rows = []
+    for i in range(samples):
+        kappa = draw_factors(24, 0.02, 1, i)
+        runs = {}
+        for name, points in (("fast", 0), ("full41", 41), ("full401", 401)):
+            ring = MistunedRingHB(model.sector, kappa, H, cf=study.cf, f0=study.f0)
+            model.tuned = model.tuned or SectorHB(ring.sector, H, cf=ring.cf, f0=ring.f0,
+                                                  mu=ring.mu, n_t=ring.basis.n_t)
+            c0 = time.process_time()
+            c = (fast_ring_frf(ring, (lo, hi), model.tuned, start_omega=start) if not points
+                 else ring_frf(ring, np.linspace(lo, hi, points), model.tuned, start_omega=start))
+            runs[name] = (time.process_time() - c0, c)
+        ref_c = runs["full401"][1]
+        row = {"case": "default band", "blades": 24, "pattern": i,
+               "band_hz": [float(lo / 2 / np.pi), float(hi / 2 / np.pi)]}
+        for name, (t, c) in runs.items():
+            row |= {f"{name}_cpu_s": t, f"{name}_evaluations": c.evaluations}
+            if name != "full401":
+                row |= {f"{name}_peak_per_blade_max_rel_diff":
+                        float(np.abs(c.peak_per_blade / ref_c.peak_per_blade - 1).max()),
+                        f"{name}_amplification_rel_diff": c.peak / ref_c.peak - 1}
+        rows.append(row)
+        print(_fmt(row), flush=True)
     return rows
 
 
@@ -285,7 +325,8 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
-                   choices=("scaling", "precond", "throughput", "worst", "worst_friction", "confidence"))
+                   choices=("scaling", "band", "precond", "throughput", "worst", "worst_friction",
+                            "confidence"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
     p.add_argument("--workers", type=int, nargs="+",
                    help="Dask local-cluster sizes of the throughput rows (0: this process; "
@@ -314,6 +355,8 @@ def main(argv=None) -> int:
     rows = []
     if "scaling" in a.rows:
         rows += scaling_rows((4, 8) if a.quick else (4, 8, 24, 48))
+    if "band" in a.rows:
+        rows += band_rows(a.samples)
     if "precond" in a.rows:
         rows += precond_rows((0.02,) if a.quick else (0.002, 0.005, 0.02), nb=8 if a.quick else 24)
     if "throughput" in a.rows:

@@ -419,6 +419,41 @@ class IwanElement:
         return (F, rows[:k].astype(np.intp), dFdX[:k], None if dFdXN is None else dFdXN[:k],
                 w.value)
 
+    def periodic_jac_terms(self, u, N=None, with_N: bool = False, max_periods: int = 100,
+                           tol: float = 1e-12):
+        """:meth:`periodic_jac`'s Jacobian as sparse terms in the samples (same numbers
+        to round-off), for any basis: row t of dF/dX is ``dX[t] Eu[t] + sum_i cX[i]
+        Eu[col[i]]`` over the terms with ``row[i] == t`` (of dF/dXN, with ``with_N`` and
+        N given, the same with dXN, cXN and EN; else they are zero). The diagonal is a
+        stuck slider's stiffness or a slipping one's strength slope; the other terms
+        are the samples where stuck sliders stuck and the ends of a re-contact step
+        (few distinct columns), so a projection onto a Fourier basis needs no (n, nb)
+        row per sample (:meth:`harmonic_balance.fourier.FourierBasis.project_terms`).
+
+        Returns
+        -------
+        F, dX, dXN : ndarray (n,);  row, col : ndarray (k,) of int (col != row);
+        cX, cXN : ndarray (k,);  W_cycle : float.
+        """
+        u = _vec(u, "u")
+        n = u.size
+        Nv = None if N is None else _normal(N, n, self.N_ref)
+        cap = n * (2 * self._model.n + 2)
+        F, dX, dXN = np.empty(n), np.empty(n), np.empty(n)
+        row, col = np.empty(cap, dtype=np.uintp), np.empty(cap, dtype=np.uintp)
+        cX, cXN = np.empty(cap), np.empty(cap)
+        k, w, p = ct.c_size_t(), ct.c_double(), ct.c_int()
+        _check(_lib.iwan_periodic_jac_terms(self._mp, n, arr(u), arr(Nv), int(bool(with_N)), arr(F),
+                                            arr(dX), arr(dXN), cap, ct.byref(k),
+                                            arr(row, _clib.SizeArray), arr(col, _clib.SizeArray),
+                                            arr(cX), arr(cXN), ct.byref(w), int(max_periods),
+                                            float(tol), ct.byref(p)),
+               "IwanElement.periodic_jac_terms")
+        r = k.value
+        # size_t -> intp without a copy (indices < n): numpy indexes and counts with intp
+        return (F, dX, dXN, row[:r].view(np.intp), col[:r].view(np.intp), cX[:r], cXN[:r],
+                w.value)
+
     def periodic_branches(self, u_ext):
         """Exact periodic loop of an input monotone between its extrema ``u_ext`` (n >= 2,
         alternating maxima and minima, periodic), at N_ref: piecewise-linear branches.
@@ -453,9 +488,8 @@ class IwanElement:
         mean alone), and their Jacobian: (Fh (n_b,), dFh (n_b, n_b), W [J], extrema found;
         0 for a constant input, then Fh and dFh are zero). ``n_scan`` > 2 max(harmonics):
         the points of u' scanned for its sign changes."""
-        h = np.ascontiguousarray(harmonics, dtype=np.int32)
+        h, nb = _harmonic_orders(harmonics)
         U = _vec(U, "U")
-        nb = int(np.sum(np.where(h == 0, 1, 2)))
         if U.size != nb:
             raise IwanInputError(f"U must have {nb} coefficients for harmonics {tuple(h)}, got {U.size}")
         Fh, dFh = np.empty(nb), np.empty((nb, nb))
@@ -473,3 +507,18 @@ class IwanElement:
         F = np.empty_like(u)
         F[order] = self.series(np.abs(u)[order], None if N is None else float(N)).F
         return np.sign(u) * F
+
+
+#: The orders of periodic_fourier's harmonic sets met so far (a basis passes the same
+#: tuple at every call): (int32 array, n_b), so a call converts none.
+_ORDERS: dict = {}
+
+
+def _harmonic_orders(harmonics):
+    """(int32 C array of the orders, n_b) of a harmonic set, kept per tuple."""
+    key = tuple(int(k) for k in harmonics) if not isinstance(harmonics, tuple) else harmonics
+    got = _ORDERS.get(key)
+    if got is None:
+        h = np.ascontiguousarray(key, dtype=np.int32)
+        got = _ORDERS[key] = (h, int(np.sum(np.where(h == 0, 1, 2))))
+    return got

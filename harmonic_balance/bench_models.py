@@ -27,6 +27,16 @@ Cases
   2 sin(j pi / 12) = 0.52 ... 1.93 rad/s; the first two resonances lie between the
   free and the stuck chain's, where the links stick and slip).
 
+* :func:`contact_point` -- a unit mass on one 3D contact point (normal z, slips x and
+  y): springs k_x = 1, k_y = 1.3, k_z = 1 and an x-z coupling 0.5 [N/m]
+  (:data:`CONTACT_POINT_K`), C = 0.02 I, a penalty normal spring k_n = 4 with lift-off,
+  Jenkins friction k_t = 2 [N/m] with slip force mu N (mu = 0.3) following the normal
+  load N; a static load of 1 N presses it down (harmonic 0), the excitation 0.3 cos
+  along x and 0.2 sin along y, so the slip traces an ellipse and, through the coupling,
+  the contact lifts off near the x resonance (for ~3/4 of the cycle at the peak,
+  omega = 0.955 rad/s, where the mass bounces on the contact); H = 7,
+  0.5 -> 1.6 rad/s. Not in :func:`all_cases` (the peers take Jenkins links only).
+
 Cases of the example benchmarks only (``examples/bench_hb.py``, ``bench_hb_robust.py``;
 not in :func:`all_cases`): :func:`sdof` with other damping, slip force, force, H and
 band; :func:`two_dof` -- the 2-DOF test model, links between the masses and to the
@@ -203,3 +213,53 @@ def by_name(name: str) -> BenchCase:
     if name not in cases:
         raise ValueError(f"unknown benchmark case {name!r}; known: {', '.join(cases)}")
     return cases[name]
+
+
+@dataclass(frozen=True)
+class ContactPointCase:
+    """The 3D contact point (:func:`contact_point`): the attributes of a
+    :class:`BenchCase` that the accuracy table reads (``name``, ``band``, ``harmonics``,
+    ``response_dof``, :meth:`model`), with the contact's data (SI units)."""
+
+    name: str
+    K: np.ndarray = field(repr=False)
+    damping: float = 0.02
+    k_n: float = 4.0
+    k_t: float = 2.0
+    mu: float = 0.3
+    preload: float = 1.0
+    force: tuple = (0.3, -0.2j, 0.0)
+    harmonics: int = 7
+    band: tuple = (0.5, 1.6)
+    response_dof: int = 0
+
+    def model(self):
+        """The :class:`~harmonic_balance.model.Model`: DOFs [x, y, z] of the mass; the
+        contact's q = [x, y, -z] (:meth:`Kinematics.contact` with normal +z from the
+        ground into the mass); harmonic 0 carries the static load -preload on z."""
+        from .contact import ContactElement
+        from .kinematics import Kinematics
+        from .linear import LinearModel
+        from .model import Model
+
+        kin = Kinematics.contact([0, 1, 2], [0.0, 0.0, 1.0], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], np.eye(3))
+        el = ContactElement.jenkins(kin, self.k_n, self.k_t, self.mu, name="contact",
+                                    max_periods=CONTACT_POINT_PERIODS)
+        lin = LinearModel(M=np.eye(3), C=self.damping * np.eye(3), K=np.asarray(self.K, dtype=float))
+        return Model(lin, [el], {0: np.array([0.0, 0.0, -self.preload]),
+                                 1: np.asarray(self.force, dtype=complex)}, self.response_dof)
+
+
+#: Structural stiffness [N/m] of the contact point's mass: x and z coupled (an inclined
+#: spring), so the x resonance moves the mass normal to the contact and lifts it off.
+CONTACT_POINT_K = ((1.0, 0.0, 0.5), (0.0, 1.3, 0.0), (0.5, 0.0, 1.0))
+#: Periods the contact's loop may be marched until it closes: with N varying and the slip
+#: in two directions, a slider that sticks part of the cycle drifts towards its periodic
+#: state slowly (at omega ~ 0.56 rad/s below the resonance: not closed to 1e-10 in 400
+#: periods, closed in 4000).
+CONTACT_POINT_PERIODS = 20000
+
+
+def contact_point() -> ContactPointCase:
+    """A mass on one 3D contact point with lift-off (module docstring)."""
+    return ContactPointCase("contact3d lift-off", np.array(CONTACT_POINT_K))

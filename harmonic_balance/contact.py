@@ -22,7 +22,11 @@ Friction with N varying in time (C2) is evaluated by the C core's periodic path
 element's state recurs (closure to ``tol`` of the force range, ``max_periods`` at
 most, else ``IwanNotConvergedError``); with N constant over the period the loop is
 exact in one pass. It returns dF/dU_s and dF/dU_p exactly, including the
-dependence of each sticking slider on N where it stuck and of the re-contact point.
+dependence of each sticking slider on N where it stuck and of the re-contact point,
+either as the rows of the samples in contact or as sparse terms in the samples (a
+diagonal plus the few samples where sliders stuck: ``periodic_jac_terms``), whose
+projection onto the harmonics takes one FFT (``FourierBasis.project_terms``) instead
+of a product over the samples; :data:`TERMS_MIN_WORK` chooses the cheaper.
 With two tangents the 2D loop (``IwanElement2D.periodic_jac``: each slider marched on
 its own from the same start convention; on a line it is the 1D loop) gives
 d(f_x, f_y)/d(U_sx, U_sy, U_p) exactly, by sensitivities carried through the march.
@@ -48,7 +52,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .aft import FrictionLink, _project_rows
+from .aft import FrictionLink
 from .forces import ForceElement, LinearElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .kinematics import Kinematics
@@ -58,6 +62,14 @@ from .kinematics import Kinematics
 CLOSURE_TOL = 1e-10
 #: Default largest number of periods marched until the loop closes.
 MAX_PERIODS = 400
+#: Work (n_b^2 n_t multiply-adds) of the product D dF/dU over the samples above which a
+#: one-tangent contact's Jacobian is projected from the C core's sparse terms instead
+#: (an FFT of the diagonal, a few anchor columns: ~80 us of fixed cost, then about
+#: n_t log n_t). Measured per contact evaluation on UPD-24 (CF 120 N, F0 30 N): H 7,
+#: n_t 256 (0.06e6): product 100 us, terms 155 us; H 15, n_t 512 (0.49e6): 210 us
+#: both; H 17, n_t 1024 (1.25e6): 435-490 us against 270-310 us; H 21 (1.9e6): 600 us
+#: against 330 us.
+TERMS_MIN_WORK = 1.0e6
 #: Condition number above which the static stiffness counts as singular (a floating
 #: body): 1e-3 / machine epsilon leaves ~3 significant digits in the solve.
 SINGULAR_COND = 1e-3 / np.finfo(float).eps
@@ -165,14 +177,7 @@ class ContactElement(ForceElement):
         if m == 3:
             s, W = self._evaluate_plane(U, basis, p, f, dF, D)
         elif m == 2:
-            s = E @ U[:, 0]
-            Ft, dFs, dFp, W = self.friction.periodic_jac(
-                s - self.slip_ref, E, N=self.k_n * p, EN=self._cached(basis, "EN"),
-                max_periods=self.max_periods, tol=self.tol)
-            f[:, 0] = Ft
-            if jac:   # rows of zeros (slipping, resp. stuck samples) skipped
-                dF[0::2, 0::2] = _project_rows(D, dFs)
-                dF[0::2, 1::2] = _project_rows(D, dFp)
+            s, W = self._evaluate_line(U, basis, p, f, dF)
         F = D @ f
         dw, C = None, self._local_damping_cached()
         if C is not None:
@@ -183,6 +188,31 @@ class ContactElement(ForceElement):
                 dF += omega * op
         return ContactForce(F, dF, dw, f, float(W), (C, U, basis, omega), (s, pl))
 
+
+    def _evaluate_line(self, U, basis: FourierBasis, p, f, dF):
+        """Friction of one tangent (m = 2) into f[:, 0] and the blocks of dF (if any).
+
+        The projection D dF/dU of the sampled Jacobian is formed from the C core's
+        sparse terms (its diagonal by an FFT, a few anchor columns) when the product
+        over the samples in contact would cost more than :data:`TERMS_MIN_WORK`, else
+        as that product over the packed rows. dF/dU_p = k_n dF/dN (N = k_n p).
+        Returns the sampled slips (n_t,) and the friction work per cycle [J]."""
+        E, nb, kn = basis.E, basis.nb, self.k_n
+        s = E @ U[:, 0]
+        kw = {"N": kn * p, "max_periods": self.max_periods, "tol": self.tol}
+        if dF is not None and nb * nb * basis.n_t < TERMS_MIN_WORK:
+            Ft, rows, dFs, dFp, W = self.friction.periodic_jac_rows(
+                s - self.slip_ref, E, EN=self._cached(basis, "EN"), **kw)
+            D = basis.D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else basis.D[:, rows]
+            dF[0::2, 0::2], dF[0::2, 1::2] = D @ dFs, D @ dFp
+        else:
+            Ft, dX, dN, row, col, cX, cN, W = self.friction.periodic_jac_terms(
+                s - self.slip_ref, with_N=dF is not None, **kw)
+            if dF is not None:
+                dF[0::2, 0::2], dF[0::2, 1::2] = basis.project_terms(
+                    np.stack([dX, kn * dN]), row, col, np.stack([cX, kn * cN]))
+        f[:, 0] = Ft
+        return s, W
 
     def _evaluate_plane(self, U, basis: FourierBasis, p, f, dF, D):
         """Friction of two tangents (m = 3) into f[:, :2] and the blocks of dF (if any).

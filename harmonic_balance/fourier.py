@@ -216,6 +216,70 @@ class FourierBasis:
         out = np.where(is_sin, np.sin(arg), np.cos(arg)) @ np.asarray(coeffs)
         return out[0] if np.ndim(theta) == 0 else out
 
+    def weighted(self, k: np.ndarray) -> np.ndarray:
+        """``D @ diag(k) @ E`` (n_b, n_b) for sample weights k (n_t,); (q, n_b, n_b) for k (q, n_t).
+
+        From the 2H + 1 discrete Fourier coefficients of k by one FFT: entry (p, q) is
+        ``w_p sum_t k_t psi_p(theta_t) phi_q(theta_t)`` and each product of two basis
+        functions of orders a, b is half a sum of the cos or sin of orders ``a - b``
+        and ``a + b`` (cos a cos b = (cos(a-b) + cos(a+b)) / 2, ...), exact on the grid:
+        Toeplitz plus Hankel in the orders. O(n_t log n_t + n_b^2) instead of the
+        O(n_t n_b^2) of the product; the same numbers to round-off.
+        """
+        k = np.asarray(k, dtype=float)
+        L = 2 * self.H + 1
+        X = (np.fft.rfft(k) if 2 * self.H <= self.n_t // 2 else np.fft.fft(k))[..., :L]
+        # interleaved (re, im) = (C_j, -S_j), C_j = sum k cos(j theta), S_j = sum k sin
+        V = np.ascontiguousarray(X).view(float).ravel()
+        i_d, a_d, i_s, a_s = self._weighted_tables(1 if k.ndim == 1 else k.shape[0])
+        return a_d * V[i_d] + a_s * V[i_s]
+
+    def _weighted_tables(self, q: int):
+        """Gather indices into the interleaved [C_0, -S_0, C_1, -S_1, ...] of q weight
+        vectors and the weights of :meth:`weighted`, for the difference (``i_d``,
+        ``a_d``) and sum (``i_s``, ``a_s``) orders; (n_b, n_b) for q = 1, else (q, n_b,
+        n_b) (cached per q)."""
+        cache = self.__dict__.setdefault("_fine_cache", {})
+        if ("weighted", q) not in cache:
+            a = self.order
+            is_sin = np.zeros(self.nb, dtype=bool)
+            is_sin[(2 if self.harmonics[0] == 0 else 1)::2] = True
+            w = np.where(a == 0, 1.0, 2.0) / self.n_t / 2.0
+            same = is_sin[:, None] == is_sin[None, :]
+            dif, add = a[:, None] - a[None, :], a[:, None] + a[None, :]
+            # cos cos: C_d + C_s; sin sin: C_d - C_s; cos_p sin_q: S_s - S_d; sin_p cos_q:
+            # S_s + S_d; an S_j is read as -(-S_j)
+            i_d = 2 * np.abs(dif) + ~same
+            a_d = w[:, None] * np.where(same, 1.0, -np.sign(dif) * np.where(is_sin[:, None], 1.0, -1.0))
+            i_s = 2 * add + ~same
+            a_s = w[:, None] * np.where(same, np.where(is_sin[:, None], -1.0, 1.0), -1.0)
+            if q > 1:
+                shift = 2 * (2 * self.H + 1) * np.arange(q)[:, None, None]
+                i_d, i_s = i_d + shift, i_s + shift
+            cache["weighted", q] = (i_d, a_d, i_s, a_s)
+        return cache["weighted", q]
+
+    def project_terms(self, diag: np.ndarray, row: np.ndarray, col: np.ndarray,
+                      coef: np.ndarray) -> np.ndarray:
+        """``D @ S @ E`` (q, n_b, n_b) of sparse sample matrices S (n_t, n_t), one per
+        row of diag (q, n_t) and coef (q, k): ``S = diag(diag) + sum_i coef[i] e_row[i]
+        e_col[i]^T`` (row != col; e.g. the Jacobian of ``IwanElement.periodic_jac_terms``).
+        The diagonal by :meth:`weighted`, the other columns J of S (few: where a stick
+        episode began) as ``(D S[:, J]) E[J]``: O(n_t log n_t + k + (n_t + n_b) n_b |J|)
+        instead of the O(n_t n_b^2) of the product over the samples."""
+        n = self.n_t
+        diag = np.asarray(diag, dtype=float).reshape(-1, n)
+        out = self.weighted(diag)
+        if len(row):
+            used = np.zeros(n, dtype=bool)
+            used[col] = True
+            J = np.flatnonzero(used)
+            idx = row + n * np.searchsorted(J, col)
+            W = np.stack([np.bincount(idx, c, n * J.size) for c in np.reshape(coef, (len(diag), -1))])
+            G = W.reshape(-1, n) @ self.D.T                   # rows of D S[:, J], per q
+            out += G.reshape(len(diag), J.size, -1).transpose(0, 2, 1) @ self.E[J]
+        return out
+
     def alias_ratio(self, samples: np.ndarray) -> float:
         """Aliasing indicator of a sampled periodic signal (n_t,) or (n_t, k).
 

@@ -35,6 +35,7 @@ from .parameter import ParameterProblem
 from .peaks import peak_indices, refine_peaks
 from .residual import CondensedResidual, FullResidual, energy_per_cycle, make_residual
 from .start import _stiffness_ratio, homotopy_start
+from .steady_state import annotate
 
 #: Newton tolerance relative to the residual's reference size (|F_ext| for the
 #: full residual, |X| of the stuck linear response for the condensed one).
@@ -108,6 +109,10 @@ class FRFResult:
         }
         if "accuracy" in self.extra:
             out["accuracy"] = _finite_dict(self.extra["accuracy"])
+        out["stuck_links"] = self.extra.get("stuck_links")
+        if "steady_state" in self.extra:
+            out["steady_state"] = _finite_dict(self.extra["steady_state"])
+            out["steady_state_warning"] = self.extra.get("steady_state_warning")
         return {k: _finite(v) for k, v in out.items()}
 
 
@@ -210,7 +215,8 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
                 ds_max: float = DS_MAX, max_points: int = 2000, refine: bool = True,
                 stability="auto", progress=None, aft: str = "exact",
                 tolerance: float = CURVE_TOL, truncation_check: bool = True,
-                accuracy: float | None = None, max_harmonic: int = 200) -> FRFResult:
+                accuracy: float | None = None, max_harmonic: int = 200,
+                steady_state_check: bool = False) -> FRFResult:
     """Forced-response curve over ``omega_range = (start, end)`` [rad/s].
 
     The first point is Newton's from the stuck linear guess or, when that fails, the
@@ -238,6 +244,12 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     ``accuracy``: a relative tolerance on the peak amplitude; the harmonics are then
     raised per curve from ``harmonics`` until the estimate is below it
     (:func:`frf_accuracy.frf_to_accuracy`; ``extra["accuracy"]`` says what was used).
+    ``steady_state_check``: time integrations at the refined peak from rest and from the
+    harmonic balance's state (:func:`steady_state.check_peak`, seconds per model of a few
+    DOFs) say whether the curve's branch is the state a start from rest reaches
+    (``extra["steady_state"]``, a warning in ``extra["steady_state_warning"]`` when not).
+    Every refined result names the links that never slip at the peak
+    (``extra["stuck_links"]``: their mean position is the harmonic balance's convention).
 
     Raises
     ------
@@ -255,11 +267,12 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     if accuracy is not None:
         from .frf_accuracy import frf_to_accuracy
 
-        return frf_to_accuracy(compute_frf, model, accuracy, omega_range, harmonics, max_harmonic,
-                               tol_rel=TOL_REL, n_t=n_t,
-                               condensed=condensed, ds_max=ds_max, max_points=max_points,
-                               refine=refine, stability=stability, progress=progress, aft=aft,
-                               tolerance=tolerance)
+        result = frf_to_accuracy(compute_frf, model, accuracy, omega_range, harmonics, max_harmonic,
+                                 tol_rel=TOL_REL, n_t=n_t,
+                                 condensed=condensed, ds_max=ds_max, max_points=max_points,
+                                 refine=refine, stability=stability, progress=progress, aft=aft,
+                                 tolerance=tolerance)
+        return annotate(result, steady_state_check)
     t0 = time.perf_counter()
     model = exact_links(model, aft == "exact")
     n_base = n_t or stiff_samples(model, harmonics) or default_samples(max(parse_harmonics(harmonics)))
@@ -308,6 +321,7 @@ def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=No
     result.evaluations = prob.evaluations
     if truncation_check and refine:
         _check_truncation(result, max_harmonic)
+    annotate(result, steady_state_check)
     result.time_s = time.perf_counter() - t0
     return result
 

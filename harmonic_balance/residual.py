@@ -42,8 +42,9 @@ class _Residual:
     ``T_e[r_e] dF_e Q_e[:, r_e]`` by products over the local index, O(n_b^2) per
     element, added into the (size, size) matrix, instead of dense products of the whole
     (size, sum n_b m_e) operators, O(n_b^3 n m) (at H = 31 on a 5-DOF chain with three
-    links, 80 % of a curve's time; :class:`_LocalMap`). When every element is
-    conservative, Q is T's transpose (a view).
+    links, 80 % of a curve's time; :class:`_LocalMap`); a link (one local displacement,
+    no neighbour) adds dF_e times (T Q)_ij straight into the strided view of each of its
+    DOF pairs (i, j). When every element is conservative, Q is T's transpose (a view).
     """
 
     def __init__(self, model: Model, basis: FourierBasis, dofs):
@@ -74,20 +75,27 @@ class _Residual:
              for el in self.elements]) if self.elements else np.zeros(0)
 
     def _local_maps(self):
-        """Each element's :class:`_LocalMap`, grouped by the rows they act on (the blocks of
-        a group are summed before the one scatter into the Jacobian)."""
+        """Each element's :class:`_LocalMap`; those without a direct path grouped by the rows
+        they act on (the blocks of a group are summed before the one scatter into the
+        Jacobian)."""
         pos = {int(d): i for i, d in enumerate(self.dofs)}
         maps = [_LocalMap(el.kinematics, self.basis, [pos[d] for d in el.kinematics.dofs], self.m)
                 for el in self.elements]
         groups = {}
         for k, lm in enumerate(maps):
-            groups.setdefault(lm.rows.tobytes(), (lm.rows, []))[1].append(k)
+            if lm.pairs is None:
+                groups.setdefault(lm.rows.tobytes(), (lm.rows, []))[1].append(k)
         self._local = maps
         self._groups = [(np.ix_(rows, rows), ks) for rows, ks in groups.values()]
 
     def _assemble(self, res) -> np.ndarray:
         """dF_nl/dx (size, size) = sum_e T_e dF_e Q_e, element by element on its rows."""
         dF = np.zeros((self.size, self.size))
+        nb = self.basis.nb
+        J4 = dF.reshape(nb, self.m, nb, self.m)
+        for lm, r in zip(self._local, res):
+            if lm.pairs is not None:
+                lm.add_direct(J4, r.dF)
         for ix, ks in self._groups:
             B = self._local[ks[0]].block(res[ks[0]].dF)
             for k in ks[1:]:
@@ -244,6 +252,13 @@ class _LocalMap:
         nb = basis.nb
         self.rows = (np.arange(nb)[:, None] * n_dofs + np.asarray(pos)[None, :]).ravel()
         self.Q, self.T, self.Qn, self.Tn = kin.Q, kin.T, kin.Q_next, kin.T_next
+        # one local displacement, no neighbour (a friction link): the block is dF times
+        # (T Q)[i, j] on DOF pair (i, j), added in place by add_direct
+        self.pairs = None
+        if not kin.cyclic and kin.m == 1:
+            TQ = kin.T @ kin.Q
+            self.pairs = [(pi, pj, float(TQ[i, j])) for i, pi in enumerate(pos)
+                          for j, pj in enumerate(pos) if TQ[i, j] != 0.0]
         if kin.cyclic:
             # harmonic h > 0 holds the coefficient pair (cos, sin) at (c, c + 1): the
             # pairs are every other coefficient from the first non-mean one
@@ -251,30 +266,52 @@ class _LocalMap:
             self._cos, self._sin = slice(first, None, 2), slice(first + 1, None, 2)
             hphi = np.array([h for h in basis.harmonics if h > 0], dtype=float) * kin.phase
             self._c, self._s = np.cos(hphi), np.sin(hphi)
+            self._rot = self._rotation(nb, kin.m)
 
-    def _phase(self, Z: np.ndarray, axis: int) -> np.ndarray:
-        """``sum_b P[b, c] Z[.., b, ..]`` along ``axis`` (harmonic coefficients), in place."""
-        shape = [1] * Z.ndim
-        shape[axis] = -1
-        c, s = self._c.reshape(shape), self._s.reshape(shape)
-        ic = (slice(None),) * axis + (self._cos,)
-        isn = (slice(None),) * axis + (self._sin,)
-        zc, zs = Z[ic].copy(), Z[isn]
-        Z[ic] = c * zc - s * zs
-        Z[isn] = s * zc + c * Z[isn]
-        return Z
+    def _rotation(self, nb: int, m: int):
+        """The phase P on a coefficient-major axis of n_b m entries (coefficient c, local j
+        at c m + j) as gathers: ``(P^T z)[r] = wa[r] z[ia[r]] + wb[r] z[ib[r]]`` (the cos
+        entry of harmonic h takes c_h cos - s_h sin, the sin entry s_h cos + c_h sin, the
+        mean itself), so that it runs on contiguous rows and columns."""
+        ia, ib = np.arange(nb), np.arange(nb)
+        wa, wb = np.ones(nb), np.zeros(nb)
+        ic, isn = np.arange(nb)[self._cos], np.arange(nb)[self._sin]
+        ib[ic], wa[ic], wb[ic] = isn, self._c, -self._s
+        ia[isn], wa[isn], wb[isn] = ic, self._s, self._c
+        j = np.arange(m)
+        return ((ia[:, None] * m + j).ravel(), (ib[:, None] * m + j).ravel(),
+                np.repeat(wa, m), np.repeat(wb, m))
+
+    def add_direct(self, J4: np.ndarray, dF: np.ndarray) -> None:
+        """J += T_e dF Q_e for a map with ``pairs``, on J viewed as (n_b, n_dofs, n_b, n_dofs):
+        n_b^2 adds per DOF pair, no block formed and no index arrays."""
+        for pi, pj, c in self.pairs:
+            if c == 1.0:
+                J4[:, pi, :, pj] += dF
+            elif c == -1.0:
+                J4[:, pi, :, pj] -= dF
+            else:
+                J4[:, pi, :, pj] += c * dF
 
     def block(self, dF: np.ndarray) -> np.ndarray:
-        """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m)."""
+        """T_e dF Q_e on ``rows``: (n_b d, n_b d) from dF (n_b m, n_b m).
+
+        With a neighbour, dF (I (x) Q + P (x) Q_next) = dF (I (x) Q) + (dF (P (x) I)) (I (x)
+        Q_next) and T_e Y = (I (x) T) Y + (I (x) T_next) (P^T (x) I) Y: the phase acts on
+        the m-sized local index, by gathers of whole columns and rows (:meth:`_rotation`),
+        and the products over the local index are matrix products, the left ones batched
+        over the row harmonics so that B comes out in its final layout."""
         m, d = self.Q.shape
         nb = dF.shape[0] // m
-        flat = dF.reshape(-1, m)
-        Y = (flat @ self.Q).reshape(nb, m, nb, d)          # dF (I (x) Q)
+        Y = dF.reshape(-1, m) @ self.Q                                      # dF (I (x) Q)
         if self.Qn is not None:
-            Y += self._phase((flat @ self.Qn).reshape(nb, m, nb, d), 2)
-        B = np.tensordot(self.T, Y, axes=([1], [1])).transpose(1, 0, 2, 3)
+            ia, ib, wa, wb = self._rot
+            Y += (dF[:, ia] * wa + dF[:, ib] * wb).reshape(-1, m) @ self.Qn
+        Y = Y.reshape(nb, m, nb * d)
+        B = np.matmul(self.T, Y)
         if self.Tn is not None:
-            B += self._phase(np.tensordot(self.Tn, Y, axes=([1], [1])).transpose(1, 0, 2, 3), 0)
+            Y2 = Y.reshape(nb * m, nb * d)
+            B += np.matmul(self.Tn, (Y2[ia] * wa[:, None] + Y2[ib] * wb[:, None]).reshape(nb, m, nb * d))
         return B.reshape(nb * d, nb * d)
 
 
@@ -297,11 +334,28 @@ class FullResidual(_Residual):
         self._pairs = tuple(np.array([p[j] for p in pairs], dtype=int if j < 2 else float)
                             for j in range(3))
         self._f = self.Fext.ravel()
-        # the dense operators of the module docstring (Hill's method, tests); the
+        # the dense operators of the module docstring (_K, _M, _C: Hill's method, tests),
+        # formed when first read, in a dict that copies (with_elements) share; the
         # residual itself applies them per harmonic (_linear_terms)
-        self._K = np.kron(np.eye(basis.nb), lin.K)
-        self._M = np.kron(np.diag(self._h2), lin.M)
-        self._C = np.kron(basis.dtheta, lin.C)
+        self._dense = {}
+
+    @property
+    def _K(self) -> np.ndarray:
+        return self._dense_operator("K", lambda: np.kron(np.eye(self.basis.nb), self.model.linear.K))
+
+    @property
+    def _M(self) -> np.ndarray:
+        return self._dense_operator("M", lambda: np.kron(np.diag(self._h2), self.model.linear.M))
+
+    @property
+    def _C(self) -> np.ndarray:
+        return self._dense_operator("C", lambda: np.kron(self.basis.dtheta, self.model.linear.C))
+
+    def _dense_operator(self, name: str, build) -> np.ndarray:
+        """The (size, size) operator ``name`` (K, M, C of the module docstring), built once."""
+        if name not in self._dense:
+            self._dense[name] = build()
+        return self._dense[name]
 
     def _linear_terms(self, X: np.ndarray, omega: float):
         """A(omega) x and dA/domega x on the harmonics X (n_b, n), per harmonic:

@@ -82,7 +82,7 @@ def _stable_steps(model: Model, omega: float, steps: int) -> int:
 
 
 def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: int = 3000,
-          tol: float = 1e-6, x0=None, v0=None) -> SteadyState:
+          tol: float = 1e-6, x0=None, v0=None, history=None) -> SteadyState:
     """March the model at frequency omega [rad/s] to its periodic steady state.
 
     Parameters
@@ -92,6 +92,9 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     max_periods : int
     tol : float, relative tolerance on the extrapolated distance to steady state
     x0, v0 : (n,) arrays, initial displacement and velocity (default rest)
+    history : (k, n) array or None, displacements the force elements are stepped
+        through before the start (oldest first), so their sliders carry that past
+        (e.g. a harmonic-balance period ending just before ``x0``); default virgin
     """
     lin = model.linear
     if lin.K is None:
@@ -102,6 +105,8 @@ def march(model: Model, omega: float, steps_per_period: int = 256, max_periods: 
     C = lin.C + model.element_damping()  # contact dashpots are linear: implicit, with C
     lhs = sla.lu_factor(lin.M / dt**2 + C / (2 * dt))
     forces, dissipated = zip(*[_link_stepper(link) for link in model.links]) if model.links else ((), ())
+    for xh in () if history is None else np.asarray(history, float):
+        _friction(model, forces, xh)
     th = 2.0 * np.pi * np.arange(ns) / ns
     fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})

@@ -126,14 +126,15 @@ def _cpu(stderr: str) -> float | None:
         return None
 
 
-def run_ours(name: str, work: Path) -> dict:
-    """One curve of the engine through the CLI (module docstring): the row's numbers."""
+def run_ours(name: str, work: Path, case=None) -> dict:
+    """One curve of the engine through the CLI (module docstring): the row's numbers
+    (``case``: this BenchCase instead of the named one, e.g. at another H)."""
     if name == "upd24":
         argv, dofs, H = ["upd", "frf", "--json"], None, 7
     else:
         from harmonic_balance.bench_models import by_name
 
-        case = by_name(name)
+        case = case or by_name(name)
         argv, dofs, H = _write_model(case, work), case.n, case.harmonics
     r = run_child(argv, TIMEOUT_S, python_code=_CHILD)
     out = {"tool": "damper", "code": r.code, "memory_mb": r.memory_mb, "wall_s": r.time_s,
@@ -149,7 +150,8 @@ def run_ours(name: str, work: Path) -> dict:
     engine = j.get("peak_interior") and j.get("peak_amplitude_h1") is not None
     pa, pw, _ = curve_peak(w, a1)
     return {**out, "points": j["points"], "evaluations": j.get("residual_evaluations"),
-            "time_s": j.get("time_s"), "status": j.get("status", ""),
+            "time_s": j.get("time_s"), "check_s": (j.get("truncation_error") or {}).get("time_s"),
+            "status": j.get("status", ""),
             "complete": r.code == 0, "gaps": "restart" in j.get("status", ""),
             "peak_amplitude": j["peak_amplitude_h1"] if engine else pa,
             "peak_omega": j["peak_omega"] if engine else pw, "peak_refined": bool(engine),
@@ -254,8 +256,9 @@ def _upd_dofs() -> int | None:
 
 
 def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) -> list[Row]:
-    """The model rows (module docstring): ours for every case, then each configured peer."""
-    from . import peers
+    """The model rows (module docstring): ours for every case, then each configured peer,
+    then each peer against ours at the H that brings each within 1 % (:mod:`.peer_accuracy`)."""
+    from . import peer_accuracy, peers
 
     opts = opts or ModelOptions()
     kinds = {}
@@ -290,6 +293,11 @@ def run(quick: bool, work: Path, log=print, opts: ModelOptions | None = None) ->
             p = peers.run(kind, case, path, sub, PEER_SETTINGS, octave, PEER_TIMEOUT_S)
             rows.append(_clean(_peer_row(name, kind, case, p, ours, ref)))
             log(_line(rows[-1].as_dict()))
+    for kind, (path, why) in kinds.items():   # then each tool at its own H for 1 %
+        if not why:
+            rows += [_clean(r) for r in peer_accuracy.run(case_names(quick, opts), kind, path, work,
+                                                          PEER_SETTINGS, run_ours, octave, PEER_TIMEOUT_S,
+                                                          log)]
     return rows
 
 
@@ -316,11 +324,14 @@ def _line(r: dict) -> str:
 
 def table(rows: list[dict]) -> str:
     """Plain-text table of the model rows, with the references they are measured against."""
+    at_1pct = [r for r in rows if r.get("mode")]
+    rows = [r for r in rows if not r.get("mode")]
     lines = [HEAD] + [_line(r) for r in rows]
     lines.append("error: against the dense high-H reference; trace: against the dense trace at the case's "
                  "own H; pts_err: our points read the peers' way (parabola through the largest first "
                  "harmonic), against the same; x_wall, x_cpu: the peer's time over ours (wall, CPU), "
                  "measured in this run")
+    lines += at_1pct_lines(at_1pct)
     for tool in dict.fromkeys(r["tool"] for r in rows if r["tool"] != "damper"):
         ran = [r for r in rows if r["tool"] == tool and r.get("time_s")]
         done = [r for r in ran if r.get("complete")]
@@ -339,6 +350,24 @@ def table(rows: list[dict]) -> str:
                      f"<= {ref['error_estimate']:.1e}; at H = {same.get('H')}: {same.get('amplitude', 0):.9g}; "
                      f"{ref['how']}")
     return "\n".join(lines)
+
+
+def at_1pct_lines(rows: list[dict]) -> list[str]:
+    """Lines of the rows of :mod:`.peer_accuracy` (each tool at its own H for 1 %)."""
+    if not rows:
+        return []
+    out = [f"each tool at the H that brings its peak within 1 % of the reference: {'case':24s} "
+           f"{'tool':7s} {'H ours':>6s} {'H peer':>6s} {'cpu ours':>8s} {'cpu peer':>8s} {'x_cpu':>6s} "
+           f"{'x_wall':>6s} {'x_curve':>7s}"]
+    for r in rows:
+        out.append(f"  {r['model']:24s} {r['tool']:7s} {_num(r.get('H_ours'), 'd'):>6s} "
+                   f"{_num(r.get('H_peer'), 'd'):>6s} {_num(r.get('cpu_ours_s'), '.2f'):>8s} "
+                   f"{_num(r.get('cpu_peer_s'), '.2f'):>8s} {_num(r.get('speedup_cpu_1pct'), '.1f'):>6s} "
+                   f"{_num(r.get('speedup_1pct'), '.1f'):>6s} {_num(r.get('speedup_curve_1pct'), '.1f'):>7s}  "
+                   f"{(r.get('status') or '')[:60]}")
+    out.append("  x_cpu, x_wall: the peer's time over our command's (its truncation check included); "
+               "x_curve: over our curve alone (wall)")
+    return out
 
 
 def markdown(rows: list[dict]) -> list[str]:

@@ -4,7 +4,8 @@ Each plot puts the error against its reference on the x axis and the time on
 the y axis (both logarithmic), one point per row labelled with its size; cold
 runs are circles, cached runs squares, the tool's default setting a star. The hb
 stage's accuracy rows (:mod:`.hb_accuracy`) also get a table of the truncation-error
-estimate beside the true error.
+estimate beside the true error, its rows of HB against time integration
+(:mod:`.hb_steady`) a table of the two peaks and the steady-state flag.
 """
 from __future__ import annotations
 
@@ -87,10 +88,14 @@ def _split(rows: list[dict]) -> tuple[list[dict], list[dict], list[dict]]:
 #: Columns of the accuracy rows' HTML and Markdown tables: (heading, key, format).
 ACCURACY_COLUMNS = (("model", "model", "s"), ("H or target", "setting", "s"), ("peak", "peak_amplitude", ".6g"),
                     ("estimate", "estimate", ".2e"), ("true error", "true_error", ".2e"),
-                    ("ratio", "ratio", ".2f"), ("check [s]", "check_time_s", ".2f"), ("total [s]", "time_s", ".2f"))
+                    ("ratio", "ratio", ".2f"), ("check [s]", "check_time_s", ".2f"), ("total [s]", "time_s", ".2f"),
+                    ("flags", "flags", "s"))
 ACCURACY_CAPTION = ("accuracy: the truncation-error estimate of the peak amplitude against the true error "
                     "(against the peak re-solved with many more harmonics); ratio = estimate / true error; "
-                    "total: the curve and its check (of a target: every curve and check it took)")
+                    "total: the curve and its check (of a target: every curve and check it took); "
+                    "flags: R ratio outside [1/3, 3], T true error above the target (t: the engine said "
+                    "not met, the harmonic limit), D! a default more than 1 % off without a warning, "
+                    "D~ with one")
 
 
 def _cells(r: dict) -> list[str]:
@@ -110,6 +115,11 @@ def table_text(stage: str, rows: list[dict]) -> str:
         from .hb_accuracy import table_lines
 
         lines += [ACCURACY_CAPTION + ":", *table_lines(acc)]
+    steady = [r for r in own if "states_differ" in r]
+    if steady:
+        from .hb_steady import table_lines as steady_lines
+
+        lines += ["harmonic balance against time integration (which steady state):", *steady_lines(steady)]
     if models:
         from .hb_classes import table
 
@@ -174,6 +184,12 @@ def markdown(result: dict) -> str:
             out += [f"**{stage}: {ACCURACY_CAPTION}**", "",
                     "| " + " | ".join(h for h, _, _ in ACCURACY_COLUMNS) + " |", "|" + "---|" * len(ACCURACY_COLUMNS),
                     *("| " + " | ".join(_cells(r)) + " |" for r in acc), ""]
+        steady = [r for r in own if "states_differ" in r]
+        if steady:
+            from .hb_steady import markdown as steady_markdown
+
+            out += [f"**{stage}: harmonic balance against time integration (which steady state)**", "",
+                    *steady_markdown(steady), ""]
         if models:
             from .hb_classes import markdown as model_markdown
 

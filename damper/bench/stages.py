@@ -17,7 +17,10 @@ error of each row is against an independent reference:
   time per curve and per point, the refined peak; no error); the truncation-error
   estimate against the true error per model and H or accuracy target
   (:mod:`.hb_accuracy`: ``error`` the true error against a high-H re-solve of the peak,
-  ``estimate`` the engine's own, ``time_s`` wall); then whole curves of
+  ``estimate`` the engine's own, ``time_s`` wall); the converged harmonic balance against
+  the time integration from rest per model (:mod:`.hb_steady`: ``error`` |HB / TI - 1| of
+  the first-harmonic peak, ``states_differ`` when the two are different steady states);
+  then whole curves of
   the model classes (:mod:`.hb_classes`: single-DOF soft and stiff,
   3- and 5-mass friction chains, UPD-24, with pyHarm and NLvib when given), their
   first-harmonic peak against a dense reference (:mod:`.hb_reference`).
@@ -189,15 +192,18 @@ def _ti_reference(log) -> float:
 
 def hb(quick: bool, work: Path, log=print, models=None) -> list[Row]:
     """Harmonic balance: harmonics and AFT samples against the error vs time integration (default H 1, auto),
-    the cost of a curve against H (:mod:`.hb_cost`), the accuracy rows (:mod:`.hb_accuracy`), then the
+    the cost of a curve against H (:mod:`.hb_cost`), the accuracy rows (:mod:`.hb_accuracy`), HB against
+    time integration per model (:mod:`.hb_steady`), then the
     model classes with their peers (:mod:`.hb_classes`; ``models``: its ModelOptions)."""
-    from . import hb_accuracy, hb_classes, hb_cost
+    from . import hb_accuracy, hb_classes, hb_cost, hb_steady
 
     rows = _hb_settings(quick, log)
     log("  hb cost against H (CPU time of a whole curve):")
     rows += hb_cost.run(quick, lambda s: log("  " + s))
     log("  hb accuracy (truncation-error estimate against the true error):")
     rows += hb_accuracy.bench_rows(quick, lambda s: log("  " + s))
+    log("  hb against time integration (which steady state):")
+    rows += hb_steady.bench_rows(quick, lambda s: log("  " + s))
     log("  hb model classes (peak error against dense references):")
     log("  " + hb_classes.HEAD)
     return rows + hb_classes.run(quick, work, lambda s: log("  " + s), models)

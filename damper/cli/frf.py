@@ -28,7 +28,11 @@ response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitud
 estimated relative error in H of the peak, check: the peak at H_check, extrapolated:
 the peak extrapolated in H when the order was observed, else null),
 ``truncation_warning``, ``accuracy`` (with --accuracy: target, met, H_sequence,
-levels, message), ``peaks`` (every
+levels, message), ``stuck_links`` (links that never slip at the peak: their mean position
+is the harmonic balance's convention, stuck since u = 0), ``steady_state`` and
+``steady_state_warning`` (with --check-steady-state: the peak |x| of time integrations
+from rest and from the harmonic balance's state at the peak frequency, ``states_differ``
+when they settle apart; docs/method/accuracy.md), ``peaks`` (every
 refined resonance peak: omega, amplitude), ``alias_ratio`` (AFT grid check), ``aft``
 ("exact": the links' Fourier coefficients without sampling, the default, n_t then only
 scans for extrema; "sampled" with ``--aft sampled``; "mixed" with contacts), ``points``,
@@ -78,6 +82,10 @@ def register(subparsers) -> None:
     p.add_argument("--stability", choices=("auto", "all", "off"), default="auto",
                    help="Hill stability per point: auto (checked where it can change, models up "
                    "to 200 full unknowns), all (Hill at every point, any size), off")
+    p.add_argument("--check-steady-state", action="store_true",
+                   help="time-integrate at the peak from rest and from the harmonic balance's state: "
+                        "says whether the curve is the state a start from rest reaches (seconds on a "
+                        "few DOFs; matrix models)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.add_argument("--out", help="also write the JSON to this file")
     p.add_argument("--plot", metavar="DIR", help="write frf.png, loops.png, harmonics.png here")
@@ -174,7 +182,8 @@ def run(args) -> int:
         result = compute_frf(model, args.harmonics, args.omega, n_t=args.samples,
                              max_points=args.max_points, aft=args.aft, **steps,
                              stability=args.stability, accuracy=args.accuracy,
-                             max_harmonic=limits.MAX_HARMONICS)
+                             max_harmonic=limits.MAX_HARMONICS,
+                             steady_state_check=args.check_steady_state)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
@@ -257,12 +266,13 @@ def _report_curve_fits(model) -> None:
 
 def _emit(args, summary, print_json, atomic_write, dumps):
     from harmonic_balance.frf_accuracy import summary_lines as accuracy_lines
+    from harmonic_balance.steady_state import summary_lines as state_lines
 
     if args.out:
         atomic_write(args.out, dumps(summary, indent=1) + "\n")
     if args.json:
         print_json(summary)
-        for line in accuracy_lines(summary)[1:]:
+        for line in accuracy_lines(summary)[1:] + state_lines(summary.get("steady_state"))[1:]:
             if line.startswith("warning"):
                 import sys
 
@@ -277,8 +287,11 @@ def _emit(args, summary, print_json, atomic_write, dumps):
     if summary.get("peak_h1_max") is not None:
         print(f"first harmonic's own peak: omega = {_num(summary['peak_h1_max_omega'])} rad/s, "
               f"amplitude = {_num(summary['peak_h1_max'])} m")
-    for line in accuracy_lines(summary):
+    for line in accuracy_lines(summary) + state_lines(summary.get("steady_state")):
         print(line)
+    if summary.get("stuck_links"):
+        print(f"links that never slip at the peak (mean position by convention): "
+              f"{', '.join(summary['stuck_links'])}")
     if summary.get("stable") is not None:
         n_unst = sum(1 for s in summary["stable"] if s is False)
         print(f"stability (Hill): {n_unst} of {summary['points']} points unstable")

@@ -8,6 +8,7 @@ Examples::
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
+    damper upd mistuning --accuracy 0.01 --samples 20 --json   # H chosen on the tuned sector
 """
 from __future__ import annotations
 
@@ -37,7 +38,7 @@ def register(sub) -> None:
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
-    _contacts(f)
+    _contacts(f, surface=True)
     f.set_defaults(func=run_frf)
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     _common(o)
@@ -80,7 +81,12 @@ def _mistuning(s) -> None:
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
     p.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
     p.add_argument("--f0", type=float, help="EO force amplitude [N] (default: config)")
-    p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H")
+    p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (with --accuracy "
+                   "the first one tried)")
+    p.add_argument("--accuracy", type=float, metavar="TOL",
+                   help="relative accuracy of the tuned peak amplitude, in (1e-6, 0.5): H is raised on "
+                   "the tuned sector until its estimated truncation error is below TOL, and every "
+                   "sample runs at that H (default: the fixed --harmonics, the tuned estimate reported)")
     p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                    help="band [Hz] (default: around the tuned peak, widened with the scatter)")
     p.add_argument("--points", type=int, default=41,
@@ -113,7 +119,7 @@ def run_mistuning(args) -> int:
     from damper.mistuning import AllSamplesFailed, Study, plot_study, run_study
 
     from .cache import store_from_args
-    from .common import check_out_dir, print_json
+    from .common import check_accuracy_option, check_out_dir, print_json
 
     given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
                             ("--serial", args.serial)) if v]
@@ -124,6 +130,10 @@ def run_mistuning(args) -> int:
     if args.workers is not None:
         limits.check_workers("--workers", args.workers)
     check_out_dir(args.plot, "--plot")
+    check_accuracy_option(args.accuracy)
+    if args.accuracy is not None and args.damper != "nonlinear":
+        raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
+                         "has no harmonic truncation (drop --accuracy)")
     draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
     if args.until_ci is not None and args.factors is None:
         draw.setdefault("samples", UNTIL_CI_SAMPLES)
@@ -132,7 +142,7 @@ def run_mistuning(args) -> int:
     study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
                   **draw, kind=args.kind,
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
-                  cf=args.cf, f0=args.f0, harmonics=args.harmonics,
+                  cf=args.cf, f0=args.f0, harmonics=args.harmonics, accuracy=args.accuracy,
                   band_hz=args.band, points=args.points, until_ci=args.until_ci, solver=args.solver)
     if args.worst or args.bound is not None or args.out is not None or args.max_evaluations is not None:
         if args.until_ci is not None:
@@ -160,7 +170,9 @@ def run_mistuning(args) -> int:
             print(out["truncation_warning"], file=sys.stderr)
         return 0
     _print_samples(out)
-    print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz; amplification "
+    print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz"
+          + ("" if out["damper"] != "nonlinear" else f" (H = {out['harmonics']}, every sample)")
+          + "; amplification "
           f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
           f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
     for line in statistics_lines(out):
@@ -286,10 +298,17 @@ def _common(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
-def _contacts(p) -> None:
-    p.add_argument("--contacts", choices=("toml", "geometry"), default="toml",
+def _contacts(p, surface: bool = False) -> None:
+    p.add_argument("--contacts", choices=("toml", "geometry") + (("surface",) if surface else ()),
+                   default="toml",
                    help="contact laws: the TOML's Jenkins points, or computed by contact_core "
-                   "from the [geometry] section (damper.upd_geometry; cached)")
+                   "from the [geometry] section (damper.upd_geometry; cached)"
+                   + ("; surface: the damper's faces as contact surfaces of many 3D points on the "
+                      "condensed FE bodies (damper.upd_surface; slower)" if surface else ""))
+    if surface:
+        p.add_argument("--surface-nodes", type=int, default=5, metavar="N",
+                       help="with --contacts surface: contact-zone nodes per side of each face "
+                       "(5 .. 41; default 5)")
 
 
 def _sector(args):
@@ -335,6 +354,9 @@ def _check_frf(args) -> None:
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
     check_out_dir(args.plot, "--plot")
+    from damper.upd_surface import check_options
+
+    check_options(args)
 
 
 def run_frf(args) -> int:
@@ -352,6 +374,7 @@ def run_frf(args) -> int:
     else:
         out = _frf_linear(sector, args, omegas)
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
+    out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -361,6 +384,8 @@ def run_frf(args) -> int:
               f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
         if "warning" in out:
             print(f"warning: {out['warning']}")
+        if out.get("zone_edge_warning"):
+            print(out["zone_edge_warning"])
     for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
@@ -400,12 +425,19 @@ def _frf_linear(sector, args, omegas) -> dict:
 
 def _frf_nonlinear(sector, args, omegas) -> dict:
     from damper import limits
+    from damper.upd_surface import static_loads
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import frf_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
 
-    if args.accuracy is None:
+    if args.contacts == "surface":
+        from damper.upd_surface import sector_hb
+
+        hb = sector_hb(sector, args)
+        c = frf(hb, omegas)
+        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
         rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
@@ -417,14 +449,19 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
                                      limits.MAX_UPD_HARMONICS, cf=args.cf, f0=args.f0)
         c.time_s = time.perf_counter() - t0
     summ = hb.contact_summary(c.peak_x)
+    if args.contacts == "surface":
+        from damper.upd_surface import face_summary
+
+        summ = face_summary(hb, summ)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
             "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
+            "zone_edge_warning": summ.get("warning_zone_edge"),
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
-            "static_normal_load": hb.static["N"].tolist(),
+            "static_normal_load": static_loads(hb),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
             "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
@@ -455,31 +492,13 @@ def _check_optimize(args) -> None:
     check_out_dir(args.plot, "--plot")
 
 
-def _optimum_truncation(sector, out, args) -> dict:
-    """Truncation-error estimate of the peak at the optimum CF (its curve on the search's
-    grid, checked at ~1.5 H: :mod:`harmonic_balance.bladed_disk.accuracy`)."""
-    from damper import limits
-    from harmonic_balance.bladed_disk.accuracy import truncation_error
-    from harmonic_balance.bladed_disk.hb import SectorHB
-    from harmonic_balance.bladed_disk.solve import SolverError, frf
-
-    lo, hi = sector.cfg["load.band_hz"]
-    hb = SectorHB(sector, args.harmonics, cf=out["optimum_cf"])
-    try:
-        c = frf(hb, 2 * np.pi * np.linspace(lo, hi, args.grid))
-    except SolverError as err:
-        return {"method": "richer harmonic set at the peak", "H_used": args.harmonics,
-                "peak_amplitude_rel": None, "peak_frequency_rel": None, "note": f"check failed: {err}"}
-    rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
-    rec["at"] = "the optimum CF"
-    return rec
-
-
 def run_optimize(args) -> int:
     import sys
     import time
 
+    from damper import limits
     from harmonic_balance.accuracy import warning
+    from harmonic_balance.bladed_disk.accuracy import optimal_load_to_accuracy, optimum_truncation
     from harmonic_balance.bladed_disk.optimize import optimal_load
 
     from .common import print_json
@@ -489,11 +508,8 @@ def run_optimize(args) -> int:
     if args.accuracy is None:
         out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
                            workers=args.workers)
-        out["truncation_error"] = _optimum_truncation(sector, out, args)
+        out["truncation_error"] = optimum_truncation(sector, out, args.grid, limits.MAX_UPD_HARMONICS)
     else:
-        from damper import limits
-        from harmonic_balance.bladed_disk.accuracy import optimal_load_to_accuracy
-
         t0 = time.perf_counter()
         out = optimal_load_to_accuracy(sector, args.cf_range, args.accuracy, args.points,
                                        args.harmonics, args.grid, args.workers, limits.MAX_UPD_HARMONICS)

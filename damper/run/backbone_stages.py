@@ -40,7 +40,7 @@ class Backbone(Kind):
         from damper import limits
         from fmu_src.element import IwanElement
         from harmonic_balance.epmc import EPMCError, compute_backbone
-        from harmonic_balance.epmc_accuracy import truncation_error, warning
+        from harmonic_balance.epmc_accuracy import backbone_to_accuracy, truncation_error, warning
 
         p, bb = stage.params, stage.params["backbone"]
         if bb["element"] == "contact":
@@ -53,14 +53,19 @@ class Backbone(Kind):
         else:
             model = matrices_model(stage.extra["matrices"], p["structure"]["element_dofs"], 1.0, element)
         try:
-            result = compute_backbone(model, str(bb["harmonics"]), bb["amplitude"], n_t=bb["samples"],
-                                      mode=bb["mode"], max_points=MAX_POINTS)
+            if bb.get("accuracy") is None:
+                result = compute_backbone(model, str(bb["harmonics"]), bb["amplitude"], n_t=bb["samples"],
+                                          mode=bb["mode"], max_points=MAX_POINTS)
+                rec = truncation_error(model, str(bb["harmonics"]), result, bb["samples"], bb["mode"],
+                                       limits.MAX_HARMONICS)
+            else:
+                result, rec = backbone_to_accuracy(model, str(bb["harmonics"]), bb["amplitude"],
+                                                   bb["accuracy"], bb["samples"], bb["mode"],
+                                                   limits.MAX_HARMONICS)
         except EPMCError as err:
             raise RuntimeError(f"{err} ({err.result.a.size} points kept)") from None
-        summary = result.summary()
-        summary["truncation_error"] = truncation_error(model, str(bb["harmonics"]), result, bb["samples"],
-                                                       bb["mode"], limits.MAX_HARMONICS)
-        summary["truncation_warning"] = warning(summary["truncation_error"])
+        summary = result.summary() | {"harmonics": rec["H_used"]}
+        summary["truncation_error"], summary["truncation_warning"] = rec, warning(rec)
         with tempfile.TemporaryDirectory() as tmp:
             plot_backbone(summary, Path(tmp) / "backbone.png")
             files = collect_files(Path(tmp))
@@ -83,8 +88,11 @@ class Backbone(Kind):
     def scalars(self, stage, result):
         s = result.data
         d = np.asarray(s["damping_ratio"], dtype=float)
+        rec = s.get("truncation_error") or {}
         return {"stuck_frequency_Hz": s["omega"][0] / (2 * np.pi), "end_frequency_Hz": s["omega"][-1] / (2 * np.pi),
-                "max_damping_ratio": float(np.nanmax(d)), "points": s["points"]}
+                "max_damping_ratio": float(np.nanmax(d)), "points": s["points"],
+                "harmonics_H": rec.get("H_used"), "truncation_error_omega_rel": rec.get("omega_rel"),
+                "truncation_error_damping_rel": rec.get("damping_ratio_rel")}
 
 
 def plot_backbone(s: dict, path: Path) -> None:
@@ -123,13 +131,26 @@ class OptimalLoad(Kind):
                       extra={"config": u.get("config")})]
 
     def compute(self, stage, inputs, ctx):
+        import time
+
+        from damper import limits
+        from harmonic_balance.accuracy import warning
+        from harmonic_balance.bladed_disk.accuracy import optimal_load_to_accuracy, optimum_truncation
         from harmonic_balance.bladed_disk.config import load_config
         from harmonic_balance.bladed_disk.optimize import optimal_load
         from harmonic_balance.bladed_disk.sector import Sector
 
         p = stage.params
-        out = optimal_load(Sector(load_config(stage.extra["config"])), p["cf_range"], p["points"],
-                           p["harmonics"], grid=p["grid"])
+        sector = Sector(load_config(stage.extra["config"]))
+        if p.get("accuracy") is None:
+            out = optimal_load(sector, p["cf_range"], p["points"], p["harmonics"], grid=p["grid"])
+            out["truncation_error"] = optimum_truncation(sector, out, p["grid"], limits.MAX_UPD_HARMONICS)
+        else:
+            t0 = time.perf_counter()
+            out = optimal_load_to_accuracy(sector, p["cf_range"], p["accuracy"], p["points"], p["harmonics"],
+                                           p["grid"], limit=limits.MAX_UPD_HARMONICS)
+            out["time_s"] = time.perf_counter() - t0   # both sweeps and the curves that chose H
+        out["truncation_warning"] = warning(out["truncation_error"])
         with tempfile.TemporaryDirectory() as tmp:
             plot_optimal_load(out, Path(tmp) / "optimal_load.png")
             files = collect_files(Path(tmp))
@@ -141,11 +162,26 @@ class OptimalLoad(Kind):
     def lines(self, stage, result):
         o = result.data
         return [f"optimum CF {o['optimum_cf']:.4g} N, peak {o['optimum_peak_amplitude']:.5e} m "
-                f"({o['method']}, {o['time_s']:.1f} s)"]
+                f"({o['method']}, H = {o['harmonics']}, {o['time_s']:.1f} s)"] + [
+                    f"   {line}" for line in truncation_lines(o)]
 
     def scalars(self, stage, result):
         o = result.data
-        return {"optimum_cf_N": o["optimum_cf"], "optimum_peak_amplitude_m": o["optimum_peak_amplitude"]}
+        return {"optimum_cf_N": o["optimum_cf"], "optimum_peak_amplitude_m": o["optimum_peak_amplitude"],
+                "harmonics_H": o["harmonics"],
+                "truncation_error_rel": (o.get("truncation_error") or {}).get("peak_amplitude_rel")}
+
+
+def truncation_lines(out: dict) -> list[str]:
+    """The truncation-error lines of a UPD result with a sector record (the optimum's, or
+    the tuned peak of a mistuning study): estimate, accuracy run, warning; frequencies in Hz."""
+    from harmonic_balance.frf_accuracy import summary_lines
+
+    rec = out.get("truncation_error")
+    if not rec:
+        return []
+    return summary_lines({"truncation_error": rec, "accuracy": rec.get("accuracy"),
+                          "truncation_warning": out.get("truncation_warning")}, hz=True)
 
 
 def plot_optimal_load(o: dict, path: Path) -> None:

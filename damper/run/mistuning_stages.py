@@ -10,6 +10,7 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+from .backbone_stages import truncation_lines
 from .contact_stages import collect_files
 from .graph import Kind, Result, Stage
 
@@ -45,12 +46,15 @@ class Mistuning(Kind):
         o = result.data
         return [f"{len(o['samples'])} samples of {o['blades']} blades ({o['failed']} failed): amplification "
                 f"max {o['max_amplification']:.4f}, median {o['quantiles']['0.5']:.4f} over the tuned peak "
-                f"{o['tuned_peak']:.4e} m at {o['tuned_frequency_hz']:.2f} Hz"] + _ci_lines(o)
+                f"{o['tuned_peak']:.4e} m at {o['tuned_frequency_hz']:.2f} Hz, H = {o['harmonics']}"] + _ci_lines(o) + [
+                    f"   {line}" for line in truncation_lines(o)]
 
     def scalars(self, stage, result):
         o = result.data
         return {"max_amplification": o["max_amplification"], "mean_amplification": o["mean_amplification"],
                 "q95_amplification": o["quantiles"]["0.95"], "tuned_peak_m": o["tuned_peak"],
+                "harmonics_H": o["harmonics"],
+                "tuned_truncation_error_rel": (o.get("truncation_error") or {}).get("peak_amplitude_rel"),
                 "failed_samples": o["failed"]} | {f"q95_amplification_{k}": v for k, v in _q95(o).items()
                                                   if k in ("low", "high") and v is not None}
 

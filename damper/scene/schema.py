@@ -166,6 +166,9 @@ BACKBONE = {
     "mode": Field("int", "mode of the stuck linear system (0-based)", default=0, ge=0),
     "samples": Field("int", "AFT samples per period (0: automatic)", default=0, ge=0,
                      le=limits.MAX_AFT_SAMPLES, why="the AFT's DFT matrices hold n_t (2H + 1) numbers each"),
+    "accuracy": Field("float", "relative accuracy of the frequency and the damping ratio: the harmonics "
+                      "are raised from `harmonics` until both estimated truncation errors are below "
+                      "it (unset: the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
 }
 #: Keys each backbone element needs.
 BACKBONE_NEEDS = {"contact": (), "jenkins": ("contact_stiffness", "slip_force")}
@@ -181,6 +184,10 @@ UPD = {
                        why=limits.harmonics_why(limits.MAX_UPD_HARMONICS)),
     "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3,
                   le=limits.MAX_UPD_GRID, why="each point is a harmonic-balance solve of the sector"),
+    "accuracy": Field("float", "relative accuracy of the optimum's peak amplitude: its curve is raised "
+                      "in H until the estimated truncation error is below it, and the load sweep run "
+                      "again at that H (unset: the fixed `harmonics`, the optimum's estimate "
+                      "reported)", gt=1e-6, lt=0.5),
 }
 
 MISTUNING = {
@@ -206,6 +213,10 @@ MISTUNING = {
                       "95 % interval's half-width); samples is then the most to run", gt=0),
     "solver": Field("str", "fast (adaptive continuation, Hermite peaks) or full (every grid "
                     "point solved: the reference)", default="fast", choices=("fast", "full")),
+    "accuracy": Field("float", "relative accuracy of the tuned peak amplitude (damper nonlinear): "
+                      "H is raised on the tuned sector from `harmonics` until its estimated "
+                      "truncation error is below it, and every sample runs at that H (unset: the "
+                      "fixed `harmonics`, the tuned estimate reported)", gt=1e-6, lt=0.5),
 }
 
 TOP = {

@@ -181,6 +181,12 @@ def scenes() -> dict[str, str | bytes]:
                              "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-4, 1e-7]\n"),
             "s_updpoints.toml": 'want = ["optimal_load"]\n[upd]\npoints = 1000000\n',
             "s_updharm.toml": 'want = ["optimal_load"]\n[upd]\nharmonics = 100000\n',
+            "s_updacc.toml": 'want = ["optimal_load"]\n[upd]\naccuracy = 1e-7\n',
+            "s_mtacc.toml": 'want = ["mistuning"]\n[mistuning]\naccuracy = 0.6\n',
+            "s_mtacclin.toml": 'want = ["mistuning"]\n[mistuning]\ndamper = "stuck"\naccuracy = 0.01\n',
+            "s_bbacc.toml": ('want = ["backbone"]\n[structure]\n' + _TWO_DOF + '[backbone]\nelement = "jenkins"\n'
+                             "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-7, 1e-4]\n"
+                             "accuracy = 0.5\n"),
             "s_updcfg.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "missing.toml"\n',
             "s_updbad.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "upd_unknown.toml"\n',
             "s_nocontact.toml": 'want = ["virgin_curve"]\n',

@@ -29,6 +29,7 @@ ARGS: dict[str, list[str]] = {
     "cylinder_approach.py": ["--out", "{out}", "--grid", "11"],       # thesis grid 21: minutes
     "virgin_curves.py": ["--smoke", "--out", "{out}"],               # 31-node BEM + FE: minutes
     "masing_loops.py": ["--out", "{out}"],
+    "contact_surface.py": ["--quick", "--out", "{out}"],             # full: grids 21 and 13
     "frf_sdof.py": ["--out", "{out}"],
     "fmu_closed_loop.py": ["--quick"],                               # 30 cycles x 14 bisections
     "craig_bampton_blade.py": ["--out", "{out}"],

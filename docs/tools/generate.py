@@ -14,8 +14,9 @@ Called by ``docs/conf.py`` before every build; writes into ``docs/_generated/``
 * ``formats.md`` and ``extra/schemas/<name>.schema.json``: every input file format's
   keys (type, bounds, meaning) and its JSON Schema, from the typed models
   (``damper.formats``); the schema files are copied into the site's ``schemas/``;
-* ``accuracy.md``, ``accuracy_upd.md``: the truncation-error tables of the chains and
-  of UPD-24, from ``docs/data/accuracy.json`` and ``accuracy_upd.json``
+* ``accuracy.md``, ``accuracy_upd.md``, ``accuracy_contact.md``: the truncation-error
+  tables of the chains, of UPD-24 and of the 3D contact point, from
+  ``docs/data/accuracy.json``, ``accuracy_upd.json`` and ``accuracy_contact.json``
   (``make docs-accuracy``), and ``accuracy_plots.md`` with its figures of error against
   time, one per model class (``accuracy_<class>.png``, drawn by ``docs/tools/plots.py``);
 * ``performance.md`` and ``stress.md``: from ``docs/data/bench.json`` and
@@ -272,4 +273,5 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "stress", tables.stress)
     data_page(docs, "accuracy", tables.accuracy)
     data_page(docs, "accuracy_upd", tables.accuracy)
+    data_page(docs, "accuracy_contact", tables.accuracy)
     plots.accuracy_plots(docs)

@@ -15,9 +15,10 @@ from pathlib import Path
 #: Model classes of the figures: file stem, title, prefix of the rows' model names.
 CLASSES = (("sdof", "single-DOF Jenkins oscillator", "sdof"),
            ("chains", "friction chains (3 and 5 masses)", "chain"),
-           ("upd24", "UPD-24 sector, F0 = 30 N", "UPD-24"))
+           ("upd24", "UPD-24 sector, F0 = 30 N", "UPD-24"),
+           ("contact", "mass on a 3D contact point with lift-off", "contact3d"))
 #: The recorded data files the figures are drawn from.
-SOURCES = ("accuracy", "accuracy_upd")
+SOURCES = ("accuracy", "accuracy_upd", "accuracy_contact")
 #: Where a zero error would sit on the logarithmic axis (never reached by recorded rows).
 FLOOR = 1e-12
 

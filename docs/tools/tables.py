@@ -136,13 +136,24 @@ def accuracy(data: dict) -> str:
            f"True error: against the curve's peak re-solved with 0..{res.get('reference_H', '?')} "
            f"harmonics (UPD-24: 0..{res.get('reference_H_upd', '?')}). Ratio: estimate / true error "
            "(the goal: between 1/3 and 3). Check: the time of the estimate; total: the curve and "
-           "its check (for an accuracy target, every curve and check of the run).", "",
-           "| model | H or target | peak | estimate | true error | ratio | check [s] | total [s] |",
-           "|---|---|---|---|---|---|---|---|"]
+           "its check (for an accuracy target, every curve and check of the run). Flags: R the "
+           "ratio outside [1/3, 3]; T a target's true error above it (t: the engine said not met, "
+           "at its harmonic limit); D~ the default setting more than 1 % off, with its warning; "
+           "D! without one.", "",
+           "| model | H or target | peak | estimate | true error | ratio | check [s] | total [s] | flags |",
+           "|---|---|---|---|---|---|---|---|---|"]
     for r in res.get("rows", []):
         out.append(f"| {_cell(r['model'])} | {_cell(r['setting'])} | {_g(r['peak_amplitude'], 6)} | "
                    f"{_pct(r['estimate'])} | {_pct(r['true_error'])} | {_g(r['ratio'])} | "
-                   f"{_g(r['check_time_s'])} | {_g(r['time_s'])} |")
+                   f"{_g(r['check_time_s'])} | {_g(r['time_s'])} | {r.get('flags') or ''} |")
+    goals = res.get("goals")
+    if goals:
+        out += ["", "Goals over these rows: " + "; ".join(
+            f"{what} {len(goals[key]['failing'])} of {goals[key]['rows']} rows"
+            + (f" ({', '.join(goals[key]['failing'])})" if goals[key]["failing"] else "")
+            for key, what in (("ratio_ok", "estimate outside a factor 3 of the true error:"),
+                              ("target_met", "target missed in truth:"),
+                              ("default", "default more than 1 % off without a warning:"))) + "."]
     return "\n".join(out) + "\n"
 
 

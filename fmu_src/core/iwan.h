@@ -188,6 +188,23 @@ iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const doub
                                    double *dFdXN, double *W_cycle, int max_periods, double tol,
                                    int *periods_used);
 
+/* iwan_periodic_jac's Jacobian as sparse terms in the samples, for any basis (same
+ * numbers as the dense rows to round-off): row t of dF/dX is
+ *   dX[t] Eu[t, :] + sum_i cX[i] Eu[col[i], :]     over the terms i with row[i] == t,
+ * and of dF/dXN (with_N != 0 and N given; else dXN and cXN are zero)
+ *   dXN[t] EN[t, :] + sum_i cXN[i] EN[col[i], :].
+ * The diagonal dX, dXN (n) is a stuck slider's stiffness and a slipping one's strength
+ * slope; the *n_terms off-diagonal terms (col != row, sweep order) are the samples
+ * where stuck sliders stuck and the ends of a re-contact step, few distinct columns.
+ * So a projection D dF/dX onto a Fourier basis costs O(n log n) for the diagonal
+ * (D diag(dX) E from the FFT of dX) plus O(n nb) per distinct column, not O(n nb^2).
+ * row, col, cX, cXN need room for cap >= n (2 n_sliders + 2) terms. */
+iwan_status iwan_periodic_jac_terms(const iwan_model *model, size_t n, const double *u,
+                                    const double *N, int with_N, double *F, double *dX,
+                                    double *dXN, size_t cap, size_t *n_terms, size_t *row,
+                                    size_t *col, double *cX, double *cXN, double *W_cycle,
+                                    int max_periods, double tol, int *periods_used);
+
 /* Exact periodic loop of an input that is monotone between its n >= 2 extrema u_ext
  * (alternating maxima and minima; after u_ext[n-1] comes u_ext[0]) at N = n_ref, the
  * convention of iwan_periodic. Between two extrema the force is piecewise linear in

@@ -147,41 +147,31 @@ iwan_status iwan_periodic(const iwan_model *model, size_t n, const double *u, co
 
 /* ------------------------------------------------- periodic loop Jacobian */
 
-/* d u_c / dX and d u_c / dXN of the re-contact point in the step p -> tc,
- * u_c = u_p + s_c (u_tc - u_p), s_c = -N_p / (N_tc - N_p) (see iwanp_advance()). */
-static void recontact_grad(size_t n, size_t nb, const double *u, const double *N,
-                           const double *Eu, const double *EN, size_t tc, double w,
-                           double *rX, double *rXN)
-{
-    const size_t p = (tc + n - 1) % n;
-    const double N0 = N[p], N1 = N[tc], D = N1 - N0, sc = -N0 / D, du = u[tc] - u[p];
-    const double ds0 = -N1 / (D * D), ds1 = N0 / (D * D);
-    for (size_t c = 0; c < nb; ++c) {
-        rX[c] -= w * ((1.0 - sc) * Eu[p * nb + c] + sc * Eu[tc * nb + c]);
-        if (rXN) rXN[c] -= w * du * (ds0 * EN[p * nb + c] + ds1 * EN[tc * nb + c]);
-    }
-}
+/* Most terms of one Jacobian row (jac_terms): per distinct (anchor, strength anchor)
+ * group two (one when both anchors are the same sample), the row's own sample, the two ends of a re-contact step. */
+#define JAC_TERMS_MAX (2 * IWAN_MAX_SLIDERS + 3)
 
-/* Row t of dF/dX (and dF/dXN): a slider that slipped into t carries
- * sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) + sg g(N(aN));
- * one stuck since the virgin state k u(t); one stuck since re-contact
- * k (u(t) - u_c). Sliders sharing an anchor are summed before the axpy.
- * Returns 0, without touching rX, rXN, when the row is structurally zero (lifted
- * off, or every slider slipping with no residual spring and no dF/dXN asked):
- * on a stiff contact in gross slip that is most samples, so the compact layout
- * (iwan_periodic_jac_rows) skips them and the work is O(stuck samples x nb). */
-static int jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
-                   size_t nb, const double *u, const double *N, const double *Eu,
-                   const double *EN, double *rX, double *rXN)
+/* Row t of dF/dX and dF/dXN as terms: dF(t)/dX = sum_i cX[i] Eu[col[i]] and
+ * dF(t)/dXN = sum_i cXN[i] EN[col[i]] (at most JAC_TERMS_MAX). A slider that slipped
+ * into t carries sg g(N(t)); one stuck since anchor a carries k (u(t) - u(a)) +
+ * sg g(N(aN)); one stuck since the virgin state k u(t); one stuck since re-contact
+ * k (u(t) - u_c), u_c = u_p + s_c (u_tc - u_p), s_c = -N_p / (N_tc - N_p) on the step
+ * p -> tc (see iwanp_advance()). Sliders sharing an anchor are summed into one term.
+ * Returns 0 when the row is structurally zero (lifted off, or every slider slipping
+ * with no residual spring and no dF/dXN asked): on a stiff contact in gross slip
+ * that is most samples. */
+static size_t jac_terms(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
+                        const double *u, const double *N, int want_N, size_t *col, double *cX,
+                        double *cXN)
 {
     if (!s->in_contact) return 0;
     const size_t t = (size_t)an->t;
     const double dgdN = m->scale / m->n_ref;
     int any = m->k_res != 0.0 || ANCHOR_IS_RECONTACT(an->res);
     for (int32_t j = 0; j < m->n && !any; ++j)
-        any = !an->slip[j] || (rXN && m->fs[j] != 0.0);
+        any = !an->slip[j] || (want_N && m->fs[j] != 0.0);
     if (!any) return 0;
-    for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
+    size_t k = 0;
     double kst = m->k_res, krc = ANCHOR_IS_RECONTACT(an->res) ? m->k_res : 0.0, cnow = 0.0;
     double gk = 0.0, gc = 0.0;
     int32_t ga = ANCHOR_ORIGIN, gn = 0;
@@ -192,10 +182,8 @@ static int jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, 
         if (!last) kst += m->k[j];
         if (!last && ANCHOR_IS_RECONTACT(a)) { krc += m->k[j]; continue; }
         if (ga >= 0 && (last || a != ga || an->aN[j] != gn)) {   /* flush the group */
-            for (size_t c = 0; c < nb; ++c) {
-                rX[c] -= gk * Eu[(size_t)ga * nb + c];
-                if (rXN) rXN[c] += gc * EN[(size_t)gn * nb + c];
-            }
+            col[k] = (size_t)ga; cX[k] = -gk; cXN[k++] = want_N && gn == ga ? gc : 0.0;
+            if (want_N && gn != ga) { col[k] = (size_t)gn; cX[k] = 0.0; cXN[k++] = gc; }
             gk = gc = 0.0;
         }
         if (last) break;
@@ -203,12 +191,48 @@ static int jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, 
         gn = an->aN[j];
         if (a >= 0) { gk += m->k[j]; gc += an->sg[j] * m->fs[j] * dgdN; }
     }
-    for (size_t c = 0; c < nb; ++c) {
-        rX[c] += kst * Eu[t * nb + c];
-        if (rXN) rXN[c] += cnow * EN[t * nb + c];
+    col[k] = t; cX[k] = kst; cXN[k++] = want_N ? cnow : 0.0;
+    if (krc > 0.0) {
+        const size_t tc = ANCHOR_RECONTACT_STEP(an->res), p = (tc + n - 1) % n;
+        const double N0 = N[p], N1 = N[tc], D = N1 - N0, sc = -N0 / D, du = u[tc] - u[p];
+        col[k] = p; cX[k] = -krc * (1.0 - sc); cXN[k++] = want_N ? -krc * du * (-N1 / (D * D)) : 0.0;
+        col[k] = tc; cX[k] = -krc * sc; cXN[k++] = want_N ? -krc * du * (N0 / (D * D)) : 0.0;
     }
-    if (krc > 0.0) recontact_grad(n, nb, u, N, Eu, EN, ANCHOR_RECONTACT_STEP(an->res), krc, rX, rXN);
+    return k;
+}
+
+/* Row t of dF/dX (and dF/dXN) written out from its terms (jac_terms) into rX, rXN
+ * (nb each). Returns 0, without touching rX, rXN, when the row is structurally zero,
+ * so the compact layout (iwan_periodic_jac_rows) skips it: O(stuck samples x nb). */
+static int jac_row(const iwan_model *m, const iwan_state *s, const anchors *an, size_t n,
+                   size_t nb, const double *u, const double *N, const double *Eu,
+                   const double *EN, double *rX, double *rXN)
+{
+    size_t col[JAC_TERMS_MAX];
+    double cX[JAC_TERMS_MAX], cXN[JAC_TERMS_MAX];
+    const size_t k = jac_terms(m, s, an, n, u, N, rXN != NULL, col, cX, cXN);
+    if (k == 0) return 0;
+    for (size_t c = 0; c < nb; ++c) { rX[c] = 0.0; if (rXN) rXN[c] = 0.0; }
+    for (size_t i = 0; i < k; ++i) {
+        const double *e = Eu + col[i] * nb, *en = rXN ? EN + col[i] * nb : NULL;
+        if (cX[i] != 0.0) for (size_t c = 0; c < nb; ++c) rX[c] += cX[i] * e[c];
+        if (rXN && cXN[i] != 0.0) for (size_t c = 0; c < nb; ++c) rXN[c] += cXN[i] * en[c];
+    }
     return 1;
+}
+
+/* The state at the sweep start tM from which the final pass runs: periodic_start,
+ * then with varying N periods marched until it recurs (p: periods marched). */
+static iwan_status closed_start(const iwan_model *model, size_t n, const double *u,
+                                const double *N, iwan_state *s, anchors *an, size_t *tM,
+                                int max_periods, double tol, int *p)
+{
+    double w = 0.0;
+    *p = 0;
+    periodic_start(model, n, u, N, s, an, tM);
+    if (N && !all_equal(N, n))
+        return march(model, n, u, N, *tM, s, an, max_periods, tol, NULL, NULL, NULL, &w, p);
+    return IWAN_OK;
 }
 
 /* Shared body of iwan_periodic_jac (rows == NULL: dense rows, t * nb) and
@@ -232,15 +256,11 @@ static iwan_status periodic_jac_impl(const iwan_model *model, size_t n, const do
     iwan_state s;
     anchors an;
     size_t tM, k_row = 0;
-    double w = 0.0;
     int p = 0;
-    periodic_start(model, n, u, N, &s, &an, &tM);
-    if (N && !all_equal(N, n)) {
-        st = march(model, n, u, N, tM, &s, &an, max_periods, tol, NULL, NULL, NULL, &w, &p);
-        if (st != IWAN_OK) {
-            if (periods_used) *periods_used = p;
-            return st;
-        }
+    st = closed_start(model, n, u, N, &s, &an, &tM, max_periods, tol, &p);
+    if (st != IWAN_OK) {
+        if (periods_used) *periods_used = p;
+        return st;
     }
     double *dXN = (EN && dFdXN) ? dFdXN : NULL;
     const double w0 = s.w_diss;
@@ -342,5 +362,49 @@ iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const doub
     }
     *n_int = m;
     if (W_cycle) *W_cycle = s.w_diss - w0;
+    return IWAN_OK;
+}
+
+iwan_status iwan_periodic_jac_terms(const iwan_model *model, size_t n, const double *u,
+                                    const double *N, int with_N, double *F, double *dX,
+                                    double *dXN, size_t cap, size_t *n_terms, size_t *row,
+                                    size_t *col, double *cX, double *cXN, double *W_cycle,
+                                    int max_periods, double tol, int *periods_used)
+{
+    iwan_status st = check_periodic(model, n, u, N, max_periods, tol);
+    if (st != IWAN_OK) return st;
+    if (!dX || !dXN || !n_terms || !row || !col || !cX || !cXN || n > (size_t)INT32_MAX / 2
+        || cap < n * (size_t)(2 * model->n + 2))
+        return IWAN_ERR_BAD_PARAM;
+    iwan_state s;
+    anchors an;
+    size_t tM, k = 0;
+    int p = 0;
+    st = closed_start(model, n, u, N, &s, &an, &tM, max_periods, tol, &p);
+    if (st != IWAN_OK) {
+        if (periods_used) *periods_used = p;
+        return st;
+    }
+    const double w0 = s.w_diss;
+    size_t tcol[JAC_TERMS_MAX];
+    double tX[JAC_TERMS_MAX], tXN[JAC_TERMS_MAX];
+    for (size_t i = 1; i <= n; ++i) {       /* final pass from the closed state */
+        const size_t t = (tM + i) % n;
+        an.t = (int32_t)t;
+        iwanp_advance(model, &s, u[t], N ? N[t] : model->n_ref, &an);
+        if (F) F[t] = iwanp_force(model, &s);
+        const size_t r = jac_terms(model, &s, &an, n, u, N, with_N && N, tcol, tX, tXN);
+        dX[t] = dXN[t] = 0.0;
+        for (size_t j = 0; j < r; ++j) {
+            if (tcol[j] == t) { dX[t] += tX[j]; dXN[t] += tXN[j]; continue; }
+            row[k] = t; col[k] = tcol[j]; cX[k] = tX[j]; cXN[k++] = tXN[j];
+        }
+    }
+    if (iwanp_check_finite(dX, n) || iwanp_check_finite(dXN, n) || iwanp_check_finite(cX, k)
+        || iwanp_check_finite(cXN, k))
+        return IWAN_ERR_NONFINITE;
+    *n_terms = k;
+    if (W_cycle) *W_cycle = s.w_diss - w0;
+    if (periods_used) *periods_used = p + 1;
     return IWAN_OK;
 }

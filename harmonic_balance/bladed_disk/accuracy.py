@@ -26,7 +26,7 @@ MAX_HARMONIC = 50
 def check_sector(hb: SectorHB, H: int) -> SectorHB:
     """The same sector and loads with harmonics 0..H (at least ``hb``'s AFT samples)."""
     n_t = max(hb.basis.n_t, sector_basis(hb.sector, H).n_t)
-    return SectorHB(hb.sector, H, cf=hb.cf, f0=hb.f0, mu=hb.mu, n_t=n_t)
+    return hb.with_harmonics(H, n_t)
 
 
 #: Richer levels checked at the sector's peak: one (H' ~ 1.5 H). The sector's peak
@@ -120,6 +120,23 @@ def frf_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = MA
     rec["accuracy"] = {"target": tol, "met": e is not None and e <= tol, "H_sequence": seq,
                        "levels": [list(lv) for lv in levels], "message": rec.get("message")}
     return best
+
+
+def optimum_truncation(sector, out: dict, grid: int = 40, limit: int = MAX_HARMONIC, f0=None) -> dict:
+    """The ``truncation_error`` record of the peak at the optimum CF of ``out`` (a result of
+    :func:`.optimize.optimal_load` at its ``harmonics``): the optimum's curve on the
+    load band's grid of ``grid`` points, checked as :func:`truncation_error` does;
+    ``at`` = "the optimum CF". A curve that fails gives null estimates and a ``note``."""
+    lo, hi = sector.cfg["load.band_hz"]
+    hb = SectorHB(sector, out["harmonics"], cf=out["optimum_cf"], f0=f0)
+    try:
+        c = frf(hb, 2 * np.pi * np.linspace(lo, hi, grid))
+    except SolverError as err:
+        return {"method": "richer harmonic sets at the peak", "H_used": hb.H, "at": "the optimum CF",
+                "peak_amplitude_rel": None, "peak_frequency_rel": None, "note": f"check failed: {err}"}
+    rec = truncation_error(hb, c, limit)
+    rec["at"] = "the optimum CF"
+    return rec
 
 
 def optimal_load_to_accuracy(sector, cf_range, accuracy: float, points: int = 20, H: int = 7,

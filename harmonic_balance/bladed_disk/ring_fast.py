@@ -64,6 +64,11 @@ STEP_GROW = 2.0
 HERMITE_RTOL = 1e-4
 #: Secant iterations of the peak polish.
 POLISH_ITER = 8
+#: The polish also ends when two successive iterates' amplitudes agree to this
+#: (relative): the peak is flat there, its value known to far better than the 1e-3
+#: the study needs, and the remaining iterates (each a converged solve) only move the
+#: frequency.
+POLISH_RTOL = 1e-7
 
 
 class Factor:
@@ -384,6 +389,8 @@ def _polish(solver: FastRingSolver, c: RingCurve, dA: np.ndarray):
             hi, ghi = wk, g
             glo, side = (0.5 * glo if side == -1 else glo), -1
         if hi - lo <= PEAK_XTOL * wk or not (glo > 0 > ghi):
+            break
+        if len(met) >= 2 and abs(a[j] - met[-2][2][j]) <= POLISH_RTOL * a[j]:
             break
         wk = lo + (hi - lo) * glo / (glo - ghi)
     wk, xk, ak = max(met, key=lambda m: m[2][j])

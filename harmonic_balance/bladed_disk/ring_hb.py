@@ -107,14 +107,16 @@ class MistunedRingHB:
         self._c = np.tile(c, self.nb)
 
     def _element_operators(self) -> None:
-        """Per element: global indices (n_b d,) of its DOFs' harmonics and Q_b = I (x) Q,
-        stacked by shape (one batched product per group)."""
+        """Per element: global indices (n_b d,) of its DOFs' harmonics and its Q (m, d),
+        stacked by shape (one batched product per group). The harmonics' operator is
+        Q_b = I (x) Q, applied as Q per harmonic (not as the dense (n_b m, n_b d) Q_b:
+        15 times fewer flops at H = 7)."""
         nb, groups = self.nb, {}
         for e, el in enumerate(self.points):
             kin = el.kinematics
             d = np.asarray(kin.dofs)
             gidx = (np.arange(nb)[:, None] * self.ndof + d[None, :]).ravel()
-            groups.setdefault((el.m, d.size), []).append((e, gidx, np.kron(np.eye(nb), kin.Q)))
+            groups.setdefault((el.m, d.size), []).append((e, gidx, np.asarray(kin.Q, dtype=float)))
         self._groups = [([e for e, _, _ in g], np.array([i for _, i, _ in g]),
                          np.array([q for _, _, q in g])) for g in groups.values()]
 
@@ -146,21 +148,22 @@ class MistunedRingHB:
         Mx, Cx = self._M @ x, self._C @ x
         R = self._K @ x + self._c * (self._K0 @ x) - w * w * Mx + w * Cx - self.Fext
         Rw = -2.0 * w * Mx + Cx
-        blocks = []
-        for idx, G, Qb in self._groups:
-            U = np.einsum("eij,ej->ei", Qb, x[G])  # (n_e, n_b m)
-            m = self.points[idx[0]].m
-            res = [self.points[e].evaluate(u.reshape(self.nb, m), self.basis, w, jac)
-                   for e, u in zip(idx, U)]
-            F = np.einsum("eij,ei->ej", Qb, np.array([r.F.ravel() for r in res]))
-            np.add.at(R, G, F)
+        blocks, nb = [], self.nb
+        for idx, G, Q in self._groups:
+            n_e, m, d = Q.shape
+            # U_e = (I (x) Q) x_e: local harmonics (n_e, n_b, m)
+            U = np.einsum("eja,eca->ecj", Q, x[G].reshape(n_e, nb, d))
+            res = [self.points[e].evaluate(u, self.basis, w, jac) for e, u in zip(idx, U)]
+            np.add.at(R, G, _back(Q, np.array([r.F for r in res])))
             dws = [r.dF_domega for r in res]
-            if jac and any(d is not None for d in dws):
-                dw = np.array([np.zeros(Qb.shape[1]) if d is None else d for d in dws])
-                np.add.at(Rw, G, np.einsum("eij,ei->ej", Qb, dw))
+            if jac and any(dv is not None for dv in dws):
+                dw = np.array([np.zeros(nb * m) if dv is None else dv for dv in dws])
+                np.add.at(Rw, G, _back(Q, dw))
             if jac:
-                dF = np.array([r.dF for r in res])
-                blocks.append(np.einsum("eki,ekl,elj->eij", Qb, dF, Qb, optimize=True).ravel())
+                # (I (x) Q)^T dF (I (x) Q), dF rows/cols c m + j: Q on each harmonic's block
+                dF = np.array([r.dF for r in res]).reshape(n_e, nb * m * nb, m) @ Q
+                blk = np.einsum("eja,ecjx->ecax", Q, dF.reshape(n_e, nb, m, nb * d))
+                blocks.append(blk.ravel())
         if not jac:
             return R
         K, K0, M, C = self._lin_data
@@ -222,3 +225,10 @@ class MistunedRingHB:
         per = len(self.points) // self.blades
         return W.reshape(self.blades, per).sum(axis=1)
 
+
+
+def _back(Q: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Local force harmonics f (n_e, n_b m) of a group's elements (Q: (n_e, m, d)) as their
+    DOFs' harmonics (I (x) Q)^T f, (n_e, n_b d)."""
+    n_e, m, _ = Q.shape
+    return np.einsum("eja,ecj->eca", Q, f.reshape(n_e, -1, m)).reshape(n_e, -1)

@@ -91,6 +91,7 @@ def test_backbone_with_the_contact_element_plans_the_contact_stages(tmp_path):
     (("slip_force = 60.0\n", ""), "backbone.slip_force", "missing"),
     (("amplitude = [1.0e-7, 1.0e-4]", "amplitude = [1.0e-4, 1.0e-7]"), "backbone.amplitude", "end > start"),
     (('element = "jenkins"', 'element = "spring"'), "backbone.element", "must be one of"),
+    (("harmonics = 1\n", "harmonics = 1\naccuracy = 0.5\n"), "backbone.accuracy", "must be < 0.5"),
 ])
 def test_malformed_backbone_table_names_the_key(edit, key, words):
     text = ONLY_BACKBONE.replace(*edit)
@@ -115,3 +116,29 @@ def test_example_backbone_scene_parses_and_plans_one_stage(tmp_path):
     path = Path(__file__).resolve().parents[2] / "examples" / "scenes" / "backbone.toml"
     plan = plan_scene(parse_scene(path.read_text(), str(path)), Store(tmp_path))
     assert [s.name for s in plan.stages if s.action == "compute"] == ["backbone"]
+
+
+#: Target of the scene's backbone run to an accuracy: the Jenkins backbone's H = 3 start
+#: misses it (measured), so H is raised at least once.
+BB_TARGET = 1e-3
+
+
+@pytest.mark.slow                                           # ~5-10 s: two or three EPMC backbones
+def test_backbone_accuracy_in_a_scene_raises_h_until_both_estimates_meet_it(tmp_path):
+    scene = parse_scene(ONLY_BACKBONE.replace("harmonics = 1\n", f"harmonics = 1\naccuracy = {BB_TARGET}\n"))
+    rec = run_scene(scene, Store(tmp_path), tmp_path / "out", **QUIET)
+    bb = rec.results["backbone"].data
+    te = bb["truncation_error"]
+    a = te["accuracy"]
+    assert a["target"] == BB_TARGET and a["met"] and a["H_sequence"][-1] == te["H_used"] == bb["harmonics"]
+    assert max(te["omega_rel"], te["damping_ratio_rel"]) <= BB_TARGET
+    assert a["H_sequence"][0] >= 3   # the start is raised to MIN_START_HARMONIC
+    lines = scene_kind_lines(rec, "backbone")
+    assert any(f"accuracy {BB_TARGET:g}: met" in line for line in lines), lines
+    assert len(a["H_sequence"]) >= 2 and a["message"] is None   # measured: H = 3, 8, 20
+
+
+def scene_kind_lines(rec, name):
+    """The printed lines of the stage ``name`` of a run record."""
+    stage = next(s for s in rec.plan.stages if s.name == name)
+    return stage.kind.lines(stage, rec.results[name])

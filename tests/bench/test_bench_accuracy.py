@@ -73,3 +73,29 @@ def test_report_shows_estimate_and_true_error_of_accuracy_rows(quick_rows, tmp_p
     md = (tmp_path / "bench.md").read_text()
     for r in rows:
         assert r["setting"] in text and f"| {r['estimate']:.2e} | {r['true_error']:.2e} |" in md
+
+
+def test_accuracy_row_flags_follow_the_goals(quick_rows):
+    for r in quick_rows[0]:
+        if r["ratio"] is not None and r["true_error"] >= hb_accuracy.TRUE_FLOOR:
+            assert r["ratio_ok"] == (1 / hb_accuracy.RATIO_BAND <= r["ratio"] <= hb_accuracy.RATIO_BAND)
+        if r["target"] is not None:
+            assert r["target_met"] == (r["true_error"] <= r["target"]) and r["engine_met"] is not None
+    default = [r for r in quick_rows[0] if r["default"] is not None]
+    assert [r["setting"].split(" -> ")[0] for r in default] == [hb_accuracy.DEFAULT_FRF]
+
+
+@pytest.mark.parametrize("true, est, verdict, flag", [
+    (0.005, 0.002, "ok", ""), (0.02, 0.03, "warned", "D~"), (0.02, 0.005, "FAIL", "R D!")])
+def test_default_row_is_ok_within_one_percent_else_warned_or_failed(true, est, verdict, flag):
+    ref = 1.0
+    r = hb_accuracy._row("m", "H 7", ref * (1 + true), {"peak_amplitude_rel": est}, ref, 1.0, 7,
+                         default_of="H 7")
+    assert r["default"] == verdict and r["flags"] == flag
+    assert hb_accuracy.goals([r])["default"] == {"rows": 1, "failing": ["m / H 7"] if verdict == "FAIL" else []}
+
+
+def test_target_row_missed_by_the_engines_limit_is_flagged_t():
+    r = hb_accuracy._row("m", "tol 0.001 -> H 27", 1.01, {"peak_amplitude_rel": 0.012}, 1.0, 1.0, 27, 1e-3,
+                         {"met": False})
+    assert r["target_met"] is False and r["engine_met"] is False and r["flags"] == "t"

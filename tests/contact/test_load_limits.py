@@ -21,6 +21,17 @@ def test_sphere_load_beyond_the_body_is_refused_with_the_limit(args, capsys):
     assert a == pytest.approx(bodies.MAX_CONTACT_SHARE * R, rel=1e-3)  # the limit is the stated share
 
 
+def test_the_largest_finite_force_names_a_finite_contact_radius(capsys):
+    """a^3 = 3 F R / (4 E*) overflows at F = 1e308: the message still names a number."""
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "1e308",
+                   "--grid", "5", "--no-cache"]) == 2
+    err = capsys.readouterr().err
+    assert "beyond what the contact model represents" in err and "inf" not in err
+    a = float(re.search(r"contact radius of ([0-9.e+-]+) m", err).group(1))
+    R, Es = 0.01, hertz.contact_modulus(200e9, 0.3, 200e9, 0.3)
+    assert a == pytest.approx((0.75 * R / Es) ** (1 / 3) * 1e308 ** (1 / 3), rel=0.05)  # 2 digits printed
+
+
 @pytest.mark.parametrize("argv, words", [
     (["--body", "sphere", "--radius", "1e308"], "radius = 1e+308 m is above the limit"),   # Hertz overflowed
     (["--body", "cylinder", "--radius", "2.5e-3", "--length", "1e308"], "length = 1e+308 m is above"),

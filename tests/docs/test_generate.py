@@ -57,9 +57,9 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 def test_accuracy_figures_one_per_model_class_from_the_recorded_data(tmp_path):
     (tmp_path / "data").mkdir()
-    for name in ("accuracy", "accuracy_upd"):
-        shutil.copy(DOCS / "data" / f"{name}.json", tmp_path / "data")
     plots = _plots()
+    for name in plots.SOURCES:
+        shutil.copy(DOCS / "data" / f"{name}.json", tmp_path / "data")
     plots.accuracy_plots(tmp_path)
     md = (tmp_path / "_generated" / "accuracy_plots.md").read_text()
     for stem, _, _ in plots.CLASSES:

@@ -144,3 +144,43 @@ def test_branches_between_extrema_are_the_loop_on_any_path_through_them():
     assert set(b["slope"]) <= {0.3 + s for s in (0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5)}
     with pytest.raises(IwanInputError, match="two extrema"):
         el.periodic_branches([1.0])
+
+
+#: Agreement of two scans that find the same extrema: the coefficients differ by the
+#: round-off of the root refinement and the integrals alone.
+SCAN_RTOL = 1e-12
+
+
+def test_fft_and_phasor_scans_give_the_same_loop():
+    """The scan of u' runs by one FFT on a power-of-two grid (128 points) and by phasors
+    on any other (96 points): on rich multiharmonic inputs (H = 15 with the mean, many
+    extrema and minor loops) both find the same extrema, so the coefficients and the
+    Jacobian agree to round-off."""
+    rng = np.random.default_rng(SEED)
+    el = IwanElement.from_sliders([1.0, 2.0, 0.5], [0.2, 0.3, 0.1], k_res=0.3)
+    hs = tuple(range(16))
+    for _ in range(5):
+        U = rng.normal(0.0, 1.0, 31) / np.repeat(np.arange(1, 17), [1] + [2] * 15)
+        a, b = el.periodic_fourier(hs, U, 128), el.periodic_fourier(hs, U, 96)
+        assert a[3] == b[3] > 2
+        np.testing.assert_allclose(a[0], b[0], rtol=0, atol=SCAN_RTOL * np.abs(a[0]).max())
+        np.testing.assert_allclose(a[1], b[1], rtol=0, atol=SCAN_RTOL * np.abs(a[1]).max())
+
+
+def test_jacobian_matches_central_differences_at_many_harmonics():
+    """As the 3-harmonic test, at H = 12 with odd harmonics only and with all of them
+    (the Jacobian is built from the stiffness's Fourier coefficients, orders up to 2H,
+    plus the anchors' outer products: both sets of orders exercise the index pairs)."""
+    rng = np.random.default_rng(SEED + 1)
+    el = IwanElement.from_sliders([1.0, 2.0, 0.5], [0.2, 0.3, 0.1], k_res=0.3)
+    for hs in (tuple(range(0, 13)), tuple(range(1, 13, 2))):
+        nb = sum(1 if h == 0 else 2 for h in hs)
+        scale = np.repeat(np.array(hs, float).clip(1.0), [1 if h == 0 else 2 for h in hs])
+        U = rng.normal(0.0, 1.0, nb) / scale
+        Fh, dFh, _, ne = el.periodic_fourier(hs, U, 64)
+        assert ne > 2
+        h = 1e-7 * np.abs(U).max()
+        fd = np.column_stack([(el.periodic_fourier(hs, U + h * e, 64)[0]
+                               - el.periodic_fourier(hs, U - h * e, 64)[0]) / (2 * h)
+                              for e in np.eye(nb)])
+        np.testing.assert_allclose(dFh, fd, rtol=0, atol=1e-6 * np.abs(dFh).max())

@@ -140,3 +140,26 @@ def test_packed_rows_refuse_a_non_finite_basis_row_they_use():
     assert np.array_equal(link.periodic_jac_rows(E @ X, ok)[2], link.periodic_jac_rows(E @ X, E)[2])
     with pytest.raises(IwanInputError, match="NaN"):   # the dense layout reads every row
         link.periodic_jac(E @ X, ok)
+
+
+#: The sparse terms and the dense rows sum the same products in another order.
+TERMS_ROUND = 1e-13
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_jacobian_terms_rebuild_the_dense_jacobian(el, case):
+    """periodic_jac_terms: diag(dX) + the off-diagonal terms, times the basis, is
+    periodic_jac's Jacobian (lift-off: the re-contact steps' ends among the terms)."""
+    X, XN = CASES[case]
+    E = basis()
+    N, EN = (None, None) if XN is None else (E @ XN, E)
+    F, J, JN, W = el.periodic_jac(E @ X, E, N, EN)
+    F2, dX, dXN, row, col, cX, cXN, W2 = el.periodic_jac_terms(E @ X, N, with_N=XN is not None)
+    assert np.array_equal(F, F2) and W == W2 and not np.any(row == col)
+    for dense, d, c in ((J, dX, cX), (JN, dXN, cXN)):
+        S = np.diag(d)
+        np.add.at(S, (row, col), c)
+        if dense is None:
+            assert not np.any(S)
+        else:
+            np.testing.assert_allclose(S @ E, dense, rtol=0, atol=TERMS_ROUND * np.abs(dense).max())

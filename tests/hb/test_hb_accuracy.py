@@ -34,7 +34,8 @@ def reference_peak(result, H_ref=REFERENCE_H) -> float:
 
 
 @pytest.mark.parametrize("case, H", [(SDOF, 1), (SDOF, 3),
-                                     (bm.chain3(1.0, 20.0), 5)])
+                                     (bm.chain3(1.0, 20.0), 5),
+                                     (bm.sdof(1.0), 7)])   # levels that oscillate (H' overshoots)
 def test_estimate_is_within_a_factor_3_of_the_true_error(case, H):
     r = compute_frf(case.model(), H, case.band, stability="off")
     est = r.truncation_error["peak_amplitude_rel"]
@@ -103,8 +104,16 @@ def test_observed_order_and_extrapolation_recover_a_power_law():
     assert rec["order_observed"] == rec["order"]
 
 
-def test_differences_that_change_sign_fall_back_to_the_largest_two_level_estimate():
+def test_oscillating_levels_are_judged_against_the_richest_check_alone():
     levels = [(7, 1.02, 1.0), (11, 0.99, 1.0), (17, 1.0, 1.0)]
+    rec = acc.estimate(levels, "test")
+    assert rec["order_observed"] is None and rec["extrapolated"] is None
+    richest = abs(1.02 / 1.0 - 1) / (1 - (7 / 17) ** acc.ASSUMED_ORDER)
+    assert abs(rec["peak_amplitude_rel"] / richest - 1) < 1e-12
+
+
+def test_an_order_out_of_range_falls_back_to_the_largest_two_level_estimate():
+    levels = [(7, 1.02, 1.0), (11, 1.0199, 1.0), (17, 1.0, 1.0)]   # p would be far below 0.3
     rec = acc.estimate(levels, "test")
     assert rec["order_observed"] is None and rec["extrapolated"] is None
     worst = max(abs(1.02 / a - 1) / (1 - (7 / H) ** acc.ASSUMED_ORDER) for H, a, _ in levels[1:])

@@ -4,6 +4,7 @@ import pytest
 from hbcases import SEED, sdof, two_dof
 
 from fmu_src.element import IwanElement
+from harmonic_balance import contact
 from harmonic_balance.aft import FrictionLink, aft_link
 from harmonic_balance.contact import ContactElement, frictionless_statics
 from harmonic_balance.forces import LinearElement, harmonic_work
@@ -118,9 +119,12 @@ def test_cyclic_spring_gives_the_harmonic_coupling_stiffness():
     assert np.abs(J - np.diag(expect)).max() < ROUND * kc
 
 
+@pytest.mark.parametrize("projection", ["product over rows", "sparse terms"])
 @pytest.mark.parametrize("kind", sorted(FRICTIONS))
 @pytest.mark.parametrize("draw", range(3))
-def test_contact_jacobian_matches_finite_differences(kind, draw):
+def test_contact_jacobian_matches_finite_differences(kind, draw, projection, monkeypatch):
+    """Both projections of the sampled Jacobian (contact.TERMS_MIN_WORK chooses)."""
+    monkeypatch.setattr(contact, "TERMS_MIN_WORK", np.inf if projection == "product over rows" else 0.0)
     el = plane_contact(FRICTIONS[kind](), preload=0.2, slip_ref=0.03, beta_c=0.01)
     b = FourierBasis("all:5")
     U = np.random.default_rng(SEED + draw).normal(scale=0.15, size=(b.nb, 2))
@@ -376,3 +380,26 @@ def test_contact_batch_stepper_gives_the_single_stepper_bits():
     for k in range(200, 400):
         fb = kept.force(q[k, [2, 0]]).copy()
         assert np.array_equal(fb, np.array([single[i].force(q[k, i]) for i in (2, 0)]))
+
+
+def test_exact_link_stuck_test_agrees_with_the_sampled_one():
+    """A link with the mean retained: a loop that never slips is the virgin stuck line
+    F = k0 u, Jacobian k0 I, whether the exact link (its test on the harmonics) or the
+    sampled one (on the samples) decides; a loop that slips a little is neither's stuck
+    line. Jenkins k0 = 100 N/m, f_s = 1 N: amplitude 5 mm stays stuck (0.5 N), 20 mm slips
+    (2 N)."""
+    b = FourierBasis("all:7", 128)
+    el = IwanElement.jenkins(100.0, 1.0)
+    exact, sampled = FrictionLink(el, 0, exact=True), FrictionLink(el, 0)
+    for amp, stuck in ((5e-3, True), (2e-2, False)):
+        U = np.zeros(b.nb)
+        U[0], U[1], U[4] = 3e-3, amp, 0.2 * amp      # a mean, harmonic 1 and harmonic 2
+        Fe, Je, We, _ = aft_link(exact, U, b)
+        Fs, Js, Ws, _ = aft_link(sampled, U, b)
+        line = np.allclose(Fe, 100.0 * U, rtol=0, atol=ROUND * 100.0 * amp)
+        assert line == stuck and np.allclose(Fs, 100.0 * U, rtol=0, atol=ROUND * 100.0 * amp) == stuck
+        if stuck:
+            assert We == 0.0 and np.array_equal(Je, 100.0 * np.eye(b.nb))
+            np.testing.assert_allclose(Js, Je, rtol=0, atol=ROUND * 100.0)
+        else:
+            assert We > 0.0 and Ws > 0.0

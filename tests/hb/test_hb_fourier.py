@@ -56,3 +56,32 @@ def test_alias_ratio_flags_an_unresolved_signal():
     th = 2 * np.pi * np.arange(64) / 64
     assert b.alias_ratio(np.cos(th)) < 1e-12
     assert b.alias_ratio(np.sign(np.cos(th))) > 1e-2  # square wave: 1/h tail
+
+
+@pytest.mark.parametrize(("spec", "n_t"), [("all:5", 0), ("odd:7", 64), ([0, 2, 3], 0),
+                                            ("all:5", 11)])
+def test_weighted_transform_is_the_product_with_the_weights(spec, n_t):
+    """D diag(k) E from the FFT of k (Toeplitz plus Hankel in the orders) equals the
+    product, also on a grid so coarse that orders up to 2H wrap (n_t = 11, H = 5)."""
+    b = FourierBasis(parse_harmonics(spec), n_t)
+    k = np.random.default_rng(SEED).normal(size=(2, b.n_t))
+    W = b.weighted(k)
+    for j in range(2):
+        np.testing.assert_allclose(W[j], (b.D * k[j]) @ b.E, rtol=0, atol=DFT_TOL)
+    np.testing.assert_allclose(b.weighted(k[0]), W[0], rtol=0, atol=DFT_TOL)
+
+
+def test_projection_of_sparse_terms_is_the_dense_product():
+    """project_terms: D (diag(d) + sum_i c_i e_row e_col^T) E for a few anchor columns."""
+    b = FourierBasis("all:6", 128)
+    rng = np.random.default_rng(SEED)
+    d = rng.normal(size=(2, b.n_t))
+    row = rng.integers(0, b.n_t, 90)
+    col = rng.choice([3, 40, 77], 90)
+    row[row == col] += 1
+    c = rng.normal(size=(2, 90))
+    P = b.project_terms(d, row, col, c)
+    for j in range(2):
+        S = np.diag(d[j])
+        np.add.at(S, (row, col), c[j])
+        np.testing.assert_allclose(P[j], b.D @ S @ b.E, rtol=0, atol=DFT_TOL)

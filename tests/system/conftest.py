@@ -2,12 +2,11 @@
 from __future__ import annotations
 
 import pytest
+from upd_system_loads import CF, F0
 
 from harmonic_balance.bladed_disk import fmus
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.sector import Sector
-
-CF, F0 = 120.0, 30.0
 
 
 @pytest.fixture(scope="session")

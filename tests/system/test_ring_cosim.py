@@ -7,7 +7,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from conftest import CF, F0
+from upd_system_loads import CF, F0
 
 from damper.cli import main
 from damper.cosim import read_info, run

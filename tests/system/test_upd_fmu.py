@@ -2,8 +2,8 @@
 HB periodic solution it returns the HB's contact forces on the platforms."""
 import numpy as np
 import pytest
-from conftest import CF
 from slaves import Slave
+from upd_system_loads import CF
 
 from harmonic_balance.bladed_disk import fmus
 from harmonic_balance.bladed_disk.hb import SectorHB, neighbour_map

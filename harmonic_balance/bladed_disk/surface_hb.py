@@ -1,0 +1,184 @@
+"""The UPD sector with contact surfaces instead of contact points.
+
+The damper's two faces (the cylinder line on blade j, the flat on blade j+1) become
+contact surfaces (:mod:`harmonic_balance.surface`, planar variant: slip along the
+face's tangent, 2 DOFs per node): each surface adds its node DOFs w to the sector,
+a linear element for the two bodies' condensed stiffness between the nodes and the
+rigid inputs, and one ContactElement per node.
+
+Rigid inputs from the sector's contact kinematics (:class:`~.sector.Sector`, rows of
+penetration p and slip s per point; the only copy of the geometry):
+
+* cylinder: approach = p and tangential = s of the ``left`` point;
+* flat: approach and tangential = the mean of the rows of its end points ``right1``
+  and ``right2`` (the face centre), rotation = theta_d (the platform does not rotate):
+  a node at x along the face's tangent from the centre closes by p_c + theta_d x for
+  either face angle (n . (z x t) = -1 on both sides), which is the flat's rigid map
+  (:meth:`contact_core.bodies.FlatFace.rigid`); its rows on blade j+1's platform
+  enter through ``Q_next`` and the phase phi, as for the point model.
+
+The bodies' dashpots are beta_c times the surface's stiffness (the point model's
+beta_c k of its stuck contact, here the bodies' series stiffness), on the linear
+element; the node contacts have none (their penalty is a numerical device, not a
+physical stiffness).
+
+Symbols as in :mod:`harmonic_balance.surface` and :mod:`.hb`.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..forces import LinearElement
+from ..kinematics import Kinematics
+from ..linear import LinearModel
+from ..model import Model
+from .hb import SectorHB, coupling_element
+from .sector import Sector
+
+#: Face names and the sector points whose rows give their inputs.
+FACES = {"left": ("left",), "flat": ("right1", "right2")}
+
+
+def face_inputs(sector: Sector, face: str):
+    """Rows (r, n_dof) on blade j and (r, n_right) on blade j+1 of a face's rigid inputs.
+
+    Order as in the surface's ``inputs``: approach, [rotation,] tangential_x.
+    """
+    if sector.rows_per_point != 2:
+        raise ValueError("contact surfaces need the planar UPD sector (platform points [u, v]); "
+                         "this blade has axial platform DOFs: use --contacts toml or geometry")
+    n, names = sector.n_dof, [c.name for c in sector.points]
+    idx = [names.index(p) for p in FACES[face]]
+    p = np.mean([sector.Q[2 * i] for i in idx], axis=0)
+    s = np.mean([sector.Q[2 * i + 1] for i in idx], axis=0)
+    rows = [p] + ([np.eye(n + 2)[n - 1]] if face == "flat" else []) + [s]
+    G = np.array(rows)
+    return G[:, :n], G[:, n:]
+
+
+def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c: float, name: str):
+    """The surface's linear element (stiffness and dashpots) and node contacts in a sector model.
+
+    Parameters
+    ----------
+    surface : harmonic_balance.surface.Surface
+        Planar (``tangents == ("x",)``).
+    offset : int
+        First model DOF of the surface's w.
+    G : ndarray (r, n_dof)
+        Rigid inputs from the sector's DOFs (:func:`face_inputs`).
+    G_next : ndarray (r, n_right)
+        From blade j+1's platform point (``right`` DOFs); zeros: no neighbour.
+    right : sequence of int
+        blade j+1's platform DOFs in the sector numbering.
+    phi : float
+        Interblade phase [rad].
+    beta_c : float
+        Dashpots beta_c K of the surface [s].
+    name : str
+    """
+    n_w = surface.n_w
+    used = np.flatnonzero(np.any(G != 0.0, axis=0))
+    cyclic = bool(np.any(G_next != 0.0))
+    if cyclic:
+        used = np.union1d(used, right)
+    r = G.shape[0]
+    Q = np.zeros((n_w + r, n_w + used.size))
+    Q[:n_w, :n_w] = np.eye(n_w)
+    Q[n_w:, n_w:] = G[:, used]
+    dofs = np.r_[offset + np.arange(n_w), used]
+    Qn = None
+    if cyclic:
+        Gn = np.zeros_like(G)
+        Gn[:, right] = G_next
+        Qn = np.zeros_like(Q)
+        Qn[n_w:, n_w:] = Gn[:, used]
+    kin = Kinematics(dofs, Q, Q_next=Qn, phase=phi if cyclic else 0.0)
+    els = [LinearElement(kin, surface.K, beta_c * surface.K if beta_c else None, name=f"{name} bodies")]
+    els += node_contacts(surface, offset, name)
+    return els
+
+
+def node_contacts(surface, offset: int, name: str) -> list:
+    """The surface's node ContactElements on model DOFs offset ... offset + d n - 1."""
+    els = []
+    for i, el in enumerate(surface.elements):
+        node = Kinematics(offset + np.arange(surface.d * i, surface.d * (i + 1)), np.eye(surface.d))
+        contact = type(el)(node, el.k_n, el.friction, preload=el.preload, name=f"{name} node {i}")
+        els.append(contact)
+    return els
+
+
+def linear_part(surface, offset: int, G, n_model: int) -> np.ndarray:
+    """T^T K T (n_model, n_model) of a surface without a neighbour: [w; q] = T x, exact in
+    every harmonic (no phase), so it joins the linear structure."""
+    T = np.zeros((surface.n_dof, n_model))
+    T[:surface.n_w, offset:offset + surface.n_w] = np.eye(surface.n_w)
+    T[surface.n_w:, :G.shape[1]] = G
+    return T.T @ surface.K @ T
+
+
+class SurfaceSectorHB(SectorHB):
+    """HB residual of the UPD sector with the damper's faces as contact surfaces.
+
+    Parameters
+    ----------
+    sector : Sector
+    surfaces : dict {"left": Surface, "flat": Surface}
+        Planar surfaces of the cylinder and the flat (:func:`build_surfaces`).
+    H, cf, f0, mu, n_t
+        As :class:`~.hb.SectorHB` (mu is the surfaces' own).
+    """
+
+    def __init__(self, sector: Sector, surfaces: dict, H: int = 7, cf=None, f0=None, mu=None,
+                 n_t: int = 0):
+        for face in FACES:
+            if surfaces[face].tangents != ("x",):
+                raise ValueError(f"the {face} surface must be planar (tangents ('x',))")
+        self.surfaces = surfaces
+        super().__init__(sector, H, cf, f0, mu, n_t)
+
+    def with_harmonics(self, H: int, n_t: int = 0) -> SurfaceSectorHB:
+        """The same sector, surfaces and loads with harmonics 0..H (``n_t`` AFT samples)."""
+        return SurfaceSectorHB(self.sector, self.surfaces, H, cf=self.cf, f0=self.f0, mu=self.mu,
+                               n_t=n_t)
+
+    def _build_model(self) -> Model:
+        sec = self.sector
+        n = sec.n_dof
+        n_w = sum(s.n_w for s in self.surfaces.values())
+        pad = [np.zeros((n + n_w, n + n_w)) for _ in range(3)]
+        for P, A in zip(pad, (sec.M, sec.C_struct(0.0), sec.K_struct(0.0))):
+            P[:n, :n] = A
+        els = [e for e in (coupling_element(sec),) if e is not None]
+        offset = n
+        for face, surf in self.surfaces.items():
+            G, G_next = face_inputs(sec, face)
+            if np.any(G_next != 0.0):   # the flat: its inputs use blade j+1 (phase phi)
+                els += surface_elements(surf, offset, G, G_next, list(sec.blade.right), sec.cfg.phi,
+                                        sec.beta_c, face)
+            else:                       # the cylinder: linear structure (cheaper, exact)
+                Ks = linear_part(surf, offset, G, n + n_w)
+                pad[2] += Ks
+                pad[1] += sec.beta_c * Ks
+                els += node_contacts(surf, offset, face)
+            offset += surf.n_w
+        f_static, f_eo = np.zeros(n + n_w), np.zeros(n + n_w, dtype=complex)
+        f_static[sec.y_d], f_eo[sec.forced] = self.cf, self.f0
+        return Model(LinearModel(M=pad[0], C=pad[1], K=pad[2]), els, {0: f_static, 1: f_eo}, sec.response)
+
+    def stuck_guess(self, omega: float) -> np.ndarray:
+        """Prestress mean + the linear response with every node stuck (a Newton start).
+
+        One Newton step from the prestress state without vibration: there every node in
+        contact is stuck, so the Jacobian is the stuck linear system (surfaces included)
+        and the step is its response to the EO force.
+        """
+        x0 = self.static_guess()
+        R, J, _ = self.residual(x0, omega, True)
+        return x0 - np.linalg.solve(J, R)
+
+    def _eo_forcing(self) -> np.ndarray:
+        f = np.zeros(self.ndof, dtype=complex)
+        f[self.sector.forced] = self.f0
+        return f

@@ -1,0 +1,90 @@
+"""The UPD with contact surfaces (`damper upd frf --contacts surface`, SurfaceSectorHB).
+
+The coarsest surfaces (5 nodes per side) keep the condensation and the HB small; the
+store is shared by the module so contact_core condenses once.
+"""
+
+import numpy as np
+import pytest
+
+from damper.cache import Store
+from damper.cli import main
+from damper.upd_surface import build_surfaces
+from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.sector import Sector
+from harmonic_balance.bladed_disk.solve import TOL_REL
+from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB, face_inputs
+
+NODES = 5
+#: The surfaces' frictionless statics carry CF like the point model's: the damper's force
+#: balance fixes the face loads (N_L = N_R = CF / (2 cos g)) whatever the contact model;
+#: the surfaces' static solve is linear per contact set, round-off ~1e-12 of CF.
+STATIC_RTOL = 1e-8
+
+
+@pytest.fixture(scope="module")
+def surfaces(tmp_path_factory):
+    store = Store(tmp_path_factory.mktemp("upd_surface_cache"))
+    return build_surfaces(load_config(None), NODES, store=store)
+
+
+def _face_loads(hb):
+    names = [e.name for e in hb.points]
+    N = hb.static["N"]
+    return {f: sum(n for n, name in zip(N, names) if name.startswith(f"{f} node")) for f in hb.surfaces}
+
+
+def test_surface_statics_carry_the_damper_force_balance(surfaces):
+    sector = Sector(load_config(None))
+    hb = SurfaceSectorHB(sector, surfaces, H=1, cf=120.0)
+    N = 120.0 / (2 * np.cos(np.radians(sector.cfg["damper.angle_deg"])))
+    loads = _face_loads(hb)
+    assert loads["left"] == pytest.approx(N, rel=STATIC_RTOL)
+    assert loads["flat"] == pytest.approx(N, rel=STATIC_RTOL)
+    # the point model's statics give the same face loads (the balance is geometric)
+    points = SectorHB(sector, H=1, cf=120.0).static["N"]
+    assert points[0] == pytest.approx(N, rel=STATIC_RTOL)
+
+
+def test_flat_inputs_are_the_centre_of_its_end_points():
+    sector = Sector(load_config(None))
+    G, G_next = face_inputs(sector, "flat")
+    names = [c.name for c in sector.points]
+    r1, r2 = names.index("right1"), names.index("right2")
+    n = sector.n_dof
+    # the end points' penetrations differ by theta_d times the face width
+    width = sector.cfg["damper.right_width"]
+    diff = sector.Q[2 * r2] - sector.Q[2 * r1]
+    assert diff[n - 1] == pytest.approx(width, rel=1e-12)
+    assert np.allclose(G[0], 0.5 * (sector.Q[2 * r1, :n] + sector.Q[2 * r2, :n]))
+    assert G[1, n - 1] == 1.0 and np.count_nonzero(G[1]) == 1
+
+
+@pytest.mark.slow
+def test_surface_sector_solves_one_frequency_with_its_energy_balanced(surfaces):
+    """Newton from the stuck start at 440 Hz (CF 300 N, H 3; measured 17 iterations): the
+    excitation's work equals the structure's, the bodies' dashpots' and the friction's."""
+    from harmonic_balance.bladed_disk.solve import energy_balance, solve_point
+
+    hb = SurfaceSectorHB(Sector(load_config(None)), surfaces, H=3, cf=300.0)
+    omega = 2 * np.pi * 440.0
+    x = solve_point(hb, omega, hb.stuck_guess(omega), max_iter=80)
+    e = energy_balance(hb, x, omega)
+    assert e["W_friction"] > 0.0 and abs(e["imbalance"]) < TOL_REL
+    assert hb.amplitude_h1(x) > 0.0
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--surface-nodes", "3"], "surface nodes per side"),
+    (["--surface-nodes", "99"], "surface nodes per side"),
+    (["--damper", "stuck"], "--damper nonlinear"),
+    (["--accuracy", "0.01"], "drop --accuracy"),
+])
+def test_bad_surface_options_are_one_line_refusals(tmp_path, capsys, monkeypatch, extra, words):
+    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
+    code = main(["upd", "frf", "--contacts", "surface", "--json", *extra])
+    captured = capsys.readouterr()
+    assert code == 2 and captured.out == ""
+    assert words in captured.err and "Traceback" not in captured.err
+    assert len(captured.err.strip().splitlines()) == 1
