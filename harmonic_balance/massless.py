@@ -1,0 +1,225 @@
+"""Quasi-static equilibrium of massless DOFs carrying contacts, one time step at a time.
+
+A contact surface (:mod:`.surface`) adds DOFs without mass: the relative
+displacements w of its node pairs (and rigid inputs held by a force only). In the
+time domain they are algebraic unknowns of a DAE (index 1: their equilibrium fixes
+them given the DOFs with mass); each time step solves, for every history h of a
+batch (the frequencies of a curve)::
+
+    A_h w + f_c(w) = r_h                                                  (E1)
+
+with A_h the massless rows' linear operator (stiffness, plus the damping of an
+implicit velocity, :mod:`.timeint_surface`), r_h the loads from the DOFs with mass
+and the forcing, and f_c the node contacts (:class:`~.contact.ContactElement`, C1,
+C2) reached from the committed friction states along the straight path in one step.
+This is one increment of the incremental plasticity problem (return mapping: trial
+states from the committed ones, committed only when the step's equilibrium is met;
+Simo & Hughes, *Computational Inelasticity*, 1998, ch. 1-2), solved by Newton on the
+contacts' consistent tangent as :mod:`.surface_static` does for one load step.
+
+The friction forces come from the C core (``IwanElement.step_batch`` on copies of
+the committed states: the trial; the copy of the converged iterate is committed).
+Node elements whose stiffnesses are one law's times a factor c (sliders c k_j with
+the same strengths fs_j, c k_res: the surface's Jenkins nodes, c the ratio of their
+k_t) share one C call: their slip radii fs_j N / (c k_j N_ref) are the reference's
+at N / c, so F_c(u, N) = c F_1(u, N / c), with the same slider positions z.
+
+Newton's tangent is the contacts' stiffness k_t (stick) or 0 (slip) in s and k_n
+(closed) or 0 (open) in p; the term dF_t/dN k_n (a slipping node's force following
+its closing) is left out, since the C batch call does not return it. The Newton
+still settles in a finite number of iterations on a surface: the normal rows of (E1)
+do not depend on the slips (the bodies' compliances are uncoupled between
+directions, :func:`.surface.node_stiffness`, the contact core's own assumption),
+so the normal set settles with its exact tangent and the tangential rows then with
+theirs. A backtracking line search on |r| keeps a node at a threshold from cycling.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .contact import ContactElement
+
+#: Newton stops when max |residual| is below this fraction of the history's force
+#: scale (largest of |r|, |A w|, |f_c|): the piecewise-linear laws give the exact
+#: step once the contact and stick/slip sets settle, down to round-off ~1e-13.
+RESIDUAL_RTOL = 1e-10
+#: Newton iterations in one step before the step counts as failed (RuntimeError).
+MAX_NEWTON = 40
+#: Relative tolerance of the homogeneity test that lets two node elements share a call.
+SAME_LAW_RTOL = 1e-12
+
+
+def _same_law(ref, f) -> float | None:
+    """Factor c with f's sliders c k_j, fs_j and c k_res (ref's k_j, fs_j, k_res; same N_ref, scale)."""
+    if f.n_sliders != ref.n_sliders or f.N_ref != ref.N_ref or f.scale != ref.scale:
+        return None
+    c = float(f.k[0] / ref.k[0])
+    same = (np.allclose(f.k, c * np.asarray(ref.k), rtol=SAME_LAW_RTOL, atol=0.0)
+            and np.allclose(f.fs, ref.fs, rtol=SAME_LAW_RTOL, atol=0.0)
+            and np.isclose(f.k_res, c * ref.k_res, rtol=SAME_LAW_RTOL, atol=0.0))
+    return c if same else None
+
+
+class MasslessContacts:
+    """The node contacts of the massless DOFs with ``n_h`` independent histories.
+
+    Parameters
+    ----------
+    elements : list of ContactElement
+        Each with one slip direction (m = 2) or normal only (m = 1), on DOFs in ``dofs``.
+    dofs : array_like of int, shape (n_b,)
+        The model DOFs of the massless set, in the order of w.
+    n_h : int
+        Number of histories (e.g. frequencies) advanced together.
+    """
+
+    def __init__(self, elements, dofs, n_h: int):
+        dofs = [int(d) for d in dofs]
+        where = {d: i for i, d in enumerate(dofs)}
+        n_b, n_c = len(dofs), len(elements)
+        self.n_b, self.n_h = n_b, int(n_h)
+        self.Qs, self.Qp = np.zeros((n_c, n_b)), np.zeros((n_c, n_b))
+        self.kn = np.array([el.k_n for el in elements], float)
+        self.p0 = np.array([el.preload for el in elements], float)
+        self.s0 = np.zeros(n_c)
+        groups = []   # [reference element, contact indices, factors]
+        for i, el in enumerate(elements):
+            if not isinstance(el, ContactElement) or el.m == 3:
+                raise ValueError("the massless DOFs take contacts with one slip direction (planar "
+                                 "surfaces, tangents ('x',)) or normal only")
+            kin = el.kinematics
+            if any(d not in where for d in kin.dofs) or kin.cyclic:
+                raise ValueError(f"contact {el.name!r} must act on massless DOFs only")
+            cols = [where[d] for d in kin.dofs]
+            self.Qp[i, cols] = kin.Q[-1]
+            if el.m == 2:
+                self.Qs[i, cols] = kin.Q[0]
+                self.s0[i] = el.slip_ref
+                for g in groups:
+                    c = _same_law(g[0], el.friction)
+                    if c is not None:
+                        g[1].append(i)
+                        g[2].append(c)
+                        break
+                else:
+                    groups.append([el.friction, [i], [1.0]])
+        self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
+        self.states = []
+        for ref, idx, c in self.groups:
+            N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
+            self.states.append(ref.initial_states(self.n_h * idx.size, np.tile(N0, self.n_h)))
+
+    def stuck_stiffness(self) -> np.ndarray:
+        """(n_b, n_b) [N/m]: every contact closed and stuck."""
+        kt = np.zeros(len(self.kn))
+        for ref, idx, c in self.groups:
+            kt[idx] = c * (np.sum(ref.k) + ref.k_res)
+        return self.Qs.T @ (kt[:, None] * self.Qs) + self.Qp.T @ (self.kn[:, None] * self.Qp)
+
+    def stuck_offset(self) -> np.ndarray:
+        """f_c(0) of the stuck linearisation, (n_b,) [N]: k_n p_0 and -k_t s_0."""
+        kt = np.zeros(len(self.kn))
+        for ref, idx, c in self.groups:
+            kt[idx] = c * (np.sum(ref.k) + ref.k_res)
+        return self.Qp.T @ (self.kn * self.p0) - self.Qs.T @ (kt * self.s0)
+
+    def evaluate(self, w: np.ndarray):
+        """Trial forces from the committed states.
+
+        Parameters
+        ----------
+        w : ndarray, shape (n_h, n_b)
+
+        Returns
+        -------
+        fc : ndarray (n_h, n_b) [N]
+        J : ndarray (n_h, n_b, n_b) [N/m], the tangent (module docstring)
+        trial : list of state buffers (the states at w, to :meth:`commit`)
+        """
+        P = w @ self.Qp.T + self.p0                   # (n_h, n_c) penetration
+        on = P > 0.0
+        N = self.kn * np.where(on, P, 0.0)
+        S = w @ self.Qs.T - self.s0
+        Ft, kt, trial = np.zeros_like(P), np.zeros_like(P), []
+        for (ref, idx, c), st in zip(self.groups, self.states):
+            tr = st.copy()
+            # unclamped k_n p: the C core treats N <= 0 as lift-off (as ContactElement)
+            F1, k1 = ref.step_batch(tr, S[:, idx].ravel(), ((self.kn[idx] * P[:, idx]) / c).ravel())
+            Ft[:, idx] = c * F1.reshape(self.n_h, -1)
+            kt[:, idx] = c * k1.reshape(self.n_h, -1)
+            trial.append(tr)
+        fc = Ft @ self.Qs + N @ self.Qp
+        J = (np.einsum("ci,hc,cj->hij", self.Qs, kt, self.Qs, optimize=True)
+             + np.einsum("ci,hc,cj->hij", self.Qp, self.kn * on, self.Qp, optimize=True))
+        return fc, J, trial
+
+    def commit(self, trial) -> None:
+        """Accept the trial states (those of the converged step)."""
+        self.states = trial
+
+    def dissipated(self) -> np.ndarray:
+        """Cumulative friction work of each history, (n_h,) [J]."""
+        W = np.zeros(self.n_h)
+        for (ref, idx, c), st in zip(self.groups, self.states):
+            W += (st["w_diss"].reshape(self.n_h, -1) * c).sum(axis=1)
+        return W
+
+    def keep(self, idx) -> None:
+        """Continue only the histories ``idx``."""
+        idx = np.asarray(idx, int)
+        self.states = [np.ascontiguousarray(st.reshape(self.n_h, -1)[idx].ravel())
+                       for st in self.states]
+        self.n_h = idx.size
+
+    def solve(self, A: np.ndarray, rhs: np.ndarray, guess: np.ndarray) -> np.ndarray:
+        """Solve (E1) for every history and commit the states there.
+
+        Parameters
+        ----------
+        A : ndarray (n_h, n_b, n_b) or (n_b, n_b)
+        rhs : ndarray (n_h, n_b) [N]
+        guess : ndarray (n_h, n_b) [m]
+
+        Returns
+        -------
+        w : ndarray (n_h, n_b)
+
+        Raises
+        ------
+        RuntimeError
+            Newton did not settle in MAX_NEWTON iterations.
+        """
+        A = np.broadcast_to(A, (self.n_h, self.n_b, self.n_b))
+        w = guess.copy()
+        fc, J, trial = self.evaluate(w)
+        r = np.einsum("hij,hj->hi", A, w) + fc - rhs
+        for _ in range(MAX_NEWTON):
+            scale = np.maximum(np.abs(rhs).max(axis=1), np.abs(fc).max(axis=1))
+            todo = np.abs(r).max(axis=1) > RESIDUAL_RTOL * np.maximum(scale, 1e-300)
+            if not todo.any():
+                self.commit(trial)
+                return w
+            dx = np.zeros_like(w)
+            dx[todo] = np.linalg.solve(A[todo] + J[todo], -r[todo][..., None])[..., 0]
+            w, r, fc, J, trial = self._line_search(A, rhs, w, r, fc, J, trial, dx, todo)
+        raise RuntimeError("the contact surface nodes found no equilibrium in a time step: "
+                           "raise the steps per period, or check that the surface stays in contact")
+
+    def _line_search(self, A, rhs, w, r, fc, J, trial, dx, todo):
+        """Backtracking on |r| per history (module docstring); returns the accepted iterate."""
+        norm = np.linalg.norm(r, axis=1)
+        alpha = np.where(todo, 1.0, 0.0)
+        pending = todo.copy()
+        while pending.any():
+            wt = w + alpha[:, None] * dx
+            fct, Jt, trt = self.evaluate(wt)
+            rt = np.einsum("hij,hj->hi", A, wt) + fct - rhs
+            ok = pending & ((np.linalg.norm(rt, axis=1) < (1.0 - 1e-4 * alpha) * norm)
+                            | (alpha < 1e-6))
+            w[ok], r[ok], fc[ok], J[ok] = wt[ok], rt[ok], fct[ok], Jt[ok]
+            for st, stt in zip(trial, trt):
+                m = st.size // self.n_h
+                st.reshape(self.n_h, m)[ok] = stt.reshape(self.n_h, m)[ok]
+            pending &= ~ok
+            alpha[pending] *= 0.5
+        return w, r, fc, J, trial
