@@ -149,8 +149,7 @@ class MasslessContacts:
             kt[:, idx] = c * k1.reshape(self.n_h, -1)
             trial.append(tr)
         fc = Ft @ self.Qs + N @ self.Qp
-        J = (np.einsum("ci,hc,cj->hij", self.Qs, kt, self.Qs, optimize=True)
-             + np.einsum("ci,hc,cj->hij", self.Qp, self.kn * on, self.Qp, optimize=True))
+        J = (self.Qs.T * kt[:, None, :]) @ self.Qs + (self.Qp.T * (self.kn * on)[:, None, :]) @ self.Qp
         return fc, J, trial
 
     def commit(self, trial) -> None:
@@ -160,7 +159,7 @@ class MasslessContacts:
     def dissipated(self) -> np.ndarray:
         """Cumulative friction work of each history, (n_h,) [J]."""
         W = np.zeros(self.n_h)
-        for (ref, idx, c), st in zip(self.groups, self.states):
+        for (_, _, c), st in zip(self.groups, self.states):
             W += (st["w_diss"].reshape(self.n_h, -1) * c).sum(axis=1)
         return W
 
@@ -192,7 +191,7 @@ class MasslessContacts:
         A = np.broadcast_to(A, (self.n_h, self.n_b, self.n_b))
         w = guess.copy()
         fc, J, trial = self.evaluate(w)
-        r = np.einsum("hij,hj->hi", A, w) + fc - rhs
+        r = (A @ w[..., None])[..., 0] + fc - rhs
         for _ in range(MAX_NEWTON):
             scale = np.maximum(np.abs(rhs).max(axis=1), np.abs(fc).max(axis=1))
             todo = np.abs(r).max(axis=1) > RESIDUAL_RTOL * np.maximum(scale, 1e-300)
@@ -213,7 +212,7 @@ class MasslessContacts:
         while pending.any():
             wt = w + alpha[:, None] * dx
             fct, Jt, trt = self.evaluate(wt)
-            rt = np.einsum("hij,hj->hi", A, wt) + fct - rhs
+            rt = (A @ wt[..., None])[..., 0] + fct - rhs
             ok = pending & ((np.linalg.norm(rt, axis=1) < (1.0 - 1e-4 * alpha) * norm)
                             | (alpha < 1e-6))
             w[ok], r[ok], fc[ok], J[ok] = wt[ok], rt[ok], fct[ok], Jt[ok]

@@ -35,6 +35,8 @@ stopping on its own).
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .contact import ContactElement
@@ -42,6 +44,13 @@ from .forces import LinearElement
 from .massless import MasslessContacts
 from .model import Model, _on_dofs
 from .timeint import _SS_HARMONICS, CFL, CurveSteadyState, _result, _settled_many
+
+
+@dataclass
+class SurfaceCurveSteadyState(CurveSteadyState):
+    """:class:`.timeint.CurveSteadyState` and the nodes' friction work over the last period."""
+
+    W_friction: np.ndarray | None = None   # (n_freq,) [J]
 
 
 def _split(model: Model):
@@ -120,7 +129,7 @@ class _SurfaceMarch:
         vb = (3 * w - 4 * self.w_m + self.w_mm) / (2 * dt)
         rhs = (self.fext[j][self.a] - xa @ self.Kaa.T - w @ self.Kab.T - vb @ self.Cab.T
                + (2 * xa - xa_m) @ self.Maa.T / dt**2 + xa_m @ self.Caa.T / (2 * dt))
-        xa_p = np.einsum("hij,hj->hi", self.Ainv, rhs)
+        xa_p = (self.Ainv @ rhs[..., None])[..., 0]
         va_p = (3 * xa_p - 4 * xa + xa_m) / (2 * dt)
         rhs_b = (self.fext[(j + 1) % self.ns][self.b] - xa_p @ self.Kba.T - va_p @ self.Cba.T
                  - (-4 * w + self.w_m) @ self.Cbb.T / (2 * dt))
@@ -156,7 +165,8 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
 
     Returns
     -------
-    CurveSteadyState (as :func:`.timeint.march_curve`)
+    SurfaceCurveSteadyState
+        As :func:`.timeint.march_curve`, with the friction work of the last period.
     """
     omegas = np.atleast_1d(np.asarray(omegas, dtype=float))
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
@@ -168,8 +178,9 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     hist, prev = np.empty((nf, ns)), np.zeros((nf, _SS_HARMONICS), complex)
     d, count = np.zeros((2, nf)), np.zeros(nf, int)
     out_hist, periods, conv = np.empty((nf, ns)), np.full(nf, max_periods), np.zeros(nf, bool)
-    steps = 0
+    steps, W = 0, np.zeros(nf)
     for p in range(1, max_periods + 1):
+        w_start = run.nodes.dissipated()
         for j in range(ns):
             hist[:, j] = run.response()      # x at t = j dt, as timeint.march
             run.step(j)
@@ -182,15 +193,16 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
         done = settled | (p == max_periods)
         if np.any(done):
             out_hist[act[done]], periods[act[done]], conv[act[done]] = hist[done], p, settled[done]
+            W[act[done]] = (run.nodes.dissipated() - w_start)[done]
             if np.all(done):
                 break
             keep = np.flatnonzero(~done)
             act, hist, prev, d, count = act[keep], hist[keep], prev[keep], d[:, keep], count[keep]
             run.keep(keep)
     res = [_result(w, out_hist[i], periods[i], ns, conv[i]) for i, w in enumerate(omegas)]
-    return CurveSteadyState(omegas, np.array([s.amplitude for s in res]),
-                            np.array([s.amplitude_h1 for s in res]), periods, conv, ns,
-                            out_hist, steps)
+    return SurfaceCurveSteadyState(omegas, np.array([s.amplitude for s in res]),
+                                   np.array([s.amplitude_h1 for s in res]), periods, conv, ns,
+                                   out_hist, steps, W)
 
 
 def steady_curve(model: Model, omegas, steps_per_period: int = 256, **kw):
