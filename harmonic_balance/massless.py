@@ -32,10 +32,17 @@ do not depend on the slips (the bodies' compliances are uncoupled between
 directions, :func:`.surface.node_stiffness`, the contact core's own assumption),
 so the normal set settles with its exact tangent and the tangential rows then with
 theirs. A backtracking line search on |r| keeps a node at a threshold from cycling.
+
+The massless DOFs fall apart into independent blocks (each face of each sector: a
+face's nodes couple through its bodies' stiffness only, the rigid inputs belong to
+the DOFs with mass; x and z are uncoupled): the connected components of the pattern
+of A and the contacts' rows, each solved on its own (dense, batched over histories).
 """
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
 
 from .contact import ContactElement
 
@@ -71,9 +78,11 @@ class MasslessContacts:
         The model DOFs of the massless set, in the order of w.
     n_h : int
         Number of histories (e.g. frequencies) advanced together.
+    pattern : ndarray (n_b, n_b) of bool, optional
+        Nonzeros of the linear operators A that :meth:`solve` will get (default: full).
     """
 
-    def __init__(self, elements, dofs, n_h: int):
+    def __init__(self, elements, dofs, n_h: int, pattern=None):
         dofs = [int(d) for d in dofs]
         where = {d: i for i, d in enumerate(dofs)}
         n_b, n_c = len(dofs), len(elements)
@@ -104,10 +113,28 @@ class MasslessContacts:
                 else:
                     groups.append([el.friction, [i], [1.0]])
         self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
+        self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
         self.states = []
         for ref, idx, c in self.groups:
             N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
             self.states.append(ref.initial_states(self.n_h * idx.size, np.tile(N0, self.n_h)))
+
+    def _blocks(self, pattern) -> None:
+        """Independent blocks: DOFs, their contacts and those contacts' rows on them."""
+        P = pattern | (self.Qs.T @ self.Qs != 0) | (self.Qp.T @ self.Qp != 0)
+        k, label = connected_components(csr_matrix(P | P.T), directed=False)
+        self.blocks = []
+        for b in range(k):
+            dofs = np.flatnonzero(label == b)
+            c = np.flatnonzero(np.any(self.Qs[:, dofs] != 0, axis=1)
+                               | np.any(self.Qp[:, dofs] != 0, axis=1))
+            self.blocks.append((dofs, c, self.Qs[np.ix_(c, dofs)], self.Qp[np.ix_(c, dofs)]))
+
+    def split(self, A: np.ndarray) -> list:
+        """The blocks of a linear operator A (n_b, n_b) or (n_h, n_b, n_b), for :meth:`solve`."""
+        A = np.asarray(A)
+        return [np.broadcast_to(A[..., dofs[:, None], dofs], (self.n_h, dofs.size, dofs.size)).copy()
+                for dofs, *_ in self.blocks]
 
     def stuck_stiffness(self) -> np.ndarray:
         """(n_b, n_b) [N/m]: every contact closed and stuck."""
@@ -133,7 +160,8 @@ class MasslessContacts:
         Returns
         -------
         fc : ndarray (n_h, n_b) [N]
-        J : ndarray (n_h, n_b, n_b) [N/m], the tangent (module docstring)
+        tangent : (kt, kp), each (n_h, n_c) [N/m]: slider and normal stiffness of each
+            contact (the tangent on q, module docstring)
         trial : list of state buffers (the states at w, to :meth:`commit`)
         """
         P = w @ self.Qp.T + self.p0                   # (n_h, n_c) penetration
@@ -149,8 +177,7 @@ class MasslessContacts:
             kt[:, idx] = c * k1.reshape(self.n_h, -1)
             trial.append(tr)
         fc = Ft @ self.Qs + N @ self.Qp
-        J = (self.Qs.T * kt[:, None, :]) @ self.Qs + (self.Qp.T * (self.kn * on)[:, None, :]) @ self.Qp
-        return fc, J, trial
+        return fc, (kt, self.kn * on), trial
 
     def commit(self, trial) -> None:
         """Accept the trial states (those of the converged step)."""
@@ -170,12 +197,13 @@ class MasslessContacts:
                        for st in self.states]
         self.n_h = idx.size
 
-    def solve(self, A: np.ndarray, rhs: np.ndarray, guess: np.ndarray) -> np.ndarray:
+    def solve(self, A: list, rhs: np.ndarray, guess: np.ndarray) -> np.ndarray:
         """Solve (E1) for every history and commit the states there.
 
         Parameters
         ----------
-        A : ndarray (n_h, n_b, n_b) or (n_b, n_b)
+        A : list of ndarray (n_h, m_k, m_k)
+            The blocks of A (:meth:`split`).
         rhs : ndarray (n_h, n_b) [N]
         guess : ndarray (n_h, n_b) [m]
 
@@ -188,10 +216,9 @@ class MasslessContacts:
         RuntimeError
             Newton did not settle in MAX_NEWTON iterations.
         """
-        A = np.broadcast_to(A, (self.n_h, self.n_b, self.n_b))
         w = guess.copy()
-        fc, J, trial = self.evaluate(w)
-        r = (A @ w[..., None])[..., 0] + fc - rhs
+        fc, tan, trial = self.evaluate(w)
+        r = self._residual(A, w, fc, rhs)
         for _ in range(MAX_NEWTON):
             scale = np.maximum(np.abs(rhs).max(axis=1), np.abs(fc).max(axis=1))
             todo = np.abs(r).max(axis=1) > RESIDUAL_RTOL * np.maximum(scale, 1e-300)
@@ -199,26 +226,36 @@ class MasslessContacts:
                 self.commit(trial)
                 return w
             dx = np.zeros_like(w)
-            dx[todo] = np.linalg.solve(A[todo] + J[todo], -r[todo][..., None])[..., 0]
-            w, r, fc, J, trial = self._line_search(A, rhs, w, r, fc, J, trial, dx, todo)
+            for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
+                J = (Ak[todo] + (Qs.T * tan[0][todo][:, None, c]) @ Qs
+                     + (Qp.T * tan[1][todo][:, None, c]) @ Qp)
+                dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+            w, r, fc, tan, trial = self._line_search(A, rhs, w, r, fc, tan, trial, dx, todo)
         raise RuntimeError("the contact surface nodes found no equilibrium in a time step: "
                            "raise the steps per period, or check that the surface stays in contact")
 
-    def _line_search(self, A, rhs, w, r, fc, J, trial, dx, todo):
+    def _residual(self, A, w, fc, rhs):
+        r = fc - rhs
+        for Ak, (dofs, *_) in zip(A, self.blocks):
+            r[:, dofs] += (Ak @ w[:, dofs, None])[..., 0]
+        return r
+
+    def _line_search(self, A, rhs, w, r, fc, tan, trial, dx, todo):
         """Backtracking on |r| per history (module docstring); returns the accepted iterate."""
         norm = np.linalg.norm(r, axis=1)
         alpha = np.where(todo, 1.0, 0.0)
         pending = todo.copy()
         while pending.any():
             wt = w + alpha[:, None] * dx
-            fct, Jt, trt = self.evaluate(wt)
-            rt = (A @ wt[..., None])[..., 0] + fct - rhs
+            fct, tant, trt = self.evaluate(wt)
+            rt = self._residual(A, wt, fct, rhs)
             ok = pending & ((np.linalg.norm(rt, axis=1) < (1.0 - 1e-4 * alpha) * norm)
                             | (alpha < 1e-6))
-            w[ok], r[ok], fc[ok], J[ok] = wt[ok], rt[ok], fct[ok], Jt[ok]
+            w[ok], r[ok], fc[ok] = wt[ok], rt[ok], fct[ok]
+            tan[0][ok], tan[1][ok] = tant[0][ok], tant[1][ok]
             for st, stt in zip(trial, trt):
                 m = st.size // self.n_h
                 st.reshape(self.n_h, m)[ok] = stt.reshape(self.n_h, m)[ok]
             pending &= ~ok
             alpha[pending] *= 0.5
-        return w, r, fc, J, trial
+        return w, r, fc, tan, trial

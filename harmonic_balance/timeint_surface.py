@@ -27,9 +27,10 @@ L-stable there (Hairer & Wanner, sec. V.1), so they relax to the quasi-static w 
 one step instead of ringing as the trapezoidal rule would. Both halves are second order;
 v_b(t_n) in (T1) is the BDF2 velocity of the steps already taken (explicit).
 
-Start: at rest at x_a = 0 with w from (T2) without velocities (the static equilibrium
-of the massless rows, the sliders virgin at w = 0, as the harmonic balance's
-convention of :mod:`.contact` with s_0 = 0). Steady state and step-size check as
+Start: at rest at x_a = x0 (default 0) with w from (T2) without velocities (the static
+equilibrium of the massless rows), the sliders virgin at s = s_0, as the harmonic
+balance's convention (:mod:`.contact`; x0 the frictionless prestress state whose slips
+are the s_0 of :func:`.contact.frictionless_statics`). Steady state and step-size check as
 :func:`.timeint.march_curve` (all frequencies of a curve marched together, each
 stopping on its own).
 """
@@ -92,11 +93,12 @@ def stable_steps(M_aa, K_cond, omega_min: float, steps: int) -> int:
 class _SurfaceMarch:
     """State of :func:`march_curve`: the DOFs with mass, the nodes, their histories."""
 
-    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int):
+    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int, x0=None):
         a, b, M, K, C, contacts = _split(model)
         nf = omegas.size
         self.a, self.b, self.r = a, b, model.response_dof
-        self.nodes = MasslessContacts(contacts, b, nf)
+        pattern = (K[np.ix_(b, b)] != 0) | (C[np.ix_(b, b)] != 0)
+        self.nodes = MasslessContacts(contacts, b, nf, pattern)
         Kbb = K[np.ix_(b, b)]
         Kcond = K[np.ix_(a, a)] - K[np.ix_(a, b)] @ np.linalg.solve(
             Kbb + self.nodes.stuck_stiffness(), K[np.ix_(b, a)])
@@ -109,17 +111,19 @@ class _SurfaceMarch:
         self.Maa, self.Caa = Maa, Caa
         self.Kaa, self.Kab, self.Kba, self.Kbb = K[np.ix_(a, a)], K[np.ix_(a, b)], K[np.ix_(b, a)], Kbb
         self.Cab, self.Cba, self.Cbb = C[np.ix_(a, b)], C[np.ix_(b, a)], C[np.ix_(b, b)]
-        self.Ab = Kbb + 1.5 * self.Cbb / dt[:, None, None]          # (T2)'s linear part
+        self.Ab = self.nodes.split(Kbb + 1.5 * self.Cbb / dt[:, None, None])   # (T2)'s linear part
         th = 2.0 * np.pi * np.arange(ns) / ns
         self.fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                         for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})
-        # start: rest, w from the static equilibrium of b (stuck linearisation as guess)
-        self.xa = np.zeros((nf, a.size))
+        # start: rest at x0, w from the static equilibrium of b (guess: x0's, else the
+        # stuck linearisation)
+        x0 = np.zeros(model.n) if x0 is None else np.asarray(x0, float)
+        self.xa = np.tile(x0[a], (nf, 1))
         self.xa_m = self.xa.copy()
-        rhs0 = np.tile(self.fext[0][b], (nf, 1))
-        guess = np.linalg.solve(Kbb + self.nodes.stuck_stiffness(),
-                                (rhs0 - self.nodes.stuck_offset()).T).T
-        self.w = self.nodes.solve(Kbb, rhs0, guess)
+        rhs0 = np.tile(self.fext[0][b], (nf, 1)) - self.xa @ self.Kba.T
+        guess = np.tile(x0[b], (nf, 1)) if np.any(x0 != 0.0) else np.linalg.solve(
+            Kbb + self.nodes.stuck_stiffness(), (rhs0 - self.nodes.stuck_offset()).T).T
+        self.w = self.nodes.solve(self.nodes.split(Kbb), rhs0, guess)
         self.w_m = self.w.copy()
         self.w_mm = self.w.copy()
 
@@ -144,13 +148,14 @@ class _SurfaceMarch:
 
     def keep(self, idx: np.ndarray) -> None:
         """Continue only the histories idx."""
-        for name in ("xa", "xa_m", "w", "w_m", "w_mm", "dt", "Ainv", "Ab"):
+        for name in ("xa", "xa_m", "w", "w_m", "w_mm", "dt", "Ainv"):
             setattr(self, name, getattr(self, name)[idx])
+        self.Ab = [A[idx] for A in self.Ab]
         self.nodes.keep(idx)
 
 
 def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: int = 3000,
-                tol: float = 1e-6) -> CurveSteadyState:
+                tol: float = 1e-6, x0=None) -> SurfaceCurveSteadyState:
     """March a model with massless DOFs at every frequency of ``omegas`` to periodic steady state.
 
     Parameters
@@ -162,6 +167,9 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     steps_per_period : int, raised if needed for stability at the lowest frequency
     max_periods : int
     tol : float, relative tolerance on the extrapolated distance to steady state
+    x0 : array_like (n,), optional
+        Start at rest [m]: the DOFs with mass there, the massless ones in equilibrium
+        (guess x0's); default 0 (e.g. a prestress state, its sliders virgin there).
 
     Returns
     -------
@@ -172,7 +180,7 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
         raise ValueError(f"omegas must be a non-empty 1-D array of positive numbers, got {omegas}")
     nf = omegas.size
-    run = _SurfaceMarch(model, omegas, steps_per_period)
+    run = _SurfaceMarch(model, omegas, steps_per_period, x0)
     ns = run.ns
     act = np.arange(nf)
     hist, prev = np.empty((nf, ns)), np.zeros((nf, _SS_HARMONICS), complex)
