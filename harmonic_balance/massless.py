@@ -123,6 +123,9 @@ class MasslessContacts:
                     groups.append([el.friction, [i], [1.0]])
         self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
         self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
+        # sparse copies for the products on all DOFs (a contact touches a few DOFs)
+        self._Qs, self._Qp = csr_matrix(self.Qs), csr_matrix(self.Qp)
+        self._QsT, self._QpT = self._Qs.T.tocsr(), self._Qp.T.tocsr()
         self.states = []
         for ref, idx, c in self.groups:
             N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
@@ -138,6 +141,16 @@ class MasslessContacts:
             c = np.flatnonzero(np.any(self.Qs[:, dofs] != 0, axis=1)
                                | np.any(self.Qp[:, dofs] != 0, axis=1))
             self.blocks.append((dofs, c, self.Qs[np.ix_(c, dofs)], self.Qp[np.ix_(c, dofs)]))
+
+    @staticmethod
+    def _add_tangent(J, Q, k):
+        """J += Q^T diag(k) Q for every history (J (n, m, m), Q (c, m), k (n, c)); a row of Q
+        with one entry (a node coordinate) adds to the diagonal only."""
+        if np.all(np.count_nonzero(Q, axis=1) <= 1):
+            col = np.argmax(Q != 0, axis=1)
+            np.add.at(J, (slice(None), col, col), k * Q[np.arange(len(col)), col] ** 2)
+            return J
+        return J + (Q.T * k[:, None, :]) @ Q
 
     def split(self, A: np.ndarray) -> list:
         """The blocks of a linear operator A (n_b, n_b) or (n_h, n_b, n_b), for :meth:`solve`."""
@@ -173,10 +186,10 @@ class MasslessContacts:
             contact (the tangent on q, module docstring)
         trial : list of state buffers (the states at w, to :meth:`commit`)
         """
-        P = w @ self.Qp.T + self.p0                   # (n_h, n_c) penetration
+        P = (self._Qp @ w.T).T + self.p0              # (n_h, n_c) penetration
         on = P > 0.0
         N = self.kn * np.where(on, P, 0.0)
-        S = w @ self.Qs.T - self.s0
+        S = (self._Qs @ w.T).T - self.s0
         Ft, kt, trial = np.zeros_like(P), np.zeros_like(P), []
         for (ref, idx, c), st in zip(self.groups, self.states):
             tr = st.copy()
@@ -191,7 +204,7 @@ class MasslessContacts:
             Ft[:, idx] = c * F1.reshape(self.n_h, -1)
             kt[:, idx] = c * ((F2 - F1) / ds).reshape(self.n_h, -1)
             trial.append(tr)
-        fc = Ft @ self.Qs + N @ self.Qp
+        fc = (self._QsT @ Ft.T + self._QpT @ N.T).T
         return fc, (kt, self.kn * on), trial
 
     def commit(self, trial) -> None:
@@ -242,8 +255,8 @@ class MasslessContacts:
                 return w
             dx = np.zeros_like(w)
             for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
-                J = (Ak[todo] + (Qs.T * tan[0][todo][:, None, c]) @ Qs
-                     + (Qp.T * tan[1][todo][:, None, c]) @ Qp)
+                J = self._add_tangent(self._add_tangent(Ak[todo], Qs, tan[0][todo][:, c]),
+                                      Qp, tan[1][todo][:, c])
                 dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
             w, r, fc, tan, trial = self._line_search(A, rhs, w, r, fc, tan, trial, dx, todo)
         raise RuntimeError("the contact surface nodes found no equilibrium in a time step: "
