@@ -137,3 +137,31 @@ def test_slow_forcing_gives_the_quasi_static_loop_of_the_surface(surface):
     assert work > 0.0
     assert 0.5 * (u.max() - u.min()) == pytest.approx(amplitude, rel=QS_RTOL)
     assert ti.W_friction[0] == pytest.approx(work, rel=QS_RTOL)
+
+
+#: Grouped call against each node's own element: the homogeneity F_c(u, N) = c F_1(u, N / c)
+#: is exact; the scaled inputs round differently (~1e-15 relative).
+GROUPED_RTOL = 1e-11
+
+
+def test_nodes_sharing_one_c_call_give_each_elements_own_forces(surface):
+    """The node contacts of a surface (one Jenkins law up to each node's k_t, one C call)
+    stepped along a random path give the forces of every node's own ContactElement."""
+    from harmonic_balance.massless import MasslessContacts
+
+    surf, static = surface
+    dofs = np.arange(surf.n_w)
+    nodes = MasslessContacts(surf.elements, dofs, 1)
+    assert len(nodes.groups) == 1
+    own = [el.stepper() for el in surf.elements]
+    rng = np.random.default_rng(20261127)
+    w0 = static.x[:surf.n_w]
+    slip = MU * NORMAL / ss.stuck_stiffness(surf, static)      # the face's gross-slip scale [m]
+    for _ in range(40):
+        w = w0.copy()
+        w[0::2] += slip * rng.uniform(-1.5, 1.5)                # a tangential sweep of all nodes
+        w[1::2] *= rng.uniform(0.7, 1.3)                        # the normal load breathing
+        fc, _, trial = nodes.evaluate(w[None, :])
+        nodes.commit(trial)
+        ref = np.concatenate([o.force(w[2 * i:2 * i + 2]) for i, o in enumerate(own)])
+        assert np.allclose(fc[0], ref, rtol=GROUPED_RTOL, atol=GROUPED_RTOL * np.abs(ref).max())
