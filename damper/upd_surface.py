@@ -13,6 +13,8 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
+
 #: Contact penalty of the UPD surfaces (relative to each node's own body stiffness). The
 #: harmonic balance's Newton converged at 100 and stalled at 1000 and 1e4 (UPD-24, 5 nodes per
 #: side, CF 300 N, H 3, 440 Hz: |R| stuck near 0.1-0.2 N); at 100 the quasi-static cylinder
@@ -58,4 +60,67 @@ def build_surfaces(cfg, nodes_per_side: int, cf: float | None = None, store=None
         cc = condense(replace(spec, grid=nodes, model=model), directions=("z", "x"),
                       cache=store if store is not None else False)
         out[face] = build(cc, p["mu"], penalty=DYNAMICS_PENALTY if penalty is None else penalty, tangents=("x",))
+    return out
+
+
+def check_options(args) -> None:
+    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run."""
+    from harmonic_balance.surface import check_nodes
+
+    if args.contacts != "surface":
+        return
+    check_nodes(args.surface_nodes)
+    if args.damper != "nonlinear":
+        raise ValueError(f"--contacts surface with --damper {args.damper}: the linear limits use the "
+                         "point model; drop --contacts surface or use --damper nonlinear")
+    if args.accuracy is not None:
+        raise ValueError("--contacts surface runs at the fixed --harmonics: drop --accuracy")
+
+
+def sector_hb(sector, args):
+    """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
+    from damper.cache import Store
+    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+
+    surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
+    hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)
+    args.surface_report = {face: {"nodes": s.n, "dofs": s.n_w, "nodes_per_side": args.surface_nodes}
+                           for face, s in surfaces.items()}
+    return hb
+
+
+def static_loads(hb) -> list:
+    """Prestress normal load per contact point [N]; with surfaces, per face (sum over its nodes)."""
+    N = hb.static["N"]
+    if not hasattr(hb, "surfaces"):
+        return N.tolist()
+    names = [e.name for e in hb.points]
+    return [float(sum(n for n, name in zip(N, names) if name.startswith(f"{face} node")))
+            for face in hb.surfaces]
+
+
+def face_summary(hb, summ: dict) -> dict:
+    """Per face (sums over its nodes): mean and range of N [N], the share of the period
+    lifted off (mean over its nodes of the share of the period), friction energy per cycle [J];
+    refuses a damper that left both faces; warns when a face loads its zone edge."""
+    out = {"names": [], "normal_load_mean": [], "normal_load_range": [], "lift_off": [],
+           "friction_energy": []}
+    for face in hb.surfaces:
+        idx = [i for i, name in enumerate(summ["names"]) if name.startswith(f"{face} node")]
+        out["names"].append(face)
+        out["normal_load_mean"].append(sum(summ["normal_load_mean"][i] for i in idx))
+        out["normal_load_range"].append(sum(summ["normal_load_range"][i] for i in idx))
+        out["lift_off"].append(float(np.mean([summ["lift_off"][i] for i in idx])))
+        out["friction_energy"].append(sum(summ["friction_energy"][i] for i in idx))
+    if max(out["normal_load_mean"]) <= 0.0:
+        raise RuntimeError("the damper lost contact on both faces at the peak (no node carries a "
+                           "load): raise --cf or lower --f0")
+    edge = [face for face, surf in hb.surfaces.items()
+            if any(summ["normal_load_mean"][i] + summ["normal_load_range"][i] > 0
+                   for i, name in enumerate(summ["names"])
+                   if name.startswith(f"{face} node ") and surf.zone_edge[int(name.split()[-1])])]
+    if edge:
+        out["warning_zone_edge"] = (f"warning: the {' and '.join(edge)} contact reaches the edge of its "
+                                    "potential zone at the peak: the surface cuts it there (raise "
+                                    "geometry.normal_load_left, which sizes the zone)")
     return out

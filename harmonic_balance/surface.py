@@ -134,6 +134,17 @@ class Surface:
             raise ValueError(f"this surface has no input {name!r}; it has {list(self.inputs)}")
         return self.n_w + self.inputs.index(name)
 
+    @property
+    def zone_edge(self) -> np.ndarray:
+        """Mask (n,) of nodes on the outer edge of the potential contact zone (a cylinder's
+        edge across its axis; none on a flat face, whose zone is the face): a load there
+        means the contact would reach beyond the modelled zone."""
+        from contact_core import bodies
+
+        body = self.contact.meta.get("spec", {}).get("body")
+        edge = None if body is None else bodies.get(body).zone_edge(self.contact.grid)
+        return np.zeros(self.n, bool) if edge is None else np.asarray(edge, bool)
+
     def normal_forces(self, x: np.ndarray) -> np.ndarray:
         """Nodal compressive forces f (n,) of the modelled part at DOFs x [N] (S2 / m_i)."""
         p = x[self.d - 1:self.n_w:self.d] - self.contact.grid.h

@@ -221,8 +221,12 @@ def preload(surface, force: float, eccentricity: float = 0.0,
     x[surface.input_dof("approach")] = surface.contact.grid.h.max()
     pres = {f"tangential_{t}": u for t, u in zip(surface.tangents, tangential)}
     state = step(surface, state, pres, loads, guess=x)
-    if not np.any(surface.normal_forces(state.x) > 0):
+    loaded = surface.normal_forces(state.x) > 0
+    if not np.any(loaded):
         raise RuntimeError("the contact surface lost contact at every node: raise the normal load")
+    if np.any(loaded & surface.zone_edge):
+        raise ValueError("the contact reaches the edge of the potential contact zone: condense with "
+                         "a larger zone (the spec's p_design or load_hint) for this load")
     return state
 
 

@@ -305,21 +305,9 @@ def _check_frf(args) -> None:
         if v is not None and not (np.isfinite(v) and v > 0):
             raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
     check_out_dir(args.plot, "--plot")
-    _check_surface(args)
+    from damper.upd_surface import check_options
 
-
-def _check_surface(args) -> None:
-    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run."""
-    from harmonic_balance.surface import check_nodes
-
-    if args.contacts != "surface":
-        return
-    check_nodes(args.surface_nodes)
-    if args.damper != "nonlinear":
-        raise ValueError(f"--contacts surface with --damper {args.damper}: the linear limits use the "
-                         "point model; drop --contacts surface or use --damper nonlinear")
-    if args.accuracy is not None:
-        raise ValueError("--contacts surface runs at the fixed --harmonics: drop --accuracy")
+    check_options(args)
 
 
 def run_frf(args) -> int:
@@ -347,6 +335,8 @@ def run_frf(args) -> int:
               f"{out['peak_amplitude']:.6e} m ({out['time_s']:.2f} s)")
         if "warning" in out:
             print(f"warning: {out['warning']}")
+        if out.get("zone_edge_warning"):
+            print(out["zone_edge_warning"])
     for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
@@ -386,15 +376,18 @@ def _frf_linear(sector, args, omegas) -> dict:
 
 def _frf_nonlinear(sector, args, omegas) -> dict:
     from damper import limits
+    from damper.upd_surface import static_loads
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import frf_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
 
     if args.contacts == "surface":
-        hb = _surface_hb(sector, args)
+        from damper.upd_surface import sector_hb
+
+        hb = sector_hb(sector, args)
         c = frf(hb, omegas)
-        rec = None
+        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
     elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
@@ -408,15 +401,18 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
         c.time_s = time.perf_counter() - t0
     summ = hb.contact_summary(c.peak_x)
     if args.contacts == "surface":
-        summ = _surface_summary(hb, summ)
+        from damper.upd_surface import face_summary
+
+        summ = face_summary(hb, summ)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
             "amplitude_max": c.amplitude_max.tolist(),
             "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
             "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
+            "zone_edge_warning": summ.get("warning_zone_edge"),
             "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
-            "static_normal_load": _static_loads(hb),
+            "static_normal_load": static_loads(hb),
             "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
             "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
             "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
@@ -424,47 +420,6 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
             "truncation_warning": warning(rec)}
     if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
         out["warning"] = c.extra["warning"]
-    return out
-
-
-def _surface_hb(sector, args):
-    """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
-    from damper.cache import Store
-    from damper.upd_surface import build_surfaces
-    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
-
-    surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
-    hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)
-    args.surface_report = {face: {"nodes": s.n, "dofs": s.n_w, "nodes_per_side": args.surface_nodes}
-                           for face, s in surfaces.items()}
-    return hb
-
-
-def _static_loads(hb) -> list:
-    """Prestress normal load per contact point [N]; with surfaces, per face (sum over its nodes)."""
-    N = hb.static["N"]
-    if not hasattr(hb, "surfaces"):
-        return N.tolist()
-    names = [e.name for e in hb.points]
-    return [float(sum(n for n, name in zip(N, names) if name.startswith(f"{face} node")))
-            for face in hb.surfaces]
-
-
-def _surface_summary(hb, summ: dict) -> dict:
-    """Per face (the sums over its nodes): mean and range of N [N], share of nodes ever
-    lifted off, friction energy per cycle [J]; refuses a damper that left both faces."""
-    out = {"names": [], "normal_load_mean": [], "normal_load_range": [], "lift_off": [],
-           "friction_energy": []}
-    for face in hb.surfaces:
-        idx = [i for i, name in enumerate(summ["names"]) if name.startswith(f"{face} node")]
-        out["names"].append(face)
-        out["normal_load_mean"].append(sum(summ["normal_load_mean"][i] for i in idx))
-        out["normal_load_range"].append(sum(summ["normal_load_range"][i] for i in idx))
-        out["lift_off"].append(float(np.mean([summ["lift_off"][i] for i in idx])))
-        out["friction_energy"].append(sum(summ["friction_energy"][i] for i in idx))
-    if max(out["normal_load_mean"]) <= 0.0:
-        raise RuntimeError("the damper lost contact on both faces at the peak (no node carries a "
-                           "load): raise --cf or lower --f0")
     return out
 
 

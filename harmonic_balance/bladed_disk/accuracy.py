@@ -26,7 +26,7 @@ MAX_HARMONIC = 50
 def check_sector(hb: SectorHB, H: int) -> SectorHB:
     """The same sector and loads with harmonics 0..H (at least ``hb``'s AFT samples)."""
     n_t = max(hb.basis.n_t, sector_basis(hb.sector, H).n_t)
-    return SectorHB(hb.sector, H, cf=hb.cf, f0=hb.f0, mu=hb.mu, n_t=n_t)
+    return hb.with_harmonics(H, n_t)
 
 
 #: Richer levels checked at the sector's peak: one (H' ~ 1.5 H). The sector's peak

@@ -175,6 +175,10 @@ class SectorHB:
     def _build_model(self) -> Model:
         return sector_model(self.sector, self.cf, self.f0, self.mu)
 
+    def with_harmonics(self, H: int, n_t: int = 0) -> SectorHB:
+        """The same sector, contacts and loads with harmonics 0..H (``n_t`` AFT samples)."""
+        return SectorHB(self.sector, H, cf=self.cf, f0=self.f0, mu=self.mu, n_t=n_t)
+
     @property
     def points(self):
         return [self.model.elements[i] for i in self.contacts]

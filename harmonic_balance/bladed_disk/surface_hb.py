@@ -138,6 +138,11 @@ class SurfaceSectorHB(SectorHB):
         self.surfaces = surfaces
         super().__init__(sector, H, cf, f0, mu, n_t)
 
+    def with_harmonics(self, H: int, n_t: int = 0) -> SurfaceSectorHB:
+        """The same sector, surfaces and loads with harmonics 0..H (``n_t`` AFT samples)."""
+        return SurfaceSectorHB(self.sector, self.surfaces, H, cf=self.cf, f0=self.f0, mu=self.mu,
+                               n_t=n_t)
+
     def _build_model(self) -> Model:
         sec = self.sector
         n = sec.n_dof

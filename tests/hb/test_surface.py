@@ -170,3 +170,12 @@ def test_planar_surface_gives_the_loop_of_the_3d_surface(condensed):
         loops.append(ss.hysteresis_loop(surface, state, a, steps=10)[0])
     tol = 1.0 / sf.PENALTY
     assert np.allclose(loops[1].T, loops[0].T, rtol=tol, atol=tol * np.abs(loops[0].T).max())
+
+
+def test_surface_whose_contact_reaches_the_zone_edge_is_refused(condensed):
+    """The cylinder's zone holds its Hertz contact at the design pressure (~450 N here):
+    at 1000 N the contact would reach beyond the modelled nodes."""
+    surface = sf.build(condensed("cylinder"), MU)
+    assert surface.zone_edge.any() and not sf.build(condensed("flat"), MU).zone_edge.any()
+    with pytest.raises(ValueError, match="edge of the potential contact zone"):
+        ss.preload(surface, 1000.0)
