@@ -24,10 +24,11 @@ the same strengths fs_j, c k_res: the surface's Jenkins nodes, c the ratio of th
 k_t) share one C call: their slip radii fs_j N / (c k_j N_ref) are the reference's
 at N / c, so F_c(u, N) = c F_1(u, N / c), with the same slider positions z.
 
-Newton's tangent is the slope of each node's trial map s -> F_t at its N (a forward
-difference of two C calls: with N changing along the step's straight path, the
+Newton's tangent is the slope of each node's trial map s -> F_t at its N (one-sided
+differences of three C calls: with N changing along the step's straight path, the
 element's own tangent, for continued motion, differs from it where a slider slipped
-inside the step) in s and k_n (closed) or 0 (open) in p; the term dF_t/dN k_n (a
+inside the step; at a kink, the slope of the side the node moves to) in s and k_n
+(closed) or 0 (open) in p; the term dF_t/dN k_n (a
 slipping node's force following its closing) is left out. The Newton
 still settles in a finite number of iterations on a surface: the normal rows of (E1)
 do not depend on the slips (the bodies' compliances are uncoupled between
@@ -59,6 +60,8 @@ MAX_NEWTON = 40
 #: Bracket doublings and regula-falsi steps of the line search, and the share of the
 #: potential's initial slope at which its minimum along the step counts as found.
 MAX_BRACKET, MAX_SECTION, SECTION_RTOL = 20, 30, 0.1
+#: Passes of the Newton step that settle the side of the nodes at a kink.
+MAX_SIDES = 4
 #: Forward-difference step of the trial map's slope, relative to the slip plus a slip radius.
 FD_REL = 1e-7
 #: Relative tolerance of the homogeneity test that lets two node elements share a call.
@@ -182,15 +185,16 @@ class MasslessContacts:
         Returns
         -------
         fc : ndarray (n_h, n_b) [N]
-        tangent : (kt, kp), each (n_h, n_c) [N/m]: slider and normal stiffness of each
-            contact (the tangent on q, module docstring)
+        tangent : (kt, kp, kt_minus), each (n_h, n_c) [N/m]: slider stiffness for an
+            increasing slip, normal stiffness, slider stiffness for a decreasing slip
+            (the one-sided slopes of the trial map, module docstring)
         trial : list of state buffers (the states at w, to :meth:`commit`)
         """
         P = (self._Qp @ w.T).T + self.p0              # (n_h, n_c) penetration
         on = P > 0.0
         N = self.kn * np.where(on, P, 0.0)
         S = (self._Qs @ w.T).T - self.s0
-        Ft, kt, trial = np.zeros_like(P), np.zeros_like(P), []
+        Ft, kt, ktm, trial = np.zeros_like(P), np.zeros_like(P), np.zeros_like(P), []
         for (ref, idx, c), st in zip(self.groups, self.states):
             tr = st.copy()
             s, n1 = S[:, idx].ravel(), ((self.kn[idx] * P[:, idx]) / c).ravel()
@@ -200,12 +204,14 @@ class MasslessContacts:
             # piecewise-linear map away from a kink within ds): with N changing along the
             # step's straight path the element's own tangent (for continued motion) is not it
             ds = FD_REL * (np.abs(s) + np.abs(n1) * np.sum(ref.fs) / (ref.N_ref * np.sum(ref.k)) + 1e-300)
-            F2 = ref.step_batch(st.copy(), s + ds, n1)[0]
+            F2 = ref.step_batch(st.copy(), s + ds, n1)[0].copy()
+            F0 = ref.step_batch(st.copy(), s - ds, n1)[0]
             Ft[:, idx] = c * F1.reshape(self.n_h, -1)
             kt[:, idx] = c * ((F2 - F1) / ds).reshape(self.n_h, -1)
+            ktm[:, idx] = c * ((F1 - F0) / ds).reshape(self.n_h, -1)
             trial.append(tr)
         fc = (self._QsT @ Ft.T + self._QpT @ N.T).T
-        return fc, (kt, self.kn * on), trial
+        return fc, (kt, self.kn * on, ktm), trial
 
     def commit(self, trial) -> None:
         """Accept the trial states (those of the converged step)."""
@@ -253,14 +259,32 @@ class MasslessContacts:
             if not todo.any():
                 self.commit(trial)
                 return w
-            dx = np.zeros_like(w)
-            for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
-                J = self._add_tangent(self._add_tangent(Ak[todo], Qs, tan[0][todo][:, c]),
-                                      Qp, tan[1][todo][:, c])
-                dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+            dx = self._newton_step(A, r, tan, todo)
             w, r, fc, tan, trial = self._line_search(A, rhs, w, r, fc, tan, trial, dx, todo)
         raise RuntimeError("the contact surface nodes found no equilibrium in a time step: "
                            "raise the steps per period, or check that the surface stays in contact")
+
+    def _newton_step(self, A, r, tan, todo):
+        """dx of every history in ``todo``: each node's slope taken on the side it moves to.
+
+        A node at a kink of its trial map (slope k on one side, 0 on the other) gets the
+        slope of the side its step points to; a step that reverses a node's side is solved
+        again with the other slope (a few passes settle the sides)."""
+        dx = np.zeros_like(r)
+        side = np.ones((self.n_h, len(self.kn)), bool)           # True: increasing slip
+        for _ in range(MAX_SIDES):
+            kt = np.where(side, tan[0], tan[2])
+            for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
+                J = self._add_tangent(self._add_tangent(Ak[todo], Qs, kt[todo][:, c]),
+                                      Qp, tan[1][todo][:, c])
+                dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+            ds = (self._Qs @ dx.T).T
+            kink = tan[0] != tan[2]
+            new = np.where(ds != 0.0, ds > 0.0, side)
+            if not np.any(kink & (new != side)):
+                break
+            side = np.where(kink, new, side)
+        return dx
 
     def _residual(self, A, w, fc, rhs):
         r = fc - rhs
@@ -285,7 +309,8 @@ class MasslessContacts:
         def take(ok, got):
             wt, rt, fct, tant, trt, _ = got
             w[ok], r[ok], fc[ok] = wt[ok], rt[ok], fct[ok]
-            tan[0][ok], tan[1][ok] = tant[0][ok], tant[1][ok]
+            for t, tt in zip(tan, tant):
+                t[ok] = tt[ok]
             for st, stt in zip(trial, trt):
                 m = st.size // self.n_h
                 st.reshape(self.n_h, m)[ok] = stt.reshape(self.n_h, m)[ok]
