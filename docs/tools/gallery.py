@@ -44,6 +44,7 @@ ARGS: dict[str, list[str]] = {
     "bench_tangential.py": ["--smoke"],                              # full: BEM 61, FE 21
     "bench_upd.py": ["--quick", "--workers", "1", "--out", "{out}"],  # full: ~1 h of TI; no process pool
     "upd_cosim.py": ["--quick", "--out", "{out}"],                   # full: ~15 min of co-simulation
+    "upd_surface_timeint.py": ["--quick"],                           # full: ~1 h of ring TI
     "bench_mistuning.py": ["--quick", "--rows", "scaling", "--out", "{out}"],  # full: N_b to 48, Dask: ~15 min
     "mistuning_confidence.py": ["--quick", "--out", "{out}"],        # full: 1000 + 4000 samples, ~30 min
 }

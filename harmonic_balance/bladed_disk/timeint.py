@@ -31,12 +31,15 @@ CFL = 0.5
 
 
 def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int = 0,
-               max_periods: int = 3000, tol: float = 1e-6, kappa=None) -> dict:
+               max_periods: int = 3000, tol: float = 1e-6, kappa=None, surfaces=None) -> dict:
     """Steady first-harmonic amplitude of the response DOF (u_a) of blade 0 at each
     frequency [rad/s].
 
     ``kappa`` (N_b,): blade stiffness factors; the whole ring of N_b blades is marched
     (:class:`.ring_hb.MistunedRingHB`'s model, the same elements as its HB).
+    ``surfaces`` {"left": Surface, "flat": Surface}: the damper's faces as contact
+    surfaces (:class:`.surface_hb.SurfaceSectorHB`'s model on the ring, marched by
+    :func:`.ring_surface.march_ring_surface`, whose dict is returned).
 
     Returns
     -------
@@ -47,6 +50,13 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     cfg = sector.cfg
     cf = cfg.cf if cf is None else float(cf)
     f0 = cfg.f0 if f0 is None else float(f0)
+    if surfaces is not None:
+        if kappa is not None:
+            raise ValueError("the ring with contact surfaces is tuned: drop the mistuning (kappa)")
+        from .ring_surface import march_ring_surface
+        from .surface_hb import SurfaceSectorHB
+        return march_ring_surface(SurfaceSectorHB(sector, surfaces, 1, cf=cf, f0=f0), omegas,
+                                  steps_per_period, max_periods, tol)
     # the ring's model, its contacts and prestress
     ring = (RingHB(sector, 1, cf=cf, f0=f0) if kappa is None
             else MistunedRingHB(sector, kappa, 1, cf=cf, f0=f0))

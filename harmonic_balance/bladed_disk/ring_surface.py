@@ -1,0 +1,90 @@
+"""Time-integration reference of the UPD ring with contact surfaces.
+
+The sector model of :class:`.surface_hb.SurfaceSectorHB` (the blade, its damper's
+faces as contact surfaces: massless node DOFs w, the bodies' condensed stiffness, one
+ContactElement per node) is unrolled onto the short ring of N_r sectors
+(:mod:`.ring`): sector j's DOFs (blade, damper and its nodes) are n j .. n (j + 1) - 1,
+and every cyclic element of the sector (the blade coupling, the flat face on blade
+j+1's platform) acts on sector j's DOFs through ``Q`` and on sector (j + 1) mod N_r's
+through ``Q_next``, at the same time (no phase: the ring carries it). The EO force on
+blade j is F0 cos(omega t + j phi). No cyclic-symmetry assumption, no Fourier series:
+the ring is marched by :func:`harmonic_balance.timeint_surface.march_curve` from the
+frictionless prestress state (its sliders virgin there, the harmonic balance's
+convention) to its periodic steady state.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..contact import ContactElement, frictionless_statics
+from ..forces import LinearElement
+from ..kinematics import Kinematics
+from ..linear import LinearModel
+from ..model import Model
+from ..timeint_surface import march_curve
+
+
+def _unrolled(kin: Kinematics, offset: int, next_offset: int) -> Kinematics:
+    """Kinematics of a sector element on ring DOFs (the neighbour's columns at next_offset)."""
+    if not kin.cyclic:
+        return Kinematics(np.asarray(kin.dofs) + offset, kin.Q)
+    dofs = np.r_[np.asarray(kin.dofs) + offset, np.asarray(kin.dofs) + next_offset]
+    Q = np.hstack([kin.Q, kin.Q_next])
+    uniq, inv = np.unique(dofs, return_inverse=True)   # N_r = 1: the neighbour is itself
+    Qu = np.zeros((Q.shape[0], uniq.size))
+    np.add.at(Qu.T, inv, Q.T)
+    return Kinematics(uniq, Qu)
+
+
+def _element_on_ring(el, offset: int, next_offset: int, blade: int):
+    kin = _unrolled(el.kinematics, offset, next_offset)
+    name = f"{el.name} blade {blade}"
+    if isinstance(el, LinearElement):
+        return LinearElement(kin, el.K, el.C, name=name)
+    if isinstance(el, ContactElement):
+        return ContactElement(kin, el.k_n, el.friction, preload=el.preload, beta_c=el.beta_c,
+                              name=name)
+    raise ValueError(f"element {el.name!r} ({type(el).__name__}) has no ring form")
+
+
+def surface_ring_model(shb) -> Model:
+    """The ring of N_r sectors of a SurfaceSectorHB's model (module docstring).
+
+    Parameters
+    ----------
+    shb : SurfaceSectorHB (or any SectorHB whose model's linear part is per sector)
+
+    Returns
+    -------
+    Model on N_r n DOFs; the response DOF is blade 0's.
+    """
+    sec, model = shb.sector, shb.model
+    nr, n, phi = sec.cfg.ring_blades, model.n, sec.cfg.phi
+    lin = model.linear
+    M, C, K = (np.kron(np.eye(nr), A) for A in (lin.M, lin.C, lin.K))
+    els = [_element_on_ring(el, n * j, n * ((j + 1) % nr), j)
+           for j in range(nr) for el in model.elements]
+    f_static = np.tile(np.real(model.forcing[0]), nr)
+    f_eo = np.concatenate([model.forcing[1] * np.exp(1j * phi * j) for j in range(nr)])
+    return Model(LinearModel(M=M, C=C, K=K), els, {0: f_static, 1: f_eo}, model.response_dof)
+
+
+def march_ring_surface(shb, omegas, steps_per_period: int = 0, max_periods: int = 3000,
+                       tol: float = 1e-6) -> dict:
+    """Steady response of blade 0's u_a on the ring with surfaces at each frequency [rad/s].
+
+    Returns
+    -------
+    dict: amplitude (n_f,) first-harmonic |u_a| of blade 0 [m] (the sector HB's
+    ``amplitude_h1``), amplitude_max (n_f,) peak |u_a - mean| [m], periods (n_f,),
+    converged (n_f,), steps_per_period, time_steps, W_friction (n_f,) [J] (all nodes of
+    the ring over the last period), ring_dofs.
+    """
+    ring = surface_ring_model(shb)
+    x0, _ = frictionless_statics(ring, apply=True)
+    res = march_curve(ring, omegas, steps_per_period, max_periods, tol, x0=x0)
+    mean = res.x_last.mean(axis=1, keepdims=True)
+    return {"amplitude": res.amplitude_h1, "amplitude_max": np.abs(res.x_last - mean).max(axis=1),
+            "periods": res.periods, "converged": res.converged,
+            "steps_per_period": res.steps_per_period, "time_steps": res.time_steps,
+            "W_friction": res.W_friction, "ring_dofs": ring.n}

@@ -1,0 +1,350 @@
+"""Quasi-static equilibrium of massless DOFs carrying contacts, one time step at a time.
+
+A contact surface (:mod:`.surface`) adds DOFs without mass: the relative
+displacements w of its node pairs (and rigid inputs held by a force only). In the
+time domain they are algebraic unknowns of a DAE (index 1: their equilibrium fixes
+them given the DOFs with mass); each time step solves, for every history h of a
+batch (the frequencies of a curve)::
+
+    A_h w + f_c(w) = r_h                                                  (E1)
+
+with A_h the massless rows' linear operator (stiffness, plus the damping of an
+implicit velocity, :mod:`.timeint_surface`), r_h the loads from the DOFs with mass
+and the forcing, and f_c the node contacts (:class:`~.contact.ContactElement`, C1,
+C2) reached from the committed friction states along the straight path in one step.
+This is one increment of the incremental plasticity problem (return mapping: trial
+states from the committed ones, committed only when the step's equilibrium is met;
+Simo & Hughes, *Computational Inelasticity*, 1998, ch. 1-2), solved by Newton on the
+contacts' consistent tangent as :mod:`.surface_static` does for one load step.
+
+The friction forces come from the C core (``IwanElement.step_batch`` on copies of
+the committed states: the trial; the copy of the converged iterate is committed).
+Node elements whose stiffnesses are one law's times a factor c (sliders c k_j with
+the same strengths fs_j, c k_res: the surface's Jenkins nodes, c the ratio of their
+k_t) share one C call: their slip radii fs_j N / (c k_j N_ref) are the reference's
+at N / c, so F_c(u, N) = c F_1(u, N / c), with the same slider positions z.
+
+Newton's tangent is the slope of each node's trial map s -> F_t at its N (one-sided
+differences of three C calls: with N changing along the step's straight path, the
+element's own tangent, for continued motion, differs from it where a slider slipped
+inside the step; at a kink, the slope of the side the node moves to) in s and k_n
+(closed) or 0 (open) in p; the term dF_t/dN k_n (a
+slipping node's force following its closing) is left out. The Newton
+still settles in a finite number of iterations on a surface: the normal rows of (E1)
+do not depend on the slips (the bodies' compliances are uncoupled between
+directions, :func:`.surface.node_stiffness`, the contact core's own assumption),
+so the normal set settles with its exact tangent and the tangential rows then with
+theirs. A backtracking line search on |r| keeps a node at a threshold from cycling.
+
+The massless DOFs fall apart into independent blocks (each face of each sector: a
+face's nodes couple through its bodies' stiffness only, the rigid inputs belong to
+the DOFs with mass; x and z are uncoupled): the connected components of the pattern
+of A and the contacts' rows, each solved on its own (dense, batched over histories).
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import csr_matrix
+from scipy.sparse.csgraph import connected_components
+
+from .contact import ContactElement
+
+#: Newton stops when max |residual| is below this fraction of the history's force
+#: scale (largest of |r|, |f_c|). The laws are piecewise linear, but a node exactly at a
+#: kink of its trial map at the solution (incipient slip) leaves Newton converging
+#: linearly (UPD ring: ~6 % per iteration below 1e-7 of the load); 1e-7 is far below
+#: the comparisons the time integration serves (1e-2 .. 1e-4).
+RESIDUAL_RTOL = 1e-7
+#: Newton iterations in one step before the step counts as failed (RuntimeError).
+MAX_NEWTON = 40
+#: Bracket doublings and regula-falsi steps of the line search, and the share of the
+#: potential's initial slope at which its minimum along the step counts as found.
+MAX_BRACKET, MAX_SECTION, SECTION_RTOL = 20, 30, 0.1
+#: Passes of the Newton step that settle the side of the nodes at a kink.
+MAX_SIDES = 4
+#: Forward-difference step of the trial map's slope, relative to the slip plus a slip radius.
+FD_REL = 1e-7
+#: Relative tolerance of the homogeneity test that lets two node elements share a call.
+SAME_LAW_RTOL = 1e-12
+
+
+def _same_law(ref, f) -> float | None:
+    """Factor c with f's sliders c k_j, fs_j and c k_res (ref's k_j, fs_j, k_res; same N_ref, scale)."""
+    if f.n_sliders != ref.n_sliders or f.N_ref != ref.N_ref or f.scale != ref.scale:
+        return None
+    c = float(f.k[0] / ref.k[0])
+    same = (np.allclose(f.k, c * np.asarray(ref.k), rtol=SAME_LAW_RTOL, atol=0.0)
+            and np.allclose(f.fs, ref.fs, rtol=SAME_LAW_RTOL, atol=0.0)
+            and np.isclose(f.k_res, c * ref.k_res, rtol=SAME_LAW_RTOL, atol=0.0))
+    return c if same else None
+
+
+class MasslessContacts:
+    """The node contacts of the massless DOFs with ``n_h`` independent histories.
+
+    Parameters
+    ----------
+    elements : list of ContactElement
+        Each with one slip direction (m = 2) or normal only (m = 1), on DOFs in ``dofs``.
+    dofs : array_like of int, shape (n_b,)
+        The model DOFs of the massless set, in the order of w.
+    n_h : int
+        Number of histories (e.g. frequencies) advanced together.
+    pattern : ndarray (n_b, n_b) of bool, optional
+        Nonzeros of the linear operators A that :meth:`solve` will get (default: full).
+    """
+
+    def __init__(self, elements, dofs, n_h: int, pattern=None):
+        dofs = [int(d) for d in dofs]
+        where = {d: i for i, d in enumerate(dofs)}
+        n_b, n_c = len(dofs), len(elements)
+        self.n_b, self.n_h = n_b, int(n_h)
+        self.Qs, self.Qp = np.zeros((n_c, n_b)), np.zeros((n_c, n_b))
+        self.kn = np.array([el.k_n for el in elements], float)
+        self.p0 = np.array([el.preload for el in elements], float)
+        self.s0 = np.zeros(n_c)
+        groups = []   # [reference element, contact indices, factors]
+        for i, el in enumerate(elements):
+            if not isinstance(el, ContactElement) or el.m == 3:
+                raise ValueError("the massless DOFs take contacts with one slip direction (planar "
+                                 "surfaces, tangents ('x',)) or normal only")
+            kin = el.kinematics
+            if any(d not in where for d in kin.dofs) or kin.cyclic:
+                raise ValueError(f"contact {el.name!r} must act on massless DOFs only")
+            cols = [where[d] for d in kin.dofs]
+            self.Qp[i, cols] = kin.Q[-1]
+            if el.m == 2:
+                self.Qs[i, cols] = kin.Q[0]
+                self.s0[i] = el.slip_ref
+                for g in groups:
+                    c = _same_law(g[0], el.friction)
+                    if c is not None:
+                        g[1].append(i)
+                        g[2].append(c)
+                        break
+                else:
+                    groups.append([el.friction, [i], [1.0]])
+        self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
+        self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
+        # sparse copies for the products on all DOFs (a contact touches a few DOFs)
+        self._Qs, self._Qp = csr_matrix(self.Qs), csr_matrix(self.Qp)
+        self._QsT, self._QpT = self._Qs.T.tocsr(), self._Qp.T.tocsr()
+        self.states = []
+        for ref, idx, c in self.groups:
+            N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
+            self.states.append(ref.initial_states(self.n_h * idx.size, np.tile(N0, self.n_h)))
+
+    def _blocks(self, pattern) -> None:
+        """Independent blocks: DOFs, their contacts and those contacts' rows on them."""
+        P = pattern | (self.Qs.T @ self.Qs != 0) | (self.Qp.T @ self.Qp != 0)
+        k, label = connected_components(csr_matrix(P | P.T), directed=False)
+        self.blocks = []
+        for b in range(k):
+            dofs = np.flatnonzero(label == b)
+            c = np.flatnonzero(np.any(self.Qs[:, dofs] != 0, axis=1)
+                               | np.any(self.Qp[:, dofs] != 0, axis=1))
+            self.blocks.append((dofs, c, self.Qs[np.ix_(c, dofs)], self.Qp[np.ix_(c, dofs)]))
+
+    @staticmethod
+    def _add_tangent(J, Q, k):
+        """J += Q^T diag(k) Q for every history (J (n, m, m), Q (c, m), k (n, c)); a row of Q
+        with one entry (a node coordinate) adds to the diagonal only."""
+        if np.all(np.count_nonzero(Q, axis=1) <= 1):
+            col = np.argmax(Q != 0, axis=1)
+            np.add.at(J, (slice(None), col, col), k * Q[np.arange(len(col)), col] ** 2)
+            return J
+        return J + (Q.T * k[:, None, :]) @ Q
+
+    def split(self, A: np.ndarray) -> list:
+        """The blocks of a linear operator A (n_b, n_b) or (n_h, n_b, n_b), for :meth:`solve`."""
+        A = np.asarray(A)
+        return [np.broadcast_to(A[..., dofs[:, None], dofs], (self.n_h, dofs.size, dofs.size)).copy()
+                for dofs, *_ in self.blocks]
+
+    def stuck_stiffness(self) -> np.ndarray:
+        """(n_b, n_b) [N/m]: every contact closed and stuck."""
+        kt = np.zeros(len(self.kn))
+        for ref, idx, c in self.groups:
+            kt[idx] = c * (np.sum(ref.k) + ref.k_res)
+        return self.Qs.T @ (kt[:, None] * self.Qs) + self.Qp.T @ (self.kn[:, None] * self.Qp)
+
+    def stuck_offset(self) -> np.ndarray:
+        """f_c(0) of the stuck linearisation, (n_b,) [N]: k_n p_0 and -k_t s_0."""
+        kt = np.zeros(len(self.kn))
+        for ref, idx, c in self.groups:
+            kt[idx] = c * (np.sum(ref.k) + ref.k_res)
+        return self.Qp.T @ (self.kn * self.p0) - self.Qs.T @ (kt * self.s0)
+
+    def evaluate(self, w: np.ndarray):
+        """Trial forces from the committed states.
+
+        Parameters
+        ----------
+        w : ndarray, shape (n_h, n_b)
+
+        Returns
+        -------
+        fc : ndarray (n_h, n_b) [N]
+        tangent : (kt, kp, kt_minus), each (n_h, n_c) [N/m]: slider stiffness for an
+            increasing slip, normal stiffness, slider stiffness for a decreasing slip
+            (the one-sided slopes of the trial map, module docstring)
+        trial : list of state buffers (the states at w, to :meth:`commit`)
+        """
+        P = (self._Qp @ w.T).T + self.p0              # (n_h, n_c) penetration
+        on = P > 0.0
+        N = self.kn * np.where(on, P, 0.0)
+        S = (self._Qs @ w.T).T - self.s0
+        Ft, kt, ktm, trial = np.zeros_like(P), np.zeros_like(P), np.zeros_like(P), []
+        for (ref, idx, c), st in zip(self.groups, self.states):
+            tr = st.copy()
+            s, n1 = S[:, idx].ravel(), ((self.kn[idx] * P[:, idx]) / c).ravel()
+            # unclamped k_n p: the C core treats N <= 0 as lift-off (as ContactElement)
+            F1 = ref.step_batch(tr, s, n1)[0].copy()
+            # the trial map's slope dF/ds at this N by a forward difference (exact on the
+            # piecewise-linear map away from a kink within ds): with N changing along the
+            # step's straight path the element's own tangent (for continued motion) is not it
+            ds = FD_REL * (np.abs(s) + np.abs(n1) * np.sum(ref.fs) / (ref.N_ref * np.sum(ref.k)) + 1e-300)
+            F2 = ref.step_batch(st.copy(), s + ds, n1)[0].copy()
+            F0 = ref.step_batch(st.copy(), s - ds, n1)[0]
+            Ft[:, idx] = c * F1.reshape(self.n_h, -1)
+            kt[:, idx] = c * ((F2 - F1) / ds).reshape(self.n_h, -1)
+            ktm[:, idx] = c * ((F1 - F0) / ds).reshape(self.n_h, -1)
+            trial.append(tr)
+        fc = (self._QsT @ Ft.T + self._QpT @ N.T).T
+        return fc, (kt, self.kn * on, ktm), trial
+
+    def commit(self, trial) -> None:
+        """Accept the trial states (those of the converged step)."""
+        self.states = trial
+
+    def dissipated(self) -> np.ndarray:
+        """Cumulative friction work of each history, (n_h,) [J]."""
+        W = np.zeros(self.n_h)
+        for (_, _, c), st in zip(self.groups, self.states):
+            W += (st["w_diss"].reshape(self.n_h, -1) * c).sum(axis=1)
+        return W
+
+    def keep(self, idx) -> None:
+        """Continue only the histories ``idx``."""
+        idx = np.asarray(idx, int)
+        self.states = [np.ascontiguousarray(st.reshape(self.n_h, -1)[idx].ravel())
+                       for st in self.states]
+        self.n_h = idx.size
+
+    def solve(self, A: list, rhs: np.ndarray, guess: np.ndarray) -> np.ndarray:
+        """Solve (E1) for every history and commit the states there.
+
+        Parameters
+        ----------
+        A : list of ndarray (n_h, m_k, m_k)
+            The blocks of A (:meth:`split`).
+        rhs : ndarray (n_h, n_b) [N]
+        guess : ndarray (n_h, n_b) [m]
+
+        Returns
+        -------
+        w : ndarray (n_h, n_b)
+
+        Raises
+        ------
+        RuntimeError
+            Newton did not settle in MAX_NEWTON iterations.
+        """
+        w = guess.copy()
+        fc, tan, trial = self.evaluate(w)
+        r = self._residual(A, w, fc, rhs)
+        for _ in range(MAX_NEWTON):
+            scale = np.maximum(np.abs(rhs).max(axis=1), np.abs(fc).max(axis=1))
+            todo = np.abs(r).max(axis=1) > RESIDUAL_RTOL * np.maximum(scale, 1e-300)
+            if not todo.any():
+                self.commit(trial)
+                return w
+            dx = self._newton_step(A, r, tan, todo)
+            w, r, fc, tan, trial = self._line_search(A, rhs, w, r, fc, tan, trial, dx, todo)
+        raise RuntimeError("the contact surface nodes found no equilibrium in a time step: "
+                           "raise the steps per period, or check that the surface stays in contact")
+
+    def _newton_step(self, A, r, tan, todo):
+        """dx of every history in ``todo``: each node's slope taken on the side it moves to.
+
+        A node at a kink of its trial map (slope k on one side, 0 on the other) gets the
+        slope of the side its step points to; a step that reverses a node's side is solved
+        again with the other slope (a few passes settle the sides)."""
+        dx = np.zeros_like(r)
+        side = np.ones((self.n_h, len(self.kn)), bool)           # True: increasing slip
+        for _ in range(MAX_SIDES):
+            kt = np.where(side, tan[0], tan[2])
+            for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
+                J = self._add_tangent(self._add_tangent(Ak[todo], Qs, kt[todo][:, c]),
+                                      Qp, tan[1][todo][:, c])
+                dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+            ds = (self._Qs @ dx.T).T
+            kink = tan[0] != tan[2]
+            new = np.where(ds != 0.0, ds > 0.0, side)
+            if not np.any(kink & (new != side)):
+                break
+            side = np.where(kink, new, side)
+        return dx
+
+    def _residual(self, A, w, fc, rhs):
+        r = fc - rhs
+        for Ak, (dofs, *_) in zip(A, self.blocks):
+            r[:, dofs] += (Ak @ w[:, dofs, None])[..., 0]
+        return r
+
+    def _line_search(self, A, rhs, w, r, fc, tan, trial, dx, todo):
+        """The step along dx per history (module docstring); returns the accepted iterate.
+
+        The full step unless it overshoots the minimum along dx; else the zero of g(alpha) = dx . r(w + alpha dx),
+        the slope of the step's incremental potential along dx, increasing in alpha (the
+        potential is convex: A symmetric positive, each node's trial map monotone), by
+        regula falsi (Illinois) on a bracket: a descent step even across the kinks where a
+        step on |r| stalls."""
+        def at(alpha, rows):
+            wt = w + alpha[:, None] * dx
+            fct, tant, trt = self.evaluate(wt)
+            rt = self._residual(A, wt, fct, rhs)
+            return wt, rt, fct, tant, trt, np.einsum("hi,hi->h", dx, rt)
+
+        def take(ok, got):
+            wt, rt, fct, tant, trt, _ = got
+            w[ok], r[ok], fc[ok] = wt[ok], rt[ok], fct[ok]
+            for t, tt in zip(tan, tant):
+                t[ok] = tt[ok]
+            for st, stt in zip(trial, trt):
+                m = st.size // self.n_h
+                st.reshape(self.n_h, m)[ok] = stt.reshape(self.n_h, m)[ok]
+
+        g0 = np.einsum("hi,hi->h", dx, r)
+        full = at(np.where(todo, 1.0, 0.0), todo)
+        ok = todo & (full[5] <= SECTION_RTOL * np.abs(g0))   # no overshoot of the minimum
+        pending = todo & ~ok
+        lo, glo = np.zeros(self.n_h), g0.copy()
+        hi, ghi = np.ones(self.n_h), full[5].copy()
+        for _ in range(MAX_BRACKET):                 # bracket the zero of g
+            grow = pending & (ghi < 0)
+            if not grow.any():
+                break
+            lo[grow], glo[grow], hi[grow] = hi[grow], ghi[grow], 2 * hi[grow]
+            ghi[grow] = at(np.where(grow, hi, 0.0), grow)[5][grow]
+        take(ok, full)
+        side = np.zeros(self.n_h, int)
+        for _ in range(MAX_SECTION):                 # Illinois regula falsi on [lo, hi]
+            if not pending.any():
+                break
+            a = np.where(pending, lo - glo * (hi - lo) / np.where(ghi != glo, ghi - glo, 1.0), 0.0)
+            got = at(a, pending)
+            g = got[5]
+            done = pending & (np.abs(g) <= SECTION_RTOL * np.abs(g0))
+            take(done, got)
+            pending &= ~done
+            up = pending & (g > 0)
+            dn = pending & ~(g > 0)
+            hi[up], ghi[up] = a[up], g[up]
+            lo[dn], glo[dn] = a[dn], g[dn]
+            glo[up & (side == 1)] *= 0.5
+            ghi[dn & (side == -1)] *= 0.5
+            side = np.where(up, 1, np.where(dn, -1, side))
+        if pending.any():
+            take(pending, at(np.where(pending, lo, 0.0), pending))
+        return w, r, fc, tan, trial
