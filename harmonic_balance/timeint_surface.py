@@ -211,19 +211,3 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     return SurfaceCurveSteadyState(omegas, np.array([s.amplitude for s in res]),
                                    np.array([s.amplitude_h1 for s in res]), periods, conv, ns,
                                    out_hist, steps, W)
-
-
-def steady_curve(model: Model, omegas, steps_per_period: int = 256, **kw):
-    """:func:`march_curve` at steps_per_period and twice as many (as :func:`.timeint.steady_curve`).
-
-    Returns (amplitude (n_freq,), amplitude_h1 (n_freq,), relative step-size error
-    estimate (n_freq,), finer CurveSteadyState); RuntimeError if a frequency did not settle.
-    """
-    a = march_curve(model, omegas, steps_per_period, **kw)
-    b = march_curve(model, omegas, 2 * a.steps_per_period, **kw)
-    bad = ~(a.converged & b.converged)
-    if np.any(bad):
-        raise RuntimeError("time integration did not reach steady state at omega = "
-                           f"{', '.join(f'{w:g}' for w in b.omega[bad])}")
-    err = np.abs(b.amplitude - a.amplitude) / np.maximum(b.amplitude, 1e-300)
-    return b.amplitude, b.amplitude_h1, err, b
