@@ -185,7 +185,7 @@ class FRFProblem:
         exact links (no sampling, ``FrictionLink.exact``) have none: 0."""
         samples = self.residual.link_samples(x)
         return max([self.basis.alias_ratio(F) for el, (_, F, _) in zip(self.residual.elements, samples)
-                    if not getattr(el, "exact", False)], default=0.0)
+                    if F is not None and not getattr(el, "exact", False)], default=0.0)
 
     def energy(self, x, omega) -> dict:
         """Energy per cycle [J]: excitation, viscous, friction (sampled loops), and the

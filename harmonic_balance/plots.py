@@ -44,7 +44,9 @@ def plot_frf(result, out_dir) -> list[Path]:
 
     x, w = result.peak_solution, result.peak_omega
     fig, ax = plt.subplots(figsize=(6, 4))
-    for (u, F, W), link in zip(prob.residual.link_samples(x), prob.model.links):
+    for (u, F, W), link in zip(prob.residual.link_samples(x), prob.residual.elements):
+        if u is None:   # no samples (a linear element): no loop to draw
+            continue
         ax.plot(np.append(u, u[0]), np.append(F, F[0]), label=f"{link.name} (W = {W:.3g} J)")
     ax.set(xlabel="relative displacement [m]", ylabel="friction force [N]",
            title=f"hysteresis loops at the peak, omega = {w:.6g} rad/s")

@@ -196,8 +196,11 @@ class _Residual:
         return self.force_to_residual(v, omega)
 
     def link_samples(self, x: np.ndarray, omega: float | None = None):
-        """Per element: first local displacement, its force over one period (n_t,) each, and W."""
-        return [(r.q[:, 0], r.f[:, 0], r.W) for r in self.evaluate(x, omega, jac=False)]
+        """Per element: first local displacement, its force over one period (n_t,) each, and W;
+        the samples are None for an element evaluated without them (a LinearElement's
+        harmonics are exact, it has no AFT samples)."""
+        return [(None if r.q is None else r.q[:, 0], None if r.f is None else r.f[:, 0], r.W)
+                for r in self.evaluate(x, omega, jac=False)]
 
     def stuck_operator(self) -> np.ndarray:
         """Stiffness (size, size) of every element stuck (``stuck_stiffness``), element by element."""
