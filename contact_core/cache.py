@@ -29,6 +29,11 @@ from .fileio import atomic_write
 
 ENV_VAR = "DAMPER_CACHE_DIR"
 DEFAULT_DIR = ".damper_cache"
+#: The Cache Directory Tagging file (https://bford.info/cachedir/). A folder this cache
+#: starts is tagged, so backup tools skip it and the damper application's store, whose
+#: default folder is the same, takes it for a cache rather than a user's folder.
+TAG_NAME = "CACHEDIR.TAG"
+TAG_SIGNATURE = "Signature: 8a477f597d28d172789f06886806bc55"
 
 
 @runtime_checkable
@@ -104,6 +109,17 @@ class DiskCache:
 
     def put(self, key: str, arrays: dict, meta: dict) -> Path:
         """Store ``arrays`` (name -> ndarray) and ``meta`` (JSON-able) under ``key``."""
+        self._tag_new_folder()
         buf = io.BytesIO()
         np.savez(buf, meta=np.array(json.dumps(meta, default=str)), **arrays)
         return atomic_write(self.path(key), buf.getvalue())
+
+    def _tag_new_folder(self) -> None:
+        """Create the folder with its TAG_NAME when it is new or empty (a folder already
+        holding files is left as it is: it may be the user's)."""
+        tag = self.folder / TAG_NAME
+        if tag.exists() or (self.folder.is_dir() and any(self.folder.iterdir())):
+            return
+        self.folder.mkdir(parents=True, exist_ok=True)
+        atomic_write(tag, (f"{TAG_SIGNATURE}\n# This file is a cache directory tag created by "
+                           "contact_core: its entries can be recomputed.\n").encode())

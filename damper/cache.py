@@ -55,6 +55,7 @@ from pathlib import Path
 
 import numpy as np
 
+from contact_core.cache import TAG_NAME, TAG_SIGNATURE
 from contact_core.fileio import atomic_write, new_file_mode
 
 ENV_DIR = "DAMPER_CACHE_DIR"
@@ -71,8 +72,6 @@ TEMP_NAME = re.compile(r"^\.entry-[0-9a-z_-]+\.damper-cache\..*\.tmp$")
 #: The tag while another run writes it, and the eviction lock (a folder holding only
 #: these, entries and their temporary files is being made a cache by another run).
 TAG_TEMP = re.compile(r"^(CACHEDIR\.TAG|\.CACHEDIR\.TAG\..*\.tmp|\.lock)$")
-TAG_NAME = "CACHEDIR.TAG"
-TAG_SIGNATURE = "Signature: 8a477f597d28d172789f06886806bc55"
 TAG_TEXT = (f"{TAG_SIGNATURE}\n# This file is a cache directory tag created by damper (the friction-damper\n"
             "# toolkit): its entries can be recomputed. See https://bford.info/cachedir/\n")
 #: Format of the JSON object inside an entry (key, stage, meta).

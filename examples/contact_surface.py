@@ -30,6 +30,7 @@ from contact_core.condense import condense
 from contact_core.fileio import atomic_write
 from contact_core.spec import ContactSpec
 from contact_core.tangential import TangentialProblem
+from damper.cache import Store
 from harmonic_balance import surface as sf
 from harmonic_balance import surface_static as ss
 
@@ -95,15 +96,19 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", type=Path, default=Path("out/contact_surface"))
     p.add_argument("--quick", action="store_true", help="the tests' grids (15 and 9)")
-    p.add_argument("--cache-dir", default=None, help="condensation cache (default: contact_core's)")
+    p.add_argument("--cache-dir", default=None, help="condensation cache (default: the damper cache's "
+                   "folder, $DAMPER_CACHE_DIR or .damper_cache)")
     args = p.parse_args(argv)
+    # the damper's own store (tagged folder, size limit), as every damper stage uses: a
+    # bare contact_core DiskCache in the same default folder would make it a foreign one
+    cache = Store(args.cache_dir).prepare()
     grids = {"cylinder": 15, "flat": 9} if args.quick else {"cylinder": 21, "flat": 13}
     rows = []
     print(f"{'case':9} {'nodes':>5} {'contact':>7} {'k_t err':>9} {'W err':>9} {'T err':>9} "
           f"{'p err':>9} {'set':>4} {'core s':>7} {'surf s':>7}")
     for name, geo, force, e in CASES:
         spec = ContactSpec(**geo, grid=grids[geo["body"]])
-        r = run_case(spec, force, e, args.cache_dir)
+        r = run_case(spec, force, e, cache)
         rows.append((name, r))
         print(f"{name:9} {r['nodes']:5d} {r['contact']:7d} {r['k_t']:9.1e} {r['W']:9.1e} {r['T']:9.1e} "
               f"{r['p']:9.1e} {'=' if r['same_set'] else 'DIFF':>4} {r['t_core']:7.2f} {r['t_surface']:7.2f}")

@@ -119,3 +119,32 @@ def test_two_concurrent_runs_of_one_scene_share_the_cache_safely(tmp_path):
     third = json.loads(subprocess.run(cmd + ["--out", str(tmp_path / "out3")], capture_output=True,
                                       text=True, check=True).stdout)
     assert {s["action"] for s in third["stages"]} <= {"cached", "skip"}
+
+
+def test_a_folder_started_by_the_contact_core_cache_is_the_stores_too(tmp_path):
+    """contact_core's DiskCache and the damper store share the default folder: one that
+    the library's cache started carries the tag, so the store uses it instead of refusing
+    it as a user's folder (a gallery run of two examples met that refusal)."""
+    import numpy as np
+
+    from contact_core.cache import DiskCache
+    from damper.cache import Store, is_cache_folder
+
+    folder = tmp_path / "shared"
+    DiskCache(folder).put("abc", {"a": np.ones(2)}, {"m": 1})
+    assert is_cache_folder(folder)
+    store = Store(folder).prepare()
+    store.put("k1", {"x": np.zeros(3)}, {"n": 2})
+    assert store.get("k1")[1] == {"n": 2}
+    assert DiskCache(folder).get("abc")[1] == {"m": 1}
+
+
+def test_the_contact_core_cache_does_not_tag_a_folder_of_yours(tmp_path):
+    """A folder that already holds other files gets entries but no tag (it may be the user's)."""
+    import numpy as np
+
+    from contact_core.cache import TAG_NAME, DiskCache
+
+    (tmp_path / "notes.txt").write_text("mine")
+    DiskCache(tmp_path).put("abc", {"a": np.ones(2)}, {})
+    assert not (tmp_path / TAG_NAME).exists()
