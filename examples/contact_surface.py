@@ -1,5 +1,5 @@
 """Contact surface: the condensed faces as 3D contact points against the contact core.
-==================================================================================
+===================================================================================
 
 The contact surface of the harmonic balance (``harmonic_balance.surface``: one 3D
 contact point per node pair of the condensed FE faces, penalty normal with lift-off,

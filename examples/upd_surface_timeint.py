@@ -1,4 +1,5 @@
 """UPD-24 with contact surfaces: the sector harmonic balance against the ring time integration.
+============================================================================================
 
 The damper's faces as planar contact surfaces (``damper upd frf --contacts surface``,
 :class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`) solved by harmonic

@@ -1,11 +1,11 @@
 """Time-integration reference for models with massless DOFs (contact surfaces).
 
 A contact surface (:mod:`.surface`) joins its node DOFs w to a model without mass:
-M is singular and the explicit scheme of :mod:`.timeint` cannot advance them. The
+M is singular and the explicit scheme of :mod:`harmonic_balance.timeint` cannot advance them. The
 DOFs split into those with mass (a, M_aa invertible, M_ab = 0) and the massless
 ones (b, carrying every node contact); each time step of length dt::
 
-    a: central differences at t_n (as :mod:`.timeint`, C_aa implicit)
+    a: central differences at t_n (as :mod:`harmonic_balance.timeint`, C_aa implicit)
        M_aa (x_a+ - 2 x_a + x_a-) / dt^2 + C_aa (x_a+ - x_a-) / (2 dt)
            = f_a(t_n) - K_aa x_a - K_ab w - C_ab v_b(t_n)                    (T1)
     b: equilibrium at t_(n+1), velocities by the backward difference (BDF2)

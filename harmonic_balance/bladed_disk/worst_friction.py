@@ -18,7 +18,7 @@ with the Jacobian J = dR/dx at (x*, omega*)::
     dR/dkappa_i = P_i (I (x) K0) x*                                             (WF1)
 
 P_i keeping blade i's rows (in (R1) the pattern enters only through the scaled
-blockdiag(K0), :mod:`.mistuning` (M1)). (WF1) is the derivative wherever the worst
+blockdiag(K0), :mod:`harmonic_balance.bladed_disk.mistuning` (M1)). (WF1) is the derivative wherever the worst
 blade and its peak are unique and the contacts' stick-slip pattern does not switch:
 the residual is only piecewise smooth in x (friction), so the objective is too, and a
 line search may stop on a kink.
