@@ -118,7 +118,14 @@ def pad(x: np.ndarray, basis: FourierBasis, rich: FourierBasis) -> np.ndarray:
 
 
 def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
-    """Refined peak of ``amplitude`` on the branch of ``fun`` near the given points.
+    """Refined peak of ``amplitude`` on the branch of ``fun`` near the given points:
+    (x, omega, amplitude, solves) of :func:`peak_window`."""
+    return peak_window(fun, amplitude, xs, omegas, i, tol, tol_lam)[:4]
+
+
+def peak_window(fun, amplitude, xs, omegas, i, tol, tol_lam, window: int = WINDOW):
+    """Refined peak of ``amplitude`` on the branch of ``fun`` near the given points, and the
+    corrected points of the window searched.
 
     Parameters
     ----------
@@ -129,10 +136,13 @@ def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
     i : int, index of the curve's peak in ``xs``
     tol : float, Newton tolerance on |R|_2
     tol_lam : float, tolerance on the peak frequency [rad/s]
+    window : int, points on each side of ``i`` corrected first (more when the peak lies
+        at the window's end)
 
     Returns
     -------
-    x, omega, amplitude, solves (int); RuntimeError when no peak is found.
+    x, omega, amplitude, solves (int), window (dict index -> (N,) corrected solution, or
+    None where Newton failed); RuntimeError when no peak is found.
     """
     solved = {}
 
@@ -148,7 +158,7 @@ def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
             except NewtonError:
                 solved[j] = None
         return solved[j]
-    lo, hi = max(i - WINDOW, 0), min(i + WINDOW, len(xs) - 1)
+    lo, hi = max(i - window, 0), min(i + window, len(xs) - 1)
     for _ in range(MAX_EXTEND + 1):
         idx = [j for j in range(lo, hi + 1) if at(j) is not None]
         if len(idx) < 3:
@@ -159,7 +169,7 @@ def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
             break
         if (top == 0 and lo == 0) or (top == len(idx) - 1 and hi == len(xs) - 1):
             raise RuntimeError("the peak with the richer harmonic set lies at the band's end")
-        lo, hi = (max(lo - WINDOW, 0), hi) if top == 0 else (lo, min(hi + WINDOW, len(xs) - 1))
+        lo, hi = (max(lo - window, 0), hi) if top == 0 else (lo, min(hi + window, len(xs) - 1))
     else:
         raise RuntimeError("the peak with the richer harmonic set is outside the window searched")
     j = idx[top]
@@ -167,7 +177,7 @@ def peak_at(fun, amplitude, xs, omegas, i, tol, tol_lam):
     branch = Branch(x=[solved[k0], solved[j], solved[k1]],
                     lam=[omegas[k0], omegas[j], omegas[k1]], iterations=[0, 0, 0])
     x, w, a, n = refine_max(fun, branch, 1, amplitude, tol, tol_lam)
-    return x, w, a, len(solved) + n
+    return x, w, a, len(solved) + n, solved
 
 
 def observed_order(levels) -> float | None:
@@ -253,6 +263,181 @@ def warning(record: dict | None, limit: float = WARN_REL) -> str | None:
     e = record["peak_amplitude_rel"]
     if e <= limit:
         return None
+    how = ("from the levels below it" if record.get("levels")
+           else f"checked at H = {record['H_check']}")
     return (f"warning: estimated truncation error of the peak amplitude {100 * e:.2g} % "
-            f"(H = {record['H_used']}, checked at H = {record['H_check']}) exceeds "
+            f"(H = {record['H_used']}, {how}) exceeds "
             f"{100 * limit:g} %: raise the harmonics or ask for an accuracy")
+
+
+# --- a peak to an accuracy: the curve once, richer harmonic sets at its peak only ---------
+
+#: Margin on the H predicted to meet a tolerance (the order is an estimate).
+H_MARGIN = 1.15
+#: Largest factor on H from one level to the next: an order below the true one would
+#: otherwise overshoot (the 3-mass chain at 1e-3 from H = 3: order ~4, predicted H = 40
+#: where 11 suffices).
+RAISE_MAX = 2.5
+#: Points on each side of the previous level's peak corrected at a level after the first.
+LEVEL_WINDOW = 1
+#: Smallest factor on H between predicted levels: closer levels differ too little for the
+#: order to be told from the corrector's tolerance.
+MIN_STEP = 1.25
+#: Levels (the curve's H and the peak's richer sets) before a target counts as met: three
+#: give the observed order; two rely on the assumed one, which misjudges a slowly
+#: converging peak (the 5-mass chain, order ~0.5) several times.
+MIN_LEVELS = 3
+
+
+def richest_error(levels) -> dict:
+    """Estimated relative truncation error of the RICHEST level's peak.
+
+    Parameters
+    ----------
+    levels : list of (H, peak_amplitude, peak_omega), increasing H, at least two
+
+    Returns
+    -------
+    dict: peak_amplitude_rel, peak_frequency_rel (None when a value is not finite),
+    order_observed (p from the last three levels, :func:`observed_order`, or None), order
+    (p used), extrapolated (peak_amplitude, peak_omega at H -> infinity, or None without
+    an observed order).
+
+    The error of the richest value v_K is Richardson's (Roache 1998, eq. 5.4.1),
+    |v_K - v_inf| = |v_K - v_{K-1}| / ((H_K / H_{K-1})^p - 1), with the observed order
+    when the last three levels give one in ORDER_RANGE, else ASSUMED_ORDER.
+    """
+    out = {}
+    for key, col in (("amplitude", 1), ("omega", 2)):
+        seq = [(lv[0], lv[col]) for lv in levels]
+        out[key] = _richest(seq)
+    (e_a, a_inf, p), (e_w, w_inf, _) = out["amplitude"], out["omega"]
+    return {"peak_amplitude_rel": e_a, "peak_frequency_rel": e_w, "order_observed": p,
+            "order": ASSUMED_ORDER if p is None else p,
+            "extrapolated": None if a_inf is None else {"peak_amplitude": a_inf, "peak_omega": w_inf}}
+
+
+def _richest(seq):
+    """(relative error of the last value, extrapolated value or None, observed order or
+    None) of a sequence (H, value) of increasing H (:func:`richest_error`)."""
+    if len(seq) < 2 or not all(np.isfinite(v) for _, v in seq):
+        return None, None, None
+    p = observed_order(seq) if len(seq) >= 3 else None
+    (H1, v1), (H2, v2) = seq[-2], seq[-1]
+    d = (v2 - v1) / ((H2 / H1) ** (ASSUMED_ORDER if p is None else p) - 1.0)
+    return abs(d) / abs(v2 + d), (None if p is None else v2 + d), p
+
+
+def next_level(hs: tuple, levels, error, tol: float, limit: int) -> tuple | None:
+    """The harmonic set of the next peak level after ``hs`` (the richest so far), or None
+    when ``limit`` leaves no richer set.
+
+    Until MIN_LEVELS levels exist (or without an estimate): :func:`richer` (~1.5 H). Then
+    the H predicted to meet ``tol``, H_K (e_K / tol)^(1/p) H_MARGIN, kept within
+    [MIN_STEP H_K, RAISE_MAX H_K] (``error``: the :func:`richest_error` record).
+    """
+    e = None if error is None else error["peak_amplitude_rel"]
+    if len(levels) < MIN_LEVELS or not e:
+        nxt = richer(hs, limit=limit)
+    else:
+        want = (e / tol) ** (1.0 / error["order"]) * H_MARGIN
+        nxt = richer(hs, min(max(want, MIN_STEP), RAISE_MAX), limit)
+    return None if nxt == tuple(hs) else nxt
+
+
+def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: int, tol_lam: float) -> dict:
+    """The peak of a curve re-solved at successively richer harmonic sets, on a short
+    branch around it only, until the richest level's estimated error is below ``tol``.
+
+    Parameters
+    ----------
+    problem_at : callable (harmonics tuple) -> (fun, amplitude, newton_tol, basis) of the
+        same model at that set (``fun(x, omega) -> (R, dR/dx, dR/domega)``,
+        ``amplitude(x, omega) -> float``)
+    basis : FourierBasis of the curve
+    xs : list of (N,) arrays, the curve's solutions at ``omegas`` [rad/s] (monotone)
+    i : int, index of the curve's highest point
+    level0 : (H, peak_amplitude, peak_omega) of the curve's refined peak
+    tol : float, relative target on the peak amplitude
+    limit : int, highest harmonic of a level
+    tol_lam : float, tolerance on the peak frequency [rad/s]
+
+    Returns
+    -------
+    dict: levels (list of (H, amplitude, omega), the curve's first), harmonics (set of the
+    richest level), x (its peak solution, None when no level beyond the curve was
+    solved), error (:func:`richest_error` of the levels, None with one level), met
+    (bool), message (why not met, else None), solves (Newton solves at the levels).
+
+    Each level's starting guesses are the previous level's corrected window padded with
+    zeros (:func:`pad`), the other curve points padded from the curve; the window moves
+    with the peak.
+    """
+    levels, hs, cur, x_peak, solves = [tuple(level0)], tuple(basis.harmonics), list(xs), None, 0
+    error, message = None, None
+    while True:
+        nxt = next_level(hs, levels, error, tol, limit)
+        if nxt is None:
+            message = f"H = {hs[-1]} at the peak is the limit H <= {limit}"
+            break
+        fun, amplitude, ntol, rich = problem_at(nxt)
+        guesses = [pad(x, basis, rich) for x in cur]
+        try:
+            # the first level looks around the curve's peak; later ones around the previous
+            # level's, which moves less than a grid step
+            x, w, a, n, window = peak_window(fun, amplitude, guesses, omegas, i, ntol, tol_lam,
+                                             WINDOW if len(levels) == 1 else LEVEL_WINDOW)
+        except RuntimeError as err:
+            message = f"the peak at H = {nxt[-1]} failed ({err}); H = {hs[-1]} kept"
+            break
+        for j, xj in window.items():
+            if xj is not None:
+                guesses[j] = xj
+        ok = [j for j, xj in window.items() if xj is not None]
+        i = max(ok, key=lambda j: amplitude(window[j], omegas[j]))
+        hs, basis, cur, x_peak, solves = nxt, rich, guesses, x, solves + n
+        levels.append((hs[-1], float(a), float(w)))
+        error = richest_error(levels)
+        e = error["peak_amplitude_rel"]
+        if e is not None and e <= tol and len(levels) >= MIN_LEVELS:
+            break
+    met = error is not None and error["peak_amplitude_rel"] is not None \
+        and error["peak_amplitude_rel"] <= tol and len(levels) >= MIN_LEVELS
+    return {"levels": levels, "harmonics": hs, "x": x_peak, "error": error, "met": met,
+            "message": None if met else message, "solves": solves}
+
+
+def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict, dict]:
+    """(truncation_error, accuracy) records of a :func:`raise_at_peak` run.
+
+    truncation_error: method, H_used (the richest level's H), H_check (the same: the
+    estimate comes from the levels below it), levels (H, peak_amplitude, peak_omega of
+    each), order, order_observed, peak_amplitude_rel, peak_frequency_rel (of the richest
+    level), extrapolated. accuracy: target, met, H_curve, H_peak, peak_amplitude and
+    peak_omega (computed at H_peak), levels, extrapolated (with its order, or None),
+    message.
+    """
+    levels, err = run["levels"], run["error"] or {}
+    H = int(levels[-1][0])
+    rec = {"method": method, "H_used": H, "H_check": H,
+           "levels": [{"H": int(h), "peak_amplitude": a, "peak_omega": w} for h, a, w in levels],
+           "order": err.get("order", ASSUMED_ORDER), "order_observed": err.get("order_observed"),
+           "peak_amplitude_rel": err.get("peak_amplitude_rel"),
+           "peak_frequency_rel": err.get("peak_frequency_rel"),
+           "extrapolated": err.get("extrapolated")}
+    if len(levels) < 2:
+        rec["note"] = run["message"]
+    ex = err.get("extrapolated")
+    acc = {"target": tol, "met": bool(run["met"]), "H_curve": int(H_curve), "H_peak": H,
+           "peak_amplitude": levels[-1][1], "peak_omega": levels[-1][2],
+           "levels": [list(lv) for lv in levels],
+           "extrapolated": None if ex is None else {**ex, "order": err["order_observed"]},
+           "message": None if run["met"] else _not_met(run, tol)}
+    return rec, acc
+
+
+def _not_met(run, tol) -> str:
+    e = (run["error"] or {}).get("peak_amplitude_rel")
+    est = "unknown" if e is None else f"{100 * e:.3g} %"
+    return (f"accuracy {tol:g} not reached: {run['message'] or 'too few levels'}; the estimate "
+            f"is {est} at H = {run['levels'][-1][0]}")

@@ -18,12 +18,9 @@ from .fourier import default_samples, parse_harmonics
 #: Highest harmonic the library goes to when raising H for an accuracy (the CLI passes
 #: its own limit): ~H^2 time per curve point.
 MAX_HARMONIC = 200
-#: Margin on the H predicted to meet a tolerance (the order is an estimate).
-H_MARGIN = 1.15
-#: Largest factor on H from one curve to the next: an assumed order below the true one
-#: would otherwise overshoot (the 3-mass chain at 1e-3 from H = 3: order ~4, predicted
-#: H = 40 where 11 suffices).
-RAISE_MAX = 2.5
+#: Margin and largest factor on H (one definition, :mod:`accuracy`; the backbone's and the
+#: sector's runs use them too).
+H_MARGIN, RAISE_MAX = acc.H_MARGIN, acc.RAISE_MAX
 
 
 def check_problem(prob, harmonics):
@@ -106,77 +103,76 @@ def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVE
 
 def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
                     limit: int = MAX_HARMONIC, *, tol_rel: float, **kwargs):
-    """Forced-response curve whose peak amplitude's estimated truncation error is below
-    ``accuracy`` (relative), raising H per curve.
+    """Forced-response curve traced once, its peak raised in H until the peak amplitude's
+    estimated truncation error is below ``accuracy`` (relative).
 
-    Starts at ``harmonics`` (its kind, odd or all, is kept; at least
-    :data:`accuracy.MIN_START_HARMONIC`); after each curve the peak
-    is checked at richer sets (:func:`truncation_error`); while the estimate e exceeds
-    ``accuracy`` the next curve has H_next = H (e / accuracy)^(1/p) H_MARGIN (p the
-    observed order, else :data:`accuracy.ASSUMED_ORDER`), at most RAISE_MAX H, at least
-    the first check's H, at most the highest H whose checks still fit within ``limit``.
-    ``curve(model, harmonics, omega_range, truncation_check=False, **kwargs)`` traces one
+    The curve is traced at ``harmonics`` (its kind, odd or all, is kept; at least
+    :data:`accuracy.MIN_START_HARMONIC`); then only its peak is re-solved at richer
+    harmonic sets (:func:`accuracy.raise_at_peak`: the padded curve points around the
+    peak corrected at each level and the peak refined, a few dozen solves per level, up to
+    H = ``limit``), level after level, until the richest level's estimate
+    (:func:`accuracy.richest_error`) is below ``accuracy``.
+    ``curve(model, harmonics, omega_range, truncation_check=False, **kwargs)`` traces the
     curve (:func:`frf.compute_frf`, which passes itself: this module sits above frf);
     other keyword arguments go to it.
 
     Returns
     -------
-    FRFResult of the last curve (``time_s`` and ``evaluations`` of the whole run),
-    ``truncation_error`` set, ``extra["accuracy"]``:
-    target, met (bool), levels (H, peak amplitude, peak omega per curve and check),
-    H_sequence, message (when the limit stopped it).
+    FRFResult of the curve (its ``harmonics``, ``solutions``, ``problem`` and
+    ``peak_solution`` at the curve's H), with ``peak_amplitude``, ``peak_omega`` and
+    ``peak_amplitude_h1`` those of the richest level; ``time_s`` and ``evaluations`` of
+    the whole run; ``truncation_error`` the richest level's estimate
+    (:func:`accuracy.peak_records`); ``extra["accuracy"]``: target, met, H_curve,
+    H_peak, peak_amplitude, peak_omega, levels, extrapolated, message;
+    ``extra["peak_problem"]`` and ``extra["peak_level_solution"]`` the richest level's
+    problem and peak solution.
 
     Raises
     ------
-    ValueError (bad accuracy), frf.FRFError (a RuntimeError) when the first curve fails
-    (a later curve that fails ends the run with the previous result, said in its status).
+    ValueError (bad accuracy), frf.FRFError (a RuntimeError) when the curve fails.
     """
-    tol = acc.check_accuracy(accuracy)
-    hs = parse_harmonics(harmonics)
-    odd = all(h % 2 for h in hs)
-    if hs[-1] < acc.MIN_START_HARMONIC:
-        hs = _harmonic_set(acc.MIN_START_HARMONIC, odd, 0 in hs)
-    top = _curve_limit(hs, limit)
     import time
 
-    t0, evaluations = time.perf_counter(), 0
-    levels, seq, best = [], [], None
-    while True:
-        try:
-            res = curve(model, hs, omega_range, truncation_check=False, **kwargs)
-        except RuntimeError as err:
-            if best is None:
-                raise
-            best.status += (f"; warning: the curve at H = {hs[-1]} failed ({err}), the result at "
-                            f"H = {best.problem.basis.H} is kept")
-            break
-        best = res
-        evaluations += res.evaluations
-        seq.append(hs[-1])
-        rec = truncation_error(res, limit, tol_rel=tol_rel)
-        res.truncation_error = rec
-        res.extra["truncation_warning"] = acc.warning(rec)
-        levels.append((hs[-1], res.peak_amplitude, res.peak_omega))
-        levels += [(c["H"], c["peak_amplitude"], c["peak_omega"]) for c in rec.get("checks", ())]
-        e = rec.get("peak_amplitude_rel")
-        if e is not None and e <= tol:
-            break
-        if e is None or hs[-1] >= top:
-            why = rec.get("note") or f"H = {hs[-1]} is the highest whose check fits the limit H <= {limit}"
-            res.extra["accuracy_message"] = (f"accuracy {tol:g} not reached: {why}; the estimate "
-                                             f"is {_pct(e)} at H = {hs[-1]}")
-            break
-        p = rec.get("order") or acc.ASSUMED_ORDER
-        want = min(hs[-1] * (e / tol) ** (1.0 / p) * H_MARGIN, RAISE_MAX * hs[-1])
-        H_next = min(max(int(math.ceil(want)), rec["checks"][0]["H"]), top)
-        hs = _harmonic_set(H_next, odd, 0 in hs)
-    best.extra["accuracy"] = {"target": tol, "met": (best.truncation_error or {}).get(
-        "peak_amplitude_rel") is not None and best.truncation_error["peak_amplitude_rel"] <= tol,
-        "H_sequence": seq, "levels": [list(lv) for lv in levels],
-        "message": best.extra.get("accuracy_message")}
-    best.time_s = time.perf_counter() - t0   # every curve and check of the run
-    best.evaluations = evaluations
-    return best
+    tol = acc.check_accuracy(accuracy)
+    hs = parse_harmonics(harmonics)
+    if hs[-1] < acc.MIN_START_HARMONIC:
+        hs = _harmonic_set(acc.MIN_START_HARMONIC, all(h % 2 for h in hs), 0 in hs)
+    t0 = time.perf_counter()
+    res = curve(model, hs, omega_range, truncation_check=False, **kwargs)
+    prob, H0 = res.problem, res.problem.basis.H
+    riches = []
+
+    def problem_at(h):
+        rich = check_problem(prob, h)
+        riches.append(rich)
+        return rich, rich.amplitude, tol_rel * max(rich.reference(res.peak_omega), 1e-300), rich.basis
+
+    if res.peak_interior and np.isfinite(res.peak_amplitude):
+        run = acc.raise_at_peak(problem_at, prob.basis, res.solutions, np.asarray(res.omega),
+                                int(np.argmax(res.amplitude)),
+                                (H0, res.peak_amplitude, res.peak_omega), tol, limit,
+                                1e-6 * abs(res.peak_omega))
+    else:   # a maximum at the band's end has no peak to refine
+        run = {"levels": [(H0, res.peak_amplitude, res.peak_omega)], "harmonics": hs, "x": None,
+               "error": None, "met": False, "solves": 0,
+               "message": "the maximum is at an end of the band (widen the band)"}
+    rec, a = acc.peak_records(run, tol, H0, PEAK_METHOD)
+    if run["x"] is not None:
+        rich = riches[-1] if riches[-1].basis.harmonics == run["harmonics"] else check_problem(prob, run["harmonics"])
+        res.peak_amplitude, res.peak_omega = a["peak_amplitude"], a["peak_omega"]
+        r = rich.response(run["x"], res.peak_omega)
+        res.peak_amplitude_h1 = float(rich.basis.magnitude(r, 1)) if 1 in rich.basis.harmonics else float("nan")
+        res.extra["peak_problem"], res.extra["peak_level_solution"] = rich, run["x"]
+    res.truncation_error = rec
+    res.extra["truncation_warning"] = None if a["met"] else acc.warning(rec)
+    res.extra["accuracy"] = a
+    res.evaluations += sum(r.evaluations for r in riches)
+    res.time_s = time.perf_counter() - t0   # the curve and every level at the peak
+    return res
+
+
+#: The ``method`` of a peak raised to an accuracy.
+PEAK_METHOD = "the curve's peak re-solved at richer harmonic sets (peak-local levels)"
 
 
 def _pct(e) -> str:
@@ -207,6 +203,11 @@ def summary_lines(summary, hz: bool = False) -> list[str]:
     e, ef = rec.get("peak_amplitude_rel"), rec.get("peak_frequency_rel")
     if e is None:
         lines = [f"truncation error: not estimated ({rec.get('note', 'no check')})"]
+    elif rec.get("levels"):
+        lines = [f"truncation error (estimate of the peak at H = {rec['H_used']} from the levels H = "
+                 f"{', '.join(str(lv['H']) for lv in rec['levels'])}, order {rec['order']:.2g}"
+                 f"{' observed' if rec.get('order_observed') else ' assumed'}): peak amplitude {100 * e:.2g} %"
+                 + ("" if ef is None else f", peak frequency {100 * ef:.2g} %")]
     else:
         lines = [f"truncation error (estimate, H = {rec['H_used']} checked at H = {rec['H_check']}, "
                  f"order {rec['order']:.2g}{' observed' if rec.get('order_observed') else ' assumed'}): "
@@ -230,6 +231,11 @@ def accuracy_lines(a: dict | None) -> list[str]:
     H_sequence, message), for forced responses and backbones alike."""
     if not a:
         return []
+    if "H_peak" in a:   # a peak raised to the accuracy
+        lines = [f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}; curve at H = "
+                 f"{a['H_curve']}, peak at H = {a['H_peak']} (levels H = "
+                 f"{', '.join(str(lv[0]) for lv in a['levels'])})"]
+        return lines + ([f"warning: {a['message']}"] if a.get("message") else [])
     lines = [f"accuracy {a['target']:g}: {'met' if a['met'] else 'not met'}, harmonics "
              f"tried {a['H_sequence']}"]
     return lines + ([f"warning: {a['message']}"] if a.get("message") else [])

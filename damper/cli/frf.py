@@ -8,10 +8,12 @@ Examples::
         --omega 100 300 --json --plot out/frf
 
 Harmonics and accuracy: ``--harmonics`` fixes the harmonic set; ``--accuracy TOL``
-raises H per curve (from ``--harmonics``, default 3) until the estimated truncation
-error of the peak amplitude is below TOL; with neither, ``--accuracy 0.01`` from H = 3.
-Every result carries that estimate (the peak re-solved with ~1.5 H and ~2.25 H harmonics,
-docs/method/accuracy.md) and a warning line when it exceeds 1 %.
+traces the curve once (at ``--harmonics``, default 3) and raises H at its peak only
+(the curve points near the peak re-solved with richer harmonic sets, level after level)
+until the estimated truncation error of the peak amplitude is below TOL; with neither,
+``--accuracy 0.01`` from H = 3. Every result carries that estimate (with a fixed set:
+the peak re-solved with ~1.5 H and ~2.25 H harmonics, docs/method/accuracy.md) and a
+warning line when it exceeds 1 %.
 
 ``--model`` is ``sdof`` (a mass on a spring and dashpot with one Jenkins element to
 the ground, forced by ``--force`` cos(omega t)) or a ``.npz`` file with an
@@ -27,9 +29,12 @@ response DOF over the period) [m], ``amplitude_h1`` (its first-harmonic magnitud
 (method, H_used, H_check, order, peak_amplitude_rel and peak_frequency_rel: the
 estimated relative error in H of the peak, check: the peak at H_check, extrapolated:
 the peak extrapolated in H when the order was observed, else null),
-``truncation_warning``, ``accuracy`` (with --accuracy: target, met, H_sequence,
-levels, message), ``stuck_links`` (links that never slip at the peak: their mean position
-is the harmonic balance's convention, stuck since u = 0), ``steady_state`` and
+``truncation_warning``, ``accuracy`` (with --accuracy: target, met, H_curve (the
+curve's H), H_peak (the H of the reported peak), peak_amplitude and peak_omega (computed
+at H_peak, the same as the top-level peak), levels ([H, peak amplitude, peak omega] of
+the curve and each richer level), extrapolated (the peak extrapolated in H with the
+observed order, or null), message (why not met)), ``stuck_links`` (links that never
+slip at the peak: their mean position is the harmonic balance's convention, stuck since u = 0), ``steady_state`` and
 ``steady_state_warning`` (with --check-steady-state: the peak |x| of time integrations
 from rest and from the harmonic balance's state at the peak frequency, ``states_differ``
 when they settle apart; docs/method/accuracy.md), ``peaks`` (every
@@ -62,8 +67,9 @@ def register(subparsers) -> None:
     p.add_argument("--harmonics", help="H, odd:H or all:H: a fixed harmonic set (with --accuracy: "
                    "the first one tried; default: --accuracy 0.01 from H = 3)")
     p.add_argument("--accuracy", type=float, metavar="TOL",
-                   help="relative accuracy of the peak amplitude, in (1e-6, 0.5): the harmonics are "
-                   "raised per curve until the estimated truncation error is below TOL")
+                   help="relative accuracy of the peak amplitude, in (1e-6, 0.5): the curve is traced "
+                   "at --harmonics, then its peak alone is re-solved with more harmonics until the "
+                   "estimated truncation error is below TOL")
     p.add_argument("--samples", type=int, default=0,
                    help="AFT samples per period (0: auto); exact links only scan them for the extrema")
     p.add_argument("--aft", choices=("exact", "sampled"), default="exact",

@@ -15,7 +15,6 @@ import time
 import numpy as np
 
 from .. import accuracy as acc
-from ..frf_accuracy import H_MARGIN, RAISE_MAX
 from .hb import SectorHB, sector_basis
 from .solve import SolverError, frf
 
@@ -112,14 +111,62 @@ def frf_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = MA
             rec["message"] = (f"accuracy {tol:g} not reached: {why}; the estimate is "
                               f"{'unknown' if e is None else f'{100 * e:.3g} %'} at H = {H}")
             break
-        want = min(H * (e / tol) ** (1.0 / (rec.get("order") or acc.ASSUMED_ORDER)) * H_MARGIN,
-                   RAISE_MAX * H)
+        want = min(H * (e / tol) ** (1.0 / (rec.get("order") or acc.ASSUMED_ORDER)) * acc.H_MARGIN,
+                   acc.RAISE_MAX * H)
         H = min(max(int(math.ceil(want)), rec["checks"][0]["H"]), top)
     hb, curve, rec = best
     e = rec.get("peak_amplitude_rel")
     rec["accuracy"] = {"target": tol, "met": e is not None and e <= tol, "H_sequence": seq,
                        "levels": [list(lv) for lv in levels], "message": rec.get("message")}
     return best
+
+
+#: Highest harmonic of the peak-local levels of :func:`peak_to_accuracy`: above the
+#: curves' limit (MAX_HARMONIC) because a level is a few dozen solves at the peak, not a
+#: curve of 200 points. Its unknowns are (2H + 1) times the sector's DOFs; the dense
+#: Jacobian at H = 80 holds ~0.1 GB on UPD-24.
+PEAK_MAX_HARMONIC = 80
+#: The ``method`` of a sector peak raised to an accuracy.
+PEAK_METHOD = "the curve's peak re-solved at richer harmonic sets (peak-local levels)"
+
+
+def peak_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = PEAK_MAX_HARMONIC,
+                     cf=None, f0=None, mu=None):
+    """(hb, curve, record): the sector curve over ``omegas`` [rad/s] traced once at ``H``
+    (at least :data:`..accuracy.MIN_START_HARMONIC`), then its peak only raised in H
+    (:func:`..accuracy.raise_at_peak`, up to ``limit``) until the richest level's
+    estimated truncation error is below ``accuracy`` (relative).
+
+    ``hb`` and ``curve`` are the curve's (its H); ``record`` is the richest level's
+    ``truncation_error`` (:func:`..accuracy.peak_records`) carrying ``accuracy``: target,
+    met, H_curve, H_peak, peak_amplitude [m] and peak_omega [rad/s] at H_peak, levels,
+    extrapolated, message; ``time_s`` of the levels.
+
+    Raises
+    ------
+    ValueError (bad accuracy); the curve's StartError / SolverError.
+    """
+    tol = acc.check_accuracy(accuracy)
+    hb = SectorHB(sector, max(int(H), acc.MIN_START_HARMONIC), cf=cf, f0=f0, mu=mu)
+    curve = frf(hb, omegas)
+    t0 = time.perf_counter()
+    amp = np.asarray(curve.amplitude)
+    i = int(np.argmax(amp))
+    level0 = (hb.H, curve.peak_amplitude, curve.peak_omega)
+    if 0 < i < amp.size - 1:
+        def problem_at(hs):
+            rich = check_sector(hb, hs[-1])
+            return (rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x),
+                    1e-10 * max(hb.f0, hb.cf), rich.basis)
+        run = acc.raise_at_peak(problem_at, hb.basis, curve.x, np.asarray(curve.omega), i, level0,
+                                tol, limit, 1e-6 * curve.peak_omega)
+    else:
+        run = {"levels": [level0], "harmonics": hb.basis.harmonics, "x": None, "error": None,
+               "met": False, "solves": 0, "message": "the peak is at the band's end (widen the band)"}
+    rec, accuracy_record = acc.peak_records(run, tol, hb.H, PEAK_METHOD)
+    rec["accuracy"] = accuracy_record
+    rec["time_s"] = time.perf_counter() - t0
+    return hb, curve, rec
 
 
 def optimum_truncation(sector, out: dict, grid: int = 40, limit: int = MAX_HARMONIC, f0=None) -> dict:
