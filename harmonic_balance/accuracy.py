@@ -280,6 +280,13 @@ H_MARGIN = 1.15
 RAISE_MAX = 2.5
 #: Points on each side of the previous level's peak corrected at a level after the first.
 LEVEL_WINDOW = 1
+#: The peak of a level after the first is refined in frequency until the amplitude error
+#: that leaves is this share of the target: far below the differences between levels
+#: that the estimate is made of.
+LEVEL_PRECISION = 1e-2
+#: Smallest half-width of the bracket around the previous level's peak, relative to its
+#: frequency (the shift between levels sets it otherwise, :func:`_bracket`).
+BRACKET_MIN = 1e-5
 #: Smallest factor on H between predicted levels: closer levels differ too little for the
 #: order to be told from the corrector's tolerance.
 MIN_STEP = 1.25
@@ -299,33 +306,48 @@ def richest_error(levels) -> dict:
     Returns
     -------
     dict: peak_amplitude_rel, peak_frequency_rel (None when a value is not finite),
-    order_observed (p from the last three levels, :func:`observed_order`, or None), order
-    (p used), extrapolated (peak_amplitude, peak_omega at H -> infinity, or None without
-    an observed order).
+    order_observed (p from the last three levels, :func:`observed_order`, or None),
+    order_stable (the last two triples of levels agree on p within ORDER_STABLE), order
+    (p used), extrapolated (peak_amplitude, peak_omega at H -> infinity when the order is
+    stable, else None).
 
     The error of the richest value v_K is Richardson's (Roache 1998, eq. 5.4.1),
     |v_K - v_inf| = |v_K - v_{K-1}| / ((H_K / H_{K-1})^p - 1), with the observed order
-    when the last three levels give one in ORDER_RANGE, else ASSUMED_ORDER.
+    when it is stable; otherwise with the smaller of the last observed order and
+    ASSUMED_ORDER (a lower order means a larger error left: a sequence still outside its
+    asymptotic range, as the 5-mass chain below H ~ 50, is not trusted to have reached it).
     """
     out = {}
     for key, col in (("amplitude", 1), ("omega", 2)):
-        seq = [(lv[0], lv[col]) for lv in levels]
-        out[key] = _richest(seq)
-    (e_a, a_inf, p), (e_w, w_inf, _) = out["amplitude"], out["omega"]
+        out[key] = _richest([(lv[0], lv[col]) for lv in levels])
+    (e_a, a_inf, p, stable), (e_w, w_inf, _, _) = out["amplitude"], out["omega"]
     return {"peak_amplitude_rel": e_a, "peak_frequency_rel": e_w, "order_observed": p,
-            "order": ASSUMED_ORDER if p is None else p,
+            "order_stable": stable, "order": _used_order(p, stable),
             "extrapolated": None if a_inf is None else {"peak_amplitude": a_inf, "peak_omega": w_inf}}
+
+
+#: Two observed orders (of successive triples of levels) are stable when within this
+#: factor of each other.
+ORDER_STABLE = 1.5
+
+
+def _used_order(p, stable: bool) -> float:
+    if stable:
+        return p
+    return ASSUMED_ORDER if p is None else min(p, ASSUMED_ORDER)
 
 
 def _richest(seq):
     """(relative error of the last value, extrapolated value or None, observed order or
-    None) of a sequence (H, value) of increasing H (:func:`richest_error`)."""
+    None, order stable) of a sequence (H, value) of increasing H (:func:`richest_error`)."""
     if len(seq) < 2 or not all(np.isfinite(v) for _, v in seq):
-        return None, None, None
-    p = observed_order(seq) if len(seq) >= 3 else None
+        return None, None, None, False
+    p = observed_order(seq[-3:]) if len(seq) >= 3 else None
+    p0 = observed_order(seq[-4:-1]) if len(seq) >= 4 else None
+    stable = p is not None and p0 is not None and max(p, p0) <= ORDER_STABLE * min(p, p0)
     (H1, v1), (H2, v2) = seq[-2], seq[-1]
-    d = (v2 - v1) / ((H2 / H1) ** (ASSUMED_ORDER if p is None else p) - 1.0)
-    return abs(d) / abs(v2 + d), (None if p is None else v2 + d), p
+    d = (v2 - v1) / ((H2 / H1) ** _used_order(p, stable) - 1.0)
+    return abs(d) / abs(v2 + d), (v2 + d if stable else None), p, stable
 
 
 def next_level(hs: tuple, levels, error, tol: float, limit: int) -> tuple | None:
@@ -382,19 +404,24 @@ def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: i
             break
         fun, amplitude, ntol, rich = problem_at(nxt)
         guesses = [pad(x, basis, rich) for x in cur]
+        near = None
+        if x_peak is not None:   # later levels: around the previous level's peak
+            near = peak_near(fun, amplitude, pad(x_peak, basis, rich), levels[-1][2],
+                             _bracket(levels, omegas), ntol, tol_lam, LEVEL_PRECISION * tol)
         try:
-            # the first level looks around the curve's peak; later ones around the previous
-            # level's, which moves less than a grid step
-            x, w, a, n, window = peak_window(fun, amplitude, guesses, omegas, i, ntol, tol_lam,
-                                             WINDOW if len(levels) == 1 else LEVEL_WINDOW)
+            if near is None:   # the first level, or the bracket failed: the curve's window
+                x, w, a, n, window = peak_window(fun, amplitude, guesses, omegas, i, ntol, tol_lam,
+                                                 WINDOW if len(levels) == 1 else LEVEL_WINDOW)
+                for j, xj in window.items():
+                    if xj is not None:
+                        guesses[j] = xj
+                i = max((j for j, xj in window.items() if xj is not None),
+                        key=lambda j: amplitude(window[j], omegas[j]))
+            else:
+                x, w, a, n = near
         except RuntimeError as err:
             message = f"the peak at H = {nxt[-1]} failed ({err}); H = {hs[-1]} kept"
             break
-        for j, xj in window.items():
-            if xj is not None:
-                guesses[j] = xj
-        ok = [j for j, xj in window.items() if xj is not None]
-        i = max(ok, key=lambda j: amplitude(window[j], omegas[j]))
         hs, basis, cur, x_peak, solves = nxt, rich, guesses, x, solves + n
         levels.append((hs[-1], float(a), float(w)))
         error = richest_error(levels)
@@ -405,6 +432,53 @@ def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: i
         and error["peak_amplitude_rel"] <= tol and len(levels) >= MIN_LEVELS
     return {"levels": levels, "harmonics": hs, "x": x_peak, "error": error, "met": met,
             "message": None if met else message, "solves": solves}
+
+
+def _bracket(levels, omegas) -> float:
+    """Half-width [rad/s] of the bracket around the previous level's peak frequency: the
+    last shift of the peak between levels (the shifts shrink with H), at least
+    BRACKET_MIN of the frequency, at most a grid step of the curve."""
+    step = float(np.max(np.abs(np.diff(omegas))))
+    w = levels[-1][2]
+    shift = abs(w - levels[-2][2]) if len(levels) >= 2 and np.isfinite(levels[-2][2]) else step
+    return min(max(shift, BRACKET_MIN * abs(w)), step)
+
+
+def peak_near(fun, amplitude, x0, w0: float, delta: float, tol: float, tol_lam: float,
+              amp_rel: float = 0.0):
+    """Refined peak of ``amplitude`` on the branch of ``fun`` near (``x0``, ``w0``):
+    Newton at w0 - delta, w0, w0 + delta from ``x0``, the three points moved by delta
+    while the highest is at an end (up to MAX_EXTEND times), then
+    :func:`continuation.refine_max` on them, to ``tol_lam`` [rad/s] or, when
+    ``amp_rel`` > 0, to the frequency tolerance that leaves a relative error ``amp_rel``
+    in the amplitude (the amplitude is flat at its maximum: A'' tol_lam^2 / 2, A'' from
+    the three points) if that is larger. Returns (x, omega, amplitude, solves), or
+    None when a Newton solve fails or the peak stays outside (the caller falls back to
+    :func:`peak_window`)."""
+    def solve(w, guess):
+        return newton(lambda z: fun(z, w)[:2], guess, tol, 40).x
+    try:
+        ws = [w0 - delta, w0, w0 + delta]
+        xs = [solve(w, x0) for w in ws]
+        for _ in range(MAX_EXTEND + 1):
+            amps = [amplitude(x, w) for x, w in zip(xs, ws)]
+            top = int(np.argmax(amps))
+            if top == 1:
+                break
+            if top == 0:
+                ws, xs = [ws[0] - delta] + ws[:2], [solve(ws[0] - delta, xs[0])] + xs[:2]
+            else:
+                ws, xs = ws[1:] + [ws[2] + delta], xs[1:] + [solve(ws[2] + delta, xs[2])]
+        else:
+            return None
+        if amp_rel:   # the frequency tolerance that leaves amp_rel in the amplitude
+            curv = abs(amps[0] - 2.0 * amps[1] + amps[2]) / delta**2
+            if curv > 0:
+                tol_lam = min(max(tol_lam, math.sqrt(2.0 * amp_rel * amps[1] / curv)), 0.25 * delta)
+        x, w, a, n = refine_max(fun, Branch(x=xs, lam=ws, iterations=[0, 0, 0]), 1, amplitude, tol, tol_lam)
+    except (NewtonError, RuntimeError):
+        return None
+    return x, w, a, n + 3
 
 
 def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict, dict]:
@@ -422,6 +496,7 @@ def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict
     rec = {"method": method, "H_used": H, "H_check": H,
            "levels": [{"H": int(h), "peak_amplitude": a, "peak_omega": w} for h, a, w in levels],
            "order": err.get("order", ASSUMED_ORDER), "order_observed": err.get("order_observed"),
+           "order_stable": bool(err.get("order_stable")),
            "peak_amplitude_rel": err.get("peak_amplitude_rel"),
            "peak_frequency_rel": err.get("peak_frequency_rel"),
            "extrapolated": err.get("extrapolated")}
