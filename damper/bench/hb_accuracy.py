@@ -37,14 +37,18 @@ import numpy as np
 
 from .common import Row, self_peak_mb
 
-#: Harmonics of the reference peak: ~(7 / 61)^1.7 = 2.5 % of the H = 7 error is left.
+#: Harmonics of the reference peak (at least; twice the richest peak level of a model's
+#: accuracy rows when higher, :func:`_reference_h`): ~(7 / 61)^1.7 = 2.5 % of the H = 7
+#: error is left. The reference is the first curve's peak raised level after level
+#: (:func:`harmonic_balance.accuracy.raise_at_peak`), the same corrector as the runs'.
 REFERENCE_H = 61
-#: Reference of the sector: ~(7 / 49)^1.7 = 4 % of the H = 7 error is left, ~(33 / 49)^1.7
-#: = 50 % of that of H = 33, the highest curve a 1e-3 target may reach within the sector's
-#: limit (its check at 1.5 H <= 50); a peak re-solve, seconds to a minute.
-REFERENCE_H_UPD = 49
-#: Highest harmonic of the sector's runs to an accuracy (below the reference's).
-LIMIT_UPD = 50
+#: Highest harmonic of the chains' runs to an accuracy.
+LIMIT_FRF = 200
+#: Reference of the sector: the peak-level limit (bladed_disk.accuracy.PEAK_MAX_HARMONIC):
+#: UPD-24's peak moves ~0.03 % from H = 43 to 80; seconds per load.
+REFERENCE_H_UPD = 80
+#: A target no level meets: the reference's levels run to their limit.
+REFERENCE_TOL = 1e-15
 #: H of the table's rows.
 HS = (3, 7, 15)
 #: Accuracy targets of the table's rows.
@@ -80,53 +84,71 @@ def _contact_cases():
 
 
 def _frf_reference(result, H_ref: int) -> float:
-    from harmonic_balance import accuracy as acc
+    """The peak of ``result``'s curve raised level after level (:func:`accuracy.raise_at_peak`
+    with a target no level meets) to the set 0..``H_ref``: its amplitude [m]."""
     from harmonic_balance.frf import TOL_REL
     from harmonic_balance.frf_accuracy import check_problem
 
     prob = result.problem
-    rich = check_problem(prob, tuple(range(H_ref + 1)))
-    xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
-    tol = TOL_REL * rich.reference(result.peak_omega)
-    i = int(np.argmax(result.amplitude))
-    return acc.peak_at(rich, rich.amplitude, xs, np.asarray(result.omega), i, tol,
-                       1e-6 * result.peak_omega)[2]
+
+    def problem_at(hs):
+        rich = check_problem(prob, hs)
+        return rich, rich.amplitude, TOL_REL * rich.reference(result.peak_omega), rich.basis
+    return _chain(problem_at, prob.basis, result.solutions, result.omega, result.amplitude,
+                  (prob.basis.H, result.peak_amplitude, result.peak_omega), H_ref)
+
+
+def _chain(problem_at, basis, xs, omegas, amplitude, level0, H_ref: int) -> float:
+    from harmonic_balance import accuracy as acc
+
+    run = acc.raise_at_peak(problem_at, basis, xs,
+                            np.asarray(omegas), int(np.argmax(amplitude)), level0, REFERENCE_TOL,
+                            H_ref, 1e-6 * level0[2])
+    if run["levels"][-1][0] < H_ref - 1:
+        raise RuntimeError(f"the reference stopped at H = {run['levels'][-1][0]}: {run['message']}")
+    return run["levels"][-1][1]
+
+
+def _reference_h(h_peaks, base: int) -> int:
+    """Harmonics of a model's reference: ``base``, or twice the richest peak level of its
+    accuracy rows when that is higher (the reference must lie well beyond what it judges)."""
+    return max([base] + [2 * h for h in h_peaks])
 
 
 def frf_rows(quick: bool = False, names: tuple[str, ...] | None = None, contact: bool = False) -> list[dict]:
     """Rows of the chain models (``contact``: of the 3D contact point instead): per H and
-    per accuracy target (``names``: only these models)."""
+    per accuracy target (``names``: only these models). The reference of a model is its
+    first curve's peak raised to :func:`_reference_h` (after every row of the model)."""
     from harmonic_balance.frf import compute_frf
 
     rows = []
     for case in _contact_cases() if contact else _frf_cases(quick):
         if names is not None and case.name not in names:
             continue
-        model, ref = case.model(), None
+        model, pending, first = case.model(), [], None
         for H in HS[:2] if quick else HS:
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             r = compute_frf(model, H, case.band, stability="off")
-            dt = time.perf_counter() - t0
-            if ref is None:
-                ref = _frf_reference(r, REFERENCE_H)
-            rows.append(_row(case.name, f"H {H}", r.peak_amplitude, r.truncation_error, ref, dt, H,
-                             default_of=DEFAULT_FRF))
+            first = first or r
+            pending.append((case.name, f"H {H}", r.peak_amplitude, r.truncation_error, None,
+                            time.process_time() - t0, H, None, None, DEFAULT_FRF))
         for tol in TOLS[:1] if quick else TOLS:
-            t0 = time.perf_counter()
-            # below the reference's H: the chain5 at 1e-3 stops at this limit, not met (it
-            # converges like H^-0.5 up to H ~ 20), and says so
+            t0 = time.process_time()
             r = compute_frf(model, 3, case.band, stability="off", accuracy=tol,
-                            max_harmonic=REFERENCE_H)
-            H = r.problem.basis.H
-            rows.append(_row(case.name, f"tol {tol:g} -> H {H}", r.peak_amplitude, r.truncation_error, ref,
-                             time.perf_counter() - t0, H, tol, r.extra.get("accuracy"), DEFAULT_FRF))
+                            max_harmonic=LIMIT_FRF)
+            a = r.extra["accuracy"]
+            pending.append((case.name, f"tol {tol:g} -> H {a['H_curve']}/{a['H_peak']}", r.peak_amplitude,
+                            r.truncation_error, None, time.process_time() - t0, a["H_peak"], tol, a,
+                            DEFAULT_FRF))
+        ref = _frf_reference(first, _reference_h([p[6] for p in pending if p[7] is not None], REFERENCE_H))
+        rows += [_row(*p[:4], ref, *p[5:]) for p in pending]
     return rows
 
 
 def upd_rows(quick: bool = False) -> list[dict]:
-    """Rows of UPD-24 (F0 = 30 N, the config's band, 200 points) at UPD_CF."""
-    from harmonic_balance import accuracy as acc
-    from harmonic_balance.bladed_disk.accuracy import check_sector, frf_to_accuracy, truncation_error
+    """Rows of UPD-24 (F0 = 30 N, the config's band, 200 points) at UPD_CF; at the stored
+    time integration's load (hb_reference.json) the peak against it too (``vs_time_integration``)."""
+    from harmonic_balance.bladed_disk.accuracy import check_sector, peak_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.sector import Sector
@@ -135,28 +157,51 @@ def upd_rows(quick: bool = False) -> list[dict]:
     sector = Sector(load_config(None))
     lo, hi = sector.cfg["load.band_hz"]
     om = 2 * np.pi * np.linspace(lo, hi, 200)
-    rows = []
+    rows, ti = [], _time_integration()
     for cf in UPD_CF[1:2] if quick else UPD_CF:
-        name, ref = f"UPD-24 CF {cf:g}", None
+        name, pending, first = f"UPD-24 CF {cf:g}", [], None
         for H in (7,) if quick else (7, 15):
-            t0 = time.perf_counter()
+            t0 = time.process_time()
             hb = SectorHB(sector, H, cf=cf, f0=30.0)
             c = frf(hb, om)
             rec = truncation_error(hb, c)
-            dt = time.perf_counter() - t0
-            if ref is None:
-                rich = check_sector(hb, REFERENCE_H_UPD)
-                xs = [acc.pad(x, hb.basis, rich.basis) for x in c.x]
-                ref = acc.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs, om,
-                                  int(np.argmax(c.amplitude)), 1e-10 * max(hb.f0, hb.cf),
-                                  1e-6 * c.peak_omega)[2]
-            rows.append(_row(name, f"H {H}", c.peak_amplitude, rec, ref, dt, H, default_of=DEFAULT_UPD))
-        for tol in TOLS[:1] if quick else TOLS:   # 1e-3: H ~ 20-33 on UPD-24, minutes
-            t0 = time.perf_counter()
-            hb, c, rec = frf_to_accuracy(sector, om, tol, 7, LIMIT_UPD, cf=cf, f0=30.0)
-            rows.append(_row(name, f"tol {tol:g} -> H {hb.H}", c.peak_amplitude, rec, ref,
-                             time.perf_counter() - t0, hb.H, tol, rec.get("accuracy"), DEFAULT_UPD))
+            first = first or (hb, c)
+            pending.append((name, f"H {H}", c.peak_amplitude, rec, None, time.process_time() - t0, H,
+                            None, None, DEFAULT_UPD))
+        for tol in TOLS[:1] if quick else TOLS:
+            t0 = time.process_time()
+            hb, c, rec = peak_to_accuracy(sector, om, tol, 7, cf=cf, f0=30.0)
+            a = rec["accuracy"]
+            pending.append((name, f"tol {tol:g} -> H {a['H_curve']}/{a['H_peak']}", a["peak_amplitude"], rec,
+                            None, time.process_time() - t0, a["H_peak"], tol, a, DEFAULT_UPD))
+        hb, c = first
+
+        def problem_at(hs, hb=hb):
+            rich = check_sector(hb, hs[-1])
+            return rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), 1e-10 * max(hb.f0, hb.cf), rich.basis
+        ref = _chain(problem_at, hb.basis, c.x, c.omega, c.amplitude, (hb.H, c.peak_amplitude, c.peak_omega),
+                     REFERENCE_H_UPD)
+        for p in pending:
+            row = _row(*p[:4], ref, *p[5:])
+            if ti is not None and cf == ti["cf"]:
+                row["vs_time_integration"] = p[2] / ti["amplitude"] - 1.0
+            rows.append(row)
     return rows
+
+
+def _time_integration() -> dict | None:
+    """The ring time integration stored with the UPD-24 reference (hb_reference.json):
+    cf [N] (the config's) and amplitude [m] (first harmonic at the peak), or None."""
+    from pathlib import Path
+
+    from harmonic_balance.bladed_disk.config import load_config
+
+    path = Path(__file__).with_name("hb_reference.json")
+    ti = json.loads(path.read_text()).get("upd24", {}).get("time_integration")
+    cfg = load_config(None)
+    if not ti or float(cfg["load.f0"]) != 30.0:
+        return None
+    return {"cf": float(cfg["load.cf"]), "amplitude": float(ti["amplitude"])}
 
 
 #: Where each row is printed as soon as it is computed (None: not printed).
@@ -176,7 +221,8 @@ def _row(model, setting, amp, rec, ref, dt, H, target=None, run=None, default_of
            "target_met": None if target is None else true <= target,
            "engine_met": None if run is None else bool(run.get("met")),
            "default": None, "order": (rec or {}).get("order_observed"),
-           "check_time_s": (rec or {}).get("time_s"), "time_s": dt}
+           "check_time_s": (rec or {}).get("time_s"), "time_s": dt,
+           "H_curve": None if run is None else run.get("H_curve")}
     if default_of is not None and setting.split(" -> ")[0] == default_of:
         row["default"] = ("ok" if true <= DEFAULT_REL else
                           "warned" if est is not None and est > DEFAULT_REL else "FAIL")
@@ -204,7 +250,7 @@ def bench_rows(quick: bool, log=print) -> list[Row]:
 
     A row's ``case`` is ``"accuracy <model>"`` (``"accuracy <model> target"`` for an
     accuracy target), ``size`` the H used, ``error`` the true error against the reference
-    peak, ``time_s`` the wall time of the curve and its check (of a target: every curve and
+    peak, ``time_s`` the CPU time of the curve and its check (of a target: every curve and
     check it took); the rest of :func:`frf_rows`'s row rides along (``estimate``, ``ratio``,
     ``setting``, ``target``...).
     """
@@ -217,7 +263,7 @@ def bench_rows(quick: bool, log=print) -> list[Row]:
         case = f"accuracy {r['model']}" + (" target" if r["target"] is not None else "")
         out.append(Row(case, r["H"], r["true_error"], r["time_s"], self_peak_mb(), False,
                        {k: v for k, v in r.items() if k not in ("H", "true_error", "time_s")}
-                       | {"true_error": r["true_error"], "clock": "wall"}))
+                       | {"true_error": r["true_error"], "clock": "process"}))
     return out
 
 
