@@ -43,6 +43,9 @@ def plot_frf(result, out_dir) -> list[Path]:
     plt.close(fig)
 
     x, w = result.peak_solution, result.peak_omega
+    if result.extra.get("peak_problem") is not None:   # a peak raised in H: its richest level
+        prob, x = result.extra["peak_problem"], result.extra["peak_level_solution"]
+        b = prob.basis
     fig, ax = plt.subplots(figsize=(6, 4))
     for (u, F, W), link in zip(prob.residual.link_samples(x), prob.residual.elements):
         if u is None:   # no samples (a linear element): no loop to draw
