@@ -31,6 +31,13 @@ spectrum falls like h^-2 and the response's truncation error slowly (p ~ 0.5-4 m
 on the bench models and UPD-24): hence checks at 1.5 H and 2.25 H, not H + 2, whose
 difference would be too small to tell the error from.
 
+A peak to an accuracy (:func:`raise_at_peak`): the curve is traced once; its peak alone
+is re-solved at richer sets, level after level (each padded from the previous level's
+corrected points), and the RICHEST level's error is estimated from the levels below it
+(:func:`richest_error`: Richardson with the observed order when two successive triples
+agree on it, else with the smaller of it and ASSUMED_ORDER; the last difference itself
+when the levels oscillate) until it is below the target with at least MIN_LEVELS levels.
+
 The estimate is of the truncation in H only: the AFT sampling error (exact friction
 links have none) and the continuation's tolerance (the peak is refined to 1e-6 in
 frequency) are far smaller in the cases measured.

@@ -2,9 +2,9 @@
 
 :func:`truncation_error` estimates the error in H of a :class:`frf.FRFResult`'s peak
 amplitude and frequency by :mod:`accuracy`'s check at a richer harmonic set;
-:func:`frf_to_accuracy` traces curves with more harmonics until that estimate is below
-a relative tolerance on the peak amplitude, choosing the next H from the observed (or
-assumed) convergence order.
+:func:`frf_to_accuracy` traces the curve once and raises H at its peak only
+(:func:`accuracy.raise_at_peak`) until the richest level's estimate is below a relative
+tolerance on the peak amplitude.
 """
 from __future__ import annotations
 

@@ -133,10 +133,13 @@ def accuracy(data: dict) -> str:
     """The truncation-error table of ``python -m damper.bench.hb_accuracy --json``."""
     res = data.get("result", {})
     out = [stamp_text(data, "accuracy"), "",
-           f"True error: against the curve's peak re-solved with 0..{res.get('reference_H', '?')} "
-           f"harmonics (UPD-24: 0..{res.get('reference_H_upd', '?')}). Ratio: estimate / true error "
-           "(the goal: between 1/3 and 3). Check: the time of the estimate; total: the curve and "
-           "its check (for an accuracy target, every curve and check of the run). Flags: R the "
+           f"True error: against the first curve's peak raised level by level to 0..{res.get('reference_H', '?')} "
+           "harmonics, or to twice the richest peak level of the model's targets when higher "
+           f"(UPD-24: 0..{res.get('reference_H_upd', '?')}). A target's setting reads \"tol -> H "
+           "curve/peak\": the curve traced once at the first H, its peak raised to the second. "
+           "Ratio: estimate / true error (the goal: between 1/3 and 3). Check: the time of the "
+           "estimate (of a target: its peak levels); total: CPU time of the curve and its check "
+           "(of a target: the curve and every level at its peak). Flags: R the "
            "ratio outside [1/3, 3]; T a target's true error above it (t: the engine said not met, "
            "at its harmonic limit); D~ the default setting more than 1 % off, with its warning; "
            "D! without one.", "",

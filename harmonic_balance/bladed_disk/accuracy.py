@@ -6,6 +6,11 @@ amplitude of the response DOF) padded to a richer set 0..H' (H' = ceil(1.5 H)), 
 at their frequencies, and the peak of that short branch refined; the difference of the
 two peaks, scaled for the error left at H' with the assumed order, estimates the
 truncation error of the computed peak (CHECK_LEVELS).
+
+:func:`peak_to_accuracy` (``damper upd frf --accuracy``) traces the curve once and raises
+H at its peak only (:func:`..accuracy.raise_at_peak`, up to PEAK_MAX_HARMONIC).
+:func:`frf_to_accuracy` raises H per whole curve: the mistuning study and the load
+optimum need one H for whole curves (every ring sample, every load of the sweep).
 """
 from __future__ import annotations
 
