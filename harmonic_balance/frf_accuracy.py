@@ -147,6 +147,7 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
         riches.append(rich)
         return rich, rich.amplitude, tol_rel * max(rich.reference(res.peak_omega), 1e-300), rich.basis
 
+    t_levels = time.perf_counter()
     if res.peak_interior and np.isfinite(res.peak_amplitude):
         run = acc.raise_at_peak(problem_at, prob.basis, res.solutions, np.asarray(res.omega),
                                 int(np.argmax(res.amplitude)),
@@ -157,6 +158,7 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
                "error": None, "met": False, "solves": 0,
                "message": "the maximum is at an end of the band (widen the band)"}
     rec, a = acc.peak_records(run, tol, H0, PEAK_METHOD)
+    rec["time_s"] = time.perf_counter() - t_levels
     if run["x"] is not None:
         rich = riches[-1] if riches[-1].basis.harmonics == run["harmonics"] else check_problem(prob, run["harmonics"])
         res.peak_amplitude, res.peak_omega = a["peak_amplitude"], a["peak_omega"]
