@@ -159,8 +159,17 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
                "message": "the maximum is at an end of the band (widen the band)"}
     rec, a = acc.peak_records(run, tol, H0, PEAK_METHOD)
     rec["time_s"] = time.perf_counter() - t_levels
+    _report_peak(res, run, rec, a, riches)
+    res.evaluations += sum(r.evaluations for r in riches)
+    res.time_s = time.perf_counter() - t0   # the curve and every level at the peak
+    return res
+
+
+def _report_peak(res, run, rec, a, riches) -> None:
+    """``res`` (in place) with the richest level's peak and the run's records."""
     if run["x"] is not None:
-        rich = riches[-1] if riches[-1].basis.harmonics == run["harmonics"] else check_problem(prob, run["harmonics"])
+        rich = next((r for r in reversed(riches) if r.basis.harmonics == run["harmonics"]), None) \
+            or check_problem(res.problem, run["harmonics"])
         res.peak_amplitude, res.peak_omega = a["peak_amplitude"], a["peak_omega"]
         r = rich.response(run["x"], res.peak_omega)
         res.peak_amplitude_h1 = float(rich.basis.magnitude(r, 1)) if 1 in rich.basis.harmonics else float("nan")
@@ -168,9 +177,6 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
     res.truncation_error = rec
     res.extra["truncation_warning"] = None if a["met"] else acc.warning(rec)
     res.extra["accuracy"] = a
-    res.evaluations += sum(r.evaluations for r in riches)
-    res.time_s = time.perf_counter() - t0   # the curve and every level at the peak
-    return res
 
 
 #: The ``method`` of a peak raised to an accuracy.

@@ -65,6 +65,14 @@ def test_accuracy_traces_the_curve_once_and_raises_h_at_the_peak_only():
     assert r.truncation_error["H_used"] == a["H_peak"]
 
 
+def test_peak_levels_keep_an_odd_harmonic_set_odd():
+    # a symmetric friction loop has no even harmonics: an odd set stays odd at every level
+    r = compute_frf(SDOF.model(), "odd:3", SDOF.band, stability="off", accuracy=1e-3)
+    a = r.extra["accuracy"]
+    assert a["met"] and all(lv[0] % 2 == 1 for lv in a["levels"])
+    assert all(h % 2 == 1 for h in r.extra["peak_problem"].basis.harmonics)
+
+
 def test_a_run_to_an_accuracy_starts_at_three_harmonics_or_more():
     # from H = 1 the check at H' = 3 is outside the steady range and may say "met" far from
     # it (accuracy.MIN_START_HARMONIC): asked to start at 1, the curve is at 3
