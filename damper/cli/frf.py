@@ -287,12 +287,16 @@ def _emit(args, summary, print_json, atomic_write, dumps):
     print(f"{summary['points']} points, {summary['newton_iterations']} Newton iterations, "
           f"{_num(summary['time_s'], '.3f')} s, harmonics {summary['harmonics']}, "
           f"n_t {summary['n_t']}" + (f", {summary['aft']} AFT" if summary.get("aft") else ""))
-    print(f"peak: omega = {_num(summary['peak_omega'])} rad/s, amplitude = "
-          f"{_num(summary['peak_amplitude'])} m (first harmonic "
+    acc = summary.get("accuracy") or {}
+    raised = acc.get("H_peak") is not None and acc["H_peak"] != acc.get("H_curve")
+    at_peak = f" (H = {acc['H_peak']})" if raised else ""
+    at_curve = f" (the curve, H = {acc['H_curve']})" if raised else ""
+    print(f"peak{at_peak}: omega = {_num(summary['peak_omega'])} rad/s, "
+          f"amplitude = {_num(summary['peak_amplitude'])} m (first harmonic "
           f"{_num(summary['peak_amplitude_h1'])} m there)")
     if summary.get("peak_h1_max") is not None:
-        print(f"first harmonic's own peak: omega = {_num(summary['peak_h1_max_omega'])} rad/s, "
-              f"amplitude = {_num(summary['peak_h1_max'])} m")
+        print(f"first harmonic's own peak{at_curve}: "
+              f"omega = {_num(summary['peak_h1_max_omega'])} rad/s, amplitude = {_num(summary['peak_h1_max'])} m")
     for line in accuracy_lines(summary) + state_lines(summary.get("steady_state")):
         print(line)
     if summary.get("stuck_links"):
