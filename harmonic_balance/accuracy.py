@@ -337,8 +337,9 @@ def richest_error(levels) -> dict:
     dict: peak_amplitude_rel, peak_frequency_rel (None when a value is not finite),
     order_observed (p from the last three levels, :func:`observed_order`, or None),
     order_stable (the last two triples of levels agree on p within ORDER_STABLE), order
-    (p used), extrapolated (peak_amplitude, peak_omega at H -> infinity when the order is
-    stable, else None).
+    (p used), oscillating (the last three amplitudes oscillate: no order used),
+    extrapolated (peak_amplitude, peak_omega at H -> infinity when the order is stable,
+    else None).
 
     The error of the richest value v_K is Richardson's (Roache 1998, eq. 5.4.1),
     |v_K - v_inf| = |v_K - v_{K-1}| / ((H_K / H_{K-1})^p - 1), with the observed order
@@ -352,8 +353,10 @@ def richest_error(levels) -> dict:
     for key, col in (("amplitude", 1), ("omega", 2)):
         out[key] = _richest([(lv[0], lv[col]) for lv in levels])
     (e_a, a_inf, p, stable), (e_w, w_inf, _, _) = out["amplitude"], out["omega"]
+    a = [lv[1] for lv in levels[-3:]]
     return {"peak_amplitude_rel": e_a, "peak_frequency_rel": e_w, "order_observed": p,
             "order_stable": stable, "order": _used_order(p, stable),
+            "oscillating": len(a) == 3 and (a[0] - a[1]) * (a[1] - a[2]) < 0,
             "extrapolated": None if a_inf is None else {"peak_amplitude": a_inf, "peak_omega": w_inf}}
 
 
@@ -493,7 +496,7 @@ def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict
     rec = {"method": method, "H_used": H, "H_check": H,
            "levels": [{"H": int(h), "peak_amplitude": a, "peak_omega": w} for h, a, w in levels],
            "order": err.get("order", ASSUMED_ORDER), "order_observed": err.get("order_observed"),
-           "order_stable": bool(err.get("order_stable")),
+           "order_stable": bool(err.get("order_stable")), "oscillating": bool(err.get("oscillating")),
            "peak_amplitude_rel": err.get("peak_amplitude_rel"),
            "peak_frequency_rel": err.get("peak_frequency_rel"),
            "extrapolated": err.get("extrapolated")}

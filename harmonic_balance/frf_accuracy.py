@@ -212,11 +212,12 @@ def summary_lines(summary, hz: bool = False) -> list[str]:
     if e is None:
         lines = [f"truncation error: not estimated ({rec.get('note', 'no check')})"]
     elif rec.get("levels"):
-        how = ("observed and stable" if rec.get("order_stable") else "assumed" if rec.get("order_observed") is None
-               else f"the observed one not stable: the lower of it and {acc.ASSUMED_ORDER:g}")
+        how = ("the levels oscillate: their last difference" if rec.get("oscillating") else
+               f"order {rec['order']:.2g}, " + (
+                   "observed and stable" if rec.get("order_stable") else "assumed" if rec.get("order_observed") is None
+                   else f"the observed one not stable: the lower of it and {acc.ASSUMED_ORDER:g}"))
         lines = [f"truncation error (estimate of the peak at H = {rec['H_used']} from the levels H = "
-                 f"{', '.join(str(lv['H']) for lv in rec['levels'])}, order {rec['order']:.2g}, "
-                 f"{how}): peak amplitude {100 * e:.2g} %"
+                 f"{', '.join(str(lv['H']) for lv in rec['levels'])}, {how}): peak amplitude {100 * e:.2g} %"
                  + ("" if ef is None else f", peak frequency {100 * ef:.2g} %")]
     else:
         lines = [f"truncation error (estimate, H = {rec['H_used']} checked at H = {rec['H_check']}, "
