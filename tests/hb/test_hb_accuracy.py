@@ -113,6 +113,16 @@ def test_accuracy_outside_its_range_is_refused(tol):
         acc.check_accuracy(tol)
 
 
+@pytest.mark.parametrize("tol", [0.6, 1e-7])
+def test_peak_local_runs_refuse_an_accuracy_outside_its_range_before_any_work(tol):
+    from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy
+
+    with pytest.raises(ValueError, match="accuracy"):
+        compute_frf(SDOF.model(), 3, SDOF.band, accuracy=tol)
+    with pytest.raises(ValueError, match="accuracy"):
+        peak_to_accuracy(None, None, tol)   # refused before the sector is touched
+
+
 def test_richer_set_keeps_the_kind_and_adds_an_odd_harmonic():
     assert acc.richer((1, 3, 5, 7)) == (1, 3, 5, 7, 9, 11)
     assert acc.richer(tuple(range(2))) == (0, 1, 2, 3)         # H + 2: a new odd harmonic
