@@ -137,7 +137,7 @@ def accuracy(data: dict) -> str:
            "harmonics, or to twice the richest peak level of the model's targets when higher "
            f"(UPD-24: 0..{res.get('reference_H_upd', '?')}). A target's setting reads \"tol -> H "
            "curve/peak\": the curve traced once at the first H, its peak raised to the second. "
-           "Ratio: estimate / true error (the goal: between 1/3 and 3). Check: the time of the "
+           "Ratio: estimate / true error (the goal: between 1/3 and 3). Check: the wall time of the "
            "estimate (of a target: its peak levels); total: CPU time of the curve and its check "
            "(of a target: the curve and every level at its peak). Flags: R the "
            "ratio outside [1/3, 3]; T a target's true error above it (t: the engine said not met, "
