@@ -129,7 +129,9 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
 
     Raises
     ------
-    ValueError (bad accuracy), frf.FRFError (a RuntimeError) when the curve fails.
+    ValueError (bad accuracy), frf.FRFError (a RuntimeError) when the first curve fails.
+    When the first level finds no peak from the padded curve, the curve is traced again
+    at that level's set (up to CURVE_RETRIES times; ``H_curve`` says which).
     """
     import time
 
@@ -137,32 +139,55 @@ def frf_to_accuracy(curve, model, accuracy: float, omega_range, harmonics="3",
     hs = parse_harmonics(harmonics)
     if hs[-1] < acc.MIN_START_HARMONIC:
         hs = _harmonic_set(acc.MIN_START_HARMONIC, all(h % 2 for h in hs), 0 in hs)
-    t0 = time.perf_counter()
-    res = curve(model, hs, omega_range, truncation_check=False, **kwargs)
-    prob, H0 = res.problem, res.problem.basis.H
-    riches = []
+    t0, evaluations, res = time.perf_counter(), 0, None
+    for _ in range(CURVE_RETRIES + 1):
+        try:
+            new = curve(model, hs, omega_range, truncation_check=False, **kwargs)
+        except RuntimeError:
+            if res is None:
+                raise
+            break   # a retried curve that fails: the previous one and its message stand
+        res = new
+        evaluations += res.evaluations
+        t_levels = time.perf_counter()
+        run, riches = _levels(res, tol, limit, tol_rel)
+        evaluations += sum(r.evaluations for r in riches)
+        nxt = acc.richer(hs, limit=limit)
+        if len(run["levels"]) > 1 or not res.peak_interior or nxt == hs:
+            break
+        # the first level found no peak from the padded curve (the 3-mass chain at
+        # F = 0.5 N from H = 3): the curve again at that richer set, closer to its peaks
+        hs = nxt
+    H0 = res.problem.basis.H
+    rec, a = acc.peak_records(run, tol, H0, PEAK_METHOD)
+    rec["time_s"] = time.perf_counter() - t_levels
+    _report_peak(res, run, rec, a, riches)
+    res.evaluations = evaluations
+    res.time_s = time.perf_counter() - t0   # the curves and every level at the peak
+    return res
+
+
+#: Curves traced again at the next richer set when the first peak level finds no peak
+#: from the padded curve.
+CURVE_RETRIES = 2
+
+
+def _levels(res, tol: float, limit: int, tol_rel: float):
+    """(:func:`accuracy.raise_at_peak` run, the level problems) of the curve ``res``."""
+    prob, riches = res.problem, []
 
     def problem_at(h):
         rich = check_problem(prob, h)
         riches.append(rich)
         return rich, rich.amplitude, tol_rel * max(rich.reference(res.peak_omega), 1e-300), rich.basis
 
-    t_levels = time.perf_counter()
-    if res.peak_interior and np.isfinite(res.peak_amplitude):
-        run = acc.raise_at_peak(problem_at, prob.basis, res.solutions, np.asarray(res.omega),
-                                int(np.argmax(res.amplitude)),
-                                (H0, res.peak_amplitude, res.peak_omega), tol, limit,
-                                1e-6 * abs(res.peak_omega))
-    else:   # a maximum at the band's end has no peak to refine
-        run = {"levels": [(H0, res.peak_amplitude, res.peak_omega)], "harmonics": hs, "x": None,
-               "error": None, "met": False, "solves": 0,
-               "message": "the maximum is at an end of the band (widen the band)"}
-    rec, a = acc.peak_records(run, tol, H0, PEAK_METHOD)
-    rec["time_s"] = time.perf_counter() - t_levels
-    _report_peak(res, run, rec, a, riches)
-    res.evaluations += sum(r.evaluations for r in riches)
-    res.time_s = time.perf_counter() - t0   # the curve and every level at the peak
-    return res
+    level0 = (prob.basis.H, res.peak_amplitude, res.peak_omega)
+    if not (res.peak_interior and np.isfinite(res.peak_amplitude)):   # a maximum at the band's end
+        return {"levels": [level0], "harmonics": prob.basis.harmonics, "x": None, "error": None,
+                "met": False, "solves": 0, "message": "the maximum is at an end of the band (widen the band)"}, riches
+    return acc.raise_at_peak(problem_at, prob.basis, res.solutions, np.asarray(res.omega),
+                             int(np.argmax(res.amplitude)), level0, tol, limit,
+                             1e-6 * abs(res.peak_omega)), riches
 
 
 def _report_peak(res, run, rec, a, riches) -> None:

@@ -65,6 +65,19 @@ def test_accuracy_traces_the_curve_once_and_raises_h_at_the_peak_only():
     assert r.truncation_error["H_used"] == a["H_peak"]
 
 
+def test_a_peak_the_first_level_cannot_reach_from_the_curve_gets_a_richer_curve():
+    # the 3-mass chain at F = 0.5 N: no peak at H = 5 from the padded H = 3 curve; the curve
+    # is traced again at H = 5, and its peak raised from there; checked against the peak
+    # of a whole curve traced at H = 25 (independent of the levels)
+    case = bm.chain3(0.5, 20.0)
+    tol = 1e-3
+    r = compute_frf(case.model(), 3, case.band, stability="off", accuracy=tol)
+    a = r.extra["accuracy"]
+    assert a["met"] and a["H_curve"] == 5 == max(r.harmonics) < a["H_peak"]
+    whole = compute_frf(case.model(), 25, case.band, stability="off", truncation_check=False)
+    assert abs(r.peak_amplitude / whole.peak_amplitude - 1.0) < tol
+
+
 def test_peak_levels_keep_an_odd_harmonic_set_odd():
     # a symmetric friction loop has no even harmonics: an odd set stays odd at every level
     r = compute_frf(SDOF.model(), "odd:3", SDOF.band, stability="off", accuracy=1e-3)
