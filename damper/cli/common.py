@@ -10,8 +10,8 @@ links: compared by device and inode), is refused, as is an output that exists an
 not a regular file (``/dev/null``, a FIFO, a socket: writing through a temporary file
 and a rename would replace it). A result folder (``run --out``, ``sweep --out``) that
 holds one of the inputs is refused too: the command writes that folder's files as its
-own. A figure folder (``--plot``) may hold inputs: its files have fixed ``.png`` names,
-and while the command runs no input it read is ever replaced
+own. Two outputs naming one path are refused. A figure folder (``--plot``) may hold
+inputs: its files have fixed ``.png`` names, and while the command runs no input it read is ever replaced
 (:func:`contact_core.fileio.guard_inputs`).
 """
 from __future__ import annotations
@@ -57,7 +57,19 @@ def dumps(obj, indent: int | None = None) -> str:
 
 def print_json(obj) -> None:
     """Print one JSON object on stdout."""
+    from . import STDOUT
+
     sys.stdout.write(dumps(obj) + "\n")
+    STDOUT["json_printed"] = True
+
+
+def print_json_error(message: str, exit_code: int) -> None:
+    """With ``--json``, a failure's one JSON object on stdout (``error``, ``exit_code``), unless
+    the command printed its own (a partial result with its error)."""
+    from . import STDOUT
+
+    if not STDOUT["json_printed"]:
+        print_json({"error": message, "exit_code": exit_code})
 
 
 def check_accuracy_option(tol) -> None:
@@ -133,8 +145,25 @@ def _inside(folder: Path, path: Path) -> bool:
     return folder in path.parents
 
 
+def _distinct_outputs(args) -> None:
+    """Two output options naming one path (``--out r.json --normal-curve r.json``, ``--out c.json
+    --plot c.json``): the second write would replace or block the first, after work and
+    with one output already written; refused before any work."""
+    seen = {}
+    for dest, (flag, _) in OUTPUTS.items():
+        value = getattr(args, dest, None)
+        if value is None or isinstance(value, bool) or not str(value):
+            continue
+        key = Path(value).resolve()
+        if key in seen:
+            raise ValueError(f"{flag} {value} and {seen[key]} name the same path: give each output its own name")
+        seen[key] = f"{flag} {value}"
+
+
 def check_outputs(args) -> None:
-    """Refuse, before any work, an output that is one of the inputs or not a regular file (module docstring)."""
+    """Refuse, before any work, an output that is one of the inputs or not a regular file, or two
+    outputs that are one path (module docstring)."""
+    _distinct_outputs(args)
     inputs = _inputs(args)
     for dest, (flag, kind) in OUTPUTS.items():
         value = getattr(args, dest, None)

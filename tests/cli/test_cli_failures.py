@@ -1,0 +1,63 @@
+"""Failures of the ``damper`` command as a program reading its output sees them: with
+``--json`` one JSON object on stdout (the error and the exit code) besides the one line on
+stderr; two outputs naming one path refused before anything is written."""
+import json
+
+import pytest
+
+from damper.cli import main as damper
+from damper.stress import input_fixtures as fx
+
+CURVE = fx.curves()["curve.json"]
+
+
+@pytest.fixture
+def curve(tmp_path):
+    path = tmp_path / "c.json"
+    path.write_text(CURVE)
+    return str(path)
+
+
+def _stderr_line(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+def test_json_refusal_prints_one_error_object_with_the_message_and_exit_code(curve, capsys):
+    code = damper(["loop", "--curve", curve, "--amplitude", "2e-6", "--N", "nan", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 2
+    assert json.loads(out) == {"error": _stderr_line(err), "exit_code": 2}
+
+
+def test_json_command_line_refusal_prints_one_error_object(curve, capsys):
+    with pytest.raises(SystemExit) as stop:
+        damper(["loop", "--curve", curve, "--amplitude", "2e-6", "--json", "--wobble"])
+    out, err = capsys.readouterr()
+    assert stop.value.code == 2
+    obj = json.loads(out)
+    assert obj["exit_code"] == 2 and obj["error"] == _stderr_line(err) and "--wobble" in obj["error"]
+
+
+def test_refusal_without_json_prints_nothing_on_stdout(curve, capsys):
+    assert damper(["loop", "--curve", curve, "--amplitude", "2e-6", "--N", "nan"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and "--N" in _stderr_line(err)
+
+
+def test_json_error_object_after_an_earlier_command_of_the_same_process(curve, capsys):
+    assert damper(["loop", "--curve", curve, "--amplitude", "2e-6", "--json"]) == 0
+    capsys.readouterr()
+    assert damper(["loop", "--curve", curve, "--amplitude", "2e-6", "--N", "-1", "--json"]) == 2
+    assert json.loads(capsys.readouterr().out)["exit_code"] == 2
+
+
+@pytest.mark.parametrize("first, second", [("--out", "--normal-curve"), ("--out", "--plot")])
+def test_two_outputs_naming_one_path_are_refused_before_any_work(tmp_path, monkeypatch, capsys, first, second):
+    monkeypatch.chdir(tmp_path)
+    code = damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "100", "--grid", "5",
+                   "--model", "halfspace", "--no-cache", first, "r.json", second, "./r.json"])
+    assert code == 2
+    assert "same path" in _stderr_line(capsys.readouterr().err)
+    assert list(tmp_path.iterdir()) == []
