@@ -85,6 +85,11 @@ MAX_COSIM_STEPS = 50_000_000
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6
+#: Largest mean strain of a flat face's contact (``damper normal``/``tangential --body flat``):
+#: mean pressure over E*, or approach over the face's smaller side. The sphere's bound
+#: (contact radius <= 0.15 R) is a mean pressure of 0.064 E*; an approach of 1 m on a
+#: 1.2 mm face gave 9e13 Pa as a result.
+MAX_CONTACT_STRAIN = 0.1
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 

@@ -78,6 +78,12 @@ def _normal() -> list[InputCase]:
         ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
         ("force 1e12 (Hertz radius > R)", f"{SPHERE} --force 1e12"),
         ("eccentricity on a sphere", f"{SPHERE} --force 100 --eccentricity 1e-4"),
+        ("force 1e-300 (Hertz radius below round-off)", f"{SPHERE} --force 1e-300 --grid 5"),
+        ("approach 5e-324", f"{SPHERE} --approach 5e-324 --grid 5"),
+        ("approach 1 (Hertz radius > R)", f"{SPHERE} --approach 1 --grid 5"),
+        ("cylinder approach 5e-324", "--body cylinder --radius 2.5e-3 --length 1.2e-3 --approach 5e-324 --grid 5"),
+        ("flat approach 1", "--body flat --width 1.2e-3 --length 5e-3 --approach 1 --grid 5"),
+        ("flat force 1e12", "--body flat --width 1.2e-3 --length 5e-3 --force 1e12 --grid 5"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
         ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),
         ("curve 1e6 points", f"{SPHERE} --force 100 --curve 1000000"), ("curve -1", f"{SPHERE} --force 100 --curve=-1"),
@@ -118,6 +124,7 @@ def _tangential() -> list[InputCase]:
         ("force 0", f"tangential {SPHERE} --force 0 --mu 0.5"),
         ("grid 100000", f"tangential {SPHERE} --force 200 --mu 0.5 --grid 100000"),
         ("width on a sphere", f"{base} --mu 0.5 --width 1e-3"),
+        ("approach 1 (Hertz radius > R)", f"tangential {SPHERE} --approach 1 --mu 0.5 --model bem --grid 11"),
     ])
 
 
