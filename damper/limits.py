@@ -90,6 +90,10 @@ MIN_CURVE_TOL = 1e-6
 #: (contact radius <= 0.15 R) is a mean pressure of 0.064 E*; an approach of 1 m on a
 #: 1.2 mm face gave 9e13 Pa as a result.
 MAX_CONTACT_STRAIN = 0.1
+#: Largest hysteresis-loop amplitude of ``damper tangential --loop-amplitude`` in gross-slip
+#: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
+#: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).
+MAX_LOOP_SLIPS = 100.0
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 

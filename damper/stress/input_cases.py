@@ -115,6 +115,7 @@ def _tangential() -> list[InputCase]:
         ("tangential force above mu N", f"{base} --mu 0.5 --tangential-force 150"),
         ("loop amplitude -1", f"{base} --mu 0.5 --loop-amplitude=-1"),
         ("loop amplitude nan", f"{base} --mu 0.5 --loop-amplitude nan"),
+        ("loop amplitude 1e300 (hung)", f"{base} --mu 0.5 --loop-amplitude 1e300"),
         ("flat, approach, eccentricity", "tangential --body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 "
                                          "--mu 0.5 --eccentricity 1e-4"),
         ("eccentricity on a sphere", f"{base} --mu 0.5 --eccentricity 1e-4"),

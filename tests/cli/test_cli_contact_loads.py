@@ -62,3 +62,27 @@ def test_cylinder_approach_below_round_off_is_refused(capsys):
 def test_flat_face_load_beyond_small_strain_is_refused_with_the_bound(load, capsys):
     err = _refused([*FLAT, *load], capsys)
     assert f"{MAX_CONTACT_STRAIN:g}" in err and "give at most" in err
+
+
+#: Gross-slip displacement of the bem model on 11 nodes against Mindlin's closed form
+#: (3 mu N / (16 G* a)): measured 0.1 %.
+MINDLIN_BEM11 = 0.02
+
+
+def test_loop_amplitude_far_beyond_gross_slip_is_refused_with_the_bound(capsys):
+    """1e300 m marched for ever (the loop's points grow as the amplitude)."""
+    from damper.limits import MAX_LOOP_SLIPS
+
+    err = _refused(["tangential", "--body", "sphere", "--radius", str(R), "--force", "200", "--mu", "0.5",
+                    "--model", "bem", "--grid", "11", "--no-cache", "--loop-amplitude", "1e300"], capsys)
+    u_gross, bound = (float(v) for v in re.search(r"displacement ([0-9.e+-]+) m.*at most ([0-9.e+-]+) m",
+                                                   err).groups())
+    ref = bodies.Sphere().tangential_reference(_steel_sphere(), 200.0, 0.5)["mindlin"]["u_slip"]
+    assert u_gross == pytest.approx(ref, rel=MINDLIN_BEM11)
+    assert bound == pytest.approx(MAX_LOOP_SLIPS * u_gross, rel=PRINTED)
+
+
+def _steel_sphere():
+    from contact_core.spec import ContactSpec
+
+    return ContactSpec(body="sphere", radius=R, grid=11)
