@@ -52,6 +52,10 @@ MAX_FORCE_LEVELS = 100
 #: Angular frequency [rad/s]: far above any structural mode a blade model holds
 #: (1e9 rad/s is 160 MHz), and omega^2 M must stay far from floating-point overflow.
 MAX_OMEGA = 1e9
+#: Smallest angular frequency [rad/s] of a frequency range: 1e-6 rad/s is a period of 72
+#: days, a static load for any blade; far below, omega^2 M underflows against K and the
+#: stability and accuracy checks divide by zero (1e-300 rad/s printed two warnings).
+MIN_OMEGA = 1e-6
 #: Friction coefficient: dry contacts have mu below a few; beyond 100 the input is a typo.
 MAX_MU = 100.0
 #: Largest magnitude of a model parameter typed on the command line (mass, stiffness,
@@ -147,12 +151,16 @@ def check_range(name: str, value: float, low: float, high: float, unit: str, why
 
 
 def check_omega_range(name: str, lo: float, hi: float, unit: str = "rad/s", scale: float = 1.0) -> None:
-    """A frequency range: finite, positive, different, at most MAX_OMEGA (``scale``: to rad/s)."""
+    """A frequency range: finite, positive, different, in [MIN_OMEGA, MAX_OMEGA] (``scale``: to rad/s)."""
     for v in (lo, hi):
         if not math.isfinite(v) or v <= 0:
             raise ValueError(f"{name} {lo:g} {hi:g}: both ends must be positive finite numbers [{unit}]")
     if lo == hi:
         raise ValueError(f"{name} {lo:g} {hi:g}: the ends must differ")
+    bottom = MIN_OMEGA / scale
+    if min(lo, hi) < bottom:
+        raise ValueError(f"{name} {lo:g} {hi:g}: below the limit {bottom:.3g} {unit} (1e-6 rad/s, a period of "
+                         "72 days: a static load; the dynamics underflow further down)")
     top = MAX_OMEGA / scale
     if max(lo, hi) > top:
         raise ValueError(f"{name} {lo:g} {hi:g}: above the limit {top:.3g} {unit} (1e9 rad/s, 160 MHz: "

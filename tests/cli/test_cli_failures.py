@@ -61,3 +61,12 @@ def test_two_outputs_naming_one_path_are_refused_before_any_work(tmp_path, monke
     assert code == 2
     assert "same path" in _stderr_line(capsys.readouterr().err)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_frequency_below_the_static_limit_is_refused_with_the_limit(capsys):
+    from damper.limits import MIN_OMEGA
+
+    code = damper(["frf", "--model", "sdof", "--mass", "1", "--stiffness", "1", "--damping", "0.01",
+                   "--contact-stiffness", "1", "--slip-force", "0.05", "--force", "0.05", "--omega", "1e-300", "1"])
+    assert code == 2
+    assert f"below the limit {MIN_OMEGA:g} rad/s" in _stderr_line(capsys.readouterr().err)
