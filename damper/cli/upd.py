@@ -351,8 +351,9 @@ def _check_frf(args) -> None:
     check_accuracy_option(args.accuracy)
     for name in ("cf", "f0"):
         v = getattr(args, name)
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
+        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
+            raise ValueError(f"--{name.replace('_', '-')} must be finite, > 0 and at most "
+                             f"{limits.MAX_MAGNITUDE:g} N, got {v:g}")
     check_out_dir(args.plot, "--plot")
     from damper.upd_surface import check_options
 

@@ -70,3 +70,20 @@ def test_frequency_below_the_static_limit_is_refused_with_the_limit(capsys):
                    "--contact-stiffness", "1", "--slip-force", "0.05", "--force", "0.05", "--omega", "1e-300", "1"])
     assert code == 2
     assert f"below the limit {MIN_OMEGA:g} rad/s" in _stderr_line(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("option", ["--cf", "--f0"])
+def test_upd_load_beyond_the_magnitude_limit_is_refused_not_failed(option, capsys):
+    """1e300 N overflowed in the harmonic balance: exit 3 with advice about harmonics."""
+    from damper.limits import MAX_MAGNITUDE
+
+    assert damper(["upd", "frf", option, "1e300", "--points", "5"]) == 2
+    assert f"at most {MAX_MAGNITUDE:g} N" in _stderr_line(capsys.readouterr().err)
+
+
+def test_config_bound_is_printed_as_a_number_not_its_digits(tmp_path, capsys):
+    cfg = tmp_path / "u.toml"
+    cfg.write_text("[blade]\nbeta = 1e300\n")
+    assert damper(["upd", "modes", "--config", str(cfg)]) == 2
+    line = _stderr_line(capsys.readouterr().err)
+    assert "blade.beta: must be less than or equal to 1e+100" in line and "0000000000" not in line
