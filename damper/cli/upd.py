@@ -480,8 +480,8 @@ def _check_optimize(args) -> None:
     from .common import check_accuracy_option, check_out_dir
 
     lo, hi = args.cf_range
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-        raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI, both finite [N]")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= limits.MAX_MAGNITUDE):
+        raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI <= {limits.MAX_MAGNITUDE:g} [N]")
     limits.check_size("--points", args.points, 3, limits.MAX_LOAD_POINTS,
                       "each CF value is a whole forced response (seconds)")
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,

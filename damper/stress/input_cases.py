@@ -263,6 +263,7 @@ def _upd() -> list[InputCase]:
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
         ("config bad TOML", "modes --config {fx}/upd_badtoml.toml"),
         ("config unknown section", "modes --config {fx}/upd_section.toml"),
+        ("optimize cf-range 1 1e300 (overflowed: exit 3)", "optimize --cf-range 1 1e300 --points 3"),
         ("optimize cf-range 0 10", "optimize --cf-range 0 10"), ("optimize cf-range 10 1", "optimize --cf-range 10 1"),
         ("optimize points 1e6", "optimize --points 1000000"), ("optimize grid 1e6", "optimize --grid 1000000"),
         ("optimize harmonics 1000", "optimize --harmonics 1000"),
