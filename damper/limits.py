@@ -62,6 +62,11 @@ MAX_MU = 100.0
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
+#: Largest damping ratio of a structure's mode (a scene's ``structure.zeta``): 1 is critical
+#: damping, a blade's structural damping is below 1 %; 1e300 overflowed the Rayleigh
+#: matrix beta K into NaN.
+MAX_DAMPING_RATIO = 10.0
+DAMPING_RATIO_WHY = "1 is critical damping (a blade's structural damping is below 1 %)"
 #: Smallest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): the
 #: slip limits scale with N / N_ref, which overflows far below (N_ref = 1e-320 fails at
 #: the FMU's start); contacts of friction dampers carry mN to MN.
