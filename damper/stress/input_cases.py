@@ -251,6 +251,7 @@ def _upd() -> list[InputCase]:
         ("frf band 1e-300 1", "frf --band 1e-300 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
         ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
         ("frf cf 1e300 (overflowed: exit 3)", "frf --cf 1e300 --points 5"),
+        ("frf geometry contacts at CF 1e-300", "frf --contacts geometry --cf 1e-300 --points 5"),
         ("frf f0 1e300 (overflowed: exit 3)", "frf --f0 1e300 --points 5"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
         ("frf accuracy 0.6", "frf --accuracy 0.6"), ("frf accuracy nan", "frf --accuracy nan"),
@@ -309,7 +310,10 @@ def _upd() -> list[InputCase]:
 def _system() -> list[InputCase]:
     return _table("system", [
         ("system cf -1", "system --cf=-1 -o r.ssp"),
-        ("system cf 1e300", "system --cf 1e300 -o r.ssp"), ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system cf 1e300", "system --cf 1e300 -o r.ssp"),
+        ("system frequency 1e300", "system --frequency-hz 1e300 -o r.ssp"),
+        ("system geometry contacts at CF 1e-300 (hung)", "system --contacts geometry --cf 1e-300 -o r.ssp"),
+        ("system f0 nan", "system --f0 nan -o r.ssp"),
         ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
         ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
         ("system frequency -1", "system --frequency-hz=-1 -o r.ssp"),
