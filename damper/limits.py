@@ -74,6 +74,10 @@ MIN_NORMAL_LOAD = 1e-6
 #: Largest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): far
 #: above, N / N_ref underflows (N_ref = 1e308 gives F = 0).
 MAX_NORMAL_LOAD = 1e9
+#: Range of ``damper loop --scale``, a factor on every slip force (a change of mu): at
+#: --N 1e300 --scale 1e300 the slip forces overflowed (a JSON "out of range float" error).
+MIN_FRICTION_SCALE = 1e-6
+MAX_FRICTION_SCALE = 1e6
 #: Smallest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is
 #: a 0.2 m penetration; far below, the start penetration N / k_n overflows (k_n = 1e-300
 #: fails at the start).
@@ -148,10 +152,11 @@ def harmonics_why(high: int) -> str:
 def check_range(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
     """``value`` finite in [low, high] (``low`` > 0), else ValueError naming ``name``, the
     range and ``why``."""
+    u = f" {unit}" if unit else ""
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be finite and > 0 {unit}, got {value:g}")
+        raise ValueError(f"{name} must be finite and > 0{u}, got {value:g}")
     if not low <= value <= high:
-        raise ValueError(f"{name} {value:g} {unit} is outside [{low:g}, {high:g}] {unit}: {why}")
+        raise ValueError(f"{name} {value:g}{u} is outside [{low:g}, {high:g}]{u}: {why}")
     return value
 
 

@@ -87,3 +87,12 @@ def test_config_bound_is_printed_as_a_number_not_its_digits(tmp_path, capsys):
     assert damper(["upd", "modes", "--config", str(cfg)]) == 2
     line = _stderr_line(capsys.readouterr().err)
     assert "blade.beta: must be less than or equal to 1e+100" in line and "0000000000" not in line
+
+
+@pytest.mark.parametrize("extra, option", [(["--N", "1e300", "--scale", "1e300"], "--N"),
+                                           (["--N", "1e-300"], "--N"), (["--scale", "1e300"], "--scale")])
+def test_loop_normal_load_and_friction_scale_outside_their_range_are_refused(curve, capsys, extra, option):
+    """N and the scale multiply every slip force: 1e300 each overflowed into a JSON encoding error."""
+    assert damper(["loop", "--curve", curve, "--amplitude", "2e-6", *extra]) == 2
+    line = _stderr_line(capsys.readouterr().err)
+    assert line.startswith(f"damper loop: error: {option} ") and "is outside [" in line
