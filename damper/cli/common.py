@@ -51,8 +51,30 @@ def to_jsonable(obj):
 
 
 def dumps(obj, indent: int | None = None) -> str:
-    """JSON text of ``obj``; NaN and infinity are refused (never a silent bad number)."""
-    return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False)
+    """JSON text of ``obj``; NaN and infinity are refused (never a silent bad number): a
+    RuntimeError (exit 3) naming the first such key, not json's "out of range float"."""
+    data = to_jsonable(obj)
+    try:
+        return json.dumps(data, indent=indent, allow_nan=False)
+    except ValueError:
+        where = _non_finite(data)
+        if where is None:
+            raise
+        raise RuntimeError(f"the result's {where} is not a finite number (an overflow or a failed "
+                           "solve): nothing written; inputs of more moderate size may help") from None
+
+
+def _non_finite(data, path: str = "") -> str | None:
+    """Path (``loop.T[3]``) of the first NaN or infinity in plain JSON data, or None."""
+    if isinstance(data, float):
+        return None if np.isfinite(data) else (path or "value")
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, list) else ()
+    for key, value in items:
+        found = _non_finite(value, f"{path}.{key}" if isinstance(key, str) and path else
+                            key if isinstance(key, str) else f"{path}[{key}]")
+        if found is not None:
+            return found
+    return None
 
 
 def print_json(obj) -> None:

@@ -96,3 +96,10 @@ def test_loop_normal_load_and_friction_scale_outside_their_range_are_refused(cur
     assert damper(["loop", "--curve", curve, "--amplitude", "2e-6", *extra]) == 2
     line = _stderr_line(capsys.readouterr().err)
     assert line.startswith(f"damper loop: error: {option} ") and "is outside [" in line
+
+
+def test_a_non_finite_result_is_a_solver_failure_naming_its_key():
+    from damper.cli.common import dumps
+
+    with pytest.raises(RuntimeError, match=r"loop\.T\[1\] is not a finite number"):
+        dumps({"N": 1.0, "loop": {"T": [0.0, float("inf")]}})
