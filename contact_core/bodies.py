@@ -97,6 +97,10 @@ def share_far(out: dict, cc, sol, size: float) -> None:
 #: contact are millimetres to centimetres; far beyond, the Hertz relations (a^3 / R, the
 #: force for a contact radius) leave double precision (R = 1e308 m overflows).
 MAX_SIZE = 1e3
+#: Smallest body dimension [m]: 1 um, far below a damper's (millimetres); below, the
+#: Hertz relations divide by underflowed sizes (R = 1e-300 m: a ZeroDivisionError) and
+#: a continuum model of the body no longer holds.
+MIN_SIZE = 1e-6
 
 
 def _positive(name: str, value: float) -> None:
@@ -104,6 +108,9 @@ def _positive(name: str, value: float) -> None:
         raise ValueError(f"{name} must be a positive finite number, got {value!r}")
     if value > MAX_SIZE:
         raise ValueError(f"{name} = {value:.4g} m is above the limit {MAX_SIZE:g} m (a contact body "
+                         "of a friction damper is millimetres to centimetres)")
+    if value < MIN_SIZE:
+        raise ValueError(f"{name} = {value:.4g} m is below the limit {MIN_SIZE:g} m (a contact body "
                          "of a friction damper is millimetres to centimetres)")
 
 

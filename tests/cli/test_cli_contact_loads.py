@@ -86,3 +86,12 @@ def _steel_sphere():
     from contact_core.spec import ContactSpec
 
     return ContactSpec(body="sphere", radius=R, grid=11)
+
+
+@pytest.mark.parametrize("geometry, words", [
+    (["--body", "sphere", "--radius", "1e-300"], "radius = 1e-300 m is below the limit"),   # ZeroDivisionError
+    (["--body", "cylinder", "--radius", "2.5e-3", "--length", "1e-300"], "length = 1e-300 m is below the limit"),
+    (["--body", "sphere", "--radius", "0.01", "--E", "1e-300"], "E1 = 1e-300 Pa is below the limit"),
+])
+def test_a_size_or_modulus_below_any_contact_is_refused(geometry, words, capsys):
+    assert words in _refused(["normal", *geometry, "--force", "100", "--grid", "5", "--no-cache"], capsys)
