@@ -39,11 +39,6 @@ SUBCOMMANDS = ("run", "sweep", "cache", "normal", "tangential", "loop", "fmu", "
 #: argparse's own pattern knows only ``-5`` and ``-0.5`` and reads ``-5e7`` as an option.
 NEGATIVE_NUMBER = re.compile(r"^-(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE)
 
-#: What this process's command printed on stdout: ``json_printed`` once
-#: :func:`.common.print_json` printed its object (a failure then prints no error object
-#: after it: one JSON object on stdout, whatever happens).
-STDOUT = {"json_printed": False}
-
 
 class Parser(argparse.ArgumentParser):
     """``argparse.ArgumentParser`` whose errors are one line (``prog: error: message``,
@@ -163,7 +158,9 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None) -> int:
     command = "damper"
-    STDOUT["json_printed"] = False  # main may run several commands in one process (tests)
+    from .jsonout import STATE
+
+    STATE["printed"] = False  # main may run several commands in one process (tests)
     _blas_threads_as_set()
     try:
         parser = build_parser()

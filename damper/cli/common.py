@@ -79,18 +79,18 @@ def _non_finite(data, path: str = "") -> str | None:
 
 def print_json(obj) -> None:
     """Print one JSON object on stdout."""
-    from . import STDOUT
+    from .jsonout import STATE
 
     sys.stdout.write(dumps(obj) + "\n")
-    STDOUT["json_printed"] = True
+    STATE["printed"] = True
 
 
 def print_json_error(message: str, exit_code: int) -> None:
     """With ``--json``, a failure's one JSON object on stdout (``error``, ``exit_code``), unless
     the command printed its own (a partial result with its error)."""
-    from . import STDOUT
+    from .jsonout import STATE
 
-    if not STDOUT["json_printed"]:
+    if not STATE["printed"]:
         print_json({"error": message, "exit_code": exit_code})
 
 
