@@ -34,6 +34,12 @@ CYLINDER_END_WIDENING = 1.3
 #: Measured: the real half-sphere meshes with a/R = 0.17 and inverts elements at
 #: 0.19 (zone 1.15 a), at 7, 21 and 41 nodes per side.
 MAX_CONTACT_SHARE = 0.15
+#: Smallest Hertz contact radius of a sphere as a share of its radius R: the gap at the
+#: contact's edge, a^2 / (2R), is then 4.5e-12 R, a few hundred ulp of the mesh's
+#: coordinates (~R). Measured on R = 10 mm steel, halfspace, 5 nodes per side: 1e-9 N
+#: (a = 4.5e-6 R) solves, 2e-11 N (a = 1.2e-6 R) puts contact on the zone's edge, 1e-20 N
+#: asks for a mesh of 6e7 nodes and an approach of 5e-324 m divides by zero.
+MIN_CONTACT_SHARE = 3e-6
 
 _KINDS: dict[str, Body] = {}
 
@@ -91,6 +97,10 @@ def share_far(out: dict, cc, sol, size: float) -> None:
 #: contact are millimetres to centimetres; far beyond, the Hertz relations (a^3 / R, the
 #: force for a contact radius) leave double precision (R = 1e308 m overflows).
 MAX_SIZE = 1e3
+#: Smallest body dimension [m]: 1 um, far below a damper's (millimetres); below, the
+#: Hertz relations divide by underflowed sizes (R = 1e-300 m: a ZeroDivisionError) and
+#: a continuum model of the body no longer holds.
+MIN_SIZE = 1e-6
 
 
 def _positive(name: str, value: float) -> None:
@@ -98,6 +108,9 @@ def _positive(name: str, value: float) -> None:
         raise ValueError(f"{name} must be a positive finite number, got {value!r}")
     if value > MAX_SIZE:
         raise ValueError(f"{name} = {value:.4g} m is above the limit {MAX_SIZE:g} m (a contact body "
+                         "of a friction damper is millimetres to centimetres)")
+    if value < MIN_SIZE:
+        raise ValueError(f"{name} = {value:.4g} m is below the limit {MIN_SIZE:g} m (a contact body "
                          "of a friction damper is millimetres to centimetres)")
 
 
@@ -231,6 +244,16 @@ class Sphere(Body):
                              f"{spec.radius:.3g} m: lower --p-design")
 
     def check_load(self, spec, force):
+        """Refuse a force whose Hertz contact radius is outside [MIN_CONTACT_SHARE,
+        MAX_CONTACT_SHARE] R."""
+        a_min = MIN_CONTACT_SHARE * spec.radius
+        f_min = 4.0 * spec.Estar * a_min**3 / (3.0 * spec.radius)
+        if force < f_min:
+            a = a_min * (max(force, 0.0) / f_min) ** (1.0 / 3.0)
+            raise ValueError(f"a force of {force:.4g} N gives a Hertz contact radius of "
+                             f"{a:.3g} m, {a / spec.radius:.2g} of the sphere radius {spec.radius:.3g} m: "
+                             f"below what the mesh resolves in double precision (a >= "
+                             f"{MIN_CONTACT_SHARE:g} R); use a force of at least {f_min:.4g} N")
         a_max = MAX_CONTACT_SHARE * spec.radius
         f_max = 4.0 * spec.Estar * a_max**3 / (3.0 * spec.radius)   # Hertz: a^3 = 3 F R / (4 E*)
         if force > f_max * (1.0 + 3e-9):

@@ -107,6 +107,9 @@ def describe(model: type[BaseModel], error: dict) -> str:
     text = error["msg"]
     text = text.replace("Input should be", "must be").replace("Input", "the value")
     if kind in ("less_than", "less_than_equal", "greater_than", "greater_than_equal"):
+        bound = next(iter(error.get("ctx", {}).values()), None)
+        if isinstance(bound, (int, float)) and not isinstance(bound, bool):  # 1e100, not its 101 digits
+            text = f"must be {kind.replace('_equal', ' or equal to').replace('_', ' ')} {bound:g}"
         why = reason(model, error["loc"])
         if why:
             return f"{text}, got {shown(value)}: {why}"

@@ -25,6 +25,9 @@ MODELS = ("real", "halfspace")
 #: Largest Young's modulus [Pa]: ten times diamond's (1.2e12 Pa); far beyond, the Hertz
 #: relations (E* a^3) leave double precision.
 MAX_MODULUS = 1e13
+#: Smallest Young's modulus [Pa]: a soft elastomer's (1e5 Pa); far below, the Hertz
+#: contact radius of any load overflows (E = 1e-300 Pa: "a contact radius of inf m").
+MIN_MODULUS = 1e5
 
 
 @dataclass(frozen=True)
@@ -132,6 +135,9 @@ def validate(spec: ContactSpec) -> None:
         if getattr(spec, name) > MAX_MODULUS:
             raise ValueError(f"{name} = {getattr(spec, name):.4g} Pa is above the limit {MAX_MODULUS:g} Pa "
                              "(ten times diamond's Young's modulus)")
+        if getattr(spec, name) < MIN_MODULUS:
+            raise ValueError(f"{name} = {getattr(spec, name):.4g} Pa is below the limit {MIN_MODULUS:g} Pa "
+                             "(a soft elastomer's Young's modulus)")
     for name in ("nu1", "nu2"):
         nu = getattr(spec, name)
         if not (-1.0 < nu < 0.5):

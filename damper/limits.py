@@ -52,12 +52,21 @@ MAX_FORCE_LEVELS = 100
 #: Angular frequency [rad/s]: far above any structural mode a blade model holds
 #: (1e9 rad/s is 160 MHz), and omega^2 M must stay far from floating-point overflow.
 MAX_OMEGA = 1e9
+#: Smallest angular frequency [rad/s] of a frequency range: 1e-6 rad/s is a period of 72
+#: days, a static load for any blade; far below, omega^2 M underflows against K and the
+#: stability and accuracy checks divide by zero (1e-300 rad/s printed two warnings).
+MIN_OMEGA = 1e-6
 #: Friction coefficient: dry contacts have mu below a few; beyond 100 the input is a typo.
 MAX_MU = 100.0
 #: Largest magnitude of a model parameter typed on the command line (mass, stiffness,
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
+#: Largest damping ratio of a structure's mode (a scene's ``structure.zeta``): 1 is critical
+#: damping, a blade's structural damping is below 1 %; 1e300 overflowed the Rayleigh
+#: matrix beta K into NaN.
+MAX_DAMPING_RATIO = 10.0
+DAMPING_RATIO_WHY = "1 is critical damping (a blade's structural damping is below 1 %)"
 #: Smallest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): the
 #: slip limits scale with N / N_ref, which overflows far below (N_ref = 1e-320 fails at
 #: the FMU's start); contacts of friction dampers carry mN to MN.
@@ -65,6 +74,10 @@ MIN_NORMAL_LOAD = 1e-6
 #: Largest normal load [N] of a friction element (``fmu --n-ref``, ``--preload``): far
 #: above, N / N_ref underflows (N_ref = 1e308 gives F = 0).
 MAX_NORMAL_LOAD = 1e9
+#: Range of ``damper loop --scale``, a factor on every slip force (a change of mu): at
+#: --N 1e300 --scale 1e300 the slip forces overflowed (a JSON "out of range float" error).
+MIN_FRICTION_SCALE = 1e-6
+MAX_FRICTION_SCALE = 1e6
 #: Smallest penalty normal stiffness [N/m] (``fmu --k-n``): at 1e3 N/m a 200 N preload is
 #: a 0.2 m penetration; far below, the start penetration N / k_n overflows (k_n = 1e-300
 #: fails at the start).
@@ -85,6 +98,15 @@ MAX_COSIM_STEPS = 50_000_000
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6
+#: Largest mean strain of a flat face's contact (``damper normal``/``tangential --body flat``):
+#: mean pressure over E*, or approach over the face's smaller side. The sphere's bound
+#: (contact radius <= 0.15 R) is a mean pressure of 0.064 E*; an approach of 1 m on a
+#: 1.2 mm face gave 9e13 Pa as a result.
+MAX_CONTACT_STRAIN = 0.1
+#: Largest hysteresis-loop amplitude of ``damper tangential --loop-amplitude`` in gross-slip
+#: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
+#: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).
+MAX_LOOP_SLIPS = 100.0
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 
@@ -130,20 +152,25 @@ def harmonics_why(high: int) -> str:
 def check_range(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
     """``value`` finite in [low, high] (``low`` > 0), else ValueError naming ``name``, the
     range and ``why``."""
+    u = f" {unit}" if unit else ""
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} must be finite and > 0 {unit}, got {value:g}")
+        raise ValueError(f"{name} must be finite and > 0{u}, got {value:g}")
     if not low <= value <= high:
-        raise ValueError(f"{name} {value:g} {unit} is outside [{low:g}, {high:g}] {unit}: {why}")
+        raise ValueError(f"{name} {value:g}{u} is outside [{low:g}, {high:g}]{u}: {why}")
     return value
 
 
 def check_omega_range(name: str, lo: float, hi: float, unit: str = "rad/s", scale: float = 1.0) -> None:
-    """A frequency range: finite, positive, different, at most MAX_OMEGA (``scale``: to rad/s)."""
+    """A frequency range: finite, positive, different, in [MIN_OMEGA, MAX_OMEGA] (``scale``: to rad/s)."""
     for v in (lo, hi):
         if not math.isfinite(v) or v <= 0:
             raise ValueError(f"{name} {lo:g} {hi:g}: both ends must be positive finite numbers [{unit}]")
     if lo == hi:
         raise ValueError(f"{name} {lo:g} {hi:g}: the ends must differ")
+    bottom = MIN_OMEGA / scale
+    if min(lo, hi) < bottom:
+        raise ValueError(f"{name} {lo:g} {hi:g}: below the limit {bottom:.3g} {unit} (1e-6 rad/s, a period of "
+                         "72 days: a static load; the dynamics underflow further down)")
     top = MAX_OMEGA / scale
     if max(lo, hi) > top:
         raise ValueError(f"{name} {lo:g} {hi:g}: above the limit {top:.3g} {unit} (1e9 rad/s, 160 MHz: "

@@ -130,7 +130,7 @@ class Study:
         for name in ("cf", "f0"):
             v = getattr(self, name)
             if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
-                raise ValueError(f"{name} must be finite and > 0, got {v}")
+                raise ValueError(f"{name} must be finite, > 0 and at most {limits.MAX_MAGNITUDE:g} N, got {v}")
         limits.check_size("harmonics", self.harmonics, 1, limits.MAX_UPD_HARMONICS,
                           limits.harmonics_why(limits.MAX_UPD_HARMONICS))
         limits.check_size("points", self.points, 3, limits.MAX_UPD_POINTS, "each point is a harmonic-"

@@ -98,6 +98,12 @@ def geometry_params(cfg, cf: float | None = None) -> dict:
         if not (val[key] or N_static) > 0:
             raise ValueError(f"config: geometry.{key} = 0 takes the static load at CF = {cf:g} N, "
                              "which is 0: give a CF > 0 or the load itself")
+    from damper import limits
+
+    for key in _LOADS:  # a contact model at 1e-300 N marched for minutes (CF = 1e-300 N)
+        limits.check_range(f"the nominal normal load of geometry.{key} (CF = {cf:g} N)", val[key] or N_static,
+                           limits.MIN_NORMAL_LOAD, limits.MAX_NORMAL_LOAD, "N",
+                           "a friction damper's contacts carry mN to MN; give another CF or the load itself")
     return {"R": val["cylinder_radius"], "L": float(cfg["damper.contact_length"]),
             "W": float(cfg["damper.right_width"]), "h": val["flat_height"],
             "E1": val["E_damper"], "nu1": val["nu_damper"], "E2": val["E_blade"],

@@ -20,6 +20,7 @@ where it stalls at a non-zero local minimum of phi it says so.
 """
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,11 +44,12 @@ LM_TRIALS = 60
 
 
 class NewtonError(RuntimeError):
-    """Newton did not converge; ``reason`` says why, ``x`` is the last iterate."""
+    """Newton did not converge; ``reason`` says why, ``x`` is the last iterate (``iterations``
+    None: not counted, where the residual failed)."""
 
     def __init__(self, reason: str, x: np.ndarray, iterations: int, residual: float):
-        super().__init__(f"Newton failed after {iterations} iterations: {reason} "
-                         f"(|R| = {residual:.3e})")
+        after = "" if iterations is None else f" after {iterations} iterations"
+        super().__init__(f"Newton failed{after}: {reason} (|R| = {residual:.3e})")
         self.reason, self.x, self.iterations, self.residual = reason, x, iterations, residual
 
 
@@ -89,8 +91,10 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
     Raises
     ------
     NewtonError (a RuntimeError) with the reason: non-finite residual, singular
-    Jacobian, line-search failure, or iteration limit.
+    Jacobian, line-search failure, iteration limit, or a residual that cannot be
+    evaluated at an iterate (:func:`_guarded`).
     """
+    fun, value = _guarded(fun), _guarded(value)
     x = np.array(x0, dtype=float)
     R, J = fun(x)
     nr = _norm(R, x, 0)
@@ -123,6 +127,36 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
                                   "is no solution, or no nearby solution)", x, it, nr)
         x, R, J, nr = step
     raise NewtonError(f"no convergence to {tol:.1e} within {max_iter} iterations", x, max_iter, nr)
+
+
+def _guarded(f):
+    """``f`` with an evaluation failure turned into a :class:`NewtonError`, or None.
+
+    A friction element whose periodic loop does not close within its period limit
+    (``fmu_src``'s ``IwanNotConvergedError``: near lift-off of a 3D contact, with the
+    normal load varying and the slip in two directions) cannot give R at that x. For the
+    solver this is a failed iteration, as a singular Jacobian is, so a continuation
+    corrector shortens its step instead of ending the curve. Only that error: any other
+    exception is a bug and passes through.
+    """
+    if f is None:
+        return None
+
+    def g(x):
+        try:
+            return f(x)
+        except evaluation_errors() as err:  # evaluated only when f raised
+            raise NewtonError(f"the residual cannot be evaluated there ({err})", x, None,
+                              np.inf) from err
+    return g
+
+
+def evaluation_errors() -> tuple:
+    """The exception types by which a residual says it cannot be evaluated at x (a failed
+    iteration, :func:`_guarded`): the friction element's, when its C layer is loaded (a
+    residual that never loaded it cannot raise it; no import of the library)."""
+    clib = sys.modules.get("fmu_src._clib")
+    return () if clib is None else (clib.IwanNotConvergedError,)
 
 
 #: |R| up to this many times the tolerance may be declared round-off (_at_noise_floor).

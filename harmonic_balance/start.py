@@ -31,7 +31,7 @@ from .aft import FrictionLink
 from .continuation import ContinuationError, continuation
 from .fourier import FourierBasis, default_samples
 from .homotopy import HomotopyError, forcing_vector, solve_with_homotopy
-from .newton import NewtonError, newton
+from .newton import NewtonError, evaluation_errors, newton
 from .parameter import ParameterProblem, contact_stiffness_scale
 from .residual import CondensedResidual, make_residual
 
@@ -116,7 +116,10 @@ def _homotopies(model, basis, cond, omega, tol, ratio, errors):
 def _forcing(model, basis, cond, omega, tol, ratio):
     res = make_residual(model, basis, cond)
     x0 = res.linear_guess(omega)
-    f = forcing_vector(lambda m: make_residual(m, basis, cond), model, x0, omega)
+    try:
+        f = forcing_vector(lambda m: make_residual(m, basis, cond), model, x0, omega)
+    except evaluation_errors() as err:  # evaluated only when it raised
+        raise HomotopyError(f"the residual cannot be evaluated at the linear guess ({err})") from err
     return solve_with_homotopy(lambda z: res(z, omega)[:2], x0, f, tol)
 
 

@@ -9,6 +9,9 @@ Exit codes: 0 success, 2 bad input (``ValueError``, ``OSError``: a clear
 message on stderr, nothing written), 3 a solver that did not converge
 (``RuntimeError``), 130 interrupted (Ctrl-C: one line saying where), 143 terminated
 (SIGTERM: handled as Ctrl-C, so temporary folders are removed on the way out).
+With ``--json``, exit codes 2 and 3 also print one JSON object on stdout,
+``{"error": message, "exit_code": code}``, unless the command printed its own
+partial result.
 Warnings (numpy's overflow, a library's note) print as one line each, once per
 message, however often their cause repeats.
 """
@@ -48,10 +51,14 @@ class Parser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
 
+    #: The last refusal's line (``damper.cli._parse`` prints it as JSON with ``--json``).
+    last_error = None
+
     def error(self, message: str):
         """Print one line naming the command and where its options are listed; exit 2."""
         text = " ".join(str(message).split())
-        self.exit(2, f"{self.prog}: error: {text} (see {self.prog} --help)\n")
+        Parser.last_error = f"{self.prog}: error: {text} (see {self.prog} --help)"
+        self.exit(2, Parser.last_error + "\n")
 
     def add_subparsers(self, **kwargs):
         kwargs.setdefault("parser_class", _SubParser)
@@ -151,10 +158,13 @@ def main(argv: list[str] | None = None) -> int:
 
 def _main(argv: list[str] | None) -> int:
     command = "damper"
+    from .jsonout import STATE
+
+    STATE["printed"] = False  # main may run several commands in one process (tests)
     _blas_threads_as_set()
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args = _parse(parser, argv)
         command = args.command
         _one_line_warnings(command)
         try:
@@ -166,11 +176,9 @@ def _main(argv: list[str] | None) -> int:
             with guard_inputs():
                 return int(args.func(args) or 0)
         except (ValueError, OSError) as err:
-            print(f"damper {command}: error: {_text(err)}", file=sys.stderr)
-            return 2
+            return _failed(args, f"damper {command}: error: {_text(err)}", 2)
         except RuntimeError as err:
-            print(f"damper {command}: failed: {_text(err)}", file=sys.stderr)
-            return 3
+            return _failed(args, f"damper {command}: failed: {_text(err)}", 3)
     except KeyboardInterrupt as err:
         where = getattr(err, "message", "")
         if isinstance(err, Terminated) or isinstance(err.__context__, Terminated):  # (re-raised with a where)
@@ -179,6 +187,31 @@ def _main(argv: list[str] | None) -> int:
             return 143
         print(f"damper {command}: {where or 'interrupted'}", file=sys.stderr)
         return 130
+
+
+def _parse(parser, argv):
+    """``parser.parse_args``; with ``--json`` among the arguments, a refusal of the command
+    line also prints its JSON error object (:func:`_failed`)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        return parser.parse_args(argv)
+    except SystemExit as stop:
+        if stop.code == 2 and "--json" in argv:
+            from .common import print_json_error
+
+            print_json_error(Parser.last_error or "bad command line", 2)
+        raise
+
+
+def _failed(args, line: str, code: int) -> int:
+    """Print the one-line message on stderr (and, with ``--json``, the JSON error object on
+    stdout, so a program reading stdout gets an object on failure too); return ``code``."""
+    print(line, file=sys.stderr)
+    if getattr(args, "json", False) is True:
+        from .common import print_json_error
+
+        print_json_error(line, code)
+    return code
 
 
 def _blas_threads_as_set() -> None:

@@ -10,8 +10,8 @@ links: compared by device and inode), is refused, as is an output that exists an
 not a regular file (``/dev/null``, a FIFO, a socket: writing through a temporary file
 and a rename would replace it). A result folder (``run --out``, ``sweep --out``) that
 holds one of the inputs is refused too: the command writes that folder's files as its
-own. A figure folder (``--plot``) may hold inputs: its files have fixed ``.png`` names,
-and while the command runs no input it read is ever replaced
+own. Two outputs naming one path are refused. A figure folder (``--plot``) may hold
+inputs: its files have fixed ``.png`` names, and while the command runs no input it read is ever replaced
 (:func:`contact_core.fileio.guard_inputs`).
 """
 from __future__ import annotations
@@ -51,13 +51,47 @@ def to_jsonable(obj):
 
 
 def dumps(obj, indent: int | None = None) -> str:
-    """JSON text of ``obj``; NaN and infinity are refused (never a silent bad number)."""
-    return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False)
+    """JSON text of ``obj``; NaN and infinity are refused (never a silent bad number): a
+    RuntimeError (exit 3) naming the first such key, not json's "out of range float"."""
+    data = to_jsonable(obj)
+    try:
+        return json.dumps(data, indent=indent, allow_nan=False)
+    except ValueError:
+        where = _non_finite(data)
+        if where is None:
+            raise
+        raise RuntimeError(f"the result's {where} is not a finite number (an overflow or a failed "
+                           "solve): nothing written; inputs of more moderate size may help") from None
+
+
+def _non_finite(data, path: str = "") -> str | None:
+    """Path (``loop.T[3]``) of the first NaN or infinity in plain JSON data, or None."""
+    if isinstance(data, float):
+        return None if np.isfinite(data) else (path or "value")
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, list) else ()
+    for key, value in items:
+        found = _non_finite(value, f"{path}.{key}" if isinstance(key, str) and path else
+                            key if isinstance(key, str) else f"{path}[{key}]")
+        if found is not None:
+            return found
+    return None
 
 
 def print_json(obj) -> None:
     """Print one JSON object on stdout."""
+    from .jsonout import STATE
+
     sys.stdout.write(dumps(obj) + "\n")
+    STATE["printed"] = True
+
+
+def print_json_error(message: str, exit_code: int) -> None:
+    """With ``--json``, a failure's one JSON object on stdout (``error``, ``exit_code``), unless
+    the command printed its own (a partial result with its error)."""
+    from .jsonout import STATE
+
+    if not STATE["printed"]:
+        print_json({"error": message, "exit_code": exit_code})
 
 
 def check_accuracy_option(tol) -> None:
@@ -133,8 +167,25 @@ def _inside(folder: Path, path: Path) -> bool:
     return folder in path.parents
 
 
+def _distinct_outputs(args) -> None:
+    """Two output options naming one path (``--out r.json --normal-curve r.json``, ``--out c.json
+    --plot c.json``): the second write would replace or block the first, after work and
+    with one output already written; refused before any work."""
+    seen = {}
+    for dest, (flag, _) in OUTPUTS.items():
+        value = getattr(args, dest, None)
+        if value is None or isinstance(value, bool) or not str(value):
+            continue
+        key = Path(value).resolve()
+        if key in seen:
+            raise ValueError(f"{flag} {value} and {seen[key]} name the same path: give each output its own name")
+        seen[key] = f"{flag} {value}"
+
+
 def check_outputs(args) -> None:
-    """Refuse, before any work, an output that is one of the inputs or not a regular file (module docstring)."""
+    """Refuse, before any work, an output that is one of the inputs or not a regular file, or two
+    outputs that are one path (module docstring)."""
+    _distinct_outputs(args)
     inputs = _inputs(args)
     for dest, (flag, kind) in OUTPUTS.items():
         value = getattr(args, dest, None)

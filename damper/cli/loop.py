@@ -72,6 +72,12 @@ def _check_args(args) -> None:
         raise ValueError(f"--N must be > 0 (N <= 0 is lift-off: no loop), got {args.N:g}")
     if not args.scale > 0.0:
         raise ValueError(f"--scale must be > 0 (a friction scale), got {args.scale:g}")
+    if args.N is not None:  # as the FMU's --n-ref and --preload: N / N_ref scales the slip limits
+        limits.check_range("--N", args.N, limits.MIN_NORMAL_LOAD, limits.MAX_NORMAL_LOAD, "N",
+                           "the slip limits scale with N / N_ref, which underflows or overflows far outside")
+    limits.check_range("--scale", args.scale, limits.MIN_FRICTION_SCALE, limits.MAX_FRICTION_SCALE, "",
+                       "a factor on every slip force (a change of mu); far outside, the slip limits "
+                       "underflow or overflow")
     check_out_dir(args.plot, "--plot")
 
 

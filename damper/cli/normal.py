@@ -18,6 +18,7 @@ cache). ``--out`` adds the per-node maps and the F-approach curve.
 from __future__ import annotations
 
 import argparse
+import math
 
 from .common import atomic_write, dumps, print_json
 
@@ -119,7 +120,61 @@ def spec_from_args(args):
                        load_hint=args.force or 0.0, height=getattr(args, "height", None) or 0.0)
     if args.p_design is None and args.force:
         spec = zone_for_load(spec, args.force)
+    if args.approach is not None and spec.body == "sphere":
+        force = sphere_approach_force(spec, args.approach)
+        if args.p_design is None:
+            spec = zone_for_load(spec, force)
+    elif args.approach is not None and spec.body == "cylinder":
+        _check_approach_floor(spec, args.approach)
+    elif spec.body == "flat":
+        _check_flat_load(spec, args.force, args.approach)
     return spec
+
+
+def _check_approach_floor(spec, approach: float) -> None:
+    """A curved body's approach at least that of a Hertz contact radius of MIN_CONTACT_SHARE R
+    (the gap at the contact's edge above round-off of the coordinates; an approach of
+    5e-324 m gave a zero force and a division by zero)."""
+    from contact_core.bodies import MIN_CONTACT_SHARE
+
+    low = MIN_CONTACT_SHARE**2 * spec.radius
+    if approach < low:
+        raise ValueError(f"--approach {approach:g} m is below {low:.3g} m, what the mesh resolves in double "
+                         f"precision for a radius of {spec.radius:.3g} m; give a larger approach")
+
+
+def _check_flat_load(spec, force, approach) -> None:
+    """A flat face's mean pressure (force) or mean strain (approach / the face's smaller
+    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*): linear elasticity."""
+    from damper.limits import MAX_CONTACT_STRAIN
+
+    side = min(spec.width, spec.length)
+    if approach is not None and approach > MAX_CONTACT_STRAIN * side:
+        raise ValueError(f"--approach {approach:g} m is above {MAX_CONTACT_STRAIN:g} of the face's smaller side "
+                         f"({side:.3g} m): beyond the small strains of the linear-elastic model; give at most "
+                         f"{MAX_CONTACT_STRAIN * side:.3g} m")
+    f_max = MAX_CONTACT_STRAIN * spec.Estar * spec.width * spec.length
+    if force is not None and force > f_max:
+        raise ValueError(f"--force {force:g} N gives a mean pressure above {MAX_CONTACT_STRAIN:g} E* on the "
+                         f"{spec.width:.3g} x {spec.length:.3g} m face: beyond the small strains of the "
+                         f"linear-elastic model; give at most {f_max:.4g} N")
+
+
+def sphere_approach_force(spec, approach: float) -> float:
+    """Hertz force [N] of a sphere's ``approach`` [m] (d = a^2 / R, a^3 = 3 F R / (4 E*)), after
+    refusing an approach whose contact radius a lies outside what the contact model
+    represents (:data:`contact_core.bodies.MIN_CONTACT_SHARE` ... ``MAX_CONTACT_SHARE`` R)."""
+    from contact_core.bodies import MAX_CONTACT_SHARE, MIN_CONTACT_SHARE
+
+    R = spec.radius
+    a = math.sqrt(R * approach)
+    lo, hi = MIN_CONTACT_SHARE * R, MAX_CONTACT_SHARE * R
+    if not lo <= a <= hi:
+        raise ValueError(f"--approach {approach:g} m gives a Hertz contact radius of {a:.3g} m, {a / R:.2g} of "
+                         f"the sphere radius {R:.3g} m, outside [{MIN_CONTACT_SHARE:g}, {MAX_CONTACT_SHARE:g}] R "
+                         f"(what the contact model represents); give an approach in "
+                         f"[{lo**2 / R:.3g}, {hi**2 / R:.3g}] m")
+    return 4.0 * spec.Estar * a**3 / (3.0 * R)
 
 
 #: Points of the normal approach curve when --normal-curve is given without --curve.

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from damper import limits
+
 
 def register(sub) -> None:
     p = sub.add_parser("system", help="the UPD ring (blade and damper FMUs) as an SSP archive",
@@ -40,9 +42,13 @@ def run(args) -> int:
     cfg = load_config(args.config)
     cf = cfg.cf if args.cf is None else args.cf
     f0 = cfg.f0 if args.f0 is None else args.f0
-    for label, v in (("--cf", cf), ("--f0", f0), ("--frequency-hz", args.frequency_hz)):
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ValueError(f"{label} must be finite and > 0, got {v}")
+    for label, v in (("--cf", cf), ("--f0", f0)):
+        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
+            raise ValueError(f"{label} must be finite, > 0 and at most {limits.MAX_MAGNITUDE:g} N, got {v}")
+    if args.frequency_hz is not None:
+        limits.check_range("--frequency-hz", args.frequency_hz, limits.MIN_OMEGA / (2 * np.pi),
+                           limits.MAX_OMEGA / (2 * np.pi), "Hz", "the band of a structural mode, "
+                           "1e-6 to 1e9 rad/s")
     args.cf = cf
     cfg = apply_to_args(args, cfg)
     info = build_ring(cfg, cf, f0, args.output, fmi_version=args.fmi_version,

@@ -162,6 +162,17 @@ def _reference_curve(result):
     return spec.kind.tangential_reference_curve(spec, prob.N, prob.mu)
 
 
+def _check_loop_amplitude(amplitude: float, u_gross: float) -> None:
+    """A loop amplitude [m] at most :data:`damper.limits.MAX_LOOP_SLIPS` times the
+    gross-slip displacement ``u_gross`` [m] (refused before the loop is marched)."""
+    from damper.limits import MAX_LOOP_SLIPS
+
+    if amplitude > MAX_LOOP_SLIPS * u_gross:
+        raise ValueError(f"--loop-amplitude {amplitude:g} m is above {MAX_LOOP_SLIPS:g} times the gross-slip "
+                         f"displacement {u_gross:.4g} m: the loop is then sliding almost throughout (energy "
+                         f"~ 4 mu N A) and its points grow as A; give at most {MAX_LOOP_SLIPS * u_gross:.4g} m")
+
+
 def _extras(result, args) -> dict:
     """Force-control point and hysteresis loop, when asked."""
     from contact_core import tangential_curve as tc
@@ -174,6 +185,7 @@ def _extras(result, args) -> dict:
         out["force_control"] = {"T": sol.T, "u": sol.delta, "stick_fraction": sol.stick_fraction,
                                 "iterations": sol.iterations}
     if args.loop_amplitude is not None:
+        _check_loop_amplitude(args.loop_amplitude, float(result.curve.u[-1]))
         path, energy = tc.hysteresis_loop(prob, args.loop_amplitude)
         W_masing = masing_loop_energy(args.loop_amplitude, result.curve.u, result.curve.T)
         out["loop"] = {"amplitude": args.loop_amplitude, "u": path.u, "T": path.T,

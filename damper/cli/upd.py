@@ -352,8 +352,9 @@ def _check_frf(args) -> None:
     check_accuracy_option(args.accuracy)
     for name in ("cf", "f0"):
         v = getattr(args, name)
-        if v is not None and not (np.isfinite(v) and v > 0):
-            raise ValueError(f"--{name.replace('_', '-')} must be finite and > 0, got {v:g}")
+        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
+            raise ValueError(f"--{name.replace('_', '-')} must be finite, > 0 and at most "
+                             f"{limits.MAX_MAGNITUDE:g} N, got {v:g}")
     check_out_dir(args.plot, "--plot")
     from damper.upd_surface import check_options
 
@@ -488,8 +489,8 @@ def _check_optimize(args) -> None:
     from .common import check_accuracy_option, check_out_dir
 
     lo, hi = args.cf_range
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-        raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI, both finite [N]")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= limits.MAX_MAGNITUDE):
+        raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI <= {limits.MAX_MAGNITUDE:g} [N]")
     limits.check_size("--points", args.points, 3, limits.MAX_LOAD_POINTS,
                       "each CF value is a whole forced response (seconds)")
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,

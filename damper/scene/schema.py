@@ -118,14 +118,20 @@ ELEMENT = {
     "fmi_versions": Field("list[int]", "FMI versions of the FMUs", default=[2, 3], choices=(2, 3)),
 }
 
+#: Why a model parameter is bounded by limits.MAX_MAGNITUDE.
+_MAG_WHY = "the harmonic balance squares forces and displacements (omega^2 M, residual norms) and overflows"
+
 STRUCTURE = {
     "model": Field("str", "two_dof: the bundled blade-damper model; matrices: a matrices file",
                    default="two_dof", choices=("two_dof", "matrices")),
-    "m_tip": Field("float", "two_dof: blade tip mass [kg]", gt=0),
-    "m_platform": Field("float", "two_dof: platform mass [kg]", gt=0),
-    "k_blade": Field("float", "two_dof: blade stiffness tip-platform [N/m]", gt=0),
-    "k_disk": Field("float", "two_dof: disk stiffness platform-ground [N/m]", gt=0),
-    "zeta": Field("float", "two_dof: damping ratio at the first free mode (Rayleigh beta K)", ge=0),
+    "m_tip": Field("float", "two_dof: blade tip mass [kg]", gt=0, le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "m_platform": Field("float", "two_dof: platform mass [kg]", gt=0, le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "k_blade": Field("float", "two_dof: blade stiffness tip-platform [N/m]", gt=0, le=limits.MAX_MAGNITUDE,
+                     why=_MAG_WHY),
+    "k_disk": Field("float", "two_dof: disk stiffness platform-ground [N/m]", gt=0, le=limits.MAX_MAGNITUDE,
+                    why=_MAG_WHY),
+    "zeta": Field("float", "two_dof: damping ratio at the first free mode (Rayleigh beta K)", ge=0,
+                  le=limits.MAX_DAMPING_RATIO, why=limits.DAMPING_RATIO_WHY),
     "matrices": Field("str", "matrices: the .npz file (harmonic_balance.model's format; relative to the scene)"),
     "element_dofs": Field("list[int]", "matrices: DOF [a] (to the ground) or [a, b] the element links", ge=0),
 }
@@ -135,15 +141,17 @@ STRUCTURE_NEEDS = {"two_dof": ("m_tip", "m_platform", "k_blade", "k_disk", "zeta
 
 EXCITATION = {
     "forces": Field("list[float]", "two_dof: tip force amplitudes [N]; matrices: factors on the file's "
-                    "force; one forced response each", required=True, gt=0),
+                    "force; one forced response each", required=True, gt=0, le=limits.MAX_MAGNITUDE,
+                    why=_MAG_WHY),
 }
 
 _F_MAX = limits.MAX_OMEGA / (2 * math.pi)
+_F_MIN = limits.MIN_OMEGA / (2 * math.pi)
 _F_WHY = "far above any structural mode, and omega^2 M must not overflow"
 
 SWEEP = {
-    "f_min": Field("float", "start frequency [Hz]", required=True, gt=0, le=_F_MAX, why=_F_WHY),
-    "f_max": Field("float", "end frequency [Hz]", required=True, gt=0, le=_F_MAX, why=_F_WHY),
+    "f_min": Field("float", "start frequency [Hz]", required=True, ge=_F_MIN, le=_F_MAX, why=_F_WHY),
+    "f_max": Field("float", "end frequency [Hz]", required=True, ge=_F_MIN, le=_F_MAX, why=_F_WHY),
     "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1, le=limits.MAX_HARMONICS,
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "

@@ -2,8 +2,8 @@
 inputs that are too large, endless or forged archives.
 
 * Data loss: an output path that is one of the command's inputs, however spelled
-  (``./``, a symbolic link, a hard link), a result folder holding the scene, an output
-  that is a FIFO, a cache folder of the user's: refused, nothing written, the input's
+  (``./``, a symbolic link, a hard link), a result folder holding the scene, two outputs
+  naming one path, an output that is a FIFO, a cache folder of the user's: refused, nothing written, the input's
   bytes unchanged (the case's ``files`` are checked).
 * Bounded reads: ``/dev/zero``, a 3 GiB (sparse) file and a FIFO as input files; an SSP
   and an .npz whose members declare more bytes than the cap; a Matrix Market header
@@ -48,6 +48,12 @@ def _loss() -> list[InputCase]:
               mutate="fifo:p.json"),
         _case("files", "backbone --out the model", f"backbone {SDOF} --amplitude 1e-6 1e-4 --out m.npz",
               files=model),
+        _case("files", "normal --out and --normal-curve one path",
+              "normal --body sphere --radius 0.01 --force 100 --grid 5 --model halfspace --out r.json "
+              "--normal-curve ./r.json"),
+        _case("files", "tangential --out and --plot one path",
+              "tangential --body sphere --radius 0.01 --force 200 --mu 0.5 --model bem --grid 11 --out c.json "
+              "--plot c.json"),
         _case("files", "run --out the scene's folder", "run s.toml --out .", files={"s.toml": SCENE}),
         _case("files", "sweep --out the scene's folder",
               "sweep s.toml --param contact.damper.mu --values 0.4 --serial --out .", files={"s.toml": SCENE}),

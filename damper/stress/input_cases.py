@@ -78,6 +78,16 @@ def _normal() -> list[InputCase]:
         ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
         ("force 1e12 (Hertz radius > R)", f"{SPHERE} --force 1e12"),
         ("eccentricity on a sphere", f"{SPHERE} --force 100 --eccentricity 1e-4"),
+        ("force 1e-300 (Hertz radius below round-off)", f"{SPHERE} --force 1e-300 --grid 5"),
+        ("approach 5e-324", f"{SPHERE} --approach 5e-324 --grid 5"),
+        ("approach 1 (Hertz radius > R)", f"{SPHERE} --approach 1 --grid 5"),
+        ("cylinder approach 5e-324", "--body cylinder --radius 2.5e-3 --length 1.2e-3 --approach 5e-324 --grid 5"),
+        ("flat approach 1", "--body flat --width 1.2e-3 --length 5e-3 --approach 1 --grid 5"),
+        ("flat force 1e12", "--body flat --width 1.2e-3 --length 5e-3 --force 1e12 --grid 5"),
+        ("radius 1e-300 (divided by zero)", "--body sphere --radius 1e-300 --force 100 --grid 5"),
+        ("cylinder length 1e-300", "--body cylinder --radius 2.5e-3 --length 1e-300 --force 100 --grid 5"),
+        ("flat height 1e-300", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 1e-300"),
+        ("E 1e-300 (an infinite contact radius)", f"{SPHERE} --force 100 --grid 5 --E 1e-300"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
         ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),
         ("curve 1e6 points", f"{SPHERE} --force 100 --curve 1000000"), ("curve -1", f"{SPHERE} --force 100 --curve=-1"),
@@ -109,6 +119,7 @@ def _tangential() -> list[InputCase]:
         ("tangential force above mu N", f"{base} --mu 0.5 --tangential-force 150"),
         ("loop amplitude -1", f"{base} --mu 0.5 --loop-amplitude=-1"),
         ("loop amplitude nan", f"{base} --mu 0.5 --loop-amplitude nan"),
+        ("loop amplitude 1e300 (hung)", f"{base} --mu 0.5 --loop-amplitude 1e300"),
         ("flat, approach, eccentricity", "tangential --body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 "
                                          "--mu 0.5 --eccentricity 1e-4"),
         ("eccentricity on a sphere", f"{base} --mu 0.5 --eccentricity 1e-4"),
@@ -118,6 +129,7 @@ def _tangential() -> list[InputCase]:
         ("force 0", f"tangential {SPHERE} --force 0 --mu 0.5"),
         ("grid 100000", f"tangential {SPHERE} --force 200 --mu 0.5 --grid 100000"),
         ("width on a sphere", f"{base} --mu 0.5 --width 1e-3"),
+        ("approach 1 (Hertz radius > R)", f"tangential {SPHERE} --approach 1 --mu 0.5 --model bem --grid 11"),
     ])
 
 
@@ -140,6 +152,9 @@ def _loop() -> list[InputCase]:
         ("samples 1e9", f"--curve {{fx}}/curve.json {a} --samples 1000000000"),
         ("samples 3", f"--curve {{fx}}/curve.json {a} --samples 3"),
         ("N 0", f"--curve {{fx}}/curve.json {a} --N 0"), ("N nan", f"--curve {{fx}}/curve.json {a} --N nan"),
+        ("N 1e300 and scale 1e300 (overflowed)", f"--curve {{fx}}/curve.json {a} --N 1e300 --scale 1e300"),
+        ("N 1e-300", f"--curve {{fx}}/curve.json {a} --N 1e-300"),
+        ("scale 1e300", f"--curve {{fx}}/curve.json {a} --scale 1e300"),
         ("scale 0", f"--curve {{fx}}/curve.json {a} --scale 0"),
         ("scale -1", f"--curve {{fx}}/curve.json {a} --scale=-1"),
         ("--plot a file", f"--curve {{fx}}/curve.json {a} --plot {{fx}}/a_file"),
@@ -180,7 +195,8 @@ def _frf() -> list[InputCase]:
     rows = [
         ("omega 1 1e300", f"{SDOF} --harmonics 1 --omega 1 1e300"), ("omega 0 1", f"{SDOF} --omega 0 1"),
         ("omega -1 1", f"{SDOF} --omega -1 1"), ("omega 1 1", f"{SDOF} --omega 1 1"),
-        ("omega nan 1", f"{SDOF} --omega nan 1"), ("harmonics 0", f"{SDOF} {o} --harmonics 0"),
+        ("omega nan 1", f"{SDOF} --omega nan 1"),
+        ("omega 1e-300 1e-299", f"{SDOF} --omega 1e-300 1e-299"), ("harmonics 0", f"{SDOF} {o} --harmonics 0"),
         ("harmonics 100000", f"{SDOF} {o} --harmonics 100000"), ("harmonics odd:0", f"{SDOF} {o} --harmonics odd:0"),
         ("harmonics abc", f"{SDOF} {o} --harmonics abc"), ("harmonics even:3", f"{SDOF} {o} --harmonics even:3"),
         ("samples -1", f"{SDOF} {o} --samples=-1"), ("samples 1e8", f"{SDOF} {o} --samples 100000000"),
@@ -238,8 +254,12 @@ def _upd() -> list[InputCase]:
         ("frf harmonics 100000", "frf --harmonics 100000"), ("frf points 1e8", "frf --points 100000000"),
         ("frf harmonics 0", "frf --harmonics 0"), ("frf points 2", "frf --points 2"),
         ("frf band 0 100", "frf --band 0 100"), ("frf band 500 400", "frf --band 500 400"),
-        ("frf band nan 1", "frf --band nan 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
+        ("frf band nan 1", "frf --band nan 1"),
+        ("frf band 1e-300 1", "frf --band 1e-300 1"), ("frf band 1 1e300", "frf --band 1 1e300"),
         ("frf cf -1", "frf --cf=-1"), ("frf f0 nan", "frf --f0 nan"),
+        ("frf cf 1e300 (overflowed: exit 3)", "frf --cf 1e300 --points 5"),
+        ("frf geometry contacts at CF 1e-300", "frf --contacts geometry --cf 1e-300 --points 5"),
+        ("frf f0 1e300 (overflowed: exit 3)", "frf --f0 1e300 --points 5"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
         ("frf accuracy 0.6", "frf --accuracy 0.6"), ("frf accuracy nan", "frf --accuracy nan"),
         ("frf surface nodes 3", "frf --contacts surface --surface-nodes 3"),
@@ -251,6 +271,7 @@ def _upd() -> list[InputCase]:
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
         ("config bad TOML", "modes --config {fx}/upd_badtoml.toml"),
         ("config unknown section", "modes --config {fx}/upd_section.toml"),
+        ("optimize cf-range 1 1e300 (overflowed: exit 3)", "optimize --cf-range 1 1e300 --points 3"),
         ("optimize cf-range 0 10", "optimize --cf-range 0 10"), ("optimize cf-range 10 1", "optimize --cf-range 10 1"),
         ("optimize points 1e6", "optimize --points 1000000"), ("optimize grid 1e6", "optimize --grid 1000000"),
         ("optimize harmonics 1000", "optimize --harmonics 1000"),
@@ -295,7 +316,11 @@ def _upd() -> list[InputCase]:
 
 def _system() -> list[InputCase]:
     return _table("system", [
-        ("system cf -1", "system --cf=-1 -o r.ssp"), ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system cf -1", "system --cf=-1 -o r.ssp"),
+        ("system cf 1e300", "system --cf 1e300 -o r.ssp"),
+        ("system frequency 1e300", "system --frequency-hz 1e300 -o r.ssp"),
+        ("system geometry contacts at CF 1e-300 (hung)", "system --contacts geometry --cf 1e-300 -o r.ssp"),
+        ("system f0 nan", "system --f0 nan -o r.ssp"),
         ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
         ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
         ("system frequency -1", "system --frequency-hz=-1 -o r.ssp"),
@@ -322,7 +347,7 @@ def _run() -> list[InputCase]:
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
         "s_empty.toml", "s_binary.toml", "s_bbmode.toml", "s_bbamp.toml", "s_updpoints.toml", "s_updharm.toml",
         "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
-        "s_mtacc.toml", "s_mtacclin.toml")]
+        "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),

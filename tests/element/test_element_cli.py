@@ -6,6 +6,7 @@ import json
 import numpy as np
 import pytest
 from elcases import MU, N_SPHERE, cattaneo_table, mindlin_deresiewicz_energy
+from failure_output import no_result
 
 from damper.cli import main
 
@@ -67,7 +68,8 @@ def test_bad_curve_exits_with_code_2(tmp_path, capsys, content):
     path = tmp_path / "bad.json"
     path.write_text(content)
     assert main(["loop", "--curve", str(path), "--amplitude", "1e-6", "--json"]) == 2
-    assert capsys.readouterr().out == ""
+    cap = capsys.readouterr()
+    assert no_result(cap.out, cap.err, 2)
 
 
 def test_force_above_gross_slip_and_bad_numbers_exit_with_code_2(sphere_curve, capsys):
