@@ -41,8 +41,9 @@ from damper import mistuning_stats
 from damper.cache import Store, make_key
 from damper.provenance import code_version
 
-#: Part of every sample's key (bump when a sample's result format changes).
-VERSION = 1
+#: Part of every sample's key (bump when a sample's result format or meaning changes:
+#: 2, the full solver's grid resolves every blade's peak).
+VERSION = 2
 #: Modules a sample runs (their source hash is part of the key).
 MODULES = ("harmonic_balance", "fmu_src")
 #: Quantiles of the amplification factor reported.
@@ -275,15 +276,23 @@ def sample_key(study: Study, fp: str, band: list, kappa) -> str:
 class SampleModel:
     """What the samples of one chunk share, built once in the worker: the sector, the
     band's grid, and the linear ring family (:class:`LinearRingFamily`, the tuned matrices)
-    or the tuned sector's harmonic balance (the starts of every ring solve)."""
+    or the tuned sector's harmonic balance (the starts of every ring solve).
+
+    The full solver's grid has ``points``, or more where the tuned ring's narrowest
+    half-power width on the band asks for them (:func:`.ring_solve.resolving_points`; the
+    solver then refines it around every blade's peaks)."""
 
     def __init__(self, study: Study, band, f_tuned: float):
         from harmonic_balance.bladed_disk.mistuning import LinearRingFamily
+        from harmonic_balance.bladed_disk.ring_solve import resolving_points
         from harmonic_balance.bladed_disk.sector import Sector
 
         self.study, self.f_tuned = study, f_tuned
         self.sector = Sector(study.load())
-        self.om = 2 * np.pi * np.linspace(band[0], band[1], study.points)
+        n = study.points
+        if study.damper == "nonlinear" and study.solver == "full":
+            n = resolving_points(self.sector, 2 * np.pi * band[0], 2 * np.pi * band[1], n)
+        self.om = 2 * np.pi * np.linspace(band[0], band[1], n)
         self.family = (LinearRingFamily(self.sector, study.damper, study.f0)
                        if study.damper != "nonlinear" else None)
         self.tuned = None       # the tuned SectorHB, from the first ring (its H, CF, F0, mu, n_t)

@@ -20,6 +20,17 @@ When B(0) > alpha / 2 no order statistic bounds xi_q from below (``low`` is None
 B(n - 1) < 1 - alpha / 2 none bounds it from above (``high`` is None): the two-sided
 95 % interval of the 0.95 quantile needs n >= 72, the 0.99 quantile's n >= 368.
 
+An interval checked against the q-quantile *estimate* of an independent sample of m
+(not the true xi_q) holds it less often than its coverage: the estimate scatters too.
+For large n and m both estimates are nearly normal about xi_q with variances
+q (1 - q) / (n f^2) and q (1 - q) / (m f^2) (f the density at xi_q: the sample quantile's asymptotic
+normality, David and Nagaraja ch. 10), the interval is about the n-estimate +- z sigma_n with z the normal quantile
+of its coverage, so::
+
+    P(low <= estimate_m <= high) ~ 2 Phi(z / sqrt(1 + n / m)) - 1                  (S2)
+
+0.93 for n = 1000, m = 4000 (coverage 0.958): one such pair in 15 misses.
+
 Mean interval: Student's t, mean +- t_(1 - alpha/2, n - 1) s / sqrt(n) (s the sample
 standard deviation): exact for normal samples, asymptotically right for any finite
 variance (the amplification is bounded); at n = 1 there is none.
@@ -96,6 +107,16 @@ def quantile_ci(x, q: float, level: float = LEVEL) -> dict:
     half = None if low is None or high is None else (high - low) / 2.0
     return {"q": q, "value": float(np.quantile(xs, q)), "low": low, "high": high,
             "coverage": cov, "half_width": half}
+
+
+def containment_probability(n: int, m: int, q: float = 0.95, level: float = LEVEL) -> float:
+    """Probability (S2) that the q-quantile's interval from n samples holds the q-quantile
+    estimate of an independent sample of m (large-sample normal approximation)."""
+    cov = quantile_ci_ranks(n, q, level)[2]
+    if not m >= 1:
+        raise ValueError(f"need m >= 1 (got {m})")
+    z = stats.norm.ppf(0.5 + 0.5 * cov)
+    return float(2.0 * stats.norm.cdf(z / math.sqrt(1.0 + n / m)) - 1.0)
 
 
 def mean_ci(x, level: float = LEVEL) -> dict:

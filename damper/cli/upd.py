@@ -91,7 +91,8 @@ def _mistuning(s) -> None:
     p.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
                    help="band [Hz] (default: around the tuned peak, widened with the scatter)")
     p.add_argument("--points", type=int, default=41,
-                   help="frequency points per ring curve (--solver full)")
+                   help="least number of frequency points per ring curve (--solver full; more where the "
+                   "tuned ring's narrowest half-power width asks, then refined at the peaks)")
     p.add_argument("--until-ci", type=float, metavar="W",
                    help="stop when the amplification's 0.95 quantile is known to +-W (its 95 %% "
                    "interval's half-width); --samples is then the most to run (default 2000)")

@@ -17,6 +17,11 @@ limit at single samples (the loop placement of the C core, :mod:`..contact`): th
 residual is then only piecewise smooth in many contacts at once and Newton can stall;
 such a flank ends there (reported), the curve keeps the solved part.
 
+Grid: the given one (best no coarser than the narrowest half-power width of the tuned
+ring's modes, :func:`resolving_points`), then bisected around every blade's local
+maxima until the parabola through each predicts the cells' midpoints (:func:`resolve`):
+a narrow, lightly damped resonance between two grid points is resolved there only.
+
 Peaks: every blade's first-harmonic amplitude of its response DOF on the grid; each
 blade's peak from the parabolas through each local maximum of its grid values and the
 two neighbours (the largest vertex); the largest over blades and frequency refined by Brent's bounded search (each
@@ -275,6 +280,21 @@ class RingSolver:
             return self.step(omegas[i - 1], xs[i - 1], slope, omega)
 
 
+def _vertex(w: np.ndarray, a: np.ndarray):
+    """(frequency, value) of the parabola through three points (w, a) at a local maximum
+    a[1], its vertex kept inside them and not below a[1]; None when it opens upwards."""
+    c2, c1, c0 = np.polyfit(w - w[1], a, 2)
+    if c2 >= 0:
+        return None
+    d = np.clip(-c1 / (2 * c2), w[0] - w[1], w[2] - w[1])
+    return w[1] + d, max(c0 + c1 * d + c2 * d * d, a[1])
+
+
+def _local_maxima(col: np.ndarray) -> np.ndarray:
+    """Interior grid indices i with col[i] >= both neighbours."""
+    return np.flatnonzero((col[1:-1] >= col[:-2]) & (col[1:-1] >= col[2:])) + 1
+
+
 def parabola_peaks(omegas: np.ndarray, A: np.ndarray):
     """Per column of A (n_f, N_b): the largest vertex of the parabolas through each local
     maximum of the grid and its neighbours (kept inside them), or the grid maximum when
@@ -284,25 +304,113 @@ def parabola_peaks(omegas: np.ndarray, A: np.ndarray):
     pk, wk = A.max(axis=0).copy(), omegas[A.argmax(axis=0)].copy()
     for j in range(nb):
         col = A[:, j]
-        for i in np.flatnonzero((col[1:-1] >= col[:-2]) & (col[1:-1] >= col[2:])) + 1:
-            w, a = omegas[i - 1:i + 2], col[i - 1:i + 2]
-            c2, c1, c0 = np.polyfit(w - w[1], a, 2)
-            if c2 < 0:
-                d = np.clip(-c1 / (2 * c2), w[0] - w[1], w[2] - w[1])
-                v = max(c0 + c1 * d + c2 * d * d, a[1])
-                if v > pk[j]:
-                    pk[j], wk[j] = v, w[1] + d
+        for i in _local_maxima(col):
+            v = _vertex(omegas[i - 1:i + 2], col[i - 1:i + 2])
+            if v is not None and v[1] > pk[j]:
+                wk[j], pk[j] = v
     return pk, wk
 
 
+#: Relative accuracy to which :func:`resolve` resolves each blade's peaks: a local maximum
+#: is resolved when the parabola through it and its two neighbours predicts the midpoints
+#: of both cells to this fraction of its value (its vertex is then about as accurate).
+RESOLVE_RTOL = 1e-4
+#: Bisection levels of :func:`resolve` (cells down to 2^-6 of the grid step).
+RESOLVE_LEVELS = 6
+#: Local maxima of a blade below this fraction of its highest parabola estimate are not
+#: resolved (they cannot be its peak): a parabola through a resonance sampled at its
+#: half-power width is off by at most 25 % (Lorentzian shape), so 0.7 keeps every
+#: candidate on a grid of that spacing.
+RESOLVE_CANDIDATE = 0.7
+
+
+def resolve(solver: RingSolver, omegas, xs: list, A: np.ndarray, rtol: float = RESOLVE_RTOL,
+            levels: int = RESOLVE_LEVELS):
+    """The solved grid refined where a blade's peak is not resolved (the per-blade peaks'
+    accuracy of a reference).
+
+    Each level bisects both cells beside every candidate local maximum of any blade
+    (:data:`RESOLVE_CANDIDATE`) not yet resolved (:data:`RESOLVE_RTOL`); each midpoint is a
+    Newton solve from its grid neighbours (:meth:`RingSolver.at`). A narrow resonance
+    (a lightly damped mode the friction does not reach) that a grid step straddles is
+    thus refined until its parabola estimate holds, while the flanks keep the grid.
+
+    Returns
+    -------
+    omegas : (n_f',) array, xs : list of (size,) arrays, A : (n_f', N_b) array
+        the refined grid, solutions and amplitudes [m]
+    record : dict
+        ``added`` (points solved), ``levels`` (used), ``unresolved`` (frequencies [rad/s]
+        of local maxima still unresolved at the last level)
+    """
+    omegas, xs, A = np.asarray(omegas, float), list(xs), np.asarray(A, float)
+    done, added, level, todo = [], 0, 0, []
+    for level in range(levels + 1):
+        todo = _unresolved(omegas, A, done)
+        if not todo or level == levels:
+            break
+        cells = sorted({c for _, i in todo for c in (i - 1, i)})
+        mids = 0.5 * (omegas[cells] + omegas[np.add(cells, 1)])
+        try:
+            new = [solver.at(w, omegas, xs) for w in mids]
+        except (NewtonError, SolverError) as err:
+            raise SolverError(f"grid refinement near {mids[0] / 2 / np.pi:.6g} Hz failed ({err}); "
+                              "use more points") from None
+        An = np.array([solver.ring.amplitudes(x) for x in new])
+        done += _checked(omegas, A, todo, dict(zip(mids, An)), rtol)
+        order = np.argsort(np.concatenate([omegas, mids]), kind="stable")
+        omegas = np.concatenate([omegas, mids])[order]
+        xs = [(xs + new)[k] for k in order]
+        A = np.vstack([A, An])[order]
+        added += len(new)
+    return omegas, xs, A, {"added": added, "levels": level,
+                           "unresolved": [float(omegas[i]) for _, i in todo]}
+
+
+def _unresolved(omegas, A, done) -> list:
+    """(blade, index) of every candidate local maximum not inside a resolved interval of
+    that blade (``done``: (blade, lo, hi) [rad/s])."""
+    todo = []
+    best = parabola_peaks(omegas, A)[0]
+    for j in range(A.shape[1]):
+        col = A[:, j]
+        for i in _local_maxima(col):
+            v = _vertex(omegas[i - 1:i + 2], col[i - 1:i + 2])
+            if max(col[i], v[1] if v else 0.0) < RESOLVE_CANDIDATE * best[j]:
+                continue
+            if not any(b == j and lo <= omegas[i] <= hi for b, lo, hi in done):
+                todo.append((j, int(i)))
+    return todo
+
+
+def _checked(omegas, A, todo, at_mid: dict, rtol: float) -> list:
+    """Resolved intervals (blade, lo, hi) among ``todo``: the parabola through the local
+    maximum and its neighbours predicts the solved midpoints ``at_mid`` (frequency ->
+    amplitudes (N_b,)) of both cells within ``rtol`` of the maximum."""
+    out = []
+    for j, i in todo:
+        w, a = omegas[i - 1:i + 2], A[i - 1:i + 2, j]
+        coef = np.polyfit(w - w[1], a, 2)
+        err = max(abs(np.polyval(coef, m - w[1]) - at_mid[m][j])
+                  for m in (0.5 * (w[0] + w[1]), 0.5 * (w[1] + w[2])))
+        if err <= rtol * a[1]:
+            out.append((j, float(w[0]), float(w[2])))
+    return out
+
+
 def ring_frf(ring: MistunedRingHB, omegas, tuned: SectorHB | None = None,
-             start_omega: float | None = None, refine: bool = True) -> RingCurve:
+             start_omega: float | None = None, refine: bool = True,
+             resolve_rtol: float | None = RESOLVE_RTOL) -> RingCurve:
     """Response curve of every blade on the grid ``omegas`` [rad/s] with per-blade peaks.
 
     Solved first at the grid point nearest ``start_omega`` (default: the band's middle;
     best the tuned peak, where the dampers slip and the start converges), then along
     both flanks. A flank that fails ends the curve there (``extra["truncated"]``);
-    SolverError when the largest peak lies at such an end (not resolved).
+    SolverError when the largest peak lies at such an end (not resolved). The grid is
+    then refined around every blade's unresolved peaks (:func:`resolve`, to
+    ``resolve_rtol``; None: the grid as given; ``extra["resolve"]`` its record): give a
+    grid no coarser than the narrowest resonance's half-power width
+    (:func:`resolving_points`), so that none is stepped over unseen.
     """
     t0 = time.perf_counter()
     e0 = ring.evaluations
@@ -317,21 +425,63 @@ def ring_frf(ring: MistunedRingHB, omegas, tuned: SectorHB | None = None,
     lo = i0 - len(down) + 1
     lam, xs = omegas[lo:i0 + len(up)], down[::-1] + up[1:]
     A = np.array([ring.amplitudes(x) for x in xs])
-    c = RingCurve(lam, A, xs)
-    c.extra["truncated"] = [e for e in (err_d, err_u) if e]
-    c.peak_per_blade, c.peak_omega_per_blade = parabola_peaks(lam, A)
     g = A.max(axis=1)
     i = int(g.argmax())
-    c.worst, c.peak, c.peak_omega, c.peak_x = int(A[i].argmax()), float(g[i]), float(lam[i]), xs[i]
     if (i == 0 and err_d) or (i == lam.size - 1 and err_u):
         raise SolverError(f"the largest blade peak lies at the end of the solved band "
                           f"{lam[0] / 2 / np.pi:.6g}-{lam[-1] / 2 / np.pi:.6g} Hz: the sweep "
                           f"{(err_d if i == 0 else err_u)}")
+    record = None
+    if resolve_rtol is not None:
+        lam, xs, A, record = resolve(solver, lam, xs, A, resolve_rtol)
+    c = RingCurve(lam, A, xs)
+    c.extra["truncated"] = [e for e in (err_d, err_u) if e]
+    c.extra["resolve"] = record
+    c.peak_per_blade, c.peak_omega_per_blade = parabola_peaks(lam, A)
+    g = A.max(axis=1)
+    i = int(g.argmax())
+    c.worst, c.peak, c.peak_omega, c.peak_x = int(A[i].argmax()), float(g[i]), float(lam[i]), xs[i]
     if refine:
         _refine(solver, c, A)
     c.evaluations, c.newton_iterations = ring.evaluations - e0, solver.iterations
     c.time_s = time.perf_counter() - t0
     return c
+
+
+#: Grid points per narrowest half-power width (:func:`resolving_points`): one puts a point
+#: within half a width of every resonance's peak, at >= 1/sqrt(2) of it, so each shows as
+#: a local maximum (or a shoulder on a larger one) that :func:`resolve` then refines.
+POINTS_PER_WIDTH = 1.0
+
+
+def half_power_width(sector, lo: float, hi: float) -> float | None:
+    """Narrowest half-power width [rad/s] of the tuned ring's modes with natural
+    frequencies in [lo, hi] [rad/s], damper stuck and free (the linear limits that bound the
+    friction-damped ring's damping from below); None when no mode lies there.
+
+    For a mass-normalized mode phi_r the half-power width is 2 zeta_r omega_r =
+    phi_r^T C phi_r (light damping, the modal damping of the ring's C). Dense eigenproblem
+    of the tuned ring (n N_b unknowns, a few hundred).
+    """
+    from scipy.linalg import eigh
+
+    from .mistuning import LinearRing
+
+    widths = []
+    for damper in ("stuck", "free"):
+        r = LinearRing(sector, np.ones(sector.cfg.blades), damper)
+        _, V = eigh(r.K.toarray(), r.M.toarray(), subset_by_value=(lo * lo, hi * hi))
+        widths += list(np.einsum("ir,ij,jr->r", V, r.C.toarray(), V))
+    return float(min(widths)) if widths else None
+
+
+def resolving_points(sector, lo: float, hi: float, points: int) -> int:
+    """Points of a uniform grid on [lo, hi] [rad/s]: at least ``points``, and no coarser
+    than :data:`POINTS_PER_WIDTH` per narrowest half-power width (:func:`half_power_width`)."""
+    width = half_power_width(sector, lo, hi)
+    if width is None or width <= 0:
+        return int(points)
+    return max(int(points), int(np.ceil(POINTS_PER_WIDTH * (hi - lo) / width)) + 1)
 
 
 def _refine(solver: RingSolver, c: RingCurve, A: np.ndarray) -> None:
