@@ -66,6 +66,12 @@ TURN = 0.5
 REJECT = 2.0
 #: Largest growth of the step from one point to the next.
 GROW = 2.0
+#: After a step in which no corrector converged at ds_fail, the next steps are at most
+#: FAIL_SHARE ds_fail, a bound that grows by GROW_AFTER_FAIL per step without such a
+#: failure: the shape alone would double the step again into the failure (measured on
+#: chain5 at H = 31: 30 steps of 0.5 failed and were retried at 0.25, each with f ~ 0.25).
+FAIL_SHARE = 0.7
+GROW_AFTER_FAIL = 1.25
 #: A retry whose tangent angle stays above this share of the longer attempt's angle
 #: found a kink (a smooth branch halves the angle with the step).
 CORNER_SHARE = 0.6
@@ -200,8 +206,9 @@ class _Scaled:
         sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
         return t / n, float(sign), float(np.sign(t[-1]) * sign)
 
-    def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
-        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
+    def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER, start=None):
+        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred (+ ``start``, an
+        offset in the plane: a better first guess of the same point).
 
         The unknown is the offset d = y - y_pred, so the plane equation carries no
         round-off of |y| (which would otherwise floor |R| near tol when y is large
@@ -213,7 +220,8 @@ class _Scaled:
 
         def value(d):
             return np.append(self.value(y_pred + d), normal @ d)
-        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred),
+        d0 = np.zeros_like(y_pred) if start is None else start
+        res = newton(aug, d0, self.tol, max_iter, np.linalg.norm(y_pred),
                      value=value if self.has_value else None, **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
@@ -307,23 +315,37 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
     orient = 0.0  # sign of det([J; t]): the branch's orientation (set at the first point)
     ctl = _Control(tolerance, lam_step)
+    ds_cap = np.inf  # bound after a failed corrector (FAIL_SHARE, GROW_AFTER_FAIL)
     creep = 0  # points accepted in a row at steps below KINK_STEP
+    known = None  # (unscaled unit tangent, sign of det(R_x)) at the last point, from _step
     while len(branch.lam) < max_points:
         tol_now = max(tol, rtol * float(np.linalg.norm(J_phys[:, :-1] @ branch.x[-1])))
         sc = _Scaled(fun, s_x, s_lam, tol_now)
         y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
         col = np.append(np.full(len(x0), s_x), s_lam)
-        J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
-        try:
-            t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
-        except (np.linalg.LinAlgError, ValueError):
-            raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
-        if not orient:
-            orient = d  # t points towards lam_end here
-        elif d != orient:
-            t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
+        if known is None:
+            J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
+            try:
+                t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
+            except (np.linalg.LinAlgError, ValueError):
+                raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
+            if not orient:
+                orient = d  # t points towards lam_end here
+            elif d != orient:
+                t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
+        else:
+            # the step judged its point by this tangent, already oriented: a positive
+            # rescaling of the columns maps it (and both det signs) to the new scales
+            # without a second factorisation of the same extended Jacobian
+            t = known[0] / col
+            t /= np.linalg.norm(t)
+            branch.det_sign[-1] = known[1]
         branch.tangent[-1] = _unscaled(t, col)
-        y_new, it, ds, J_new, f = _step(sc, y, t, min(ds, ds_max), ds_min, branch, ctl, orient)
+        y_new, it, ds, J_new, f, known, ds_fail = _step(sc, y, t, min(ds, ds_max, ds_cap), ds_min,
+                                                        branch, ctl, orient)
+        known = (_unscaled(known[0], col), known[1])
+        ds_cap = (GROW_AFTER_FAIL * ds_cap if ds_fail is None
+                  else max(FAIL_SHARE * ds_fail, ds_min))
         creep = creep + 1 if ds < KINK_STEP else 0
         if creep > CREEP_POINTS:
             raise _stop(f"step below minimum (more than {CREEP_POINTS} points in steps below "
@@ -380,7 +402,9 @@ class _Control:
 
 
 def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
-    """One accepted predictor-corrector step: (y_new, iterations, ds, J, shape factor).
+    """One accepted predictor-corrector step: (y_new, iterations, ds, J, shape factor,
+    (forward unit tangent at y_new, sign of det(R_x) there), the last step at which no
+    corrector converged or None).
 
     Corrector: the pseudo-arclength plane, else Newton at the predictor's parameter
     (where the plane misses the branch: past a kink that turns it by more than 90 deg
@@ -388,22 +412,27 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
     at the corrected point is the branch's orientation's; the step is retried shorter
     while its shape factor exceeds REJECT, and halved when no corrector converges.
     """
-    alpha_prev, reason = None, ""
+    alpha_prev, reason, ds_fail = None, "", None
     if abs(t[-1]) * ds > ctl.lam_step:
         ds = ctl.lam_step / abs(t[-1])
+    # not without a tolerance: there the corrector's iterations size the steps, and a
+    # better start would lengthen them past what the homotopies were measured with
+    bend = None if ctl.delta_ok is None else _bend(sc, y, t, branch)
     while True:
         y_pred = y + ds * t
         res = None
         try:
-            res = sc.correct(y_pred, t)
+            res = sc.correct(y_pred, t, start=None if bend is None else ds**2 * bend)
         except NewtonError as err:
             reason = err.reason
             if ds >= FIXED_MIN_STEP:
                 res = sc.correct_fixed(y_pred)
         f = None
-        if res is not None:
+        if res is None:
+            ds_fail = ds
+        else:
             try:
-                t_new, d_new, _ = sc.tangent(res.J[:-1], t)
+                t_new, d_new, det_x = sc.tangent(res.J[:-1], t)
             except (np.linalg.LinAlgError, ValueError):
                 t_new, reason = None, "singular extended Jacobian at the corrected point"
             if t_new is not None:
@@ -417,13 +446,33 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
                 if ds >= KINK_STEP and _backwards(res.x[-1] - y[-1], t[-1], t_new[-1]):
                     f, reason = max(f, 2.0 * REJECT), "the corrector went back in the parameter"
                 if f <= REJECT:
-                    return res.x, res.iterations, ds, res.J[:-1], f_next
+                    return res.x, res.iterations, ds, res.J[:-1], f_next, (t_new, det_x), ds_fail
                 alpha_prev = alpha
                 if not reason.startswith("the corrector went back"):
                     reason = "the branch bends more than the tolerance allows"
         ds *= 0.5 if f is None else max(1.0 / f, 0.25)
         if ds < ds_min:
             raise _stop(f"step below minimum ({reason})", branch)
+
+
+def _bend(sc, y, t, branch):
+    """Curvature term c (N + 1,) normal to t of the quadratic through the previous point
+    with tangent t at y (scaled variables), or None at a branch's first point.
+
+    The point y + ds t + ds^2 c lies in the corrector's plane (normal t through the
+    predictor y + ds t) and is second-order closer to the branch there: Newton starts
+    from it and converges to the same point in fewer iterations (the residual of a
+    friction branch at the predictor is far outside Newton's quadratic region:
+    measured on chain5 at H = 31, |R| ~ 0.3 and five damped iterations before it).
+    """
+    if len(branch.lam) < 2:
+        return None
+    prev = np.append(branch.x[-2] / sc.s_x, branch.lam[-2] / sc.s_lam)
+    h = -float(np.linalg.norm(y - prev))
+    if h == 0.0:
+        return None
+    c = (prev - y - h * t) / h**2
+    return c - (c @ t) * t
 
 
 def _unscaled(t, col):
