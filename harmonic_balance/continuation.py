@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .newton import NewtonError, newton
+from .newton import NewtonError, lu_det_sign, lu_factor, lu_solve, newton
 
 #: Largest step in lam of a forced-response curve (frf, bladed_disk.solve), as a fraction
 #: of the range: a resonance of 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force
@@ -179,9 +179,12 @@ class _Scaled:
     def has_value(self) -> bool:
         return callable(getattr(self.fun, "value", None))
 
-    def tangent(self, J, t_prev):
+    def tangent(self, J, t_prev, factors=None):
         """Unit tangent t (N+1,) with t . t_prev > 0, the sign of det([J; t^T]) and the
-        sign of det(J_x) (J without its last column).
+        sign of det(J_x) (J without its last column). ``factors``: LU factors
+        (:func:`.newton.lu_factor`) of a matrix to use for [J; t_prev] (the corrector's
+        last one, whose plane row is t_prev: its Jacobian differs from J by the last
+        Newton step), else [J; t_prev] is factored.
 
         The first sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays
         the same along a regular branch, through turning points and peaks, whatever the
@@ -189,22 +192,21 @@ class _Scaled:
         second is free: by Cramer's rule the last component of the solution of
         [J; t_prev] t = e_(N+1) is det(J_x) / det([J; t_prev]).
         """
-        from scipy.linalg import lu_factor, lu_solve  # after the first point: start-up
-
-        A = np.vstack([J, t_prev])
-        rhs = np.zeros(A.shape[0])
+        if factors is None:
+            factors = lu_factor(np.vstack([J, t_prev]))
+            if factors is None:
+                raise np.linalg.LinAlgError("singular extended Jacobian")
+        rhs = np.zeros(J.shape[0] + 1)
         rhs[-1] = 1.0
-        lu, piv = lu_factor(A, check_finite=False)
-        t = lu_solve((lu, piv), rhs, check_finite=False)
+        t = lu_solve(factors, rhs)
         if not np.all(np.isfinite(t)):
             raise np.linalg.LinAlgError("non-finite tangent")
         n = np.linalg.norm(t)
         # det is linear in the last row, det([J; w]) = w . c with c parallel to t (the
         # cofactors), so det([J; t]) has the sign of det([J; t_prev]) (t . t_prev > 0),
         # which the LU gives.
-        perm = np.count_nonzero(piv != np.arange(len(piv))) % 2
-        sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
-        return t / n, float(sign), float(np.sign(t[-1]) * sign)
+        sign = lu_det_sign(factors)
+        return t / n, sign, float(np.sign(t[-1]) * sign)
 
     def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER, start=None):
         """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred (+ ``start``, an
@@ -221,8 +223,11 @@ class _Scaled:
         def value(d):
             return np.append(self.value(y_pred + d), normal @ d)
         d0 = np.zeros_like(y_pred) if start is None else start
+        # no Jacobian at the converged point: the step's tangent there comes from the
+        # factors of the last iteration (_step), the only use of it
         res = newton(aug, d0, self.tol, max_iter, np.linalg.norm(y_pred),
-                     value=value if self.has_value else None, **CORRECTOR_NEWTON)
+                     value=value if self.has_value else None, final_jac=False,
+                     **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
 
@@ -257,6 +262,7 @@ class _Scaled:
         e[-1] = 1.0
         res.x = np.append(y_pred[:-1] + res.x, lam)
         res.J = np.vstack([J, e])
+        res.lu = None  # factors of the fixed-parameter system, not of [J; t]
         return res
 
 
@@ -432,7 +438,7 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
             ds_fail = ds
         else:
             try:
-                t_new, d_new, det_x = sc.tangent(res.J[:-1], t)
+                t_new, d_new, det_x = sc.tangent(res.J[:-1], t, res.lu)
             except (np.linalg.LinAlgError, ValueError):
                 t_new, reason = None, "singular extended Jacobian at the corrected point"
             if t_new is not None:
