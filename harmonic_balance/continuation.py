@@ -23,6 +23,13 @@ Step (Allgower & Georg, Numerical Continuation Methods, ch. 6): tangent t from
 ``[R_x R_lam; t_prev^T] t = [0; 1]``; predictor ``y + ds t``; corrector Newton on R = 0
 and ``t . (y - y_pred) = 0`` (the pseudo-arclength plane), which passes turning points;
 where it fails, Newton at the predictor's parameter (:meth:`_Scaled.correct_fixed`).
+The corrector's matrix is ``[R_x R_lam; t^T]``, the tangent system at the corrected
+point but for R's Jacobian, which its last Newton step took one (converged) step
+earlier: the new tangent is solved with those LU factors, and the corrector asks for no
+Jacobian at its converged point, so a point costs its Newton iterations and nothing
+more. On a curve (with a tolerance) Newton starts in the plane at the quadratic through
+the previous point (:func:`_bend`), closer to the branch than the predictor; the point
+it converges to is the same.
 
 Step size by the curve's shape (Allgower & Georg sec. 6.1, steplength adaptation by
 the asymptotic error model): after a corrector the step is judged by the distance
@@ -38,8 +45,10 @@ branch (a friction link starting or stopping to slip: the residual is only piece
 smooth) turns the tangent by the same angle at any step; when a shorter retry leaves
 alpha above CORNER_SHARE of the last one, the angle is not held against the step (only
 delta, which falls like ds past a corner, is), so a kink is crossed in a few points
-instead of shrinking the step to nothing. Without a tolerance (homotopies, which only
-need to arrive) the corrector's iterations size the steps (target TARGET_ITER).
+instead of shrinking the step to nothing. A step at which no corrector converged bounds
+the next ones (FAIL_SHARE, GROW_AFTER_FAIL), so that the shape does not grow them back
+into the same failure. Without a tolerance (homotopies, which only need to arrive) the
+corrector's iterations size the steps (target TARGET_ITER).
 """
 from __future__ import annotations
 
@@ -47,6 +56,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .brent import brent_min
 from .newton import NewtonError, lu_det_sign, lu_factor, lu_solve, newton
 
 #: Largest step in lam of a forced-response curve (frf, bladed_disk.solve), as a fraction
@@ -598,62 +608,3 @@ def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: floa
     tau, f, n = brent_min(point, -1.0, 1.0, xtol, start=0.0)
     y = cache[tau]
     return y[:-1], float(y[-1]), float(-f), n
-
-
-#: Golden-section share of Brent's minimiser.
-_GOLDEN = 0.5 * (3.0 - np.sqrt(5.0))
-
-
-def brent_min(f, a: float, b: float, xtol: float, start: float | None = None,
-              max_eval: int = 200) -> tuple[float, float, int]:
-    """Minimum of f on [a, b] to an absolute tolerance xtol in x (Brent, Algorithms for
-    Minimization without Derivatives, 1973, ch. 5: golden-section steps, parabolic steps
-    through the three best points where they are safe). ``start``: the first point
-    (default the golden-section point). f may return inf (a point to avoid).
-
-    Returns
-    -------
-    x, f(x), evaluations
-    """
-    x = w = v = a + _GOLDEN * (b - a) if start is None else float(start)
-    fx = fw = fv = f(x)
-    d = e = 0.0
-    n = 1
-    while n < max_eval:
-        m = 0.5 * (a + b)
-        if abs(x - m) <= 2.0 * xtol - 0.5 * (b - a):
-            break
-        p = q = r = 0.0
-        if abs(e) > xtol and np.isfinite(fx) and np.isfinite(fw) and np.isfinite(fv):
-            r = (x - w) * (fx - fv)
-            q = (x - v) * (fx - fw)
-            p = (x - v) * q - (x - w) * r
-            q = 2.0 * (q - r)
-            p, q = (-p, q) if q > 0.0 else (p, -q)
-            r, e = e, d
-        if q != 0.0 and abs(p) < abs(0.5 * q * r) and q * (a - x) < p < q * (b - x):
-            d = p / q  # parabolic step
-            if (x + d) - a < 2.0 * xtol or b - (x + d) < 2.0 * xtol:
-                d = xtol if x < m else -xtol
-        else:
-            e = (b - x) if x < m else (a - x)  # golden-section step into the larger part
-            d = _GOLDEN * e
-        u = x + (d if abs(d) >= xtol else np.copysign(xtol, d))
-        fu = f(u)
-        n += 1
-        if fu <= fx:
-            if u < x:
-                b = x
-            else:
-                a = x
-            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
-        else:
-            if u < x:
-                a = u
-            else:
-                b = u
-            if fu <= fw or w == x:
-                v, fv, w, fw = w, fw, u, fu
-            elif fu <= fv or v in (x, w):
-                v, fv = u, fu
-    return x, fx, n
