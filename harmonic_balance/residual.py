@@ -308,43 +308,19 @@ class _LocalMap:
         Q_next) and T_e Y = (I (x) T) Y + (I (x) T_next) (P^T (x) I) Y: the phase acts on
         the m-sized local index, by gathers of whole columns and rows (:meth:`_rotation`),
         and the products over the local index are matrix products, the left ones batched
-        over the row harmonics so that B comes out in its final layout.
-
-        The result and the intermediates live in this map's workspace (:meth:`_work`),
-        overwritten by the next call: the caller adds B into the Jacobian at once. Fresh
-        arrays of this size (hundreds of kB) are fresh pages from the system at every
-        evaluation; measured on UPD-24 at H = 21, their page faults cost as much as the
-        arithmetic."""
+        over the row harmonics so that B comes out in its final layout."""
         m, d = self.Q.shape
         nb = dF.shape[0] // m
-        Y, Z, B, B2 = self._work(nb, m, d)
-        np.matmul(dF.reshape(-1, m), self.Q, out=Y)                          # dF (I (x) Q)
+        Y = dF.reshape(-1, m) @ self.Q                                      # dF (I (x) Q)
         if self.Qn is not None:
             ia, ib, wa, wb = self._rot
-            Y += np.matmul((dF[:, ia] * wa + dF[:, ib] * wb).reshape(-1, m), self.Qn, out=Z)
-        Y3 = Y.reshape(nb, m, nb * d)
-        np.matmul(self.T, Y3, out=B)
+            Y += (dF[:, ia] * wa + dF[:, ib] * wb).reshape(-1, m) @ self.Qn
+        Y = Y.reshape(nb, m, nb * d)
+        B = np.matmul(self.T, Y)
         if self.Tn is not None:
             Y2 = Y.reshape(nb * m, nb * d)
-            G, G2 = Z.reshape(nb * m, nb * d), self._gather
-            np.take(Y2, ia, axis=0, out=G)
-            G *= wa[:, None]
-            np.take(Y2, ib, axis=0, out=G2)
-            G2 *= wb[:, None]
-            G += G2
-            B += np.matmul(self.Tn, G.reshape(nb, m, nb * d), out=B2)
+            B += np.matmul(self.Tn, (Y2[ia] * wa[:, None] + Y2[ib] * wb[:, None]).reshape(nb, m, nb * d))
         return B.reshape(nb * d, nb * d)
-
-    def _work(self, nb: int, m: int, d: int):
-        """(Y, Z, B, B2) workspaces of :meth:`block` (and its gather buffer), kept per
-        size."""
-        w = getattr(self, "_ws", None)
-        if w is None or w[0] != (nb, m, d):
-            rows, cols = nb * nb * m, d
-            self._gather = np.empty((nb * m, nb * d))
-            w = self._ws = ((nb, m, d), (np.empty((rows, cols)), np.empty((rows, cols)),
-                                         np.empty((nb, d, nb * d)), np.empty((nb, d, nb * d))))
-        return w[1]
 
 
 def _mean_mask(basis: FourierBasis, m: int) -> np.ndarray:
