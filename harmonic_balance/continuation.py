@@ -23,6 +23,13 @@ Step (Allgower & Georg, Numerical Continuation Methods, ch. 6): tangent t from
 ``[R_x R_lam; t_prev^T] t = [0; 1]``; predictor ``y + ds t``; corrector Newton on R = 0
 and ``t . (y - y_pred) = 0`` (the pseudo-arclength plane), which passes turning points;
 where it fails, Newton at the predictor's parameter (:meth:`_Scaled.correct_fixed`).
+The corrector's matrix is ``[R_x R_lam; t^T]``, the tangent system at the corrected
+point but for R's Jacobian, which its last Newton step took one (converged) step
+earlier: the new tangent is solved with those LU factors, and the corrector asks for no
+Jacobian at its converged point, so a point costs its Newton iterations and nothing
+more. On a curve (with a tolerance) Newton starts in the plane at the quadratic through
+the previous point (:func:`_bend`), closer to the branch than the predictor; the point
+it converges to is the same.
 
 Step size by the curve's shape (Allgower & Georg sec. 6.1, steplength adaptation by
 the asymptotic error model): after a corrector the step is judged by the distance
@@ -38,8 +45,10 @@ branch (a friction link starting or stopping to slip: the residual is only piece
 smooth) turns the tangent by the same angle at any step; when a shorter retry leaves
 alpha above CORNER_SHARE of the last one, the angle is not held against the step (only
 delta, which falls like ds past a corner, is), so a kink is crossed in a few points
-instead of shrinking the step to nothing. Without a tolerance (homotopies, which only
-need to arrive) the corrector's iterations size the steps (target TARGET_ITER).
+instead of shrinking the step to nothing. A step at which no corrector converged bounds
+the next ones (FAIL_SHARE, GROW_AFTER_FAIL), so that the shape does not grow them back
+into the same failure. Without a tolerance (homotopies, which only need to arrive) the
+corrector's iterations size the steps (target TARGET_ITER).
 """
 from __future__ import annotations
 
@@ -47,7 +56,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .newton import NewtonError, newton
+from .brent import brent_min
+from .newton import NewtonError, lu_det_sign, lu_factor, lu_solve, newton
 
 #: Largest step in lam of a forced-response curve (frf, bladed_disk.solve), as a fraction
 #: of the range: a resonance of 0.6 % on a nearly flat curve (3-mass chain, knl 2000, force
@@ -66,6 +76,17 @@ TURN = 0.5
 REJECT = 2.0
 #: Largest growth of the step from one point to the next.
 GROW = 2.0
+#: After a step in which no corrector converged at ds_fail, the next steps of a curve (a
+#: run with a tolerance; not a homotopy, whose steps the iterations size) are at most
+#: FAIL_SHARE ds_fail, a bound that grows by GROW_AFTER_FAIL per step without such a
+#: failure: the shape alone would double the step again into the failure (measured on
+#: chain5 at H = 31: 30 steps of 0.5 failed and were retried at 0.25, each with f ~ 0.25).
+#: Measured there (points, evaluations, LU factorisations): no bound 412, 8248, 4098;
+#: 0.7 and 1.25: 448, 5995, 3303; 0.5 and 1.1: 547, 4820, 2945, but UPD-24's curve at
+#: H = 21 then took other points and its peak moved to another maximum of the sampled
+#: contact's ripple (4e-6 lower, 0.8 rad/s away), which 0.7 and 1.25 leave as it was.
+FAIL_SHARE = 0.7
+GROW_AFTER_FAIL = 1.25
 #: A retry whose tangent angle stays above this share of the longer attempt's angle
 #: found a kink (a smooth branch halves the angle with the step).
 CORNER_SHARE = 0.6
@@ -173,9 +194,12 @@ class _Scaled:
     def has_value(self) -> bool:
         return callable(getattr(self.fun, "value", None))
 
-    def tangent(self, J, t_prev):
+    def tangent(self, J, t_prev, factors=None):
         """Unit tangent t (N+1,) with t . t_prev > 0, the sign of det([J; t^T]) and the
-        sign of det(J_x) (J without its last column).
+        sign of det(J_x) (J without its last column). ``factors``: LU factors
+        (:func:`.newton.lu_factor`) of a matrix to use for [J; t_prev] (the corrector's
+        last one, whose plane row is t_prev: its Jacobian differs from J by the last
+        Newton step), else [J; t_prev] is factored.
 
         The first sign is the branch's orientation (Allgower & Georg, sec. 2.1): it stays
         the same along a regular branch, through turning points and peaks, whatever the
@@ -183,25 +207,25 @@ class _Scaled:
         second is free: by Cramer's rule the last component of the solution of
         [J; t_prev] t = e_(N+1) is det(J_x) / det([J; t_prev]).
         """
-        from scipy.linalg import lu_factor, lu_solve  # after the first point: start-up
-
-        A = np.vstack([J, t_prev])
-        rhs = np.zeros(A.shape[0])
+        if factors is None:
+            factors = lu_factor(np.vstack([J, t_prev]))
+            if factors is None:
+                raise np.linalg.LinAlgError("singular extended Jacobian")
+        rhs = np.zeros(J.shape[0] + 1)
         rhs[-1] = 1.0
-        lu, piv = lu_factor(A, check_finite=False)
-        t = lu_solve((lu, piv), rhs, check_finite=False)
+        t = lu_solve(factors, rhs)
         if not np.all(np.isfinite(t)):
             raise np.linalg.LinAlgError("non-finite tangent")
         n = np.linalg.norm(t)
         # det is linear in the last row, det([J; w]) = w . c with c parallel to t (the
         # cofactors), so det([J; t]) has the sign of det([J; t_prev]) (t . t_prev > 0),
         # which the LU gives.
-        perm = np.count_nonzero(piv != np.arange(len(piv))) % 2
-        sign = (-1.0) ** perm * np.prod(np.sign(np.diag(lu)))
-        return t / n, float(sign), float(np.sign(t[-1]) * sign)
+        sign = lu_det_sign(factors)
+        return t / n, sign, float(np.sign(t[-1]) * sign)
 
-    def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER):
-        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred.
+    def correct(self, y_pred, normal, max_iter=CORRECTOR_ITER, start=None):
+        """Newton on R = 0 and normal . (y - y_pred) = 0 from y_pred (+ ``start``, an
+        offset in the plane: a better first guess of the same point).
 
         The unknown is the offset d = y - y_pred, so the plane equation carries no
         round-off of |y| (which would otherwise floor |R| near tol when y is large
@@ -213,8 +237,12 @@ class _Scaled:
 
         def value(d):
             return np.append(self.value(y_pred + d), normal @ d)
-        res = newton(aug, np.zeros_like(y_pred), self.tol, max_iter, np.linalg.norm(y_pred),
-                     value=value if self.has_value else None, **CORRECTOR_NEWTON)
+        d0 = np.zeros_like(y_pred) if start is None else start
+        # no Jacobian at the converged point: the step's tangent there comes from the
+        # factors of the last iteration (_step), the only use of it
+        res = newton(aug, d0, self.tol, max_iter, np.linalg.norm(y_pred),
+                     value=value if self.has_value else None, final_jac=False,
+                     **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
 
@@ -249,6 +277,7 @@ class _Scaled:
         e[-1] = 1.0
         res.x = np.append(y_pred[:-1] + res.x, lam)
         res.J = np.vstack([J, e])
+        res.lu = None  # factors of the fixed-parameter system, not of [J; t]
         return res
 
 
@@ -307,23 +336,39 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
     J_phys = np.column_stack([Jx, Jl])  # unscaled Jacobian at the last accepted point
     orient = 0.0  # sign of det([J; t]): the branch's orientation (set at the first point)
     ctl = _Control(tolerance, lam_step)
+    ds_cap = np.inf  # bound after a failed corrector (FAIL_SHARE, GROW_AFTER_FAIL)
     creep = 0  # points accepted in a row at steps below KINK_STEP
+    known = None  # (unscaled unit tangent, sign of det(R_x)) at the last point, from _step
     while len(branch.lam) < max_points:
         tol_now = max(tol, rtol * float(np.linalg.norm(J_phys[:, :-1] @ branch.x[-1])))
         sc = _Scaled(fun, s_x, s_lam, tol_now)
         y = np.append(branch.x[-1] / s_x, branch.lam[-1] / s_lam)
         col = np.append(np.full(len(x0), s_x), s_lam)
-        J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
-        try:
-            t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
-        except (np.linalg.LinAlgError, ValueError):
-            raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
-        if not orient:
-            orient = d  # t points towards lam_end here
-        elif d != orient:
-            t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
+        if known is None:
+            J = J_phys * col  # reuse the corrector's last Jacobian: no extra evaluation
+            try:
+                t, d, branch.det_sign[-1] = sc.tangent(J, t_prev)
+            except (np.linalg.LinAlgError, ValueError):
+                raise _stop("singular extended Jacobian (bifurcation?)", branch) from None
+            if not orient:
+                orient = d  # t points towards lam_end here
+            elif d != orient:
+                t = -t  # forward is the branch's orientation (a turn of more than 90 deg)
+        else:
+            # the step judged its point by this tangent, already oriented: a positive
+            # rescaling of the columns maps it (and both det signs) to the new scales
+            # without a second factorisation of the same extended Jacobian
+            t = known[0] / col
+            t /= np.linalg.norm(t)
+            branch.det_sign[-1] = known[1]
         branch.tangent[-1] = _unscaled(t, col)
-        y_new, it, ds, J_new, f = _step(sc, y, t, min(ds, ds_max), ds_min, branch, ctl, orient)
+        y_new, it, ds, J_new, f, known, ds_fail = _step(sc, y, t, min(ds, ds_max, ds_cap), ds_min,
+                                                        branch, ctl, orient)
+        known = (_unscaled(known[0], col), known[1])
+        if ds_fail is not None and tolerance is not None:  # (homotopies: as measured)
+            ds_cap = max(FAIL_SHARE * ds_fail, ds_min)
+        else:
+            ds_cap *= GROW_AFTER_FAIL
         creep = creep + 1 if ds < KINK_STEP else 0
         if creep > CREEP_POINTS:
             raise _stop(f"step below minimum (more than {CREEP_POINTS} points in steps below "
@@ -380,7 +425,9 @@ class _Control:
 
 
 def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
-    """One accepted predictor-corrector step: (y_new, iterations, ds, J, shape factor).
+    """One accepted predictor-corrector step: (y_new, iterations, ds, J, shape factor,
+    (forward unit tangent at y_new, sign of det(R_x) there), the last step at which no
+    corrector converged or None).
 
     Corrector: the pseudo-arclength plane, else Newton at the predictor's parameter
     (where the plane misses the branch: past a kink that turns it by more than 90 deg
@@ -388,22 +435,27 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
     at the corrected point is the branch's orientation's; the step is retried shorter
     while its shape factor exceeds REJECT, and halved when no corrector converges.
     """
-    alpha_prev, reason = None, ""
+    alpha_prev, reason, ds_fail = None, "", None
     if abs(t[-1]) * ds > ctl.lam_step:
         ds = ctl.lam_step / abs(t[-1])
+    # not without a tolerance: there the corrector's iterations size the steps, and a
+    # better start would lengthen them past what the homotopies were measured with
+    bend = None if ctl.delta_ok is None else _bend(sc, y, t, branch)
     while True:
         y_pred = y + ds * t
         res = None
         try:
-            res = sc.correct(y_pred, t)
+            res = sc.correct(y_pred, t, start=None if bend is None else ds**2 * bend)
         except NewtonError as err:
             reason = err.reason
             if ds >= FIXED_MIN_STEP:
                 res = sc.correct_fixed(y_pred)
         f = None
-        if res is not None:
+        if res is None:
+            ds_fail = ds
+        else:
             try:
-                t_new, d_new, _ = sc.tangent(res.J[:-1], t)
+                t_new, d_new, det_x = sc.tangent(res.J[:-1], t, res.lu)
             except (np.linalg.LinAlgError, ValueError):
                 t_new, reason = None, "singular extended Jacobian at the corrected point"
             if t_new is not None:
@@ -417,13 +469,33 @@ def _step(sc, y, t, ds, ds_min, branch, ctl, orient):
                 if ds >= KINK_STEP and _backwards(res.x[-1] - y[-1], t[-1], t_new[-1]):
                     f, reason = max(f, 2.0 * REJECT), "the corrector went back in the parameter"
                 if f <= REJECT:
-                    return res.x, res.iterations, ds, res.J[:-1], f_next
+                    return res.x, res.iterations, ds, res.J[:-1], f_next, (t_new, det_x), ds_fail
                 alpha_prev = alpha
                 if not reason.startswith("the corrector went back"):
                     reason = "the branch bends more than the tolerance allows"
         ds *= 0.5 if f is None else max(1.0 / f, 0.25)
         if ds < ds_min:
             raise _stop(f"step below minimum ({reason})", branch)
+
+
+def _bend(sc, y, t, branch):
+    """Curvature term c (N + 1,) normal to t of the quadratic through the previous point
+    with tangent t at y (scaled variables), or None at a branch's first point.
+
+    The point y + ds t + ds^2 c lies in the corrector's plane (normal t through the
+    predictor y + ds t) and is second-order closer to the branch there: Newton starts
+    from it and converges to the same point in fewer iterations (the residual of a
+    friction branch at the predictor is far outside Newton's quadratic region:
+    measured on chain5 at H = 31, |R| ~ 0.3 and five damped iterations before it).
+    """
+    if len(branch.lam) < 2:
+        return None
+    prev = np.append(branch.x[-2] / sc.s_x, branch.lam[-2] / sc.s_lam)
+    h = -float(np.linalg.norm(y - prev))
+    if h == 0.0:
+        return None
+    c = (prev - y - h * t) / h**2
+    return c - (c @ t) * t
 
 
 def _unscaled(t, col):
@@ -536,62 +608,3 @@ def refine_max(fun, branch: Branch, i: int, amplitude, tol: float, tol_lam: floa
     tau, f, n = brent_min(point, -1.0, 1.0, xtol, start=0.0)
     y = cache[tau]
     return y[:-1], float(y[-1]), float(-f), n
-
-
-#: Golden-section share of Brent's minimiser.
-_GOLDEN = 0.5 * (3.0 - np.sqrt(5.0))
-
-
-def brent_min(f, a: float, b: float, xtol: float, start: float | None = None,
-              max_eval: int = 200) -> tuple[float, float, int]:
-    """Minimum of f on [a, b] to an absolute tolerance xtol in x (Brent, Algorithms for
-    Minimization without Derivatives, 1973, ch. 5: golden-section steps, parabolic steps
-    through the three best points where they are safe). ``start``: the first point
-    (default the golden-section point). f may return inf (a point to avoid).
-
-    Returns
-    -------
-    x, f(x), evaluations
-    """
-    x = w = v = a + _GOLDEN * (b - a) if start is None else float(start)
-    fx = fw = fv = f(x)
-    d = e = 0.0
-    n = 1
-    while n < max_eval:
-        m = 0.5 * (a + b)
-        if abs(x - m) <= 2.0 * xtol - 0.5 * (b - a):
-            break
-        p = q = r = 0.0
-        if abs(e) > xtol and np.isfinite(fx) and np.isfinite(fw) and np.isfinite(fv):
-            r = (x - w) * (fx - fv)
-            q = (x - v) * (fx - fw)
-            p = (x - v) * q - (x - w) * r
-            q = 2.0 * (q - r)
-            p, q = (-p, q) if q > 0.0 else (p, -q)
-            r, e = e, d
-        if q != 0.0 and abs(p) < abs(0.5 * q * r) and q * (a - x) < p < q * (b - x):
-            d = p / q  # parabolic step
-            if (x + d) - a < 2.0 * xtol or b - (x + d) < 2.0 * xtol:
-                d = xtol if x < m else -xtol
-        else:
-            e = (b - x) if x < m else (a - x)  # golden-section step into the larger part
-            d = _GOLDEN * e
-        u = x + (d if abs(d) >= xtol else np.copysign(xtol, d))
-        fu = f(u)
-        n += 1
-        if fu <= fx:
-            if u < x:
-                b = x
-            else:
-                a = x
-            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
-        else:
-            if u < x:
-                a = u
-            else:
-                b = u
-            if fu <= fw or w == x:
-                v, fv, w, fw = w, fw, u, fu
-            elif fu <= fv or v in (x, w):
-                v, fv = u, fu
-    return x, fx, n

@@ -202,8 +202,14 @@ class FourierBasis:
         """Basis sampled at oversample * default_samples(H) points (cached)."""
         cache = self.__dict__.setdefault("_fine_cache", {})
         if oversample not in cache:
+            # on a uniform grid h theta_j is 2 pi ((h j) mod n) / n: one table of n cosines
+            # and sines gathered, instead of n n_b of each (0.4 s at H = 70, 32768 points)
             n = oversample * default_samples(self.H)
-            cache[oversample] = self.evaluate(np.eye(self.nb), 2.0 * np.pi * np.arange(n) / n)
+            ang = 2.0 * np.pi * np.arange(n) / n
+            is_sin = np.zeros(self.nb, dtype=bool)
+            is_sin[(2 if self.harmonics[0] == 0 else 1)::2] = True
+            k = (np.arange(n)[:, None] * self.order[None, :]) % n + n * is_sin[None, :]
+            cache[oversample] = np.concatenate([np.cos(ang), np.sin(ang)])[k]
         return cache[oversample]
 
     def evaluate(self, coeffs: np.ndarray, theta) -> np.ndarray:

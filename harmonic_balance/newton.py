@@ -55,14 +55,47 @@ class NewtonError(RuntimeError):
 
 @dataclass
 class NewtonResult:
+    """x, and R, J evaluated there; ``lu``: the LU factors (:func:`lu_factor`) of the
+    Jacobian of the last step (at the iterate before x: O(|x - x_prev|) from J), or None
+    when no step was taken. ``J_at_x`` False: J is that last step's Jacobian, not one at x
+    (``newton(..., final_jac=False)``)."""
+
     x: np.ndarray
     R: np.ndarray
     J: np.ndarray
     iterations: int
+    lu: tuple | None = None
+    J_at_x: bool = True
+
+
+def lu_factor(A: np.ndarray):
+    """LU factors of the square A (n, n) (LAPACK getrf of A^T: a C-ordered A is a
+    Fortran-ordered A^T, so nothing is copied; cheaper than ``np.linalg.solve``'s gesv
+    from 16 to 700 unknowns), or None when A is exactly singular."""
+    from scipy.linalg.lapack import dgetrf
+
+    lu, piv, info = dgetrf(np.asarray(A, dtype=float).T)
+    return None if info != 0 else (lu, piv)
+
+
+def lu_solve(factors, b: np.ndarray) -> np.ndarray:
+    """x with A x = b from :func:`lu_factor`'s factors of A."""
+    from scipy.linalg.lapack import dgetrs
+
+    x, _ = dgetrs(factors[0], factors[1], b, trans=1)
+    return x
+
+
+def lu_det_sign(factors) -> float:
+    """Sign of det(A) from :func:`lu_factor`'s factors (0-based row swaps)."""
+    lu, piv = factors
+    swaps = np.count_nonzero(piv != np.arange(len(piv))) % 2
+    return float((-1.0) ** swaps * np.prod(np.sign(np.diag(lu))))
 
 
 def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
-           min_alpha: float = None, lm: bool = True, value=None) -> NewtonResult:
+           min_alpha: float = None, lm: bool = True, value=None,
+           final_jac: bool = True) -> NewtonResult:
     """Solve R(x) = 0 to |R|_2 <= tol, or until Newton's step is below round-off.
 
     The second test (|dx|_2 <= STEP_RTOL max(|x|_2, x_norm)) ends the iteration when
@@ -83,10 +116,14 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
     value : callable x -> R, optional
         R alone, the same numbers as ``fun(x)[0]`` at less cost: the line search's
         trial points (:func:`line_search`); None: ``fun``.
+    final_jac : bool, False (with ``value``): a step that lands within tol is not followed
+        by the Jacobian at its point; the result carries the step's own Jacobian and
+        factors (``J_at_x`` False), enough for a caller that only needs a tangent or a
+        size (a continuation corrector: one Jacobian assembly less per point).
 
     Returns
     -------
-    NewtonResult with the converged x, and R, J evaluated there.
+    NewtonResult with the converged x, and R, J evaluated there (see ``final_jac``).
 
     Raises
     ------
@@ -99,28 +136,33 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
     R, J = fun(x)
     nr = _norm(R, x, 0)
     state = _LMState()
+    lu = None
     for it in range(max_iter + 1):
         if nr <= tol:
-            return NewtonResult(x, R, J, it)
+            return NewtonResult(x, R, J, it, lu)
         if it == max_iter:
             break
-        try:
-            dx = np.linalg.solve(J, -R)  # LAPACK gesv; scipy's wrapper costs more at this size
-        except np.linalg.LinAlgError:
-            raise NewtonError("singular Jacobian", x, it, nr) from None
+        lu = lu_factor(J)
+        if lu is None:
+            raise NewtonError("singular Jacobian", x, it, nr)
+        dx = lu_solve(lu, -R)
         if not np.all(np.isfinite(dx)):
             raise NewtonError("singular or non-finite Jacobian", x, it, nr)
         if np.linalg.norm(dx) <= STEP_RTOL * max(np.linalg.norm(x), x_norm):
             x = x + dx  # the last (tiny) step, so a smooth residual keeps quadratic accuracy
             R, J = fun(x)
-            return NewtonResult(x, R, J, it + 1)
-        step = line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha, value)
+            return NewtonResult(x, R, J, it + 1, lu)
+        step = line_search(fun, x, dx, nr, MIN_ALPHA if min_alpha is None else min_alpha, value,
+                           None if final_jac else tol)
+        if step is not None and step[2] is None:  # within tol, no Jacobian there
+            return NewtonResult(step[0], step[1], J, it + 1, lu, J_at_x=False)
         if step is None and _at_noise_floor(fun, x, R, J, nr, tol, x_norm):
-            return NewtonResult(x, R, J, it)
+            return NewtonResult(x, R, J, it, lu)
         if step is None:
             if not lm:
                 raise NewtonError("no decrease along Newton's direction", x, it, nr)
             step, state = _lm_step(fun, x, R, J, nr, state)
+            lu = None  # an LM step: the factors are not the step's
             if step is None:
                 raise NewtonError("no decrease, neither along Newton's direction nor by "
                                   "Levenberg-Marquardt steps (a local minimum of |R| that "
@@ -183,13 +225,14 @@ def _at_noise_floor(fun, x, R, J, nr, tol, x_norm=0.0) -> bool:
     return bool(np.linalg.norm(R2 - R) >= 0.5 * nr and np.linalg.norm(J @ d) <= 0.1 * nr)
 
 
-def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA, value=None):
+def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA, value=None, done_tol=None):
     """Armijo backtracking along dx; (x, R, J, |R|) or None when alpha < min_alpha.
 
     ``value`` (x -> R, the same numbers as ``fun(x)[0]``): the trial points are judged by
     R alone and only the accepted one gets its Jacobian (``fun``), so a rejected trial
-    costs no Jacobian. Also the sparse ring solver's (:mod:`.bladed_disk.ring_solve`):
-    ``J`` is whatever ``fun`` returns, dense or sparse.
+    costs no Jacobian; nor does an accepted one with |R| <= ``done_tol`` (J None then).
+    Also the sparse ring solver's (:mod:`.bladed_disk.ring_solve`): ``J`` is whatever
+    ``fun`` returns, dense or sparse.
     """
     alpha = 1.0
     while alpha >= min_alpha:
@@ -197,7 +240,7 @@ def line_search(fun, x, dx, nr, min_alpha=MIN_ALPHA, value=None):
         Rt, Jt = (value(xt), None) if value is not None else fun(xt)
         nt = np.linalg.norm(Rt) if np.all(np.isfinite(Rt)) else np.inf
         if nt**2 <= (1.0 - 2.0 * ARMIJO * alpha) * nr**2:
-            if Jt is None:
+            if Jt is None and not (done_tol is not None and nt <= done_tol):
                 Rt, Jt = fun(xt)
             return xt, Rt, Jt, nt
         alpha *= 0.5

@@ -86,7 +86,11 @@ class _Residual:
             if lm.pairs is None:
                 groups.setdefault(lm.rows.tobytes(), (lm.rows, []))[1].append(k)
         self._local = maps
-        self._groups = [(np.ix_(rows, rows), ks) for rows, ks in groups.values()]
+        # each group's block enters the Jacobian through flat indices into it: one 1-D
+        # gather-add-scatter (UPD-24 at H = 21: 0.10 ms against 0.25 ms by np.ix_ or by
+        # strided views of its runs of DOFs)
+        self._groups = [((rows[:, None] * self.size + rows[None, :]).ravel(), ks)
+                        for rows, ks in groups.values()]
 
     def _assemble(self, res) -> np.ndarray:
         """dF_nl/dx (size, size) = sum_e T_e dF_e Q_e, element by element on its rows."""
@@ -96,11 +100,12 @@ class _Residual:
         for lm, r in zip(self._local, res):
             if lm.pairs is not None:
                 lm.add_direct(J4, r.dF)
-        for ix, ks in self._groups:
+        flat = dF.reshape(-1)
+        for idx, ks in self._groups:
             B = self._local[ks[0]].block(res[ks[0]].dF)
             for k in ks[1:]:
                 B += self._local[k].block(res[k].dF)
-            dF[ix] += B
+            flat[idx] += B.ravel()
         return dF
 
     def with_elements(self, model: Model):
