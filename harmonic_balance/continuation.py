@@ -373,23 +373,25 @@ def continuation(fun, x0, lam0: float, lam_end: float, tol: float, ds: float = 0
         if creep > CREEP_POINTS:
             raise _stop(f"step below minimum (more than {CREEP_POINTS} points in steps below "
                         f"{KINK_STEP:g}: the corrector creeps along a kink)", branch)
-        J_phys = J_new / col
         lam_new = y_new[-1] * s_lam
         if sign * (lam_new - lam_end) >= 0:  # passed the end: land exactly on it
-            x_end = _interpolate(branch, y_new[:-1] * s_x, lam_new, lam_end)
             try:
-                res = _solve_fixed(fun, x_end, lam_end, tol, branch)
+                res = _land(fun, branch, y_new[:-1] * s_x, lam_new, lam_end, tol)
             except ContinuationError:
-                # From the last accepted point instead: measured on the Jenkins start at
-                # 100 k, f_s = P, c = 1e-4, H = 51, 2 rad/s (grazing slip), the
-                # interpolated guess stalled at |R| = 3e-4 while Newton from the last
-                # point (lam = -0.005) converged in 24 iterations.
-                res = _solve_fixed(fun, branch.x[-1], lam_end, tol, branch)
+                if ds < 4.0 * ds_min:
+                    raise
+                # a long last step leaves both guesses too far from the end's solution
+                # (measured: a residual that cannot be evaluated off the branch): a
+                # shorter step from the last point, whose J_phys and tangent stand
+                ds_cap, known = 0.5 * ds, None
+                ds = ds_cap
+                continue
             branch.append(res.x, lam_end, res.iterations, *_end_tangent(fun, res.x, lam_end, sign))
             if on_point is not None:
                 on_point(lam_end)
             branch.status = "complete"
             return branch
+        J_phys = J_new / col
         if sign * (lam_new - lam0) < 0:
             branch.append(y_new[:-1] * s_x, lam_new, it)
             raise _stop("the branch turned back out of the parameter range", branch)
@@ -533,6 +535,17 @@ def _solve_fixed(fun, x, lam, tol, branch):
                       value=None if value is None else (lambda z: value(z, lam)))
     except NewtonError as err:
         raise _stop(f"no solution at fixed parameter {lam:.6g}: {err}", branch) from None
+
+
+def _land(fun, branch, x_new, lam_new, lam_end, tol):
+    """Solution at lam_end from a point x_new past it: Newton from the interpolated
+    guess, else from the last accepted point (measured on the Jenkins start at 100 k,
+    f_s = P, c = 1e-4, H = 51, 2 rad/s (grazing slip): the interpolated guess stalled
+    at |R| = 3e-4 while Newton from the last point converged in 24 iterations)."""
+    try:
+        return _solve_fixed(fun, _interpolate(branch, x_new, lam_new, lam_end), lam_end, tol, branch)
+    except ContinuationError:
+        return _solve_fixed(fun, branch.x[-1], lam_end, tol, branch)
 
 
 def _interpolate(branch, x_new, lam_new, lam_end):
