@@ -136,19 +136,20 @@ def check_peak(result, steps_per_period: int = CHECK_STEPS) -> dict:
 
 
 def compare(omega: float, hb_amplitude: float, from_rest: float, from_hb_state: float,
-            method: str) -> dict:
+            method: str, quantity: str | None = None) -> dict:
     """The comparison of a check (the one shared by every model): peak amplitudes [m] of the
     harmonic balance and of the time integrations from rest and from its state at ``omega``
     [rad/s] -> the record's omega, hb_amplitude, from_rest, from_hb_state, rest_vs_hb
     (from_rest / hb_amplitude - 1), states_rel (|from_rest / from_hb_state - 1|),
-    hb_state_drift (from_hb_state / hb_amplitude - 1) and states_differ (states_rel >
-    :data:`SAME_STATE_TOL`)."""
+    hb_state_drift (from_hb_state / hb_amplitude - 1), states_differ (states_rel >
+    :data:`SAME_STATE_TOL`) and, when given, ``quantity``: what the amplitudes are, named
+    in the text (default: the model's max|x| of the response DOF)."""
     states = abs(from_rest / from_hb_state - 1.0)
     return {"method": method, "omega": float(omega), "hb_amplitude": float(hb_amplitude),
             "from_rest": float(from_rest), "from_hb_state": float(from_hb_state),
             "rest_vs_hb": from_rest / hb_amplitude - 1.0, "states_rel": states,
             "hb_state_drift": from_hb_state / hb_amplitude - 1.0,
-            "states_differ": bool(states > SAME_STATE_TOL)}
+            "states_differ": bool(states > SAME_STATE_TOL)} | ({"quantity": quantity} if quantity else {})
 
 
 def annotate(result, check: bool = False):
@@ -184,8 +185,10 @@ def summary_lines(record: dict | None) -> list[str]:
         return []
     if "note" in record:
         return [f"steady state: not checked ({record['note']})"]
-    line = (f"steady state (time integration at the peak): from rest {record['from_rest']:.6g} m, "
+    what = f", {record['quantity']}" if record.get("quantity") else ""
+    line = (f"steady state (time integration at the peak{what}): from rest {record['from_rest']:.6g} m, "
             f"from the harmonic balance's state {record['from_hb_state']:.6g} m, harmonic balance "
-            f"{record['hb_amplitude']:.6g} m")
+            f"{record['hb_amplitude']:.6g} m"
+            + ("" if record.get("converged", True) else " (not settled within the period limit)"))
     w = warning(record)
     return [line] + ([w] if w else [])

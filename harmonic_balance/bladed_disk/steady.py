@@ -52,17 +52,18 @@ def stuck_contacts(hb, x: np.ndarray, omega: float) -> list[str]:
 
 
 def ring_start(hb, x: np.ndarray, omega: float, samples: int = HISTORY_SAMPLES):
-    """The ring's start at the sector solution ``x``: x0 (n_r,) [m], v0 (n_r,) [m/s] at t = 0
-    and the history (2 samples, n_r) [m]: the HB period twice, oldest first, ending just
-    before t = 0."""
+    """The ring's start at the sector solution ``x``: x0 (n_r,) [m], v0 (n_r,) [m/s], a0
+    (n_r,) [m/s^2] at t = 0 and the history (2 samples, n_r) [m]: the HB period twice,
+    oldest first, ending just before t = 0."""
     from ..steady_state import hb_period
     from .ring import RingHB
 
     ring = RingHB(hb.sector, hb.H, cf=hb.cf, f0=hb.f0, mu=hb.mu)
     X = ring.from_sector(x).reshape(ring.nb, ring.ndof)
     xs, v0 = hb_period(ring.basis, X, omega, samples)
+    a0 = omega * hb_period(ring.basis, ring.basis.dtheta @ X, omega, samples)[1]
     # the period ends at t = T = t0: the last sample before the start is xs[-1]
-    return xs[0], v0, np.vstack([xs, xs])
+    return xs[0], v0, a0, np.vstack([xs, xs])
 
 
 def check_peak(hb, curve, max_periods: int = RING_PERIODS, tol: float = RING_TOL) -> dict:
@@ -89,7 +90,9 @@ def check_peak(hb, curve, max_periods: int = RING_PERIODS, tol: float = RING_TOL
     x, w = curve.peak_x, float(curve.peak_omega)
     if x is None or not np.isfinite(w):
         return {"method": method, "note": "no refined peak"}
-    if type(hb).__name__ != "SectorHB":
+    from .hb import SectorHB
+
+    if type(hb) is not SectorHB:
         return {"method": method, "note": "the ring time integration takes point contacts on the tuned sector"}
     if hb.mu != hb.sector.cfg.mu:
         return {"method": method, "note": "the ring time integration takes the configuration's friction coefficient"}
@@ -98,7 +101,8 @@ def check_peak(hb, curve, max_periods: int = RING_PERIODS, tol: float = RING_TOL
     rest = march_ring(hb.sector, [w], **kw)
     own = march_ring(hb.sector, [w], start=ring_start(hb, x, w), **kw)
     c0 = float(np.mean(hb.basis.E @ hb.response(x)))
-    rec = compare(w, hb.amplitude_max(x), rest["amplitude_max"][0], own["amplitude_max"][0], method)
+    rec = compare(w, hb.amplitude_max(x), rest["amplitude_max"][0], own["amplitude_max"][0], method,
+                  "max|u_a - mean| of blade 0")
     return rec | {"hb_amplitude_h1": float(hb.amplitude_h1(x)), "h1_from_rest": float(rest["amplitude"][0]),
                   "h1_from_hb_state": float(own["amplitude"][0]), "hb_mean": c0,
                   "mean_from_rest": float(rest["mean"][0]), "mean_from_hb_state": float(own["mean"][0]),
@@ -107,3 +111,19 @@ def check_peak(hb, curve, max_periods: int = RING_PERIODS, tol: float = RING_TOL
                   "converged": bool(rest["converged"][0] and own["converged"][0]),
                   "steps_per_period": int(own["steps_per_period"]), "blades": hb.sector.cfg.ring_blades,
                   "cpu_s": time.process_time() - p0, "time_s": time.perf_counter() - t0}
+
+
+def annotate(hb, curve, check: bool = False) -> dict:
+    """A point-contact curve's ``stuck_links`` at its peak and, with ``check``, its
+    ``steady_state`` (:func:`check_peak`) and ``steady_state_warning``
+    (:func:`harmonic_balance.steady_state.warning`): the keys of its JSON."""
+    from ..steady_state import warning
+    from .hb import SectorHB
+
+    out = {}
+    if type(hb) is SectorHB and curve.peak_x is not None:
+        out["stuck_links"] = stuck_contacts(hb, curve.peak_x, curve.peak_omega)
+    if check:
+        rec = check_peak(hb, curve)
+        out |= {"steady_state": rec, "steady_state_warning": warning(rec)}
+    return out
