@@ -144,6 +144,7 @@ def compare(omega: float, hb_amplitude: float, from_rest: float, from_hb_state: 
     hb_state_drift (from_hb_state / hb_amplitude - 1), states_differ (states_rel >
     :data:`SAME_STATE_TOL`) and, when given, ``quantity``: what the amplitudes are, named
     in the text (default: the model's max|x| of the response DOF)."""
+    hb_amplitude, from_rest, from_hb_state = float(hb_amplitude), float(from_rest), float(from_hb_state)
     states = abs(from_rest / from_hb_state - 1.0)
     return {"method": method, "omega": float(omega), "hb_amplitude": float(hb_amplitude),
             "from_rest": float(from_rest), "from_hb_state": float(from_hb_state),
