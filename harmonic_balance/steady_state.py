@@ -189,7 +189,8 @@ def summary_lines(record: dict | None) -> list[str]:
     what = f", {record['quantity']}" if record.get("quantity") else ""
     line = (f"steady state (time integration at the peak{what}): from rest {record['from_rest']:.6g} m, "
             f"from the harmonic balance's state {record['from_hb_state']:.6g} m, harmonic balance "
-            f"{record['hb_amplitude']:.6g} m"
-            + ("" if record.get("converged", True) else " (not settled within the period limit)"))
+            f"{record['hb_amplitude']:.6g} m (from rest {100 * record['rest_vs_hb']:+.2g} % from the harmonic "
+            f"balance, {record['states_rel']:.1e} from the run started on its state)"
+            + ("" if record.get("converged", True) else "; not settled within the period limit"))
     w = warning(record)
     return [line] + ([w] if w else [])
