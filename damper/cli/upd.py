@@ -494,7 +494,6 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     return out
 
 
-
 def _check_optimize(args) -> None:
     """Every option of ``upd optimize``, before the model (or its contacts) is built."""
     from damper import limits
@@ -549,9 +548,7 @@ def run_optimize(args) -> int:
         band = out.get("optimum_band_cf")
         if band:  # the minimum is flat: the CF range a design can use
             print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
-    from harmonic_balance.steady_state import summary_lines
-
-    for line in _accuracy_lines(out) + summary_lines(out.get("steady_state")):
+    for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0

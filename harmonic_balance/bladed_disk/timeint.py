@@ -14,8 +14,8 @@ that N (``IwanElement.step_batch``: one call per element type per step, all
 frequencies and contact points at once; ContactElement.stepper is one state per call),
 dashpots in C. Start: the frictionless prestress state at rest, the
 sliders virgin there (tangential input s - s_static), the same convention as the HB;
-or (``start``) a given displacement and velocity, the sliders first stepped through a
-given displacement history (e.g. a harmonic-balance period, :mod:`.steady`).
+or (``start``) a given displacement, velocity and acceleration, the sliders first stepped
+through a given displacement history (e.g. a harmonic-balance period, :mod:`.steady`).
 No Fourier series and no periodicity assumption. Steady state: the first harmonic of
 the response DOF (u_a) of every blade, period by period; stops when its change, extrapolated
 geometrically (transient ~ rho^p), is below ``tol`` of the amplitude.
@@ -54,8 +54,8 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     Returns
     -------
     dict: amplitude (n_f,) [m], amplitude_max (n_f,) (max |u_a - mean| of blade 0 over
-    the last period) [m], mean (n_f,) (its mean) [m], amplitude_blades (n_f, N_r), phase_steps (n_f, N_r) [rad]
-    (blade j+1 minus blade j, should all be phi), periods, settle_error (n_f,)
+    the last period) [m], mean (n_f,) (its mean) [m], amplitude_blades (n_f, N_r),
+    phase_steps (n_f, N_r) [rad] (blade j+1 minus blade j, should all be phi), periods, settle_error (n_f,)
     (extrapolated remaining change, relative), steps_per_period, converged (n_f,).
     """
     cfg = sector.cfg
