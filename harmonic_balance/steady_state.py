@@ -127,16 +127,30 @@ def check_peak(result, steps_per_period: int = CHECK_STEPS) -> dict:
     # twice through the HB period: a virgin slider reaches the periodic loop within the first
     hb = march(model, w, steps_per_period, CHECK_PERIODS, CHECK_TOL, x0=xs[0], v0=v0,
                history=np.vstack([xs, xs]))
-    states = abs(rest.amplitude / hb.amplitude - 1.0)
-    return {"method": method, "omega": w, "hb_amplitude": float(result.peak_amplitude),
-            "from_rest": rest.amplitude, "from_hb_state": hb.amplitude,
-            "hb_mean": float(X[0, r]) if prob.basis.harmonics[0] == 0 else 0.0,
-            "mean_from_rest": _mean(rest.x_last), "mean_from_hb_state": _mean(hb.x_last),
-            "rest_vs_hb": rest.amplitude / result.peak_amplitude - 1.0, "states_rel": states,
-            "hb_state_drift": hb.amplitude / result.peak_amplitude - 1.0,
-            "states_differ": bool(states > SAME_STATE_TOL), "stuck_links": stuck_links(prob, x),
-            "periods": [rest.periods, hb.periods], "converged": bool(rest.converged and hb.converged),
-            "steps_per_period": hb.steps_per_period, "time_s": time.perf_counter() - t0}
+    rec = compare(w, float(result.peak_amplitude), rest.amplitude, hb.amplitude, method)
+    return rec | {"hb_mean": float(X[0, r]) if prob.basis.harmonics[0] == 0 else 0.0,
+                  "mean_from_rest": _mean(rest.x_last), "mean_from_hb_state": _mean(hb.x_last),
+                  "stuck_links": stuck_links(prob, x), "periods": [rest.periods, hb.periods],
+                  "converged": bool(rest.converged and hb.converged),
+                  "steps_per_period": hb.steps_per_period, "time_s": time.perf_counter() - t0}
+
+
+def compare(omega: float, hb_amplitude: float, from_rest: float, from_hb_state: float,
+            method: str, quantity: str | None = None) -> dict:
+    """The comparison of a check (the one shared by every model): peak amplitudes [m] of the
+    harmonic balance and of the time integrations from rest and from its state at ``omega``
+    [rad/s] -> the record's omega, hb_amplitude, from_rest, from_hb_state, rest_vs_hb
+    (from_rest / hb_amplitude - 1), states_rel (|from_rest / from_hb_state - 1|),
+    hb_state_drift (from_hb_state / hb_amplitude - 1), states_differ (states_rel >
+    :data:`SAME_STATE_TOL`) and, when given, ``quantity``: what the amplitudes are, named
+    in the text (default: the model's max|x| of the response DOF)."""
+    hb_amplitude, from_rest, from_hb_state = float(hb_amplitude), float(from_rest), float(from_hb_state)
+    states = abs(from_rest / from_hb_state - 1.0)
+    return {"method": method, "omega": float(omega), "hb_amplitude": float(hb_amplitude),
+            "from_rest": float(from_rest), "from_hb_state": float(from_hb_state),
+            "rest_vs_hb": from_rest / hb_amplitude - 1.0, "states_rel": states,
+            "hb_state_drift": from_hb_state / hb_amplitude - 1.0,
+            "states_differ": bool(states > SAME_STATE_TOL)} | ({"quantity": quantity} if quantity else {})
 
 
 def annotate(result, check: bool = False):
@@ -172,8 +186,11 @@ def summary_lines(record: dict | None) -> list[str]:
         return []
     if "note" in record:
         return [f"steady state: not checked ({record['note']})"]
-    line = (f"steady state (time integration at the peak): from rest {record['from_rest']:.6g} m, "
+    what = f", {record['quantity']}" if record.get("quantity") else ""
+    line = (f"steady state (time integration at the peak{what}): from rest {record['from_rest']:.6g} m, "
             f"from the harmonic balance's state {record['from_hb_state']:.6g} m, harmonic balance "
-            f"{record['hb_amplitude']:.6g} m")
+            f"{record['hb_amplitude']:.6g} m (from rest {100 * record['rest_vs_hb']:+.2g} % from the harmonic "
+            f"balance, {record['states_rel']:.1e} from the run started on its state)"
+            + ("" if record.get("converged", True) else "; not settled within the period limit"))
     w = warning(record)
     return [line] + ([w] if w else [])

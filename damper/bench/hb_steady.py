@@ -10,10 +10,13 @@ difference, and whether the two are different steady states: the curve at the ca
 own H near the peak, checked by :func:`harmonic_balance.steady_state.check_peak` (time
 integrations at its peak from rest and from the harmonic balance's state; both carry
 the same truncation and step, so only the states differ). UPD-24: its reference's ring
-time integration (stored with the reference), no state check (the sector is not a
-matrix model of :mod:`harmonic_balance.timeint`).
+time integration (stored with the reference), and the same question for the sector at
+the bench's H = 7 near the peak by :func:`harmonic_balance.bladed_disk.steady.check_peak`
+(the tuned ring marched from rest and from the sector HB's state; ~3 s of CPU at CF
+120 N).
 
-A row: ``case`` "steady <model>", ``size`` the reference's H, ``error`` |HB / TI - 1|,
+A row: ``case`` "steady <model>" ("steady UPD-24 CF <CF>" for UPD-24), ``size`` the
+reference's H, ``error`` |HB / TI - 1|,
 ``time_s`` the time integrations' and the check's wall time; ``states_differ`` the flag,
 ``beyond_errors`` whether the difference exceeds the reference's error estimate, the
 time integration's step error and TI_PEAK_TOL together.
@@ -43,6 +46,9 @@ TI_PEAK_TOL = 1e-3
 #: Half-width of the window of the case's own-H curve that the state check traces
 #: around the reference peak (relative; the peak moves by < 1 % with H on the bench).
 CHECK_WINDOW = 0.03
+#: UPD-24's state check: the bench's (``damper upd frf``'s) H and the grid of its window
+#: (the continuation refines the peak on the branch; the grid only starts it).
+UPD_H, UPD_CHECK_POINTS = 7, 30
 #: Models of a quick run: one whose time integration costs a second.
 QUICK_MODELS = ("sdof soft",)
 
@@ -86,6 +92,29 @@ def _state_check(case, omega: float) -> dict:
     return check_peak(r)
 
 
+def _upd_state_check(omega: float) -> dict:
+    """UPD-24's curve at the bench's H near ``omega`` (``damper upd frf`` defaults) and the
+    ring check at its peak."""
+    from harmonic_balance.bladed_disk.config import load_config
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.sector import Sector
+    from harmonic_balance.bladed_disk.solve import frf
+    from harmonic_balance.bladed_disk.steady import check_peak
+
+    hb = SectorHB(Sector(load_config()), UPD_H)
+    c = frf(hb, omega * np.linspace(1 - CHECK_WINDOW, 1 + CHECK_WINDOW, UPD_CHECK_POINTS))
+    return check_peak(hb, c)
+
+
+def case_label(key: str) -> str:
+    """The row's case name: "steady <model>", UPD-24 with its centrifugal load."""
+    if key != "upd24":
+        return f"steady {key}"
+    from harmonic_balance.bladed_disk.config import load_config
+
+    return f"steady UPD-24 CF {load_config().cf:g}"
+
+
 def model_row(key: str, log=print) -> dict:
     """One model's row (module docstring) as a dict."""
     from harmonic_balance.bench_models import by_name
@@ -99,17 +128,18 @@ def model_row(key: str, log=print) -> dict:
            "states_differ": None, "check": None}
     if key == "upd24":
         ti = ref.get("time_integration") or {}
+        chk = _upd_state_check(ref["omega"])
         row.update(ti_peak=ti.get("amplitude"), ti_omega=ti.get("omega"), ti_error=ti.get("settle_error"),
-                   how="ring time integration stored with the reference; no state check (sector model)")
+                   states_differ=chk.get("states_differ"), check=_check_fields(chk),
+                   how=f"ring time integration stored with the reference; state check on the ring at "
+                       f"H = {UPD_H} (bladed_disk.steady)")
     else:
         case = by_name(key + " up") if key.startswith(("chain3", "chain5")) else by_name(key)
         ti = _ti_peak(case.model(), ref["omega"])
         chk = _state_check(case, ref["omega"])
         row.update(ti_peak=ti["amplitude"], ti_omega=ti["omega"], ti_error=ti["step_error"],
                    states_differ=chk.get("states_differ"),
-                   check={k: chk.get(k) for k in ("omega", "hb_amplitude", "from_rest", "from_hb_state",
-                                                  "states_rel", "hb_mean", "mean_from_rest",
-                                                  "mean_from_hb_state", "stuck_links", "note")},
+                   check=_check_fields(chk),
                    how=f"timeint.march_curve at {ti['steps_per_period']} steps a period, "
                        f"+-{TI_REL:g} of the reference peak; state check at H = {case.harmonics}")
     d = row["hb_peak"] / row["ti_peak"] - 1.0 if row.get("ti_peak") else None
@@ -119,6 +149,13 @@ def model_row(key: str, log=print) -> dict:
     return row
 
 
+def _check_fields(chk: dict) -> dict:
+    """The state check's fields a row keeps."""
+    return {k: chk.get(k) for k in ("omega", "hb_amplitude", "from_rest", "from_hb_state", "states_rel",
+                                    "hb_mean", "mean_from_rest", "mean_from_hb_state", "stuck_links",
+                                    "periods", "converged", "cpu_s", "note")}
+
+
 def bench_rows(quick: bool, log=print) -> list[Row]:
     """The rows of ``damper bench --stage hb`` (module docstring), printed as they come."""
     log(HEAD)
@@ -126,7 +163,7 @@ def bench_rows(quick: bool, log=print) -> list[Row]:
     for key in models(quick):
         r = model_row(key, lambda s: log("  " + s))
         log(line(r))
-        out.append(Row(f"steady {key}", r["hb_H"] or 0, None if r["difference"] is None else abs(r["difference"]),
+        out.append(Row(case_label(key), r["hb_H"] or 0, None if r["difference"] is None else abs(r["difference"]),
                        r["time_s"], self_peak_mb(), False,
                        {k: v for k, v in r.items() if k != "time_s"} | {"clock": "wall"}))
     return out

@@ -38,6 +38,10 @@ def register(sub) -> None:
     f.add_argument("--points", type=int, default=200, help="frequency points")
     f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
                    help="free: damper removed; stuck: contacts stuck (linear limits)")
+    f.add_argument("--check-steady-state", action="store_true",
+                   help="time-integrate the ring at the peak from rest and from the harmonic balance's "
+                   "state: says whether the curve is the state a start from rest reaches (seconds; "
+                   "point contacts)")
     f.add_argument("--plot", metavar="DIR", help="write upd_frf.png here")
     _contacts(f, surface=True)
     f.set_defaults(func=run_frf)
@@ -376,6 +380,8 @@ def run_frf(args) -> int:
         out = _frf_nonlinear(sector, args, omegas)
     else:
         out = _frf_linear(sector, args, omegas)
+        if args.check_steady_state:
+            out["steady_state"] = {"note": f"--damper {args.damper} is linear: one steady state"}
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
     if args.plot:
@@ -392,7 +398,9 @@ def run_frf(args) -> int:
             print(f"warning: {out['warning']}")
         if out.get("zone_edge_warning"):
             print(out["zone_edge_warning"])
-    for line in _accuracy_lines(out):
+    from harmonic_balance.steady_state import summary_lines
+
+    for line in _accuracy_lines(out) + summary_lines(out.get("steady_state")):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
@@ -436,6 +444,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
     from harmonic_balance.bladed_disk.solve import energy_balance, frf
+    from harmonic_balance.bladed_disk.steady import annotate
 
     if args.contacts == "surface":
         from damper.upd_surface import sector_hb
@@ -480,6 +489,8 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
                 "harmonics_peak": a["H_peak"], "cpu_s": c.extra.get("cpu_s")}
     if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
         out["warning"] = c.extra["warning"]
+    out |= annotate(hb, c, args.check_steady_state)
+    out["time_s"] += out.get("steady_state", {}).get("time_s", 0.0)
     return out
 
 

@@ -13,7 +13,9 @@ friction of each element's C-core Jenkins element stepped with its own history a
 that N (``IwanElement.step_batch``: one call per element type per step, all
 frequencies and contact points at once; ContactElement.stepper is one state per call),
 dashpots in C. Start: the frictionless prestress state at rest, the
-sliders virgin there (tangential input s - s_static), the same convention as the HB.
+sliders virgin there (tangential input s - s_static), the same convention as the HB;
+or (``start``) a given displacement, velocity and acceleration, the sliders first stepped
+through a given displacement history (e.g. a harmonic-balance period, :mod:`.steady`).
 No Fourier series and no periodicity assumption. Steady state: the first harmonic of
 the response DOF (u_a) of every blade, period by period; stops when its change, extrapolated
 geometrically (transient ~ rho^p), is below ``tol`` of the amplitude.
@@ -31,7 +33,8 @@ CFL = 0.5
 
 
 def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int = 0,
-               max_periods: int = 3000, tol: float = 1e-6, kappa=None, surfaces=None) -> dict:
+               max_periods: int = 3000, tol: float = 1e-6, kappa=None, surfaces=None,
+               start=None) -> dict:
     """Steady first-harmonic amplitude of the response DOF (u_a) of blade 0 at each
     frequency [rad/s].
 
@@ -40,19 +43,28 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     ``surfaces`` {"left": Surface, "flat": Surface}: the damper's faces as contact
     surfaces (:class:`.surface_hb.SurfaceSectorHB`'s model on the ring, marched by
     :func:`.ring_surface.march_ring_surface`, whose dict is returned).
+    ``start`` (x0 (n,), v0 (n,), a0 (n,), history (k, n)) on the ring's DOFs [m, m/s,
+    m/s^2, m]: every frequency starts at x0 with velocity v0 and acceleration a0 (the
+    central-difference start x(-dt) = x0 - dt v0 + dt^2 a0 / 2, Bathe, Finite Element
+    Procedures, table 9.1: a first-order start errs by dt a0 / 2 in the velocity, 0.5 %
+    of the amplitude's phase at 600 steps a period, which decays only with the damping),
+    each contact's slider stepped through the displacements of ``history`` (oldest first)
+    beforehand so it carries that past; default: rest.
 
     Returns
     -------
-    dict: amplitude (n_f,) [m], amplitude_blades (n_f, N_r), phase_steps (n_f, N_r) [rad]
-    (blade j+1 minus blade j, should all be phi), periods, settle_error (n_f,)
+    dict: amplitude (n_f,) [m], amplitude_max (n_f,) (max |u_a - mean| of blade 0 over
+    the last period) [m], mean (n_f,) (its mean) [m], amplitude_blades (n_f, N_r),
+    phase_steps (n_f, N_r) [rad] (blade j+1 minus blade j, should all be phi), periods, settle_error (n_f,)
     (extrapolated remaining change, relative), steps_per_period, converged (n_f,).
     """
     cfg = sector.cfg
     cf = cfg.cf if cf is None else float(cf)
     f0 = cfg.f0 if f0 is None else float(f0)
     if surfaces is not None:
-        if kappa is not None:
-            raise ValueError("the ring with contact surfaces is tuned: drop the mistuning (kappa)")
+        if kappa is not None or start is not None:
+            raise ValueError("the ring with contact surfaces is marched from rest, tuned: drop the "
+                             "mistuning (kappa) and the start state")
         from .ring_surface import march_ring_surface
         from .surface_hb import SurfaceSectorHB
         return march_ring_surface(SurfaceSectorHB(sector, surfaces, 1, cf=cf, f0=f0), omegas,
@@ -71,12 +83,8 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
     ns = steps_per_period or int(np.ceil(2 * np.pi / omegas.min() / (CFL * 2 / w_max)))
     dt = 2 * np.pi / omegas / ns  # (nf,)
     Ainv = np.array([np.linalg.inv(M / h**2 + C / (2 * h)) for h in dt])
-    x = np.tile(ring.x_static, (nf, 1))
-    xm = x.copy()
-    Qp, Qs, kn, s0 = c["Qp"], c["Qs"], c["kn"], c["s0"]
-    N_static = kn * np.maximum(x[0] @ Qp.T, 0.0)
-    groups = c["groups"]
-    states = [el.initial_states(nf * len(idx), np.tile(N_static[idx], nf)) for el, idx in groups]
+    x, xm, states = _initial(ring, c, nf, dt, start)
+    Qp, Qs, kn, s0, groups = c["Qp"], c["Qs"], c["kn"], c["s0"], c["groups"]
     fext = np.zeros((nf, n))
     fext[:, sector.y_d::sector.n_dof] = cf
     phase = cfg.phi * np.arange(nr)
@@ -117,10 +125,29 @@ def march_ring(sector: Sector, omegas, cf=None, f0=None, steps_per_period: int =
         prev = H1
     else:
         out.update(converged=np.zeros(nf, bool), settle_error=est)
-    amp = np.abs(H1)
-    out.update(amplitude=amp[:, 0], amplitude_blades=amp, periods=periods,
+    amp, u0 = np.abs(H1), hist[:, :, 0]
+    out.update(amplitude=amp[:, 0], amplitude_blades=amp, periods=periods, mean=u0.mean(axis=0),
+               amplitude_max=np.abs(u0 - u0.mean(axis=0)).max(axis=0),
                phase_steps=np.angle(H1[:, (np.arange(nr) + 1) % nr] / H1))
     return out
+
+
+def _initial(ring: RingHB, c: dict, nf: int, dt: np.ndarray, start):
+    """Displacements now and one step back (nf, n) and the sliders' states (one per law
+    group) at the start: rest at the prestress state, or ``start`` (:func:`march_ring`)."""
+    Qp, Qs, kn, s0 = c["Qp"], c["Qs"], c["kn"], c["s0"]
+    x0 = ring.x_static if start is None else np.asarray(start[0], float)
+    N0 = kn * np.maximum(ring.x_static @ Qp.T, 0.0)   # virgin at the prestress state
+    states = [el.initial_states(nf * len(idx), np.tile(N0[idx], nf)) for el, idx in c["groups"]]
+    x = np.tile(x0, (nf, 1))
+    if start is None:
+        return x, x.copy(), states
+    for xh in np.asarray(start[3], float):   # the same past at every frequency
+        P, S = np.tile(xh @ Qp.T, (nf, 1)), np.tile(xh @ Qs.T - s0, (nf, 1))
+        for (el, idx), sts in zip(c["groups"], states):
+            el.step_batch(sts, S[:, idx].ravel(), (kn[idx] * P[:, idx]).ravel())
+    v0, a0 = (np.asarray(v, float)[None, :] for v in start[1:3])
+    return x, x - dt[:, None] * v0 + 0.5 * dt[:, None] ** 2 * a0, states
 
 
 def _contact_arrays(ring: RingHB) -> dict:
