@@ -107,6 +107,13 @@ MAX_CONTACT_STRAIN = 0.1
 #: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
 #: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).
 MAX_LOOP_SLIPS = 100.0
+#: Largest cache size limit [MiB] (``--cache-max-mb``, ``$DAMPER_CACHE_MAX_MB``): 2^30 MiB
+#: is 1 PiB, more than any disk the cache lives on (1e300 MiB printed a 300-digit limit).
+MAX_CACHE_MB = float(2**30)
+#: Largest ``--until-ci`` half-width of a mistuning study's 0.95 quantile: the amplification
+#: lies between 1 and the Whitehead bound (1.5 at 4 blades, 2.9 at 24), so an interval wider
+#: than +-1 says nothing of it (1e300 was accepted and never reached with few samples).
+MAX_UNTIL_CI = 1.0
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 
@@ -181,3 +188,17 @@ def check_workers(name: str, n) -> None:
     """A worker count: 1 .. :func:`max_workers`."""
     check_size(name, n, 1, max_workers(), f"{WORKERS_PER_CORE} per core of this machine "
                f"({os.cpu_count()} cores); each worker is a process with its own copy of the model")
+
+
+def cache_bytes(name: str, mb) -> int:
+    """A cache size limit ``mb`` [MiB] as bytes: at least one byte, at most
+    :data:`MAX_CACHE_MB`, else ValueError naming ``name``."""
+    if not (isinstance(mb, (int, float)) and math.isfinite(mb) and mb > 0):
+        raise ValueError(f"{name} must be a positive finite number of MiB, got {mb!r}")
+    if mb > MAX_CACHE_MB:
+        raise ValueError(f"{name} {mb:g} MiB is above the limit {MAX_CACHE_MB:g} MiB (1 PiB, more than "
+                         "any disk): give a size in MiB, e.g. 4096")
+    size = int(mb * 2**20)
+    if size < 1:
+        raise ValueError(f"{name} {mb:g} MiB is less than one byte: give a size in MiB, e.g. 4096")
+    return size

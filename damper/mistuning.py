@@ -145,6 +145,10 @@ class Study:
                     and self.until_ci > 0):
                 raise ValueError(f"until-ci half-width must be finite and > 0, got {self.until_ci}"
                                  " (the amplification's 0.95 quantile to +- this, e.g. 0.01)")
+            if self.until_ci > limits.MAX_UNTIL_CI:
+                raise ValueError(f"until-ci half-width {self.until_ci:g} is above {limits.MAX_UNTIL_CI:g}: the "
+                                 "amplification lies between 1 and the Whitehead bound (a few), so a wider "
+                                 "interval says nothing of it; give e.g. 0.01")
         if self.factors is None:
             limits.check_size("samples", self.samples, 1, limits.MAX_MISTUNING_SAMPLES,
                               "each sample is a ring curve (~20 s CPU at 24 blades, H = 7)")
