@@ -114,6 +114,11 @@ MAX_CACHE_MB = float(2**30)
 #: lies between 1 and the Whitehead bound (1.5 at 4 blades, 2.9 at 24), so an interval wider
 #: than +-1 says nothing of it (1e300 was accepted and never reached with few samples).
 MAX_UNTIL_CI = 1.0
+#: Least centrifugal load of an underplatform damper per newton of EO force (friction
+#: damper): below, the damper carries almost no normal load, its contacts open over most of
+#: the period and the sector's Newton solve finds no start (UPD-24, f0 = 30 N: CF = 1e-3 N
+#: failed at 400 Hz, 0.03 N solved); a damper that light is the free limit.
+MIN_CF_PER_F0 = 1e-3
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 
@@ -202,3 +207,17 @@ def cache_bytes(name: str, mb) -> int:
     if size < 1:
         raise ValueError(f"{name} {mb:g} MiB is less than one byte: give a size in MiB, e.g. 4096")
     return size
+
+
+def check_cf_floor(name: str, cf, f0, config, hint: str = "or --damper free for a damper without load") -> None:
+    """A centrifugal load ``cf`` [N] at least :data:`MIN_CF_PER_F0` times the EO force
+    (``f0``, default the UPD model ``config``'s), else ValueError naming ``name``."""
+    if cf is None or not math.isfinite(cf) or cf <= 0:   # (refused by the value checks)
+        return
+    if f0 is None:
+        from harmonic_balance.bladed_disk.config import load_config
+
+        f0 = load_config(config).f0
+    if cf < MIN_CF_PER_F0 * f0:
+        raise ValueError(f"{name} {cf:g} N is below {MIN_CF_PER_F0:g} x the EO force ({f0:g} N): the damper "
+                         f"carries almost no load and the sector's solve finds no start; give a larger CF, {hint}")

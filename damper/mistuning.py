@@ -138,6 +138,9 @@ class Study:
                           "balance solve of the whole ring (~0.2 s at 24 blades, H = 7)")
         if self.blades is not None:
             limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
+        if self.damper == "nonlinear":
+            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or the free limit (damper free) "
+                                  "for a damper without load")
         if self.until_ci is not None:
             if self.factors is not None:
                 raise ValueError("--until-ci needs random samples (--std/--samples), not --factors")

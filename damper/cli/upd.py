@@ -141,8 +141,6 @@ def run_mistuning(args) -> int:
         draw.setdefault("samples", UNTIL_CI_SAMPLES)
     if args.factors is not None and draw:
         raise ValueError("give --factors or --std/--samples/--seed, not both")
-    if args.damper == "nonlinear" and args.cf is not None and args.cf > 0:
-        check_cf_floor("--cf", args.cf, args.f0, args.config)
     study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
                   **draw, kind=args.kind,
                   distribution=args.distribution, factors=args.factors, damper=args.damper,
@@ -317,13 +315,6 @@ def _contacts(p, surface: bool = False) -> None:
 
 #: Contact-zone nodes per side of each face with ``--contacts surface`` when not given.
 SURFACE_NODES = 5
-#: Least centrifugal load of the damper per newton of EO force: below, the damper carries
-#: almost no normal load, its contacts open over most of the period and the sector's Newton
-#: solve finds no start (UPD-24, f0 = 30 N: CF = 1e-3 N failed at 400 Hz, 0.03 N solved);
-#: a damper that light is the free limit.
-MIN_CF_PER_F0 = 1e-3
-
-
 def check_surface_nodes(args) -> None:
     """``--surface-nodes`` only with ``--contacts surface`` (refused otherwise); its default there."""
     if args.contacts != "surface":
@@ -333,20 +324,6 @@ def check_surface_nodes(args) -> None:
         return
     if args.surface_nodes is None:
         args.surface_nodes = SURFACE_NODES
-
-
-def check_cf_floor(name: str, cf, f0, config, hint: str = "or --damper free for a damper without load") -> None:
-    """A centrifugal load ``cf`` [N] at least :data:`MIN_CF_PER_F0` times the EO force
-    (``f0``, default the config's) with the friction damper, else ValueError."""
-    if cf is None:
-        return
-    if f0 is None:
-        from harmonic_balance.bladed_disk.config import load_config
-
-        f0 = load_config(config).f0
-    if cf < MIN_CF_PER_F0 * f0:
-        raise ValueError(f"{name} {cf:g} N is below {MIN_CF_PER_F0:g} x the EO force ({f0:g} N): the damper "
-                         f"carries almost no load and the sector's solve finds no start; give a larger CF, {hint}")
 
 
 def _sector(args):
@@ -398,7 +375,7 @@ def _check_frf(args) -> None:
 
     check_options(args)
     if args.damper == "nonlinear":
-        check_cf_floor("--cf", args.cf, args.f0, args.config)
+        limits.check_cf_floor("--cf", args.cf, args.f0, args.config)
 
 
 def run_frf(args) -> int:
@@ -540,7 +517,7 @@ def _check_optimize(args) -> None:
     limits.check_workers("--workers", args.workers)
     check_accuracy_option(args.accuracy)
     check_out_dir(args.plot, "--plot")
-    check_cf_floor("--cf-range", lo, None, args.config, "a damper without load is --damper free of upd frf")
+    limits.check_cf_floor("--cf-range", lo, None, args.config, "a damper without load is --damper free of upd frf")
 
 
 def run_optimize(args) -> int:
