@@ -551,13 +551,26 @@ def run_optimize(args) -> int:
     else:
         print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
               f"({out['method']}, H = {out['harmonics']}, {out['time_s']:.1f} s)")
-        band = out.get("optimum_band_cf")
-        if band:  # the minimum is flat: the CF range a design can use
-            print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
+        line = flat_band_line(out.get("optimum_band_cf"), args.cf_range)
+        if line:  # the minimum is flat: the CF range a design can use
+            print(line)
     for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def flat_band_line(band, cf_range) -> str | None:
+    """The printed CF interval of a peak within 1 % of the optimum; an end the load sweep
+    does not bracket (None) is named as beyond the swept range."""
+    if not band:
+        return None
+    if band[0] is None and band[1] is None:
+        return (f"peak within 1 % of the optimum over the whole CF range {cf_range[0]:.4g} ... "
+                f"{cf_range[1]:.4g} N (widen --cf-range to find where it rises)")
+    lo = f"below {cf_range[0]:.4g}" if band[0] is None else f"{band[0]:.4g}"
+    hi = f"above {cf_range[1]:.4g}" if band[1] is None else f"{band[1]:.4g}"
+    return f"peak within 1 % of the optimum for CF {lo} ... {hi} N"
 
 
 def _figure():
