@@ -257,6 +257,9 @@ def check_value(f: Field, value) -> str | None:
     if f.type.startswith("list["):
         if not isinstance(value, list):
             return f"must be a list of {scalar}, got {_kind(value)}"
+        if not value:  # every list key names something to do or a range: empty is nothing asked
+            noun = {"float": "number", "int": "integer", "str": "string"}.get(scalar, scalar)
+            return f"is empty: give at least one {noun}" + ("" if f.required else " (or leave the key out)")
         for i, v in enumerate(value):
             msg = _check_scalar(f, scalar, v)
             if msg:
@@ -327,7 +330,7 @@ def _field_schema(f: Field) -> dict:
         if bound is not None:
             out[key] = bound
     if f.type.startswith("list["):
-        out = {"type": "array", "items": out}
+        out = {"type": "array", "items": out, "minItems": 1}
     out["description"] = f.doc + (f" (bounded: {f.why})" if f.why else "")
     if f.default is not None:
         out["default"] = f.default

@@ -94,3 +94,17 @@ def test_flat_band_end_outside_the_sweep_is_named_as_beyond_the_range():
     assert "below 30 ... 200" in flat_band_line([None, 200.0], (30.0, 3000.0))
     assert "100 ... above 3000" in flat_band_line([100.0, None], (30.0, 3000.0))
     assert "whole CF range" in flat_band_line([None, None], (100.0, 100.001))
+
+
+@pytest.mark.parametrize("key, line", [("want", "want = []"), ("forces", "forces = []")])
+def test_scene_empty_list_is_refused_naming_the_key(key, line):
+    from damper.scene import schema
+
+    table = schema.TOP if key == "want" else schema.EXCITATION
+    assert "is empty" in schema.check_value(table[key], [])
+    assert schema.check_value(table[key], ["frf"] if key == "want" else [30.0]) is None
+
+
+def test_backbone_decreasing_amplitude_range_is_refused(capsys):
+    assert damper(["backbone", *SDOF, "--amplitude", "1e-3", "1e-300"]) == 2
+    assert "START < END" in _one_line(capsys.readouterr().err)
