@@ -416,9 +416,15 @@ def _cache_and_rest() -> list[InputCase]:
                               ("--plot a file", "study eccentric --quick --plot {fx}/a_file"),
                               ("unknown study", "study nosuch")])
     cases += _table("bench", [("--out a file", "bench --quick --stage element --out {fx}/a_file"),
-                              ("unknown stage", "bench --quick --stage nosuch")])
+                              ("unknown stage", "bench --quick --stage nosuch"),
+                              ("empty stage name", "bench --quick --stage ''"),
+                              # /proc: writable by its permission bits for root, yet no folder can be made
+                              ("--out in a folder that takes no writes", "bench --quick --stage element "
+                               "--out /proc/damper_bench")])
     cases += _table("stress", [("--out a file", "stress --quick --stage loop --out {fx}/a_file"),
-                               ("unknown stage", "stress --stage nosuch")])
+                               ("unknown stage", "stress --stage nosuch"),
+                               ("--out in a folder that takes no writes", "stress --quick --stage loop "
+                                "--out /proc/damper_stress")])
     return cases
 
 

@@ -108,3 +108,16 @@ def test_scene_empty_list_is_refused_naming_the_key(key, line):
 def test_backbone_decreasing_amplitude_range_is_refused(capsys):
     assert damper(["backbone", *SDOF, "--amplitude", "1e-3", "1e-300"]) == 2
     assert "START < END" in _one_line(capsys.readouterr().err)
+
+
+def test_output_folder_where_no_folder_can_be_made_is_refused_before_any_work(tmp_path, monkeypatch, capsys):
+    import tempfile
+
+    def read_only(*args, **kwargs):   # a read-only mount: the permission bits say yes, the write fails
+        raise OSError(30, "Read-only file system")
+
+    monkeypatch.setattr(tempfile, "mkdtemp", read_only)
+    assert damper(["bench", "--quick", "--stage", "element", "--out", str(tmp_path / "b"), "--json"]) == 2
+    out, err = capsys.readouterr()
+    assert "read-only" in _one_line(err) and json.loads(out)["exit_code"] == 2
+    assert list(tmp_path.iterdir()) == []
