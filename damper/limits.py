@@ -109,7 +109,7 @@ MAX_CONTACT_STRAIN = 0.1
 MAX_LOOP_SLIPS = 100.0
 #: Largest cache size limit [MiB] (``--cache-max-mb``, ``$DAMPER_CACHE_MAX_MB``): 2^30 MiB
 #: is 1 PiB, more than any disk the cache lives on (1e300 MiB printed a 300-digit limit).
-MAX_CACHE_MB = float(2**30)
+MAX_CACHE_MB = 2.0**30
 #: Largest ``--until-ci`` half-width of a mistuning study's 0.95 quantile: the amplification
 #: lies between 1 and the Whitehead bound (1.5 at 4 blades, 2.9 at 24), so an interval wider
 #: than +-1 says nothing of it (1e300 was accepted and never reached with few samples).
