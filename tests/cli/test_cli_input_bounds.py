@@ -121,3 +121,19 @@ def test_output_folder_where_no_folder_can_be_made_is_refused_before_any_work(tm
     out, err = capsys.readouterr()
     assert "read-only" in _one_line(err) and json.loads(out)["exit_code"] == 2
     assert list(tmp_path.iterdir()) == []
+
+
+def test_surface_nodes_default_applies_only_with_surface_contacts():
+    from argparse import Namespace
+
+    from damper.cli.upd import SURFACE_NODES, check_surface_nodes
+
+    with_surfaces = Namespace(contacts="surface", surface_nodes=None)
+    check_surface_nodes(with_surfaces)
+    assert with_surfaces.surface_nodes == SURFACE_NODES
+    given = Namespace(contacts="surface", surface_nodes=9)
+    check_surface_nodes(given)
+    assert given.surface_nodes == 9
+    without = Namespace(contacts="geometry", surface_nodes=None)
+    check_surface_nodes(without)
+    assert without.surface_nodes is None
