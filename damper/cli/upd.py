@@ -315,15 +315,15 @@ def _contacts(p, surface: bool = False) -> None:
 
 #: Contact-zone nodes per side of each face with ``--contacts surface`` when not given.
 SURFACE_NODES = 5
+
+
 def check_surface_nodes(args) -> None:
     """``--surface-nodes`` only with ``--contacts surface`` (refused otherwise); its default there."""
-    if args.contacts != "surface":
-        if args.surface_nodes is not None:
-            raise ValueError(f"--surface-nodes goes with --contacts surface (got --contacts {args.contacts}): "
-                             "add --contacts surface or drop --surface-nodes")
-        return
-    if args.surface_nodes is None:
-        args.surface_nodes = SURFACE_NODES
+    if args.contacts == "surface":
+        args.surface_nodes = SURFACE_NODES if args.surface_nodes is None else args.surface_nodes
+    elif args.surface_nodes is not None:
+        raise ValueError(f"--surface-nodes goes with --contacts surface (got --contacts {args.contacts}): "
+                         "add --contacts surface or drop --surface-nodes")
 
 
 def _sector(args):
