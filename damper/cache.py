@@ -96,9 +96,9 @@ def default_max_bytes() -> int:
         mb = float(text) if text else DEFAULT_MAX_MB
     except ValueError:
         raise ValueError(f"${ENV_MAX_MB} must be a number of MiB, got {text!r}") from None
-    if not 0 < mb < float("inf"):
-        raise ValueError(f"${ENV_MAX_MB} must be a positive finite number of MiB, got {text!r}")
-    return int(mb * 2**20)
+    from damper import limits
+
+    return limits.cache_bytes(f"${ENV_MAX_MB}", mb)
 
 
 class NotACacheError(ValueError):

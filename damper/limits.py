@@ -107,6 +107,18 @@ MAX_CONTACT_STRAIN = 0.1
 #: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
 #: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).
 MAX_LOOP_SLIPS = 100.0
+#: Largest cache size limit [MiB] (``--cache-max-mb``, ``$DAMPER_CACHE_MAX_MB``): 2^30 MiB
+#: is 1 PiB, more than any disk the cache lives on (1e300 MiB printed a 300-digit limit).
+MAX_CACHE_MB = 2.0**30
+#: Largest ``--until-ci`` half-width of a mistuning study's 0.95 quantile: the amplification
+#: lies between 1 and the Whitehead bound (1.5 at 4 blades, 2.9 at 24), so an interval wider
+#: than +-1 says nothing of it (1e300 was accepted and never reached with few samples).
+MAX_UNTIL_CI = 1.0
+#: Least centrifugal load of an underplatform damper per newton of EO force (friction
+#: damper): below, the damper carries almost no normal load, its contacts open over most of
+#: the period and the sector's Newton solve finds no start (UPD-24, f0 = 30 N: CF = 1e-3 N
+#: failed at 400 Hz, 0.03 N solved); a damper that light is the free limit.
+MIN_CF_PER_F0 = 1e-3
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 
@@ -181,3 +193,31 @@ def check_workers(name: str, n) -> None:
     """A worker count: 1 .. :func:`max_workers`."""
     check_size(name, n, 1, max_workers(), f"{WORKERS_PER_CORE} per core of this machine "
                f"({os.cpu_count()} cores); each worker is a process with its own copy of the model")
+
+
+def cache_bytes(name: str, mb) -> int:
+    """A cache size limit ``mb`` [MiB] as bytes: at least one byte, at most
+    :data:`MAX_CACHE_MB`, else ValueError naming ``name``."""
+    if not (isinstance(mb, (int, float)) and math.isfinite(mb) and mb > 0):
+        raise ValueError(f"{name} must be a positive finite number of MiB, got {mb!r}")
+    if mb > MAX_CACHE_MB:
+        raise ValueError(f"{name} {mb:g} MiB is above the limit {MAX_CACHE_MB:g} MiB (1 PiB, more than "
+                         "any disk): give a size in MiB, e.g. 4096")
+    size = int(mb * 2**20)
+    if size < 1:
+        raise ValueError(f"{name} {mb:g} MiB is less than one byte: give a size in MiB, e.g. 4096")
+    return size
+
+
+def check_cf_floor(name: str, cf, f0, config, hint: str = "or --damper free for a damper without load") -> None:
+    """A centrifugal load ``cf`` [N] at least :data:`MIN_CF_PER_F0` times the EO force
+    (``f0``, default the UPD model ``config``'s), else ValueError naming ``name``."""
+    if cf is None or not math.isfinite(cf) or cf <= 0:   # (refused by the value checks)
+        return
+    if f0 is None:
+        from harmonic_balance.bladed_disk.config import load_config
+
+        f0 = load_config(config).f0
+    if cf < MIN_CF_PER_F0 * f0:
+        raise ValueError(f"{name} {cf:g} N is below {MIN_CF_PER_F0:g} x the EO force ({f0:g} N): the damper "
+                         f"carries almost no load and the sector's solve finds no start; give a larger CF, {hint}")

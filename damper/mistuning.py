@@ -138,6 +138,9 @@ class Study:
                           "balance solve of the whole ring (~0.2 s at 24 blades, H = 7)")
         if self.blades is not None:
             limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
+        if self.damper == "nonlinear":
+            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or the free limit (damper free) "
+                                  "for a damper without load")
         if self.until_ci is not None:
             if self.factors is not None:
                 raise ValueError("--until-ci needs random samples (--std/--samples), not --factors")
@@ -145,6 +148,10 @@ class Study:
                     and self.until_ci > 0):
                 raise ValueError(f"until-ci half-width must be finite and > 0, got {self.until_ci}"
                                  " (the amplification's 0.95 quantile to +- this, e.g. 0.01)")
+            if self.until_ci > limits.MAX_UNTIL_CI:
+                raise ValueError(f"until-ci half-width {self.until_ci:g} is above {limits.MAX_UNTIL_CI:g}: the "
+                                 "amplification lies between 1 and the Whitehead bound (a few), so a wider "
+                                 "interval says nothing of it; give e.g. 0.01")
         if self.factors is None:
             limits.check_size("samples", self.samples, 1, limits.MAX_MISTUNING_SAMPLES,
                               "each sample is a ring curve (~20 s CPU at 24 blades, H = 7)")

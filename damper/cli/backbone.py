@@ -64,6 +64,12 @@ def run(args) -> int:
     a0, a1 = args.amplitude
     if not (math.isfinite(a0) and math.isfinite(a1) and a0 > 0 and a1 > 0 and a0 != a1):
         raise ValueError(f"--amplitude {a0:g} {a1:g}: give two different positive finite amplitudes")
+    if a0 > a1:
+        raise ValueError(f"--amplitude {a0:g} {a1:g}: give START < END (the curve starts at the stuck "
+                         "linear mode, at a small amplitude)")
+    if max(a0, a1) > limits.MAX_MAGNITUDE:
+        raise ValueError(f"--amplitude {a0:g} {a1:g}: above the limit {limits.MAX_MAGNITUDE:g} m sqrt(kg) (the "
+                         "harmonic balance squares displacements and forces, which overflows)")
     if args.mode < 0:
         raise ValueError(f"--mode must be >= 0 (0 is the first mode), got {args.mode}")
     check_out_file(args.out, "--out")

@@ -55,7 +55,7 @@ def run(args) -> int:
     names = args.stage or [n for n in funcs if n != "solvers" or args.solvers]
     bad = [n for n in names if n not in funcs]
     if bad:
-        raise ValueError(f"unknown stage(s) {', '.join(bad)}: use {', '.join(funcs)}")
+        raise ValueError(f"unknown stage(s) {', '.join(map(repr, bad))}: use {', '.join(funcs)}")
     from .common import check_out_dir
 
     check_out_dir(args.out, "--out")

@@ -24,15 +24,12 @@ def add_cache_options(p) -> None:
 
 def store_from_args(args):
     """The Store the options name."""
-    import math
-
+    from damper import limits
     from damper.cache import Store
 
     limit = getattr(args, "cache_max_mb", None)
-    if limit is not None and not (limit > 0 and math.isfinite(limit)):
-        raise ValueError(f"--cache-max-mb must be a positive finite number of MiB, got {limit:g}")
-    return Store(args.cache_dir, None if limit is None else int(limit * 2**20),
-                 memory=getattr(args, "no_cache", False))
+    size = None if limit is None else limits.cache_bytes("--cache-max-mb", limit)
+    return Store(args.cache_dir, size, memory=getattr(args, "no_cache", False))
 
 
 def register(subparsers) -> None:

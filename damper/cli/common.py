@@ -112,8 +112,23 @@ def _writable_parent(path: Path, flag: str) -> None:
         probe = probe.parent
     if not probe.is_dir():
         raise ValueError(f"{flag} {path}: {probe} is a file, not a folder")
-    if not os.access(probe, os.W_OK | os.X_OK):
-        raise ValueError(f"{flag} {path}: cannot write in {probe} (permission denied)")
+    if not _can_create_in(probe):
+        raise ValueError(f"{flag} {path}: cannot write in {probe} (permission denied or a read-only file system)")
+
+
+def _can_create_in(folder: Path) -> bool:
+    """Whether a folder can be created in ``folder`` (made and removed at once): the
+    permission bits alone say yes to root on /proc or a read-only mount, where the write
+    would fail only after the work."""
+    import tempfile
+
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return False
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".damper-write-check-", dir=folder))
+    except OSError:
+        return False
+    return True
 
 
 def check_out_file(path, flag: str) -> None:
@@ -134,8 +149,9 @@ def check_out_dir(path, flag: str) -> None:
     if path.exists() and not path.is_dir():
         raise ValueError(f"{flag} {path}: a file of that name exists; give a folder")
     if path.is_dir():
-        if not os.access(path, os.W_OK | os.X_OK):
-            raise ValueError(f"{flag} {path}: cannot write in this folder (permission denied)")
+        if not _can_create_in(path):
+            raise ValueError(f"{flag} {path}: cannot write in this folder (permission denied or a read-only "
+                             "file system)")
         return
     _writable_parent(path, flag)
 

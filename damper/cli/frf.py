@@ -232,6 +232,11 @@ def check_run_arguments(args) -> None:
     limits.check_omega_range("--omega", *args.omega)
     if args.max_step is not None and not (math.isfinite(args.max_step) and args.max_step > 0):
         raise ValueError(f"--max-step must be a positive finite number, got {args.max_step:g}")
+    if args.max_step is not None and args.max_step * args.max_points < 1.0:
+        # the frequency range alone is 1 in scaled arclength: at most max_step a point
+        raise ValueError(f"--max-step {args.max_step:g} needs more than --max-points {args.max_points} points "
+                         f"to cross the range (1 in scaled arclength): give --max-step >= "
+                         f"{1.0 / args.max_points:.3g} or more --max-points")
     if args.tolerance is not None and not 1e-6 <= args.tolerance < 1:
         raise ValueError(f"--tolerance must be in [1e-6, 1) (a relative curve accuracy; finer "
                          f"steps would resolve the corrector's own accuracy), got {args.tolerance:g}")

@@ -312,9 +312,22 @@ def _contacts(p, surface: bool = False) -> None:
                    + ("; surface: the damper's faces as contact surfaces of many 3D points on the "
                       "condensed FE bodies (damper.upd_surface; slower)" if surface else ""))
     if surface:
-        p.add_argument("--surface-nodes", type=int, default=5, metavar="N",
+        p.add_argument("--surface-nodes", type=int, metavar="N",
                        help="with --contacts surface: contact-zone nodes per side of each face "
-                       "(5 .. 41; default 5)")
+                       f"(5 .. 41; default {SURFACE_NODES})")
+
+
+#: Contact-zone nodes per side of each face with ``--contacts surface`` when not given.
+SURFACE_NODES = 5
+
+
+def check_surface_nodes(args) -> None:
+    """``--surface-nodes`` only with ``--contacts surface`` (refused otherwise); its default there."""
+    if args.contacts == "surface":
+        args.surface_nodes = SURFACE_NODES if args.surface_nodes is None else args.surface_nodes
+    elif args.surface_nodes is not None:
+        raise ValueError(f"--surface-nodes goes with --contacts surface (got --contacts {args.contacts}): "
+                         "add --contacts surface or drop --surface-nodes")
 
 
 def _sector(args):
@@ -361,9 +374,12 @@ def _check_frf(args) -> None:
             raise ValueError(f"--{name.replace('_', '-')} must be finite, > 0 and at most "
                              f"{limits.MAX_MAGNITUDE:g} N, got {v:g}")
     check_out_dir(args.plot, "--plot")
+    check_surface_nodes(args)
     from damper.upd_surface import check_options
 
     check_options(args)
+    if args.damper == "nonlinear":
+        limits.check_cf_floor("--cf", args.cf, args.f0, args.config)
 
 
 def run_frf(args) -> int:
@@ -512,6 +528,7 @@ def _check_optimize(args) -> None:
     limits.check_workers("--workers", args.workers)
     check_accuracy_option(args.accuracy)
     check_out_dir(args.plot, "--plot")
+    limits.check_cf_floor("--cf-range", lo, None, args.config, "a damper without load is --damper free of upd frf")
 
 
 def run_optimize(args) -> int:
@@ -545,13 +562,26 @@ def run_optimize(args) -> int:
     else:
         print(f"optimum CF {out['optimum_cf']:.4g} N, peak {out['optimum_peak_amplitude']:.5e} m "
               f"({out['method']}, H = {out['harmonics']}, {out['time_s']:.1f} s)")
-        band = out.get("optimum_band_cf")
-        if band:  # the minimum is flat: the CF range a design can use
-            print(f"peak within 1 % of the optimum for CF {band[0]:.4g} ... {band[1]:.4g} N")
+        line = flat_band_line(out.get("optimum_band_cf"), args.cf_range)
+        if line:  # the minimum is flat: the CF range a design can use
+            print(line)
     for line in _accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def flat_band_line(band, cf_range) -> str | None:
+    """The printed CF interval of a peak within 1 % of the optimum; an end the load sweep
+    does not bracket (None) is named as beyond the swept range."""
+    if not band:
+        return None
+    if band[0] is None and band[1] is None:
+        return (f"peak within 1 % of the optimum over the whole CF range {cf_range[0]:.4g} ... "
+                f"{cf_range[1]:.4g} N (widen --cf-range to find where it rises)")
+    lo = f"below {cf_range[0]:.4g}" if band[0] is None else f"{band[0]:.4g}"
+    hi = f"above {cf_range[1]:.4g}" if band[1] is None else f"{band[1]:.4g}"
+    return f"peak within 1 % of the optimum for CF {lo} ... {hi} N"
 
 
 def _figure():

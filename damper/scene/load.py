@@ -308,6 +308,18 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
         except (OSError, ValueError) as err:
             problems.append((("upd", "config"), f"cannot read {path}: {getattr(err, 'strerror', None) or err}"))
         u["config"] = str(path)
+    if len(lo_hi) == 2 and not any(p[0] == ("upd", "config") for p in problems):
+        from damper import limits
+        from harmonic_balance.bladed_disk.config import load_config
+
+        try:
+            f0 = load_config(u.get("config")).f0
+        except (OSError, ValueError):   # the model file's own check reports it
+            return
+        try:
+            limits.check_cf_floor("cf_range low", lo_hi[0], f0, None, "a damper without load is the free limit")
+        except ValueError as err:
+            problems.append((("upd", "cf_range"), str(err)))
 
 
 def _check_mistuning(data: dict, problems: list) -> None:

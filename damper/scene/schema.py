@@ -155,7 +155,8 @@ SWEEP = {
     "harmonics": Field("int", "harmonics 0..H retained", default=5, ge=1, le=limits.MAX_HARMONICS,
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "max_step": Field("float", "largest continuation step (scaled arclength; the curve tolerance "
-                      "sizes the steps below it)", default=0.5, gt=0),
+                      "sizes the steps below it; at least 1/2000, the curve's most points, as the "
+                      "range alone is 1 in scaled arclength)", default=0.5, ge=5e-4),
     "accuracy": Field("float", "relative accuracy of the peak amplitude: the harmonics are raised "
                       "from `harmonics` until the estimated truncation error is below it (unset: "
                       "the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
@@ -165,10 +166,13 @@ BACKBONE = {
     "element": Field("str", "contact: the [element] built from its contact's virgin curve (runs the "
                      "contact stages); jenkins: a Jenkins element (contact_stiffness, slip_force), no "
                      "contact stage", default="contact", choices=("contact", "jenkins")),
-    "contact_stiffness": Field("float", "jenkins: stick stiffness of the element [N/m]", gt=0),
-    "slip_force": Field("float", "jenkins: slip force of the element [N]", gt=0),
+    "contact_stiffness": Field("float", "jenkins: stick stiffness of the element [N/m]", gt=0,
+                               le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "slip_force": Field("float", "jenkins: slip force of the element [N]", gt=0, le=limits.MAX_MAGNITUDE,
+                        why=_MAG_WHY),
     "amplitude": Field("list[float]", "[start, end] mass-normalised modal amplitude [m sqrt(kg)]; "
-                       "start small (the start is the stuck linear mode)", required=True, gt=0),
+                       "start small (the start is the stuck linear mode)", required=True, gt=0,
+                       le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
     "harmonics": Field("int", "harmonics 0..H retained", default=3, ge=1, le=limits.MAX_HARMONICS,
                        why=limits.harmonics_why(limits.MAX_HARMONICS)),
     "mode": Field("int", "mode of the stuck linear system (0-based)", default=0, ge=0),
@@ -185,7 +189,7 @@ UPD = {
     "config": Field("str", "UPD model TOML (harmonic_balance.bladed_disk's format; relative to the "
                     "scene; default: the bundled UPD-24)"),
     "cf_range": Field("list[float]", "[low, high] centrifugal load CF of the damper [N], log-spaced",
-                      default=[30.0, 3000.0], gt=0),
+                      default=[30.0, 3000.0], gt=0, le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
     "points": Field("int", "number of CF values", default=20, ge=3, le=limits.MAX_LOAD_POINTS,
                     why="each CF value is a whole forced response (seconds)"),
     "harmonics": Field("int", "highest harmonic", default=7, ge=1, le=limits.MAX_UPD_HARMONICS,
@@ -253,6 +257,9 @@ def check_value(f: Field, value) -> str | None:
     if f.type.startswith("list["):
         if not isinstance(value, list):
             return f"must be a list of {scalar}, got {_kind(value)}"
+        if not value:  # every list key names something to do or a range: empty is nothing asked
+            noun = {"float": "number", "int": "integer", "str": "string"}.get(scalar, scalar)
+            return f"is empty: give at least one {noun}" + ("" if f.required else " (or leave the key out)")
         for i, v in enumerate(value):
             msg = _check_scalar(f, scalar, v)
             if msg:
@@ -323,7 +330,7 @@ def _field_schema(f: Field) -> dict:
         if bound is not None:
             out[key] = bound
     if f.type.startswith("list["):
-        out = {"type": "array", "items": out}
+        out = {"type": "array", "items": out, "minItems": 1}
     out["description"] = f.doc + (f" (bounded: {f.why})" if f.why else "")
     if f.default is not None:
         out["default"] = f.default

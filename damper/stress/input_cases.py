@@ -202,6 +202,7 @@ def _frf() -> list[InputCase]:
         ("samples -1", f"{SDOF} {o} --samples=-1"), ("samples 1e8", f"{SDOF} {o} --samples 100000000"),
         ("samples 3 at H 7 (aliasing)", f"{SDOF} {o} --harmonics 7 --samples 3"),
         ("max-step 0", f"{SDOF} {o} --max-step 0"), ("max-step nan", f"{SDOF} {o} --max-step nan"),
+        ("max-step 1e-300 (more points than --max-points)", f"{SDOF} {o} --max-step 1e-300"),
         ("max-points 1", f"{SDOF} {o} --max-points 1"), ("max-points 1e8", f"{SDOF} {o} --max-points 100000000"),
         ("mass 0", SDOF.replace("--mass 1", "--mass 0") + f" {o}"),
         ("mass nan", SDOF.replace("--mass 1", "--mass nan") + f" {o}"),
@@ -246,6 +247,8 @@ def _backbone() -> list[InputCase]:
         ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
         ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),
         ("npz complex K", "--model {fx}/m_complex.npz --elements {fx}/el_good.toml " + a),
+        ("amplitude 1e-3 1e300 (NaN in the element)", f"{SDOF} --amplitude 1e-3 1e300"),
+        ("amplitude 1e-3 1e-300 (decreasing)", f"{SDOF} --amplitude 1e-3 1e-300"),
     ], "backbone")
 
 
@@ -266,6 +269,10 @@ def _upd() -> list[InputCase]:
         ("frf surface nodes 1e6", "frf --contacts surface --surface-nodes 1000000"),
         ("frf surface with stuck limits", "frf --contacts surface --damper stuck"),
         ("frf surface with accuracy", "frf --contacts surface --accuracy 0.01"),
+        ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
+        ("frf cf 1e-3 (a damper without load)", "frf --cf 1e-3 --points 5"),
+        ("optimize cf-range 1e-3 10 (a damper without load)", "optimize --cf-range 1e-3 10 --points 3"),
+        ("mistuning cf 1e-3 (a damper without load)", "mistuning --cf 1e-3 --samples 1"),
         ("config missing", "modes --config {fx}/nowhere.toml"),
         ("config binary", "modes --config {fx}/upd_binary.toml"),
         ("config unknown key", "modes --config {fx}/upd_unknown.toml"),
@@ -296,6 +303,8 @@ def _upd() -> list[InputCase]:
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
         ("mistuning until-ci 0", "mistuning --until-ci 0"), ("mistuning until-ci nan", "mistuning --until-ci nan"),
         ("mistuning until-ci inf", "mistuning --until-ci inf"),
+        ("mistuning until-ci 1e300", "mistuning --until-ci 1e300"),
+        ("mistuning until-ci -1", "mistuning --until-ci=-1"),
         ("mistuning until-ci with factors", "mistuning --blades 4 --engine-order 1 --factors 1 1 1 1 --until-ci 0.01"),
         ("mistuning solver bogus", "mistuning --solver bogus"),
         ("mistuning worst max-evaluations 0", "mistuning --worst --std 0.02 --max-evaluations 0"),
@@ -347,7 +356,9 @@ def _run() -> list[InputCase]:
         "s_mnan.toml", "s_mtext.toml", "s_mneg.toml", "s_mmissing.toml", "s_dofsame.toml", "s_toml.toml",
         "s_empty.toml", "s_binary.toml", "s_bbmode.toml", "s_bbamp.toml", "s_updpoints.toml", "s_updharm.toml",
         "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
-        "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml")]
+        "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml",
+        "s_step.toml", "s_bbk.toml", "s_bbf.toml", "s_bbamphuge.toml", "s_updcflow.toml", "s_mtcflow.toml",
+        "s_mtci.toml", "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),
@@ -393,6 +404,8 @@ def _sweep() -> list[InputCase]:
 def _cache_and_rest() -> list[InputCase]:
     cases = _table("cache", [
         ("info --cache-max-mb -1", "cache info --cache-max-mb=-1"),
+        ("info --cache-max-mb 1e300", "cache info --cache-max-mb 1e300"),
+        ("info --cache-max-mb 1e-300", "cache info --cache-max-mb 1e-300 --json"),
         ("clear a file", "cache clear --cache-dir {fx}/a_file"),
         ("action bogus", "cache bogus"),
     ])
@@ -403,9 +416,15 @@ def _cache_and_rest() -> list[InputCase]:
                               ("--plot a file", "study eccentric --quick --plot {fx}/a_file"),
                               ("unknown study", "study nosuch")])
     cases += _table("bench", [("--out a file", "bench --quick --stage element --out {fx}/a_file"),
-                              ("unknown stage", "bench --quick --stage nosuch")])
+                              ("unknown stage", "bench --quick --stage nosuch"),
+                              ("empty stage name", "bench --quick --stage ''"),
+                              # /proc: writable by its permission bits for root, yet no folder can be made
+                              ("--out in a folder that takes no writes", "bench --quick --stage element "
+                               "--out /proc/damper_bench")])
     cases += _table("stress", [("--out a file", "stress --quick --stage loop --out {fx}/a_file"),
-                               ("unknown stage", "stress --stage nosuch")])
+                               ("unknown stage", "stress --stage nosuch"),
+                               ("--out in a folder that takes no writes", "stress --quick --stage loop "
+                                "--out /proc/damper_stress")])
     return cases
 
 

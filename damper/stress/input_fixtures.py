@@ -163,9 +163,19 @@ SCENE_EDITS = {
     "s_fbig.toml": ("forces = [30.0]", "forces = [1e300]"),
     "s_fmintiny.toml": ("f_min = 880.0", "f_min = 1e-300"),
     "s_type.toml": ("force = 120.0", 'force = "heavy"'),
+    "s_step.toml": ("harmonics = 3", "harmonics = 3\nmax_step = 1e-300"),
+    "s_dupkey.toml": ("grid = 7", "grid = 7\ngrid = 9"),
+    "s_wantempty.toml": ('want = ["virgin_curve", "k_t", "loop", "frf"]', "want = []"),
+    "s_fmiempty.toml": None,
+    "s_duptable.toml": ("[element]", '[contact.damper]\nbody = "sphere"\n\n[element]'),
     "s_dofs.toml": None, "s_mnan.toml": None, "s_mtext.toml": None, "s_mneg.toml": None,
     "s_mmissing.toml": None, "s_dofsame.toml": None,
 }
+
+
+def _jenkins_backbone(keys: str) -> str:
+    """A backbone scene of the 2-DOF blade with a Jenkins element of the given keys."""
+    return 'want = ["backbone"]\n[structure]\n' + _TWO_DOF + '[backbone]\nelement = "jenkins"\n' + keys
 
 
 def scenes() -> dict[str, str | bytes]:
@@ -192,6 +202,18 @@ def scenes() -> dict[str, str | bytes]:
                              "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-7, 1e-4]\n"
                              "accuracy = 0.5\n"),
             "s_updcfg.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "missing.toml"\n',
+            "s_fmiempty.toml": SMALL.replace('want = ["virgin_curve", "k_t", "loop", "frf"]', 'want = ["fmu"]')
+                                    .replace("fmi_versions = [2]", "fmi_versions = []"),
+            "s_updcflow.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [1e-3, 10.0]\npoints = 3\n',
+            "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',
+            "s_mtcflow.toml": 'want = ["mistuning"]\n[mistuning]\ncf = 1e-3\nsamples = 1\n',
+            "s_mtci.toml": 'want = ["mistuning"]\n[mistuning]\nuntil_ci = 1e300\n',
+            "s_bbk.toml": _jenkins_backbone("contact_stiffness = 1e300\nslip_force = 60.0\n"
+                                            "amplitude = [1e-7, 1e-4]\n"),
+            "s_bbf.toml": _jenkins_backbone("contact_stiffness = 3.85e7\nslip_force = 1e300\n"
+                                            "amplitude = [1e-7, 1e-4]\n"),
+            "s_bbamphuge.toml": _jenkins_backbone("contact_stiffness = 3.85e7\nslip_force = 60.0\n"
+                                                  "amplitude = [1e-7, 1e300]\n"),
             "s_updbad.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "upd_unknown.toml"\n',
             "s_nocontact.toml": 'want = ["virgin_curve"]\n',
             # the SIGINT and cache cases: a cold condensation that takes a few seconds (kn only)
