@@ -1,0 +1,143 @@
+"""A contact surface condensed onto its rigid inputs: the node problem solved in time.
+
+The surface's node DOFs w are massless (:mod:`.surface`), so for a given motion of the
+rigid inputs q(theta) their response is quasi-static: at every instant
+
+    A w + f_c(w) = A R q(theta)                                            (Q1)
+
+(A the bodies' node stiffness, R the rigid map, f_c the node contacts with their
+friction history), and the surface acts on the structure only through the
+resultants on q::
+
+    f_q(theta) = R^T A (R q - w)                                           (Q2)
+
+This element marches (Q1) over the period's AFT samples with the return-mapping solve
+of :class:`~.massless.MasslessContacts` (the time integration's own node solve) and
+gives the harmonics of (Q2), so the harmonic balance's unknowns are the structure's
+alone and no node's slip is truncated to H harmonics: the node response is exact at
+the samples for the given q (a nonlinear element in the sense of the dynamic
+Lagrangian frequency-time method's condensation onto the interface, Nacivet, Pierre,
+Thouverez & Jezequel, J. Sound Vib. 265, 2003; here with the node law solved by an
+incremental return mapping, Simo & Hughes 1998, instead of a Lagrangian
+prediction-correction). The harmonic balance's Newton then sees a residual in a few
+structure unknowns whose kinks are those of the surface's resultant, not those of
+every node's contact and slip.
+
+Periodic state: the march starts from the prestress (the frictionless statics' w,
+sliders virgin there, as the node ContactElements' ``slip_ref``), moves straight to
+q(0) and runs ``periods`` periods; the last one is the steady loop (a node that slips
+in every cycle has forgotten the start; one that never slips keeps where the first
+period left it, the C core's convention for a point contact).
+
+Jacobian: dF/dU by forward differences of the whole march, all columns advanced
+together as histories of one batched march (1 + n_b r histories).
+
+Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .forces import ForceElement, LocalForce
+from .fourier import FourierBasis
+from .massless import MasslessContacts
+
+#: Periods marched; the last is the loop. A node that first slips in period 2 or later
+#: (the amplitude grows through the march only at its start) would need more.
+PERIODS = 2
+#: Forward-difference step of the Jacobian relative to each input's amplitude. The
+#: march is piecewise linear in U away from a stick/slip or contact kink, and its
+#: node solve ends on an exact linear solve of the settled set (round-off ~1e-14 of
+#: the loads), so the difference quotient is exact to ~1e-14 / FD_REL.
+FD_REL = 1e-7
+
+
+class CondensedSurface(ForceElement):
+    """A surface as a force element on its r rigid inputs (module docstring).
+
+    Parameters
+    ----------
+    surface : harmonic_balance.surface.Surface
+        Planar (node contacts with one slip direction).
+    kinematics : Kinematics
+        Maps the model's DOFs to q (m = r local coordinates, the surface's ``inputs``).
+    w_static : ndarray (n_w,)
+        Node displacements of the prestress (frictionless statics) [m].
+    slip_ref : ndarray (n,)
+        Each node's static slip (its ContactElement's ``slip_ref``) [m].
+    damping : ndarray (r, r), optional
+        Dashpots on q [N s/m].
+    name : str
+    """
+
+    def __init__(self, surface, kinematics, w_static, slip_ref, damping=None, name: str = ""):
+        if surface.tangents != ("x",):
+            raise ValueError("a condensed surface must be planar (tangents ('x',))")
+        self.surface, self.kinematics, self.name = surface, kinematics, name
+        n_w = surface.n_w
+        self.A = surface.K[:n_w, :n_w]
+        self.AR = -surface.K[:n_w, n_w:]          # A R
+        self.RtA = self.AR.T
+        self.RtAR = surface.K[n_w:, n_w:]
+        self.w_static = np.asarray(w_static, float)
+        self.elements = []
+        for el, s0 in zip(surface.elements, slip_ref):
+            self.elements.append(type(el)(el.kinematics, el.k_n, el.friction, preload=el.preload,
+                                          slip_ref=float(s0), name=el.name))
+        self.C = None if damping is None else np.asarray(damping, float)
+
+    def stuck_stiffness(self) -> np.ndarray:
+        """Condensed stiffness (r, r) on q with every node closed and stuck [N/m]."""
+        nodes = MasslessContacts(self.elements, range(self.surface.n_w), 1)
+        Kc = nodes.stuck_stiffness()
+        return self.RtAR - self.RtA @ np.linalg.solve(self.A + Kc, self.AR)
+
+    def local_damping(self):
+        return self.C
+
+    def march(self, q: np.ndarray, periods: int = PERIODS):
+        """Resultants f_q (n_h, n_t, r) [N] and the last period's friction work (n_h,) [J] of
+        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring)."""
+        n_h, n_t, _ = q.shape
+        nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
+        A = nodes.split(self.A)
+        w = np.tile(self.w_static, (n_h, 1))
+        f = np.empty_like(q)
+        W0 = None
+        for p in range(periods):
+            if p == periods - 1:
+                W0 = nodes.dissipated()
+            for k in range(n_t):
+                w = nodes.solve(A, q[:, k] @ self.AR.T, w)
+                f[:, k] = q[:, k] @ self.RtAR.T - w @ self.RtA.T
+        return f, nodes.dissipated() - W0
+
+    def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
+        """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
+        docstring)."""
+        nb, r = basis.nb, self.m
+        U = np.asarray(U, float).reshape(nb, r)
+        cols = nb * r if jac else 0
+        Us = np.repeat(U[None], 1 + cols, axis=0)
+        h = FD_REL * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
+        for j in range(cols):
+            Us[1 + j].flat[j] += h[j % r]
+        q = np.einsum("tb,hbr->htr", basis.E, Us)
+        f, W = self.march(q)
+        Fs = np.einsum("bt,htr->hbr", basis.D, f)
+        F = Fs[0]
+        dF = None
+        if jac:
+            dF = ((Fs[1:] - F).reshape(cols, nb * r) / np.tile(h, nb)[:, None]).T
+        dw = None
+        if self.C is not None:
+            op = np.kron(basis.dtheta, self.C)
+            dw = op @ U.ravel()
+            F = F + omega * dw.reshape(nb, r)
+            if jac:
+                dF = dF + omega * op
+        Wv = 0.0
+        if self.C is not None:
+            from .forces import viscous_work
+            Wv = viscous_work(self.C, U, basis, omega)
+        return LocalForce(F, dF, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
