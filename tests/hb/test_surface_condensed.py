@@ -1,0 +1,74 @@
+"""The contact surface condensed onto its rigid inputs (``surface_condensed``).
+
+A small flat face (15 nodes, planar, penalty 1e4) under a constant approach and a
+tangential displacement cycle at its rigid input, marched by the element itself:
+the linear limit (every node stuck) against the condensed stuck stiffness computed by
+linear algebra, and the energy balance of a slipping loop (the resultant's work per
+cycle equals the nodes' friction work).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from contact_core.condense import condense
+from contact_core.spec import ContactSpec
+from harmonic_balance import surface as sf
+from harmonic_balance import surface_static as ss
+from harmonic_balance.fourier import FourierBasis
+from harmonic_balance.kinematics import Kinematics
+from harmonic_balance.surface_condensed import CondensedSurface
+
+N, MU, PENALTY = 100.0, 0.5, 1e4
+#: Samples of the period (the march is exact at the samples; the loop's work is summed
+#: over them as the element's friction work is, step by step).
+N_T = 64
+#: Linear limit: a stuck face is linear, so its first harmonic is K_stuck times the
+#: amplitude to the node solve's round-off (1e-7 of the loads at most, RESIDUAL_RTOL).
+LINEAR_RTOL = 1e-6
+#: Energy balance of the sampled loop: the resultant's work by the trapezoidal rule on
+#: N_T samples against the friction work of the return mapping on the same straight
+#: steps (equal for piecewise-linear paths up to the node solve's tolerance).
+ENERGY_RTOL = 2e-3
+
+
+@pytest.fixture(scope="module")
+def element(tmp_path_factory):
+    cc = condense(ContactSpec(body="flat", width=1.2e-3, length=1.2e-3, grid=5), directions=("z", "x"),
+                  cache=tmp_path_factory.mktemp("surface_condensed_cache"))
+    surface = sf.build(cc, MU, penalty=PENALTY, tangents=("x",))
+    state = ss.preload(surface, N)
+    x = state.x
+    slips = [x[surface.d * i] for i in range(surface.n)]
+    kin = Kinematics(list(range(len(surface.inputs))), np.eye(len(surface.inputs)))
+    return CondensedSurface(surface, kin, x[:surface.n_w], slips), x[surface.n_w:], surface
+
+
+def _loop(el, q_static, surface, amp):
+    basis = FourierBasis((0, 1), N_T)
+    U = np.zeros((basis.nb, el.m))
+    U[0] = q_static
+    U[basis.index(1)[0], surface.inputs.index("tangential_x")] = amp
+    return basis, U, el.evaluate(U, basis, 1.0, jac=False)
+
+
+def test_a_stuck_condensed_surface_is_its_condensed_stuck_stiffness(element):
+    el, q_static, surface = element
+    j = surface.inputs.index("tangential_x")
+    amp = 1e-4 * MU * N / el.stuck_stiffness()[j, j]    # far below any slip
+    basis, U, res = _loop(el, q_static, surface, amp)
+    F1 = res.F[basis.index(1)[0]]
+    assert F1 == pytest.approx(el.stuck_stiffness() @ U[basis.index(1)[0]], rel=LINEAR_RTOL,
+                               abs=LINEAR_RTOL * abs(F1[j]))
+    assert res.W < LINEAR_RTOL * MU * N * amp
+
+
+def test_a_slipping_condensed_surface_balances_its_energy_per_cycle(element):
+    el, q_static, surface = element
+    j = surface.inputs.index("tangential_x")
+    amp = 2.0 * MU * N / el.stuck_stiffness()[j, j]     # gross slip: the face slides
+    _, _, res = _loop(el, q_static, surface, amp)
+    q, f = np.vstack([res.q, res.q[:1]]), np.vstack([res.f, res.f[:1]])
+    work = float(np.sum(0.5 * (f[1:] + f[:-1]) * np.diff(q, axis=0)))
+    assert res.W > 0.5 * 4 * MU * N * amp * 0.5          # a wide loop: well into slip
+    assert work == pytest.approx(res.W, rel=ENERGY_RTOL)
