@@ -50,6 +50,12 @@ PERIODS = 2
 #: node solve ends on an exact linear solve of the settled set (round-off ~1e-14 of
 #: the loads), so the difference quotient is exact to ~1e-14 / FD_REL.
 FD_REL = 1e-7
+#: Load steps from the prestress to the first sample (the node solve's Newton settles a
+#: step within MAX_NEWTON iterations only for moderate changes of the contact set).
+RAMP = 8
+#: Halvings of a time step whose node solve does not settle (the load path is the
+#: same straight line, in shorter steps).
+MAX_SPLIT = 4
 
 
 class CondensedSurface(ForceElement):
@@ -61,6 +67,8 @@ class CondensedSurface(ForceElement):
         Planar (node contacts with one slip direction).
     kinematics : Kinematics
         Maps the model's DOFs to q (m = r local coordinates, the surface's ``inputs``).
+    q_static : ndarray (r,)
+        Rigid inputs of the prestress [m, rad].
     w_static : ndarray (n_w,)
         Node displacements of the prestress (frictionless statics) [m].
     slip_ref : ndarray (n,)
@@ -70,7 +78,8 @@ class CondensedSurface(ForceElement):
     name : str
     """
 
-    def __init__(self, surface, kinematics, w_static, slip_ref, damping=None, name: str = ""):
+    def __init__(self, surface, kinematics, q_static, w_static, slip_ref, damping=None,
+                 name: str = ""):
         if surface.tangents != ("x",):
             raise ValueError("a condensed surface must be planar (tangents ('x',))")
         self.surface, self.kinematics, self.name = surface, kinematics, name
@@ -80,6 +89,7 @@ class CondensedSurface(ForceElement):
         self.RtA = self.AR.T
         self.RtAR = surface.K[n_w:, n_w:]
         self.w_static = np.asarray(w_static, float)
+        self.q_static = np.asarray(q_static, float)
         self.elements = []
         for el, s0 in zip(surface.elements, slip_ref):
             self.elements.append(type(el)(el.kinematics, el.k_n, el.friction, preload=el.preload,
@@ -97,20 +107,43 @@ class CondensedSurface(ForceElement):
 
     def march(self, q: np.ndarray, periods: int = PERIODS):
         """Resultants f_q (n_h, n_t, r) [N] and the last period's friction work (n_h,) [J] of
-        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring)."""
+        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring).
+
+        Raises
+        ------
+        RuntimeError
+            The node solve found no equilibrium even in a step split MAX_SPLIT times.
+        """
         n_h, n_t, _ = q.shape
         nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
         A = nodes.split(self.A)
         w = np.tile(self.w_static, (n_h, 1))
         f = np.empty_like(q)
+        q_prev = np.tile(self.q_static, (n_h, 1))
+        for a in np.linspace(0.0, 1.0, RAMP + 1)[1:-1]:   # from the prestress towards q(0)
+            q_a = (1.0 - a) * q_prev + a * q[:, 0]
+            w = self._step(nodes, A, q_prev, q_a, w, 0)
+            q_prev = q_a
         W0 = None
         for p in range(periods):
             if p == periods - 1:
                 W0 = nodes.dissipated()
             for k in range(n_t):
-                w = nodes.solve(A, q[:, k] @ self.AR.T, w)
+                w = self._step(nodes, A, q_prev, q[:, k], w, 0)
+                q_prev = q[:, k]
                 f[:, k] = q[:, k] @ self.RtAR.T - w @ self.RtA.T
         return f, nodes.dissipated() - W0
+
+    def _step(self, nodes, A, q0, q1, w, depth):
+        """Equilibrium (Q1) at q1 from the committed state at q0; halves the step where the
+        node solve does not settle (it commits only a settled step)."""
+        try:
+            return nodes.solve(A, q1 @ self.AR.T, w)
+        except RuntimeError:
+            if depth >= MAX_SPLIT:
+                raise
+        w = self._step(nodes, A, q0, 0.5 * (q0 + q1), w, depth + 1)
+        return self._step(nodes, A, 0.5 * (q0 + q1), q1, w, depth + 1)
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
         """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
@@ -123,7 +156,12 @@ class CondensedSurface(ForceElement):
         for j in range(cols):
             Us[1 + j].flat[j] += h[j % r]
         q = np.einsum("tb,hbr->htr", basis.E, Us)
-        f, W = self.march(q)
+        try:
+            f, W = self.march(q)
+        except RuntimeError:
+            # no node equilibrium along this motion (e.g. a trial step far off): a
+            # non-finite force, which a line search rejects and a Newton start reports
+            f, W = np.full_like(q, np.nan), np.full(q.shape[0], np.nan)
         Fs = np.einsum("bt,htr->hbr", basis.D, f)
         F = Fs[0]
         dF = None

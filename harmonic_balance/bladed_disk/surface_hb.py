@@ -239,7 +239,10 @@ class CondensedSurfaceSectorHB(SectorHB):
                 Qn = Gn[:, used]
             kin = Kinematics(used, G[:, used], Q_next=Qn, phase=sec.cfg.phi if cyclic else 0.0)
             slips = [el.slip_ref for el in nodes[k:k + surf.n]]
-            cs = CondensedSurface(surf, kin, full.x_static[offset:offset + surf.n_w], slips, name=face)
+            xs = full.x_static[list(kin.dofs)]
+            q_static = (kin.Q + (kin.Q_next if cyclic else 0.0)) @ xs   # h = 0: the neighbour's is the sector's
+            cs = CondensedSurface(surf, kin, q_static, full.x_static[offset:offset + surf.n_w], slips,
+                                  name=face)
             if sec.beta_c:
                 cs.C = sec.beta_c * cs.stuck_stiffness()
             els.append(cs)
