@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .forces import ForceElement, LocalForce
+from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .massless import MasslessContacts
 
@@ -147,14 +147,25 @@ class CondensedSurface(ForceElement):
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
         """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
-        docstring)."""
+        docstring), marched when first read (a line search's rejected trial point, whose
+        Jacobian the residual asks for but never reads, costs one history)."""
         nb, r = basis.nb, self.m
         U = np.asarray(U, float).reshape(nb, r)
-        cols = nb * r if jac else 0
-        Us = np.repeat(U[None], 1 + cols, axis=0)
-        h = FD_REL * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
-        for j in range(cols):
-            Us[1 + j].flat[j] += h[j % r]
+        Fs, f, W, q = self._resultants(U[None], basis)
+        F, dw, Wv = Fs[0], None, 0.0
+        if self.C is not None:
+            op = np.kron(basis.dtheta, self.C)
+            dw = op @ U.ravel()
+            F = F + omega * dw.reshape(nb, r)
+            Wv = viscous_work(self.C, U, basis, omega)
+        out = _CondensedForce(F, None, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
+        if jac:
+            out.jacobian = lambda: self._jacobian(U, basis, omega)
+        return out
+
+    def _resultants(self, Us, basis):
+        """Harmonics (n_h, n_b, r) of the resultants of input harmonics Us (n_h, n_b, r), with
+        the samples f, the friction work W and the inputs' samples q."""
         q = np.einsum("tb,hbr->htr", basis.E, Us)
         try:
             f, W = self.march(q)
@@ -162,20 +173,31 @@ class CondensedSurface(ForceElement):
             # no node equilibrium along this motion (e.g. a trial step far off): a
             # non-finite force, which a line search rejects and a Newton start reports
             f, W = np.full_like(q, np.nan), np.full(q.shape[0], np.nan)
-        Fs = np.einsum("bt,htr->hbr", basis.D, f)
-        F = Fs[0]
-        dF = None
-        if jac:
-            dF = ((Fs[1:] - F).reshape(cols, nb * r) / np.tile(h, nb)[:, None]).T
-        dw = None
+        return np.einsum("bt,htr->hbr", basis.D, f), f, W, q
+
+    def _jacobian(self, U, basis, omega) -> np.ndarray:
+        """dF/dU (n_b r, n_b r): forward differences, the base and every column one batch."""
+        nb, r = basis.nb, self.m
+        cols = nb * r
+        Us = np.repeat(U[None], 1 + cols, axis=0)
+        h = FD_REL * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
+        for j in range(cols):
+            Us[1 + j].flat[j] += h[j % r]
+        Fs = self._resultants(Us, basis)[0]
+        dF = ((Fs[1:] - Fs[0]).reshape(cols, cols) / np.tile(h, nb)[:, None]).T
         if self.C is not None:
-            op = np.kron(basis.dtheta, self.C)
-            dw = op @ U.ravel()
-            F = F + omega * dw.reshape(nb, r)
-            if jac:
-                dF = dF + omega * op
-        Wv = 0.0
-        if self.C is not None:
-            from .forces import viscous_work
-            Wv = viscous_work(self.C, U, basis, omega)
-        return LocalForce(F, dF, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
+            dF = dF + omega * np.kron(basis.dtheta, self.C)
+        return dF
+
+
+class _CondensedForce(LocalForce):
+    """:class:`~.forces.LocalForce` whose ``dF`` is computed on first access (``jacobian``)."""
+
+    jacobian = None
+
+    def __getattribute__(self, name):
+        if name == "dF":
+            d = object.__getattribute__(self, "__dict__")
+            if d.get("dF") is None and d.get("jacobian") is not None:
+                d["dF"], d["jacobian"] = d["jacobian"](), None
+        return object.__getattribute__(self, name)
