@@ -115,3 +115,26 @@ def _quasi_static_energy(surface, T_a, steps=40) -> float:
         state = ss.step(surface, state, {}, state.loads | {"tangential_x": T})
         W.append(sum(f.W for f in state.friction))
     return W[-1] - W[steps - 1]
+
+
+#: Directional derivative of the resultants against the Jacobian's action: the march is
+#: piecewise linear in U, so a central difference (1e-6 of the amplitude) across no kink
+#: equals it up to round-off; measured 1.7e-6 (the transposed Jacobian: 1.1, the loop
+#: slips, so dF/dU is not symmetric).
+JACOBIAN_RTOL = 1e-4
+
+
+def test_condensed_jacobian_acts_as_the_directional_derivative(element):
+    """dF/dU (read lazily, coefficient-major c * r + j) against a central difference of F
+    along a random direction in every harmonic and input (seed written out)."""
+    el, q_static, surface = element
+    j = surface.inputs.index("tangential_x")
+    amp = 1.2 * MU * N / el.stuck_stiffness()[j, j]     # slipping loop: dF/dU not symmetric
+    basis, U, _ = _loop(el, q_static, surface, amp)
+    res = el.evaluate(U, basis, 1.0, jac=True)
+    v = np.random.default_rng(20261127).standard_normal(U.shape) * np.abs(U).max(axis=0)
+    eps = 1e-6
+    Fp = el.evaluate(U + eps * v, basis, 1.0, jac=False).F
+    Fm = el.evaluate(U - eps * v, basis, 1.0, jac=False).F
+    d = ((Fp - Fm) / (2 * eps)).ravel()
+    assert res.dF @ v.ravel() == pytest.approx(d, rel=JACOBIAN_RTOL, abs=JACOBIAN_RTOL * np.abs(d).max())
