@@ -28,12 +28,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contact import ContactElement, frictionless_statics
 from ..forces import LinearElement
 from ..kinematics import Kinematics
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
-from .hb import SectorHB, coupling_element, sector_basis
+from .hb import SectorHB, coupling_element, loads, sector_basis
 from .sector import Sector
 
 #: Face names and the sector points whose rows give their inputs.
@@ -200,13 +201,18 @@ class CondensedSurfaceSectorHB(SectorHB):
 
     def __init__(self, sector: Sector, surfaces: dict, H: int = 7, cf=None, f0=None, mu=None,
                  n_t: int = 0):
-        full = SurfaceSectorHB(sector, surfaces, 1, cf, f0, mu, n_t)
-        self.surfaces, self._full = surfaces, full
-        self.sector, self.H = sector, int(H)
-        self.cf, self.f0, self.mu = full.cf, full.f0, full.mu
+        for face in FACES:
+            if surfaces[face].tangents != ("x",):
+                raise ValueError(f"the {face} surface must be planar (tangents ('x',))")
+        self.surfaces, self.sector, self.H = surfaces, sector, int(H)
+        self.cf, self.f0, self.mu = loads(sector.cfg, cf, f0, mu)
+        # the node-DOF model's frictionless statics (no residual built: only its elements)
+        nodes_model = SurfaceSectorHB._build_model(self)
+        self._x_nodes, _ = frictionless_statics(nodes_model, apply=True)
+        self._nodes = [e for e in nodes_model.elements if isinstance(e, ContactElement)]
         self.basis = sector_basis(sector, self.H, n_t)
         self.model = self._build_model()
-        self.x_static = full.x_static[:sector.n_dof].copy()
+        self.x_static = self._x_nodes[:sector.n_dof].copy()
         self.contacts = []
         self.residual = FullResidual(self.model, self.basis)
         self.nb, self.ndof = self.basis.nb, self.model.n
@@ -221,11 +227,10 @@ class CondensedSurfaceSectorHB(SectorHB):
     def _build_model(self) -> Model:
         from ..surface_condensed import CondensedSurface
 
-        sec, full = self.sector, self._full
+        sec, x_nodes, nodes = self.sector, self._x_nodes, self._nodes
         n = sec.n_dof
         els = [e for e in (coupling_element(sec),) if e is not None]
         offset, k = n, 0
-        nodes = full.points
         for face, surf in self.surfaces.items():
             G, G_next = face_inputs(sec, face)
             used = np.flatnonzero(np.any(G != 0.0, axis=0))
@@ -239,9 +244,9 @@ class CondensedSurfaceSectorHB(SectorHB):
                 Qn = Gn[:, used]
             kin = Kinematics(used, G[:, used], Q_next=Qn, phase=sec.cfg.phi if cyclic else 0.0)
             slips = [el.slip_ref for el in nodes[k:k + surf.n]]
-            xs = full.x_static[list(kin.dofs)]
+            xs = x_nodes[list(kin.dofs)]
             q_static = (kin.Q + (kin.Q_next if cyclic else 0.0)) @ xs   # h = 0: the neighbour's is the sector's
-            cs = CondensedSurface(surf, kin, q_static, full.x_static[offset:offset + surf.n_w], slips,
+            cs = CondensedSurface(surf, kin, q_static, x_nodes[offset:offset + surf.n_w], slips,
                                   name=face)
             if sec.beta_c:
                 cs.C = sec.beta_c * cs.stuck_stiffness()
