@@ -28,11 +28,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..contact import ContactElement, frictionless_statics
 from ..forces import LinearElement
 from ..kinematics import Kinematics
 from ..linear import LinearModel
 from ..model import Model
-from .hb import SectorHB, coupling_element
+from ..residual import FullResidual
+from .hb import SectorHB, coupling_element, loads, sector_basis
 from .sector import Sector
 
 #: Face names and the sector points whose rows give their inputs.
@@ -182,3 +184,76 @@ class SurfaceSectorHB(SectorHB):
         f = np.zeros(self.ndof, dtype=complex)
         f[self.sector.forced] = self.f0
         return f
+
+
+class CondensedSurfaceSectorHB(SectorHB):
+    """The sector with each surface condensed onto its rigid inputs
+    (:class:`~harmonic_balance.surface_condensed.CondensedSurface`): the unknowns are the
+    sector's DOFs alone, the nodes' response is marched in time inside each evaluation.
+
+    The prestress (the nodes' frictionless statics and slips) is that of
+    :class:`SurfaceSectorHB` on the same surfaces. The bodies' dashpots act on the rigid
+    inputs as beta_c times the surface's condensed stuck stiffness (the point model's
+    beta_c k of its stuck contact).
+
+    Parameters as :class:`SurfaceSectorHB`.
+    """
+
+    def __init__(self, sector: Sector, surfaces: dict, H: int = 7, cf=None, f0=None, mu=None,
+                 n_t: int = 0):
+        for face in FACES:
+            if surfaces[face].tangents != ("x",):
+                raise ValueError(f"the {face} surface must be planar (tangents ('x',))")
+        self.surfaces, self.sector, self.H = surfaces, sector, int(H)
+        self.cf, self.f0, self.mu = loads(sector.cfg, cf, f0, mu)
+        # the node-DOF model's frictionless statics (no residual built: only its elements)
+        nodes_model = SurfaceSectorHB._build_model(self)
+        self._x_nodes, _ = frictionless_statics(nodes_model, apply=True)
+        self._nodes = [e for e in nodes_model.elements if isinstance(e, ContactElement)]
+        self.basis = sector_basis(sector, self.H, n_t)
+        self.model = self._build_model()
+        self.x_static = self._x_nodes[:sector.n_dof].copy()
+        self.contacts = []
+        self.residual = FullResidual(self.model, self.basis)
+        self.nb, self.ndof = self.basis.nb, self.model.n
+        self.size = self.residual.size
+        self.evaluations = 0
+
+    def with_harmonics(self, H: int, n_t: int = 0) -> CondensedSurfaceSectorHB:
+        """The same sector, surfaces and loads with harmonics 0..H (``n_t`` AFT samples)."""
+        return CondensedSurfaceSectorHB(self.sector, self.surfaces, H, cf=self.cf, f0=self.f0,
+                                        mu=self.mu, n_t=n_t)
+
+    def _build_model(self) -> Model:
+        from ..surface_condensed import CondensedSurface
+
+        sec, x_nodes, nodes = self.sector, self._x_nodes, self._nodes
+        n = sec.n_dof
+        els = [e for e in (coupling_element(sec),) if e is not None]
+        offset, k = n, 0
+        for face, surf in self.surfaces.items():
+            G, G_next = face_inputs(sec, face)
+            used = np.flatnonzero(np.any(G != 0.0, axis=0))
+            cyclic = bool(np.any(G_next != 0.0))
+            Qn = None
+            if cyclic:
+                right = list(sec.blade.right)
+                used = np.union1d(used, right)
+                Gn = np.zeros_like(G)
+                Gn[:, right] = G_next
+                Qn = Gn[:, used]
+            kin = Kinematics(used, G[:, used], Q_next=Qn, phase=sec.cfg.phi if cyclic else 0.0)
+            slips = [el.slip_ref for el in nodes[k:k + surf.n]]
+            xs = x_nodes[list(kin.dofs)]
+            q_static = (kin.Q + (kin.Q_next if cyclic else 0.0)) @ xs   # h = 0: the neighbour's is the sector's
+            cs = CondensedSurface(surf, kin, q_static, x_nodes[offset:offset + surf.n_w], slips,
+                                  name=face)
+            if sec.beta_c:
+                cs.C = sec.beta_c * cs.stuck_stiffness()
+            els.append(cs)
+            offset += surf.n_w
+            k += surf.n
+        f_static, f_eo = np.zeros(n), np.zeros(n, dtype=complex)
+        f_static[sec.y_d], f_eo[sec.forced] = self.cf, self.f0
+        lin = LinearModel(M=sec.M, C=sec.C_struct(0.0), K=sec.K_struct(0.0))
+        return Model(lin, els, {0: f_static, 1: f_eo}, sec.response)

@@ -89,3 +89,44 @@ def test_bad_surface_options_are_one_line_refusals(tmp_path, capsys, monkeypatch
     assert code == 2 and no_result(captured.out, captured.err, 2)
     assert words in captured.err and "Traceback" not in captured.err
     assert len(captured.err.strip().splitlines()) == 1
+
+
+#: The node-DOF and the condensed sector at one frequency (5 nodes per side, penalty 100,
+#: H 3, CF 300 N, 440 Hz): they differ by the truncation of each node's slip to H
+#: harmonics (node-DOF only), the march's 48 samples and the bodies' dashpots (on [w; q]
+#: against the condensed stuck stiffness on q; beta_c omega ~ 3e-3). Measured 1.3e-5.
+CONDENSED_RTOL = 1e-3
+#: Energy balance of the Galerkin solution (exact up to Newton's tolerance, TOL_REL of CF).
+ENERGY_IMBALANCE = 1e-6
+#: The surfaces' harmonic work (their resultants' first H harmonics against the inputs')
+#: against the march's friction work (the loops at 48 samples): quadrature and the
+#: resultants' harmonics above H.
+MARCH_WORK_RTOL = 0.05
+
+
+@pytest.mark.slow
+def test_condensed_surface_sector_agrees_with_the_node_dof_sector(surfaces):
+    """Newton on each formulation from its stuck start: the same first-harmonic amplitude."""
+    from harmonic_balance.bladed_disk.solve import energy_balance, solve_point
+    from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
+    from harmonic_balance.forces import harmonic_work
+
+    sector, omega = Sector(load_config(None)), 2 * np.pi * 440.0
+    full = SurfaceSectorHB(sector, surfaces, H=3, cf=300.0)
+    cond = CondensedSurfaceSectorHB(sector, surfaces, H=3, cf=300.0, n_t=48)
+    x_full = solve_point(full, omega, full.stuck_guess(omega), max_iter=80)
+    x_cond = solve_point(cond, omega, cond.stuck_guess(omega), max_iter=40)
+    assert cond.amplitude_h1(x_cond) == pytest.approx(full.amplitude_h1(x_full), rel=CONDENSED_RTOL)
+    # energy: the excitation's work is the structure's and the surfaces' (Galerkin, exact at
+    # the solution), and the surfaces' harmonic work is their marched friction work
+    e = energy_balance(cond, x_cond, omega)
+    assert abs(e["imbalance"]) < ENERGY_IMBALANCE
+    res = cond.residual
+    lfs = res.evaluate(x_cond, omega, jac=False)
+    W_harm = W_march = 0.0
+    for el, lf in zip(res.elements, lfs):
+        if hasattr(el, "march"):
+            U = (el.kinematics.operators(cond.basis, res.dofs)[0] @ x_cond).reshape(cond.nb, el.m)
+            W_harm += harmonic_work(U, lf.F, cond.basis)
+            W_march += lf.W
+    assert W_march > 0.0 and W_harm == pytest.approx(W_march, rel=MARCH_WORK_RTOL)

@@ -1,0 +1,209 @@
+"""A contact surface condensed onto its rigid inputs: the node problem solved in time.
+
+The surface's node DOFs w are massless (:mod:`.surface`), so for a given motion of the
+rigid inputs q(theta) their response is quasi-static: at every instant
+
+    A w + f_c(w) = A R q(theta)                                            (Q1)
+
+(A the bodies' node stiffness, R the rigid map, f_c the node contacts with their
+friction history), and the surface acts on the structure only through the
+resultants on q::
+
+    f_q(theta) = R^T A (R q - w)                                           (Q2)
+
+This element marches (Q1) over the period's AFT samples with the return-mapping solve
+of :class:`~.massless.MasslessContacts` (the time integration's own node solve) and
+gives the harmonics of (Q2), so the harmonic balance's unknowns are the structure's
+alone and no node's slip is truncated to H harmonics: the node response is exact at
+the samples for the given q (a nonlinear element in the sense of the dynamic
+Lagrangian frequency-time method's condensation onto the interface, Nacivet, Pierre,
+Thouverez & Jezequel, J. Sound Vib. 265, 2003; here with the node law solved by an
+incremental return mapping, Simo & Hughes 1998, instead of a Lagrangian
+prediction-correction). The harmonic balance's Newton then sees a residual in a few
+structure unknowns whose kinks are those of the surface's resultant, not those of
+every node's contact and slip.
+
+Periodic state: the march starts from the prestress (the frictionless statics' w,
+sliders virgin there, as the node ContactElements' ``slip_ref``), moves straight to
+q(0) and runs ``periods`` periods; the last one is the steady loop (a node that slips
+in every cycle has forgotten the start; one that never slips keeps where the first
+period left it, the C core's convention for a point contact).
+
+Jacobian: dF/dU by forward differences of the whole march, all columns advanced
+together as histories of one batched march (1 + n_b r histories), marched only when
+the Jacobian is first read (the residual's ``value`` asks for it at a line search's
+trial points and reads it only at the accepted one).
+
+Cost: every node over ``PERIODS`` periods per history; UPD-24 with 5 nodes per side
+(63 and 40 nodes), 48 samples: 2.4 s per evaluation with its Jacobian at H 3, 4.8 s
+at H 7 (docs/method/contact_surface.md).
+
+Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .forces import ForceElement, LocalForce, viscous_work
+from .fourier import FourierBasis
+from .massless import MasslessContacts
+
+#: Periods marched; the last is the loop. A node that first slips in period 2 or later
+#: (the amplitude grows through the march only at its start) would need more.
+PERIODS = 2
+#: Forward-difference step of the Jacobian relative to each input's amplitude. The
+#: march is piecewise linear in U away from a stick/slip or contact kink, and its
+#: node solve ends on an exact linear solve of the settled set (round-off ~1e-14 of
+#: the loads), so the difference quotient is exact to ~1e-14 / FD_REL.
+FD_REL = 1e-7
+#: Load steps from the prestress to the first sample (the node solve's Newton settles a
+#: step within MAX_NEWTON iterations only for moderate changes of the contact set).
+RAMP = 8
+#: Halvings of a time step whose node solve does not settle (the load path is the
+#: same straight line, in shorter steps).
+MAX_SPLIT = 4
+
+
+class CondensedSurface(ForceElement):
+    """A surface as a force element on its r rigid inputs (module docstring).
+
+    Parameters
+    ----------
+    surface : harmonic_balance.surface.Surface
+        Planar (node contacts with one slip direction).
+    kinematics : Kinematics
+        Maps the model's DOFs to q (m = r local coordinates, the surface's ``inputs``).
+    q_static : ndarray (r,)
+        Rigid inputs of the prestress [m, rad].
+    w_static : ndarray (n_w,)
+        Node displacements of the prestress (frictionless statics) [m].
+    slip_ref : ndarray (n,)
+        Each node's static slip (its ContactElement's ``slip_ref``) [m].
+    damping : ndarray (r, r), optional
+        Dashpots on q [N s/m].
+    name : str
+    """
+
+    def __init__(self, surface, kinematics, q_static, w_static, slip_ref, damping=None,
+                 name: str = ""):
+        if surface.tangents != ("x",):
+            raise ValueError("a condensed surface must be planar (tangents ('x',))")
+        self.surface, self.kinematics, self.name = surface, kinematics, name
+        n_w = surface.n_w
+        self.A = surface.K[:n_w, :n_w]
+        self.AR = -surface.K[:n_w, n_w:]          # A R
+        self.RtA = self.AR.T
+        self.RtAR = surface.K[n_w:, n_w:]
+        self.w_static = np.asarray(w_static, float)
+        self.q_static = np.asarray(q_static, float)
+        self.elements = []
+        for el, s0 in zip(surface.elements, slip_ref):
+            self.elements.append(type(el)(el.kinematics, el.k_n, el.friction, preload=el.preload,
+                                          slip_ref=float(s0), name=el.name))
+        self.C = None if damping is None else np.asarray(damping, float)
+
+    def stuck_stiffness(self) -> np.ndarray:
+        """Condensed stiffness (r, r) on q with every node closed and stuck [N/m]."""
+        nodes = MasslessContacts(self.elements, range(self.surface.n_w), 1)
+        Kc = nodes.stuck_stiffness()
+        return self.RtAR - self.RtA @ np.linalg.solve(self.A + Kc, self.AR)
+
+    def local_damping(self):
+        return self.C
+
+    def march(self, q: np.ndarray, periods: int = PERIODS):
+        """Resultants f_q (n_h, n_t, r) [N] and the last period's friction work (n_h,) [J] of
+        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring).
+
+        Raises
+        ------
+        RuntimeError
+            The node solve found no equilibrium even in a step split MAX_SPLIT times.
+        """
+        n_h, n_t, _ = q.shape
+        nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
+        A = nodes.split(self.A)
+        w = np.tile(self.w_static, (n_h, 1))
+        f = np.empty_like(q)
+        q_prev = np.tile(self.q_static, (n_h, 1))
+        for a in np.linspace(0.0, 1.0, RAMP + 1)[1:-1]:   # from the prestress towards q(0)
+            q_a = (1.0 - a) * q_prev + a * q[:, 0]
+            w = self._step(nodes, A, q_prev, q_a, w, 0)
+            q_prev = q_a
+        W0 = None
+        for p in range(periods):
+            if p == periods - 1:
+                W0 = nodes.dissipated()
+            for k in range(n_t):
+                w = self._step(nodes, A, q_prev, q[:, k], w, 0)
+                q_prev = q[:, k]
+                f[:, k] = q[:, k] @ self.RtAR.T - w @ self.RtA.T
+        return f, nodes.dissipated() - W0
+
+    def _step(self, nodes, A, q0, q1, w, depth):
+        """Equilibrium (Q1) at q1 from the committed state at q0; halves the step where the
+        node solve does not settle (it commits only a settled step)."""
+        try:
+            return nodes.solve(A, q1 @ self.AR.T, w)
+        except RuntimeError:
+            if depth >= MAX_SPLIT:
+                raise
+        w = self._step(nodes, A, q0, 0.5 * (q0 + q1), w, depth + 1)
+        return self._step(nodes, A, 0.5 * (q0 + q1), q1, w, depth + 1)
+
+    def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
+        """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
+        docstring), marched when first read (a line search's rejected trial point, whose
+        Jacobian the residual asks for but never reads, costs one history)."""
+        nb, r = basis.nb, self.m
+        U = np.asarray(U, float).reshape(nb, r)
+        Fs, f, W, q = self._resultants(U[None], basis)
+        F, dw, Wv = Fs[0], None, 0.0
+        if self.C is not None:
+            op = np.kron(basis.dtheta, self.C)
+            dw = op @ U.ravel()
+            F = F + omega * dw.reshape(nb, r)
+            Wv = viscous_work(self.C, U, basis, omega)
+        out = _CondensedForce(F, None, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
+        if jac:
+            out.jacobian = lambda: self._jacobian(U, basis, omega)
+        return out
+
+    def _resultants(self, Us, basis):
+        """Harmonics (n_h, n_b, r) of the resultants of input harmonics Us (n_h, n_b, r), with
+        the samples f, the friction work W and the inputs' samples q."""
+        q = np.einsum("tb,hbr->htr", basis.E, Us)
+        try:
+            f, W = self.march(q)
+        except RuntimeError:
+            # no node equilibrium along this motion (e.g. a trial step far off): a
+            # non-finite force, which a line search rejects and a Newton start reports
+            f, W = np.full_like(q, np.nan), np.full(q.shape[0], np.nan)
+        return np.einsum("bt,htr->hbr", basis.D, f), f, W, q
+
+    def _jacobian(self, U, basis, omega) -> np.ndarray:
+        """dF/dU (n_b r, n_b r): forward differences, the base and every column one batch."""
+        nb, r = basis.nb, self.m
+        cols = nb * r
+        Us = np.repeat(U[None], 1 + cols, axis=0)
+        h = FD_REL * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
+        for j in range(cols):
+            Us[1 + j].flat[j] += h[j % r]
+        Fs = self._resultants(Us, basis)[0]
+        dF = ((Fs[1:] - Fs[0]).reshape(cols, cols) / np.tile(h, nb)[:, None]).T
+        if self.C is not None:
+            dF = dF + omega * np.kron(basis.dtheta, self.C)
+        return dF
+
+
+class _CondensedForce(LocalForce):
+    """:class:`~.forces.LocalForce` whose ``dF`` is computed on first access (``jacobian``)."""
+
+    jacobian = None
+
+    def __getattribute__(self, name):
+        if name == "dF":
+            d = object.__getattribute__(self, "__dict__")
+            if d.get("dF") is None and d.get("jacobian") is not None:
+                d["dF"], d["jacobian"] = d["jacobian"](), None
+        return object.__getattribute__(self, name)
