@@ -142,7 +142,7 @@ def test_generated_pages_name_their_revision_and_command():
 
 
 #: {py:mod}`name`, {py:func}`name`, ... in the Markdown pages.
-ROLE = re.compile(r"\{py:(mod|func|class|meth|attr|data)\}`([^`]+)`")
+ROLE = re.compile(r"\{py:(mod|func|class|meth|attr|data)\}`~?([^`]+)`")  # ~: last part shown
 
 
 def _resolve(target: str):
