@@ -298,3 +298,20 @@ def stuck_stiffness(surface, state: SurfaceState, direction: str = "x") -> float
     Kd[np.arange(n)[on], np.arange(n)[on]] += np.array([el.k_t for el in surface.elements])[on]
     Kww, kwu, kuu = Kd[:n, :n], Kd[:n, n], Kd[n, n]
     return float(kuu - kwu @ sla.solve(Kww, kwu, assume_a="sym"))
+
+
+def cyclic_friction_work(surface, normal: float, amplitude: float, steps: int = 40) -> float:
+    """Friction work [J] of one cycle of a force-controlled quasi-static loop.
+
+    Preload ``normal`` [N], then the tangential force ramps 0 -> T_a, T_a -> -T_a,
+    -T_a -> T_a in ``steps`` increments per leg (T_a = ``amplitude`` [N]); the work of
+    the last two legs (the closed cycle, after the virgin loading) is returned.
+    """
+    state = preload(surface, normal)
+    leg = np.linspace(0.0, 1.0, steps + 1)[1:]
+    W = []
+    for T in np.concatenate([amplitude * leg, amplitude - 2 * amplitude * leg,
+                             -amplitude + 2 * amplitude * leg]):
+        state = step(surface, state, {}, state.loads | {"tangential_x": T})
+        W.append(sum(f.W for f in state.friction))
+    return W[-1] - W[steps - 1]

@@ -102,19 +102,8 @@ def test_condensed_surface_hb_dissipates_the_quasi_static_loop_at_low_H(element)
     x0[0], x0[basis.index(1)[0]] = q_static, np.linalg.solve(el.stuck_stiffness(), f1.real)
     sol = newton(lambda z: res(z, 1.0, True)[:2], x0.ravel(), HB_TOL_REL * N, 40)
     W = sum(e.W for e in res.evaluate(sol.x, 1.0, jac=False))
-    W_qs = _quasi_static_energy(surface, T_a)
+    W_qs = ss.cyclic_friction_work(surface, N, T_a)
     assert W == pytest.approx(W_qs, rel=QS_ENERGY_RTOL_H7)
-
-
-def _quasi_static_energy(surface, T_a, steps=40) -> float:
-    """Friction work of the last cycle of the force-controlled quasi-static loop (surface_static)."""
-    state = ss.preload(surface, N)
-    leg = np.linspace(0.0, 1.0, steps + 1)[1:]
-    W = []
-    for T in np.concatenate([T_a * leg, T_a - 2 * T_a * leg, -T_a + 2 * T_a * leg]):
-        state = ss.step(surface, state, {}, state.loads | {"tangential_x": T})
-        W.append(sum(f.W for f in state.friction))
-    return W[-1] - W[steps - 1]
 
 
 #: Directional derivative of the resultants against the Jacobian's action: the march is

@@ -38,14 +38,7 @@ def surface(tmp_path_factory):
 
 
 def quasi_static_energy(surface) -> float:
-    T_a = SHARE * MU * N
-    state = ss.preload(surface, N)
-    leg = np.linspace(0.0, 1.0, STEPS + 1)[1:]
-    W = []
-    for T in np.concatenate([T_a * leg, T_a - 2 * T_a * leg, -T_a + 2 * T_a * leg]):
-        state = ss.step(surface, state, {}, state.loads | {"tangential_x": T})
-        W.append(sum(f.W for f in state.friction))
-    return W[-1] - W[STEPS - 1]
+    return ss.cyclic_friction_work(surface, N, SHARE * MU * N, STEPS)
 
 
 def hb_energy(surface, H: int) -> tuple[float, float]:
