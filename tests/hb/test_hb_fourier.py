@@ -39,6 +39,18 @@ def test_peak_abs_is_exact_not_grid_limited():
     assert abs(b.peak_abs(c) - dense) < 1e-9 * dense  # dense grid error ~ (2pi/4e5)^2
 
 
+def test_peak_abs_at_high_harmonics_is_exact_and_agrees_with_the_fine_grid():
+    # at H = 70 peak_abs searches a coarse grid and polishes every maximum near its top
+    b = FourierBasis("all:70")
+    rng = np.random.default_rng(SEED)
+    for _ in range(5):
+        c = rng.normal(size=b.nb) / (1.0 + b.order) ** 3   # a smooth response's decay
+        dense = np.abs(b.evaluate(c, np.linspace(0, 2 * np.pi, 400001))).max()
+        # dense grid error <= sum h^2 |c_h| (2 pi / 4e5)^2 / 8 ~ 1e-10 here
+        assert abs(b.peak_abs(c) - dense) < 1e-9 * dense
+        assert abs(b.peak_abs(c) - b._peak_abs_fine(c, 8)) <= 1e-13 * dense  # both exact
+
+
 def test_too_few_samples_alias_and_are_refused():
     with pytest.raises(ValueError, match="alias"):
         FourierBasis("all:8", n_t=16)
