@@ -37,6 +37,9 @@ class ScaledSystem:
 
     def __init__(self, fun, s_x, s_lam, tol):
         self.fun, self.s_x, self.s_lam, self.tol = fun, s_x, s_lam, tol
+        # a structured LU of R's Jacobian, with or without the plane row and the R_lam
+        # column (e.g. block tridiagonal: :mod:`.block_lu`), when the problem offers one
+        self.factor = getattr(fun, "factor", None)
 
     def jac(self, y, row=None):
         """R and the scaled Jacobian [R_x s_x, R_lam s_lam] (N, N + 1), with ``row`` (N + 1,)
@@ -74,7 +77,7 @@ class ScaledSystem:
         [J; t_prev] t = e_(N+1) is det(J_x) / det([J; t_prev]).
         """
         if factors is None:
-            factors = lu_factor(np.vstack([J, t_prev]))
+            factors = (self.factor or lu_factor)(np.vstack([J, t_prev]))
             if factors is None:
                 raise np.linalg.LinAlgError("singular extended Jacobian")
         rhs = np.zeros(J.shape[0] + 1)
@@ -108,7 +111,7 @@ class ScaledSystem:
         # factors of the last iteration (_step), the only use of it
         res = newton(aug, d0, self.tol, max_iter, np.linalg.norm(y_pred),
                      value=value if self.has_value else None, final_jac=False,
-                     **CORRECTOR_NEWTON)
+                     factor=self.factor, **CORRECTOR_NEWTON)
         res.x = y_pred + res.x
         return res
 
@@ -135,7 +138,7 @@ class ScaledSystem:
         try:
             res = newton(fixed, np.zeros(len(y_pred) - 1), self.tol, max_iter,
                          np.linalg.norm(y_pred[:-1]), value=value if self.has_value else None,
-                         **(FIXED_NEWTON if options is None else options))
+                         factor=self.factor, **(FIXED_NEWTON if options is None else options))
         except NewtonError:
             return None
         R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))

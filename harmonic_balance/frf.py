@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .aft import FrictionLink
+from .block_lu import chain_factorizer
 from .contact import ContactElement
 from .continuation import CURVE_TOL, LAM_STEP, Branch, ContinuationError, continuation
 from .fourier import FourierBasis, default_samples, parse_harmonics
@@ -142,6 +143,9 @@ class FRFProblem:
         self.basis = FourierBasis(parse_harmonics(harmonics), n_t)
         self.residual = make_residual(model, self.basis, condensed)
         self.evaluations = 0
+        # the continuation's LU (:class:`.corrector.ScaledSystem`): by blocks on a chain
+        self.factor = (chain_factorizer(self.basis.nb, self.residual.m, self.residual.dof_couplings())
+                       if isinstance(self.residual, FullResidual) else None)
 
     def __call__(self, x, omega):
         if not self._valued(x, omega):

@@ -79,15 +79,21 @@ def lu_factor(A: np.ndarray):
 
 
 def lu_solve(factors, b: np.ndarray) -> np.ndarray:
-    """x with A x = b from :func:`lu_factor`'s factors of A."""
+    """x with A x = b from :func:`lu_factor`'s factors of A (or structured factors with a
+    ``solve`` method, e.g. :class:`.block_lu.BlockTridiagonalLU`)."""
     from scipy.linalg.lapack import dgetrs
 
+    if hasattr(factors, "solve"):
+        return factors.solve(b)
     x, _ = dgetrs(factors[0], factors[1], b, trans=1)
     return x
 
 
 def lu_det_sign(factors) -> float:
-    """Sign of det(A) from :func:`lu_factor`'s factors (0-based row swaps)."""
+    """Sign of det(A) from :func:`lu_factor`'s factors (0-based row swaps), or from
+    structured factors' ``det_sign``."""
+    if hasattr(factors, "det_sign"):
+        return factors.det_sign()
     lu, piv = factors
     swaps = np.count_nonzero(piv != np.arange(len(piv))) % 2
     return float((-1.0) ** swaps * np.prod(np.sign(np.diag(lu))))
@@ -95,7 +101,7 @@ def lu_det_sign(factors) -> float:
 
 def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
            min_alpha: float = None, lm: bool = True, value=None,
-           final_jac: bool = True) -> NewtonResult:
+           final_jac: bool = True, factor=None) -> NewtonResult:
     """Solve R(x) = 0 to |R|_2 <= tol, or until Newton's step is below round-off.
 
     The second test (|dx|_2 <= STEP_RTOL max(|x|_2, x_norm)) ends the iteration when
@@ -120,6 +126,10 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
         by the Jacobian at its point; the result carries the step's own Jacobian and
         factors (``J_at_x`` False), enough for a caller that only needs a tangent or a
         size (a continuation corrector: one Jacobian assembly less per point).
+    factor : callable J -> factors, optional
+        The LU factorisation of J to use instead of :func:`lu_factor` (a structured one,
+        e.g. :func:`.block_lu.factor` behind a problem's ``factor``); its factors go to
+        :func:`lu_solve` and :func:`lu_det_sign`, None from it means singular.
 
     Returns
     -------
@@ -142,7 +152,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
             return NewtonResult(x, R, J, it, lu)
         if it == max_iter:
             break
-        lu = lu_factor(J)
+        lu = (factor or lu_factor)(J)
         if lu is None:
             raise NewtonError("singular Jacobian", x, it, nr)
         dx = lu_solve(lu, -R)

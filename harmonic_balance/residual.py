@@ -410,6 +410,18 @@ class FullResidual(_Residual):
         """dR/dF_nl v: the full residual carries the element forces as they are."""
         return v
 
+    def dof_couplings(self) -> set:
+        """Pairs (i, j) of DOFs whose harmonics the Jacobian couples: the nonzeros of K, M,
+        C and every element's DOFs among themselves (its neighbour's too, when cyclic)."""
+        lin = self.model.linear
+        A = sum(np.abs(np.asarray(B.todense() if hasattr(B, "todense") else B))
+                for B in (lin.K, lin.M, lin.C) if B is not None)
+        pairs = {(int(i), int(j)) for i, j in zip(*np.nonzero(A))}
+        for el in self.elements:
+            d = [int(k) for k in el.kinematics.dofs]
+            pairs.update((a, b) for a in d for b in d)
+        return pairs
+
     def linear_guess(self, omega: float) -> np.ndarray:
         """Solution with every link replaced by its stuck spring k_0."""
         A = self._add_dynamic_stiffness(self.stuck_operator(), omega)
