@@ -15,7 +15,7 @@ column and row updated alike, and the last block factored together with the bord
 (``[S_n-1, b; c^T, e]``), each S_i by LAPACK's LU with partial pivoting. The border in
 the last block keeps the factorisation regular at a fold, where the Jacobian without it
 is singular. det A = prod det S_i. Cost O(n n_b^3) against the dense O(n^3 n_b^3):
-measured on the 5-mass chain at H = 31 (316 unknowns) 0.3 ms against 0.8 ms.
+measured on the 5-mass chain at H = 31 (316 unknowns) 0.6 ms against 0.9 ms.
 
 The eliminated blocks S_0 ... S_n-2 are pivoted only within themselves: when one is
 singular (a DOF subsystem at its own resonance with the rest held) the factorisation
@@ -27,9 +27,10 @@ import numpy as np
 from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
 #: Coefficients per DOF (n_b = 2 H + 1) and DOFs from which :func:`chain_factorizer` factors
-#: by blocks: measured on the 5-mass chain, 0.5 ms against the dense 0.8 ms at H = 31
-#: (n_b 63); below ~n_b 31 the dense LU's fewer calls win.
-MIN_NB = 31
+#: by blocks. Measured on 5 DOFs with the border, block against dense: n_b 31 0.17 / 0.14
+#: ms, 43 0.31 / 0.43, 63 0.58 / 0.87, 95 1.5 / 2.6, 141 3.9 / 8.3 (below n_b 43 the
+#: dense LU's fewer calls win).
+MIN_NB = 43
 MIN_DOFS = 3
 
 
