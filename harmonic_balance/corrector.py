@@ -128,10 +128,14 @@ class ScaledSystem:
         Newton's globalisation (default FIXED_NEWTON).
         """
         lam = y_pred[-1]
+        e = np.zeros(len(y_pred))
+        e[-1] = 1.0
+        last = {}  # the augmented Jacobian of the last evaluation, reused at the solution
 
         def fixed(d):
-            R, J = self.jac(np.append(y_pred[:-1] + d, lam))
-            return R, J[:, :-1]
+            R, J = self.jac(np.append(y_pred[:-1] + d, lam), e)
+            last["d"], last["J"] = d.copy(), J
+            return R, J[:-1, :-1]
 
         def value(d):
             return self.value(np.append(y_pred[:-1] + d, lam))
@@ -141,10 +145,11 @@ class ScaledSystem:
                          factor=self.factor, **(FIXED_NEWTON if options is None else options))
         except NewtonError:
             return None
-        R, J = self.jac(np.append(y_pred[:-1] + res.x, lam))
-        e = np.zeros(len(y_pred))
-        e[-1] = 1.0
+        if np.array_equal(last["d"], res.x):  # Newton's final Jacobian is at its solution
+            J = last["J"]
+        else:
+            J = self.jac(np.append(y_pred[:-1] + res.x, lam), e)[1]
         res.x = np.append(y_pred[:-1] + res.x, lam)
-        res.J = np.vstack([J, e])
+        res.J = J
         res.lu = None  # factors of the fixed-parameter system, not of [J; t]
         return res
