@@ -1,7 +1,9 @@
 """The scaled augmented system of a continuation step and its two correctors.
 
 Knows nothing about mechanics: ``fun(x, lam) -> (R (N,), dR/dx (N, N), dR/dlam (N,))``,
-optionally with ``fun.value(x, lam) -> R`` (R alone, at less cost).
+optionally with ``fun.value(x, lam) -> R`` (R alone, at less cost) and
+``fun.factorize(A) -> factors`` (an LU of the step's matrices that knows their structure,
+e.g. :func:`.block_lu.chain_factorizer`'s; else the dense :func:`.newton.lu_factor`).
 
 In scaled variables y = (x / s_x, lam / s_lam) the step's systems are (Allgower & Georg,
 Numerical Continuation Methods, ch. 2 and 6): the tangent ``[R_x s_x, R_lam s_lam; t_prev^T] t
@@ -39,7 +41,7 @@ class ScaledSystem:
         self.fun, self.s_x, self.s_lam, self.tol = fun, s_x, s_lam, tol
         # a structured LU of R's Jacobian, with or without the plane row and the R_lam
         # column (e.g. block tridiagonal: :mod:`.block_lu`), when the problem offers one
-        self.factor = getattr(fun, "factor", None)
+        self.factor = getattr(fun, "factorize", None)
 
     def jac(self, y, row=None):
         """R and the scaled Jacobian [R_x s_x, R_lam s_lam] (N, N + 1), with ``row`` (N + 1,)

@@ -144,8 +144,8 @@ class FRFProblem:
         self.residual = make_residual(model, self.basis, condensed)
         self.evaluations = 0
         # the continuation's LU (:class:`.corrector.ScaledSystem`): by blocks on a chain
-        self.factor = (chain_factorizer(self.basis.nb, self.residual.m, self.residual.dof_couplings())
-                       if isinstance(self.residual, FullResidual) else None)
+        self.factorize = (chain_factorizer(self.basis.nb, self.residual.m, self.residual.dof_couplings())
+                          if isinstance(self.residual, FullResidual) else None)
 
     def __call__(self, x, omega):
         if not self._valued(x, omega):

@@ -128,7 +128,7 @@ def newton(fun, x0, tol: float, max_iter: int = 30, x_norm: float = 0.0,
         size (a continuation corrector: one Jacobian assembly less per point).
     factor : callable J -> factors, optional
         The LU factorisation of J to use instead of :func:`lu_factor` (a structured one,
-        e.g. :func:`.block_lu.factor` behind a problem's ``factor``); its factors go to
+        e.g. :func:`.block_lu.factor` behind a problem's ``factorize``); its factors go to
         :func:`lu_solve` and :func:`lu_det_sign`, None from it means singular.
 
     Returns

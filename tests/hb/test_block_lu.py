@@ -82,11 +82,11 @@ def test_chain_curve_is_the_same_with_the_block_lu(monkeypatch):
     H = 15
     model = case.model()
     monkeypatch.setattr(block_lu, "MIN_NB", 1)   # the block LU at this (small) H too
-    assert FRFProblem(model, H).factor is not None
+    assert FRFProblem(model, H).factorize is not None
     band = (0.45, 0.65)   # around the highest peak (omega 0.54)
     block = compute_frf(model, H, band, truncation_check=False, stability=False)
     monkeypatch.setattr(block_lu, "MIN_NB", 10**9)
-    assert FRFProblem(model, H).factor is None
+    assert FRFProblem(model, H).factorize is None
     dense = compute_frf(model, H, band, truncation_check=False, stability=False)
     assert abs(block.peak_amplitude - dense.peak_amplitude) <= SAME_PEAK_RTOL * dense.peak_amplitude
     assert abs(block.peak_omega - dense.peak_omega) <= SAME_PEAK_RTOL * dense.peak_omega
