@@ -12,7 +12,7 @@ on a parameter through a factory ``model_at(lam) -> Model``:
 * Ready-made factories: :func:`forcing_level` and :func:`slip_scale` (every friction
   slider's strength times lam, for Iwan/Jenkins links).
 
-Curves over a parameter: :func:`frf.parameter_curve`; the contact-stiffness factory
+Curves over a parameter: :func:`.parameter_curve.parameter_curve`; the contact-stiffness factory
 also serves the start of stiff models (:mod:`start`).
 """
 from __future__ import annotations

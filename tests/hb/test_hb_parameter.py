@@ -3,9 +3,10 @@ import numpy as np
 import pytest
 from hbcases import two_dof
 
-from harmonic_balance.frf import compute_frf, parameter_curve
+from harmonic_balance.frf import compute_frf
 from harmonic_balance.model import sdof_model
 from harmonic_balance.parameter import forcing_level, slip_scale
+from harmonic_balance.parameter_curve import parameter_curve
 
 #: A parameter curve's end point against the FRF solved directly with that parameter,
 #: and the stuck part's linearity in the level: the same equations solved to the Newton
