@@ -79,8 +79,8 @@ class Factor:
     factorizations, refinements : int   numerical LUs and refinement steps spent
     """
 
-    def __init__(self, backend: str | None = None):
-        self.lu = make_factor(backend)
+    def __init__(self, backend: str | None = None, blocks: tuple | None = None):
+        self.lu = make_factor(backend, blocks)
         self.factorizations = self.refinements = 0
         self.fresh = False
 
@@ -118,7 +118,7 @@ class FastRingSolver:
         self.ring = ring
         self.ref = RingSolver(ring, tuned)   # starts (tuned map, scatter homotopy), tolerance
         self.tol = self.ref.tol
-        self.factor = Factor()
+        self.factor = Factor(blocks=(ring.blades, ring.sector.n_dof, ring.nb))
         self.iterations = 0
 
     def solve(self, omega: float, x0: np.ndarray, max_iter: int = STEP_ITER):
