@@ -198,17 +198,21 @@ class BlockRingFactor:
         self.lr, self.lc = np.unique(ri[lo]), np.unique(cj[lo])
         pos = lambda idx, n: np.searchsorted(idx, n)  # noqa: E731 - position in a sorted set
         ku, kl = self.uc.size, self.lc.size
-        # one buffer: D (N, m, m) | U (N, m, k_U) on U's columns | L (N, |lr|, k_L)
+        # one buffer: D (N, m, m) | U (N, m, k_U) on U's columns, both column-major
+        # (LAPACK's order: no transposed copies) | L (N, |lr|, k_L)
         offs = np.cumsum([0, N * m * m, N * m * ku])
         dest = np.empty(J.indices.size, dtype=np.int64)
-        dest[diag] = offs[0] + (bi[diag] * m + ri[diag]) * m + cj[diag]
-        dest[up] = offs[1] + (bi[up] * m + ri[up]) * ku + pos(self.uc, cj[up])
+        dest[diag] = offs[0] + (bi[diag] * m + cj[diag]) * m + ri[diag]
+        dest[up] = offs[1] + (bi[up] * ku + pos(self.uc, cj[up])) * m + ri[up]
         dest[lo] = offs[2] + (bi[lo] * self.lr.size + pos(self.lr, ri[lo])) * kl + pos(self.lc, cj[lo])
         self.dest, self.offs = dest, offs
         self.buf = np.zeros(offs[2] + N * self.lr.size * kl)
         # the border's columns and rows: W's (L's columns, U's at the end), V's
         self.wc = np.union1d(self.lc, self.uc)
         self.vr = np.union1d(self.ur, self.lr)
+        self.w_lc, self.w_uc = pos(self.wc, self.lc), pos(self.wc, self.uc)
+        self.v_lr = pos(self.vr, self.lr)
+        self.at_lr_uc = (self.uc[None, :] * m + self.lr[:, None]).ravel()   # (lr, uc), column-major
         self.pattern = (J.shape, J.indptr.tobytes(), J.indices.tobytes())
 
     # ------------------------------------------------------------ factor, solve
@@ -232,48 +236,52 @@ class BlockRingFactor:
         self.fallback.factor(self.J)
 
     def _eliminate(self, J) -> None:
-        """The elimination of the class docstring; LinAlgError at a singular block."""
+        """The elimination of the class docstring; LinAlgError at a singular block.
+
+        The fills are kept on their non-zero rows and columns: W_i on (lr, lc) and
+        V_i on (vr, uc) for i < N_b - 2; blade N_b - 2 (both its neighbours in the
+        border) on the border's columns wc and rows vr."""
         self.buf[self.dest] = J.data
         N, m, o = self.N, self.m, self.offs
-        D = self.buf[:o[1]].reshape(N, m, m)
-        U = self.buf[o[1]:o[2]].reshape(N, m, self.uc.size)
-        L = self.buf[o[2]:].reshape(N, self.lr.size, self.lc.size)
+        D = self.buf[:o[1]].reshape(N, m, m).transpose(0, 2, 1)
+        U = self.buf[o[1]:o[2]].reshape(N, self.uc.size, m).transpose(0, 2, 1)
+        self.L = L = self.buf[o[2]:].reshape(N, self.lr.size, self.lc.size)
         uc, lr, lc, wc, vr = self.uc, self.lr, self.lc, self.wc, self.vr
-        wl, wu = np.searchsorted(wc, lc), np.searchsorted(wc, uc)   # L's, U's columns in W
-        vl = np.searchsorted(vr, lr)                                # L's rows in V
-        Dt = D[0].copy()
-        W = np.zeros((m, wc.size))
-        W[np.ix_(lr, wl)] = L[0]                      # J_0,N-1
-        V = np.zeros((vr.size, m))
-        V[:, uc] = U[N - 1][vr]                       # J_N-1,0
-        S = D[N - 1].copy()
-        self.lus, self.gu, self.gw, self.vs = [], [], [], []
-        for i in range(N - 1):
-            last = i == N - 2
-            if last:                                   # the border's own neighbours
-                W[:, wu] += U[N - 2]
-                V[np.ix_(vl, lc)] += L[N - 1]
-            wcols = slice(None) if last else wl        # W's non-zero columns
-            vcols = slice(None) if last else uc        # V's non-zero columns
+        kl = lc.size
+        rhs = np.zeros((m, kl + uc.size), order="F")   # [W_i | U_i]
+        rhs[lr, :kl] = L[0]                            # W_0 = J_0,N-1
+        V = U[N - 1][vr]                               # V_0 = J_N-1,0
+        SV = np.zeros((vr.size, kl))                   # sum_i V_i D~_i^-1 W_i, i < N - 2
+        Dt = D[0].copy(order="F")
+        self.lus, self.g, self.vs = [], [], []
+        for i in range(N - 2):
+            rhs[:, kl:] = U[i]
             lu = self._getrf(Dt)
-            gw = _getrs(lu, np.ascontiguousarray(W[:, wcols]))
-            S[np.ix_(vr, wc if last else lc)] -= V[:, vcols] @ gw[vcols]
+            g = _getrs(lu, rhs)                        # D~_i^-1 [W_i | U_i]
+            gw, gu = g[:, :kl], g[:, kl:]
+            SV += V @ gw[uc]
             self.lus.append(lu)
-            self.gw.append(gw)
-            self.vs.append((V[:, vcols].copy(), vcols))
-            if last:
-                break
-            gu = _getrs(lu, U[i])
-            self.gu.append(gu)
-            Dt = D[i + 1].copy()
-            Dt[np.ix_(lr, uc)] -= L[i + 1] @ gu[lc]
-            W = np.zeros((m, wc.size))
-            W[np.ix_(lr, wl)] = -L[i + 1] @ gw[lc]
-            Vn = np.zeros((vr.size, m))
-            Vn[:, uc] = -(V[:, uc] @ gu[uc])
-            V = Vn
-        self.lus.append(self._getrf(S))
-        self.L = L
+            self.g.append(g)
+            self.vs.append(V)
+            Dt = D[i + 1].copy(order="F")
+            Dt.T.reshape(-1)[self.at_lr_uc] -= (L[i + 1] @ gu[lc]).ravel()
+            rhs[lr, :kl] = -(L[i + 1] @ gw[lc])
+            V = -(V @ gu[uc])
+        # blade N - 2: the border is both its neighbours
+        W = np.zeros((m, wc.size), order="F")
+        W[:, self.w_lc] = rhs[:, :kl]
+        W[:, self.w_uc] += U[N - 2]
+        Vl = np.zeros((vr.size, m))
+        Vl[:, uc] = V
+        Vl[np.ix_(self.v_lr, lc)] += L[N - 1]
+        lu = self._getrf(Dt)
+        gw = _getrs(lu, W)
+        S = D[N - 1].copy(order="F")
+        S[np.ix_(vr, lc)] -= SV
+        S[np.ix_(vr, wc)] -= Vl @ gw
+        self.lus += [lu, self._getrf(S)]
+        self.g.append(gw)
+        self.vs.append(Vl)
 
     def _getrf(self, A):
         lu, piv, info = dgetrf(A, overwrite_a=True)
@@ -282,24 +290,23 @@ class BlockRingFactor:
         return lu, piv
 
     def _solve_blocks(self, b: np.ndarray) -> np.ndarray:
-        N, m = self.N, self.m
+        N, m, kl = self.N, self.m, self.lc.size
+        lr, lc, uc, wc, vr = self.lr, self.lc, self.uc, self.wc, self.vr
         y = b[self.perm].reshape(N, m).copy()
         z = np.empty_like(y)
-        lr, lc, uc, wc = self.lr, self.lc, self.uc, self.wc
-        for i in range(N - 1):          # forward: L^-1 b, blade by blade
+        yb = y[N - 1]
+        for i in range(N - 2):          # forward: L^-1 b, blade by blade
             z[i] = _getrs(self.lus[i], y[i])
-            if i < N - 2:
-                y[i + 1, lr] -= self.L[i + 1] @ z[i, lc]
-            V, vcols = self.vs[i]
-            y[N - 1, self.vr] -= V @ z[i, vcols]
-        xb = _getrs(self.lus[N - 1], y[N - 1])
+            y[i + 1, lr] -= self.L[i + 1] @ z[i, lc]
+            yb[vr] -= self.vs[i] @ z[i, uc]
+        z[N - 2] = _getrs(self.lus[N - 2], y[N - 2])
+        yb[vr] -= self.vs[N - 2] @ z[N - 2]
         x = np.empty_like(y)
-        x[N - 1] = xb
-        for i in range(N - 2, -1, -1):  # backward: x_i = z_i - D~_i^-1 (U_i x_i+1 + W_i x_b)
-            last = i == N - 2
-            x[i] = z[i] - self.gw[i] @ xb[wc if last else lc]
-            if not last:
-                x[i] -= self.gu[i] @ x[i + 1, uc]
+        x[N - 1] = xb = _getrs(self.lus[N - 1], yb)
+        x[N - 2] = z[N - 2] - self.g[N - 2] @ xb[wc]
+        for i in range(N - 3, -1, -1):  # backward: x_i = z_i - D~_i^-1 (W_i x_b + U_i x_i+1)
+            g = self.g[i]
+            x[i] = z[i] - g[:, :kl] @ xb[lc] - g[:, kl:] @ x[i + 1, uc]
         out = np.empty_like(b)
         out[self.perm] = x.ravel()
         return out
