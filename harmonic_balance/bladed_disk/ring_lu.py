@@ -1,26 +1,27 @@
-"""Sparse LU of the ring's Jacobians, one fixed sparsity pattern: symbolic analysis reused.
+"""LU of the ring's Jacobians, one fixed sparsity pattern: the blades' block structure used.
 
 The ring's Jacobian (:mod:`.ring_hb`) keeps its sparsity pattern over every Newton step,
-frequency and scatter scale; only its values change. Two back ends, the same solutions
+frequency and scatter scale; only its values change. Three back ends, the same solutions
 to round-off (``tests/upd/test_upd_ring_fast.py``):
 
-* ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in), real
-  nonsymmetric (mtype 11): the fill-reducing ordering and the symbolic factorization
-  (phase 11, METIS) once for the pattern, then the numerical factorization (phase 22)
-  and the solves (phase 33) per Jacobian, with PARDISO's pivot perturbation and
-  iterative refinement. At 24 blades, H = 7 (2520 unknowns, 205k non-zeros): ~10 ms
-  a factorization against ~24 ms for SuperLU with its ordering each time. Its calls
-  run on :func:`contact_core.linsolve.solver_threads` threads (bit-for-bit the same
-  wherever they run).
+* ``block`` (the default): :class:`BlockRingFactor`, Gaussian elimination blade by blade
+  on the cyclic block-tridiagonal Jacobian with LAPACK (``getrf``/``getrs``) on each
+  blade's dense block, the last blade the border that closes the ring. At 24 blades,
+  H = 7 (2520 unknowns, 205k non-zeros): ~9 ms a factorization against ~22-28 ms for
+  SuperLU with its ordering each time. Its arithmetic is fixed by the pattern, so its
+  bits are the same in a Dask worker and a serial run (one BLAS thread each).
+* ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in with
+  ``DAMPER_SOLVER=pardiso``), real nonsymmetric (mtype 11): the fill-reducing ordering
+  and the symbolic factorization (phase 11, METIS) once for the pattern, then the
+  numerical factorization (phase 22) and the solves (phase 33) per Jacobian, with
+  PARDISO's pivot perturbation and iterative refinement: ~10 ms a factorization at 24
+  blades. Its calls run on :func:`contact_core.linsolve.solver_threads` threads, but its
+  last bits differ between a Dask worker and a serial run (its kernels depend on more
+  than the thread count), and Newton's iterates and the per-blade peaks then differ in
+  the ~8th digit.
 * ``superlu``: scipy's SuperLU (COLAMD), the reference's factorization, always there
-  (the default).
-
-SuperLU is the default: its solutions are bit-for-bit the same in every process, so a
-study on Dask workers equals the serial one exactly. PARDISO, chosen with
-``DAMPER_SOLVER=pardiso``, is faster (20 % less CPU time a UPD-24 sample, 43 % at 48 blades) and agrees to
-round-off in each solve, but its last bits differ between a Dask worker and a serial
-run (its kernels depend on more than the thread count), and Newton's iterates and the
-per-blade peaks then differ in the ~8th digit.
+  (``DAMPER_SOLVER=superlu`` or ``scipy``; also for rings of fewer than 3 blades, and
+  for a Jacobian the block elimination cannot pivot).
 """
 from __future__ import annotations
 
