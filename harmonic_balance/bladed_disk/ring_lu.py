@@ -226,6 +226,9 @@ class BlockRingFactor:
                 and np.array_equal(np.frombuffer(self.pattern[2], J.indices.dtype), J.indices)):
             self._analyse(J)
         self.J, self.use_fallback = J, False
+        if not (self.uc.size and self.lc.size):   # blades not coupled: nothing to eliminate by
+            self._fall_back()
+            return
         try:
             self._eliminate(J)
         except np.linalg.LinAlgError:
