@@ -14,6 +14,13 @@ Rows:
   solver and by the full solver on 41 and on 401 points: CPU time, evaluations, and
   the per-blade peaks' and amplification's largest differences against the 401-point
   full solver (the band's narrow resonance near the stuck peak needs that grid).
+* ``factor``: the fast solver's factorization of the ring Jacobian, SuperLU (COLAMD)
+  against the block elimination over the blades (``ring_lu.BlockRingFactor``, the
+  default), alternately on the same ``--samples`` patterns (std 0.02, seed 1) of the
+  study's default band, N_b = ``--factor-blades`` (default 24; EO = N_b / 4): CPU time
+  per sample, factorizations, the CPU time of one factorization of the sample's peak
+  Jacobian, and the largest differences of the per-blade peaks and the amplification
+  between the two.
 * ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
   cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
   time: why the solver factors the mistuned Jacobian instead.
@@ -47,7 +54,8 @@ Times are CPU (process_time) where one process works, wall time for the clusters
 machine is shared, compare within one run only. ::
 
     OPENBLAS_NUM_THREADS=1 nice python examples/bench_mistuning.py --out out/bench_mistuning \\
-        [--rows scaling band precond throughput worst worst_friction confidence] [--samples 8] [--quick]
+        [--rows scaling band factor precond throughput worst worst_friction confidence] [--samples 8]
+        [--quick] [--factor-blades 24 48]
         [--workers 1 2] [--damper free] [--worst-blades 6 24] [--worst-samples 1000]
         [--worst-friction-blades 24] [--worst-evaluations 25]
         [--confidence-samples 1000] [--confidence-blades 8]
@@ -83,11 +91,12 @@ def sector_of(nb: int) -> Sector:
     return Sector(load_config().with_values(disk__blades=nb, disk__engine_order=nb // 4))
 
 
-def lu_ms(J) -> float:
-    """CPU time of one sparse LU (COLAMD) [ms], the mean over >= 1 s of repeats."""
+def lu_ms(J, factor=None) -> float:
+    """CPU time of one sparse LU (COLAMD; or ``factor.factor``) [ms], the mean over >= 1 s
+    of repeats."""
     t, k = time.process_time(), 0
     while time.process_time() - t < 1.0 or k == 0:
-        splu(J, permc_spec="COLAMD")
+        splu(J, permc_spec="COLAMD") if factor is None else factor.factor(J)
         k += 1
     return (time.process_time() - t) / k * 1e3
 
@@ -157,6 +166,47 @@ def band_rows(samples: int) -> list:
                         f"{name}_amplification_rel_diff": c.peak / ref_c.peak - 1}
         rows.append(row)
         print(_fmt(row), flush=True)
+    return rows
+
+
+def factor_rows(samples: int, blades: int = 24) -> list:
+    """The ``factor`` rows (module docstring): SuperLU and the block LU alternately."""
+    from damper.mistuning import SampleModel, Study, tuned_reference
+    from harmonic_balance.bladed_disk.ring_lu import make_factor
+
+    study = Study(std=0.02, samples=samples, seed=1, blades=blades, engine_order=max(1, blades // 4))
+    ref = tuned_reference(study, study.load())
+    model = SampleModel(study, ref["band_hz"], ref["tuned_frequency_hz"])
+    lo, hi, start = model.om[0], model.om[-1], 2 * np.pi * ref["tuned_frequency_hz"]
+    rows, before = [], os.environ.get("DAMPER_SOLVER")
+    try:
+        for i in range(samples):
+            kappa = draw_factors(blades, 0.02, 1, i)
+            row = {"case": "ring factorization", "blades": blades, "pattern": i}
+            curves = {}
+            for name in ("superlu", "block"):
+                os.environ["DAMPER_SOLVER"] = name
+                ring = MistunedRingHB(model.sector, kappa, H, cf=study.cf, f0=study.f0)
+                model.tuned = model.tuned or SectorHB(ring.sector, H, cf=ring.cf, f0=ring.f0,
+                                                      mu=ring.mu, n_t=ring.basis.n_t)
+                c0 = time.process_time()
+                c = fast_ring_frf(ring, (lo, hi), model.tuned, start_omega=start)
+                curves[name] = c
+                J = ring(c.peak_x, c.peak_omega)[1]
+                row |= {f"{name}_cpu_s": time.process_time() - c0, f"{name}_evaluations": c.evaluations,
+                        f"{name}_factorizations": c.extra["factorizations"],
+                        f"{name}_factor_ms": lu_ms(J, make_factor(name, (blades, ring.sector.n_dof, ring.nb)))}
+            a, b = curves["superlu"], curves["block"]
+            row |= {"speedup": row["superlu_cpu_s"] / row["block_cpu_s"],
+                    "peak_per_blade_max_rel_diff": float(np.abs(b.peak_per_blade / a.peak_per_blade - 1).max()),
+                    "amplification_rel_diff": b.peak / a.peak - 1}
+            rows.append(row)
+            print(_fmt(row), flush=True)
+    finally:
+        if before is None:
+            os.environ.pop("DAMPER_SOLVER", None)
+        else:
+            os.environ["DAMPER_SOLVER"] = before
     return rows
 
 
@@ -325,7 +375,7 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
-                   choices=("scaling", "band", "precond", "throughput", "worst", "worst_friction",
+                   choices=("scaling", "band", "factor", "precond", "throughput", "worst", "worst_friction",
                             "confidence"))
     p.add_argument("--samples", type=int, default=8, help="Monte Carlo samples per cluster size")
     p.add_argument("--workers", type=int, nargs="+",
@@ -335,6 +385,8 @@ def main(argv=None) -> int:
                    help="the throughput rows' damper (free/stuck: the cheap linear limits)")
     p.add_argument("--quick", action="store_true",
                    help="N_b = 4, 8 only; one scatter; 2 samples in this process (no Dask cluster)")
+    p.add_argument("--factor-blades", type=int, nargs="+", default=[24],
+                   help="N_b of the factor rows (EO = N_b / 4)")
     p.add_argument("--worst-blades", type=int, nargs="+", default=[6, 24],
                    help="N_b of the worst rows (differential evolution for N_b <= 6)")
     p.add_argument("--worst-samples", type=int, default=1000,
@@ -357,6 +409,9 @@ def main(argv=None) -> int:
         rows += scaling_rows((4, 8) if a.quick else (4, 8, 24, 48))
     if "band" in a.rows:
         rows += band_rows(a.samples)
+    if "factor" in a.rows:
+        for nb in ([4] if a.quick else a.factor_blades):
+            rows += factor_rows(1 if a.quick else a.samples, nb)
     if "precond" in a.rows:
         rows += precond_rows((0.02,) if a.quick else (0.002, 0.005, 0.02), nb=8 if a.quick else 24)
     if "throughput" in a.rows:

@@ -1,26 +1,27 @@
-"""Sparse LU of the ring's Jacobians, one fixed sparsity pattern: symbolic analysis reused.
+"""LU of the ring's Jacobians, one fixed sparsity pattern: the blades' block structure used.
 
 The ring's Jacobian (:mod:`.ring_hb`) keeps its sparsity pattern over every Newton step,
-frequency and scatter scale; only its values change. Two back ends, the same solutions
+frequency and scatter scale; only its values change. Three back ends, the same solutions
 to round-off (``tests/upd/test_upd_ring_fast.py``):
 
-* ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in), real
-  nonsymmetric (mtype 11): the fill-reducing ordering and the symbolic factorization
-  (phase 11, METIS) once for the pattern, then the numerical factorization (phase 22)
-  and the solves (phase 33) per Jacobian, with PARDISO's pivot perturbation and
-  iterative refinement. At 24 blades, H = 7 (2520 unknowns, 205k non-zeros): ~10 ms
-  a factorization against ~24 ms for SuperLU with its ordering each time. Its calls
-  run on :func:`contact_core.linsolve.solver_threads` threads (bit-for-bit the same
-  wherever they run).
+* ``block`` (the default): :class:`BlockRingFactor`, Gaussian elimination blade by blade
+  on the cyclic block-tridiagonal Jacobian with LAPACK (``getrf``/``getrs``) on each
+  blade's dense block, the last blade the border that closes the ring. At 24 blades,
+  H = 7 (2520 unknowns, 205k non-zeros): ~9 ms a factorization against ~22-28 ms for
+  SuperLU with its ordering each time. Its arithmetic is fixed by the pattern, so its
+  bits are the same in a Dask worker and a serial run (one BLAS thread each).
+* ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in with
+  ``DAMPER_SOLVER=pardiso``), real nonsymmetric (mtype 11): the fill-reducing ordering
+  and the symbolic factorization (phase 11, METIS) once for the pattern, then the
+  numerical factorization (phase 22) and the solves (phase 33) per Jacobian, with
+  PARDISO's pivot perturbation and iterative refinement: ~10 ms a factorization at 24
+  blades. Its calls run on :func:`contact_core.linsolve.solver_threads` threads, but its
+  last bits differ between a Dask worker and a serial run (its kernels depend on more
+  than the thread count), and Newton's iterates and the per-blade peaks then differ in
+  the ~8th digit.
 * ``superlu``: scipy's SuperLU (COLAMD), the reference's factorization, always there
-  (the default).
-
-SuperLU is the default: its solutions are bit-for-bit the same in every process, so a
-study on Dask workers equals the serial one exactly. PARDISO, chosen with
-``DAMPER_SOLVER=pardiso``, is faster (20 % less CPU time a UPD-24 sample, 43 % at 48 blades) and agrees to
-round-off in each solve, but its last bits differ between a Dask worker and a serial
-run (its kernels depend on more than the thread count), and Newton's iterates and the
-per-blade peaks then differ in the ~8th digit.
+  (``DAMPER_SOLVER=superlu`` or ``scipy``; also for rings of fewer than 3 blades, and
+  for a Jacobian the block elimination cannot pivot).
 """
 from __future__ import annotations
 
@@ -28,15 +29,19 @@ import ctypes
 import os
 
 import numpy as np
+from scipy.linalg.lapack import dgetrf, dgetrs
 from scipy.sparse.linalg import splu
 
 from contact_core import linsolve
 
 
 def ring_backend() -> str:
-    """'pardiso' when ``DAMPER_SOLVER=pardiso`` (an error if it does not load), else 'superlu'."""
+    """``DAMPER_SOLVER``: 'pardiso' (an error if it does not load), 'scipy' or 'superlu'
+    (SuperLU), else 'block' (:class:`BlockRingFactor`)."""
     want = os.environ.get("DAMPER_SOLVER", "").strip().lower()
-    return "pardiso" if want == "pardiso" and linsolve.backend() == "pardiso" else "superlu"
+    if want == "pardiso" and linsolve.backend() == "pardiso":
+        return "pardiso"
+    return "superlu" if want in ("scipy", "superlu") else "block"
 
 
 class SuperLUFactor:
@@ -124,7 +129,221 @@ class PardisoFactor:
             pass
 
 
-def make_factor(name: str | None = None):
-    """A fresh factor object of ``name`` ('pardiso', 'superlu'; default :func:`ring_backend`)."""
+#: Relative residual |b - J x| / |b| a block solve must reach (after at most
+#: :data:`BLOCK_REFINE` refinement steps on its own factors), else the Jacobian is
+#: factored by SuperLU instead: block elimination pivots within each blade's block
+#: only, so a nearly singular blade block (a blade's own resonance with its neighbours
+#: held) would lose digits that SuperLU's global pivoting keeps.
+BLOCK_RTOL, BLOCK_REFINE = 1e-10, 2
+
+
+class BlockRingFactor:
+    """LU of the ring's Jacobian by block elimination over the blades (LAPACK, dense blocks).
+
+    Ordered blade by blade (blade i's n_b n_dof unknowns, harmonic-major inside), the
+    Jacobian is cyclic block-tridiagonal: D_i = J_ii dense-ish, and the couplings
+    U_i = J_i,i+1, L_i = J_i,i-1 (indices mod N_b) non-zero only on the few DOFs the
+    neighbours share (the rim; a damper and the next blade's platform). Blades
+    0 .. N_b - 2 are eliminated in turn (Gaussian elimination by blocks, partial
+    pivoting inside each block: ``getrf``), the last blade is the border that closes
+    the ring; its Schur complement is factored at the end::
+
+        D~_0 = D_0,  D~_(i+1) = D_(i+1) - L_(i+1) D~_i^-1 U_i,
+        W_0 = L_0,   W_(i+1) = -L_(i+1) D~_i^-1 W_i        (fill in the border column)
+        V_0 = U_(N-1), V_(i+1) = -V_i D~_i^-1 U_i           (fill in the border row)
+        S = D_(N-1) - sum_i V_i D~_i^-1 W_i
+
+    with U_(N-2) added to W_(N-2) and L_(N-1) to V_(N-2). Only the couplings'
+    non-zero rows and columns enter the products, so a factorization costs about
+    N_b (2/3 m^3 + 2 m^2 (k_U + k_L)) flops (m = n_b n_dof, k the couplings' column
+    counts): at 24 UPD-24 blades, H = 7 (m = 105, k_U = 45, k_L = 60) ~70 Mflop on
+    BLAS-3 kernels. Its arithmetic is fixed by the pattern (no data-dependent
+    ordering), so results are bit-for-bit the same in every process with the same BLAS
+    thread count.
+
+    A solve is checked and refined (:data:`BLOCK_RTOL`, :data:`BLOCK_REFINE`); where it
+    stays inaccurate the Jacobian is factored by SuperLU instead (``fallbacks`` counts).
+
+    Parameters
+    ----------
+    blades, n_dof, nb : int   N_b, DOFs per sector and coefficients per DOF; unknowns
+        ordered coefficient-major over the ring (:mod:`.ring_hb`), N_b >= 3
+    """
+
+    name = "block"
+
+    def __init__(self, blades: int, n_dof: int, nb: int):
+        if blades < 3:
+            raise ValueError(f"block elimination needs >= 3 blades, not {blades}")
+        self.N, self.m = int(blades), int(n_dof) * int(nb)
+        nbl, c, d = np.meshgrid(np.arange(blades), np.arange(nb), np.arange(n_dof), indexing="ij")
+        self.perm = (c * n_dof * blades + nbl * n_dof + d).ravel()   # blade-major -> ring index
+        self.pattern = None
+        self.fallback = SuperLUFactor()
+        self.fallbacks = 0
+
+    # ------------------------------------------------------------ pattern
+    def _analyse(self, J) -> None:
+        """Where each stored entry of J goes (D, U or L of its block row) and the
+        couplings' non-zero rows and columns, from the pattern (once per ring)."""
+        N, m = self.N, self.m
+        inv = np.empty_like(self.perm)
+        inv[self.perm] = np.arange(self.perm.size)
+        col = np.repeat(np.arange(J.shape[1]), np.diff(J.indptr))
+        r, c = inv[J.indices], inv[col]
+        bi, bj, ri, cj = r // m, c // m, r % m, c % m
+        diag, up, lo = bi == bj, bj == (bi + 1) % N, bj == (bi - 1) % N
+        if not np.all(diag | up | lo):
+            raise ValueError("the Jacobian couples blades that are not neighbours")
+        self.ur, self.uc = np.unique(ri[up]), np.unique(cj[up])
+        self.lr, self.lc = np.unique(ri[lo]), np.unique(cj[lo])
+        pos = lambda idx, n: np.searchsorted(idx, n)  # noqa: E731 - position in a sorted set
+        ku, kl = self.uc.size, self.lc.size
+        # one buffer: D (N, m, m) | U (N, m, k_U) on U's columns, both column-major
+        # (LAPACK's order: no transposed copies) | L (N, |lr|, k_L)
+        offs = np.cumsum([0, N * m * m, N * m * ku])
+        dest = np.empty(J.indices.size, dtype=np.int64)
+        dest[diag] = offs[0] + (bi[diag] * m + cj[diag]) * m + ri[diag]
+        dest[up] = offs[1] + (bi[up] * ku + pos(self.uc, cj[up])) * m + ri[up]
+        dest[lo] = offs[2] + (bi[lo] * self.lr.size + pos(self.lr, ri[lo])) * kl + pos(self.lc, cj[lo])
+        self.dest, self.offs = dest, offs
+        self.buf = np.zeros(offs[2] + N * self.lr.size * kl)
+        # the border's columns and rows: W's (L's columns, U's at the end), V's
+        self.wc = np.union1d(self.lc, self.uc)
+        self.vr = np.union1d(self.ur, self.lr)
+        self.w_lc, self.w_uc = pos(self.wc, self.lc), pos(self.wc, self.uc)
+        self.v_lr = pos(self.vr, self.lr)
+        self.at_lr_uc = (self.uc[None, :] * m + self.lr[:, None]).ravel()   # (lr, uc), column-major
+        self.pattern = (J.shape, J.indptr.tobytes(), J.indices.tobytes())
+
+    # ------------------------------------------------------------ factor, solve
+    def factor(self, J) -> None:
+        """Block factors of J (the ring's CSC pattern), or SuperLU's where a blade's
+        block is singular; RuntimeError when J is."""
+        J = J.tocsc()
+        if self.pattern is None or self.pattern[0] != J.shape or not (
+                np.array_equal(np.frombuffer(self.pattern[1], J.indptr.dtype), J.indptr)
+                and np.array_equal(np.frombuffer(self.pattern[2], J.indices.dtype), J.indices)):
+            self._analyse(J)
+        self.J, self.use_fallback = J, False
+        if not (self.uc.size and self.lc.size):   # blades not coupled: nothing to eliminate by
+            self._fall_back()
+            return
+        try:
+            self._eliminate(J)
+        except np.linalg.LinAlgError:
+            self._fall_back()
+
+    def _fall_back(self) -> None:
+        self.fallbacks += 1
+        self.use_fallback = True
+        self.fallback.factor(self.J)
+
+    def _eliminate(self, J) -> None:
+        """The elimination of the class docstring; LinAlgError at a singular block.
+
+        The fills are kept on their non-zero rows and columns: W_i on (lr, lc) and
+        V_i on (vr, uc) for i < N_b - 2; blade N_b - 2 (both its neighbours in the
+        border) on the border's columns wc and rows vr."""
+        self.buf[self.dest] = J.data
+        N, m, o = self.N, self.m, self.offs
+        D = self.buf[:o[1]].reshape(N, m, m).transpose(0, 2, 1)
+        U = self.buf[o[1]:o[2]].reshape(N, self.uc.size, m).transpose(0, 2, 1)
+        self.L = L = self.buf[o[2]:].reshape(N, self.lr.size, self.lc.size)
+        uc, lr, lc, wc, vr = self.uc, self.lr, self.lc, self.wc, self.vr
+        kl = lc.size
+        rhs = np.zeros((m, kl + uc.size), order="F")   # [W_i | U_i]
+        rhs[lr, :kl] = L[0]                            # W_0 = J_0,N-1
+        V = U[N - 1][vr]                               # V_0 = J_N-1,0
+        SV = np.zeros((vr.size, kl))                   # sum_i V_i D~_i^-1 W_i, i < N - 2
+        Dt = D[0].copy(order="F")
+        self.lus, self.g, self.vs = [], [], []
+        for i in range(N - 2):
+            rhs[:, kl:] = U[i]
+            lu = self._getrf(Dt)
+            g = _getrs(lu, rhs)                        # D~_i^-1 [W_i | U_i]
+            gw, gu = g[:, :kl], g[:, kl:]
+            SV += V @ gw[uc]
+            self.lus.append(lu)
+            self.g.append(g)
+            self.vs.append(V)
+            Dt = D[i + 1].copy(order="F")
+            Dt.T.reshape(-1)[self.at_lr_uc] -= (L[i + 1] @ gu[lc]).ravel()
+            rhs[lr, :kl] = -(L[i + 1] @ gw[lc])
+            V = -(V @ gu[uc])
+        # blade N - 2: the border is both its neighbours
+        W = np.zeros((m, wc.size), order="F")
+        W[:, self.w_lc] = rhs[:, :kl]
+        W[:, self.w_uc] += U[N - 2]
+        Vl = np.zeros((vr.size, m))
+        Vl[:, uc] = V
+        Vl[np.ix_(self.v_lr, lc)] += L[N - 1]
+        lu = self._getrf(Dt)
+        gw = _getrs(lu, W)
+        S = D[N - 1].copy(order="F")
+        S[np.ix_(vr, lc)] -= SV
+        S[np.ix_(vr, wc)] -= Vl @ gw
+        self.lus += [lu, self._getrf(S)]
+        self.g.append(gw)
+        self.vs.append(Vl)
+
+    def _getrf(self, A):
+        lu, piv, info = dgetrf(A, overwrite_a=True)
+        if info != 0:
+            raise np.linalg.LinAlgError("singular block in the ring's block elimination")
+        return lu, piv
+
+    def _solve_blocks(self, b: np.ndarray) -> np.ndarray:
+        N, m, kl = self.N, self.m, self.lc.size
+        lr, lc, uc, wc, vr = self.lr, self.lc, self.uc, self.wc, self.vr
+        y = b[self.perm].reshape(N, m).copy()
+        z = np.empty_like(y)
+        yb = y[N - 1]
+        for i in range(N - 2):          # forward: L^-1 b, blade by blade
+            z[i] = _getrs(self.lus[i], y[i])
+            y[i + 1, lr] -= self.L[i + 1] @ z[i, lc]
+            yb[vr] -= self.vs[i] @ z[i, uc]
+        z[N - 2] = _getrs(self.lus[N - 2], y[N - 2])
+        yb[vr] -= self.vs[N - 2] @ z[N - 2]
+        x = np.empty_like(y)
+        x[N - 1] = xb = _getrs(self.lus[N - 1], yb)
+        x[N - 2] = z[N - 2] - self.g[N - 2] @ xb[wc]
+        for i in range(N - 3, -1, -1):  # backward: x_i = z_i - D~_i^-1 (W_i x_b + U_i x_i+1)
+            g = self.g[i]
+            x[i] = z[i] - g[:, :kl] @ xb[lc] - g[:, kl:] @ x[i + 1, uc]
+        out = np.empty_like(b)
+        out[self.perm] = x.ravel()
+        return out
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """x with J x = b (refined; SuperLU when the block factors stay inaccurate)."""
+        b = np.asarray(b, dtype=float)
+        if self.use_fallback:
+            return self.fallback.solve(b)
+        x = self._solve_blocks(b)
+        nb = np.linalg.norm(b)
+        for k in range(BLOCK_REFINE + 1):
+            r = b - self.J @ x
+            if np.linalg.norm(r) <= BLOCK_RTOL * nb:
+                return x
+            if k < BLOCK_REFINE:
+                x = x + self._solve_blocks(r)
+        self._fall_back()
+        return self.fallback.solve(b)
+
+
+def _getrs(lu, b: np.ndarray) -> np.ndarray:
+    x, info = dgetrs(lu[0], lu[1], b)
+    return x
+
+
+def make_factor(name: str | None = None, blocks: tuple | None = None):
+    """A fresh factor object of ``name`` ('block', 'pardiso', 'superlu'; default
+    :func:`ring_backend`). 'block' needs ``blocks`` = (N_b, n_dof, n_b) of the ring and
+    N_b >= 3 (else SuperLU)."""
     name = name or ring_backend()
-    return PardisoFactor() if name == "pardiso" else SuperLUFactor()
+    if name == "pardiso":
+        return PardisoFactor()
+    if name == "block" and blocks is not None and blocks[0] >= 3:
+        return BlockRingFactor(*blocks)
+    return SuperLUFactor()

@@ -2,6 +2,7 @@
 the linear ring (dampers sliding) and the tuned sector; the ring LU back ends."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from scipy.optimize import minimize_scalar
 
 from harmonic_balance.bladed_disk.config import load_config
@@ -9,7 +10,7 @@ from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.mistuning import LinearRing
 from harmonic_balance.bladed_disk.ring_fast import fast_ring_frf, hermite_peaks
 from harmonic_balance.bladed_disk.ring_hb import MistunedRingHB
-from harmonic_balance.bladed_disk.ring_lu import PardisoFactor, SuperLUFactor
+from harmonic_balance.bladed_disk.ring_lu import BlockRingFactor, PardisoFactor, SuperLUFactor
 from harmonic_balance.bladed_disk.ring_solve import RingSolver, ring_frf
 from harmonic_balance.bladed_disk.sector import Sector
 from harmonic_balance.bladed_disk.solve import frf
@@ -122,3 +123,48 @@ def test_ring_lu_backends_solve_the_same_system(sector4):
         b = rng.standard_normal(ring.size)
         y1, y2 = slu.solve(b), pard.solve(b)
         assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
+
+
+@pytest.mark.parametrize("blades", [3, 4])
+def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades):
+    """The blade-by-blade block LU on the ring's Jacobians (dampers stuck and slipping; three
+    blades: the border is both neighbours' neighbour) against SuperLU, one factor object
+    refactoring the same pattern."""
+    sector = Sector(load_config().with_values(disk__blades=blades, disk__engine_order=1))
+    ring = MistunedRingHB(sector, PATTERN[:blades], 5)
+    blk = BlockRingFactor(blades, sector.n_dof, ring.nb)
+    rng = np.random.default_rng(20261128)
+    for f, scale in ((440.0, 1.0), (455.0, 1.0), (448.0, 30.0)):
+        w = 2 * np.pi * f
+        x = ring.stuck_guess(w)
+        x[ring.basis.index(1)[0] * ring.ndof:] *= scale   # larger vibration: the dampers slip
+        J = ring(x, w)[1]
+        slu = SuperLUFactor()
+        slu.factor(J)
+        blk.factor(J)
+        b = rng.standard_normal(ring.size)
+        y1, y2 = slu.solve(b), blk.solve(b)
+        assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
+    assert blk.fallbacks == 0
+
+
+def test_block_elimination_falls_back_to_superlu_at_a_singular_blade_block():
+    """A cyclic block-tridiagonal matrix whose first blade block is zero (the whole is
+    regular through its couplings): the block LU cannot pivot across blades, so the
+    factor hands the matrix to SuperLU and still solves it."""
+    blades, n_dof, nb = 4, 2, 3
+    m, rng = n_dof * nb, np.random.default_rng(20261129)
+    perm = BlockRingFactor(blades, n_dof, nb).perm      # blade-major -> ring index
+    A = np.zeros((blades * m, blades * m))
+    for i in range(blades):
+        j = (i + 1) % blades
+        A[i * m:(i + 1) * m, i * m:(i + 1) * m] = 0.0 if i == 0 else 4 * np.eye(m) + rng.random((m, m))
+        A[i * m:(i + 1) * m, j * m:(j + 1) * m] = np.eye(m)
+        A[j * m:(j + 1) * m, i * m:(i + 1) * m] = np.eye(m)
+    J = np.empty_like(A)
+    J[np.ix_(perm, perm)] = A
+    blk = BlockRingFactor(blades, n_dof, nb)
+    blk.factor(sp.csc_matrix(J))
+    b = rng.standard_normal(J.shape[0])
+    assert blk.fallbacks == 1
+    assert np.abs(J @ blk.solve(b) - b).max() <= LU_RTOL * np.abs(b).max()
