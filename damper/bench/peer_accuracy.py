@@ -25,6 +25,7 @@ the largest first harmonic of its points refined by a parabola
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -66,7 +67,6 @@ def curve_alone(name: str, H: int, work: Path, timeout: float = 600.0) -> dict:
     """Our curve of case ``name`` at H timed like the peer's (:mod:`.peer_ours`, in a child):
     its numbers (``cpu_s``, ``solve_s``, ``peak_amplitude``...), or ``error``."""
     import json
-    import sys
 
     from .common import run_child
 
@@ -181,3 +181,67 @@ def _pct(v) -> str:
 
 def _num(v) -> str:
     return "-" if v is None else f"{v:.1f}"
+
+
+#: Columns of :func:`markdown`: header, row key, format.
+COLUMNS = (("case", "model", "s"), ("tool", "tool", "s"), ("H ours", "H_ours", "d"), ("H peer", "H_peer", "d"),
+           ("CPU ours, command [s]", "cpu_ours_s", ".3f"), ("CPU ours, curve [s]", "cpu_curve_ours_s", ".3f"),
+           ("CPU peer [s]", "cpu_peer_s", ".2f"), ("x_cpu", "speedup_cpu_1pct", ".1f"),
+           ("x_cpu_curve", "speedup_cpu_curve_1pct", ".1f"), ("x_wall", "speedup_1pct", ".1f"))
+
+
+def markdown(rows: list[dict]) -> list[str]:
+    """Markdown table of the rows of :func:`run` (as dicts), with its legend."""
+    out = ["| " + " | ".join(h for h, _, _ in COLUMNS) + " | status |", "|" + "---|" * (len(COLUMNS) + 1)]
+    for r in rows:
+        cells = [_fmt(r.get(k), f) for _, k, f in COLUMNS]
+        out.append("| " + " | ".join(cells) + f" | {(r.get('status') or '')[:80]} |")
+    out += ["", f"H: the first of {', '.join(map(str, SCAN))} whose first-harmonic peak is within "
+            f"{100 * TARGET_REL:g} % of the case's dense reference. x_cpu: the peer's CPU time over our "
+            "command's (`damper frf --harmonics H`, with Hill stability and the truncation-error "
+            "estimate); x_cpu_curve: over our curve timed as the peer's driver times the peer's "
+            "(imports first, no stability, no truncation check; `damper.bench.peer_ours`), like with "
+            "like; x_wall: wall time of the peer over our command's."]
+    return out
+
+
+def _fmt(v, fmt: str) -> str:
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "-"
+    return format(v, fmt)
+
+
+def main(argv=None) -> int:
+    """``python -m damper.bench.peer_accuracy --pyharm PYTHON [--case NAME]... [--json]``:
+    the rows of :func:`run` alone (without the rest of the hb stage)."""
+    import argparse
+    import json
+    import tempfile
+
+    from .hb_classes import PEER_SETTINGS, PEER_TIMEOUT_S, ModelOptions, case_names, run_ours
+    from .peers import available
+
+    ap = argparse.ArgumentParser(prog="python -m damper.bench.peer_accuracy", description=main.__doc__)
+    ap.add_argument("--pyharm", required=True, help="a Python interpreter with pyHarm (pip install pyharm-os)")
+    ap.add_argument("--case", action="append", default=[], help="only cases whose name contains this (repeatable)")
+    ap.add_argument("--json", action="store_true", help="print one JSON object with `rows`")
+    args = ap.parse_args(argv)
+    names = case_names(False, ModelOptions(cases=tuple(args.case)))
+    say = (lambda s: print(s, file=sys.stderr)) if args.json else print
+    with tempfile.TemporaryDirectory(prefix="peer_accuracy_") as tmp:
+        why = available("pyharm", args.pyharm, None, Path(tmp))
+        if why:
+            print(f"error: pyHarm {why}", file=sys.stderr)
+            return 2
+        rows = [r.as_dict() for r in run(names, "pyharm", args.pyharm, Path(tmp), PEER_SETTINGS, run_ours,
+                                         timeout=PEER_TIMEOUT_S, log=say)]
+    if args.json:
+        print(json.dumps({"target_rel": TARGET_REL, "scan": list(SCAN), "peer_settings": PEER_SETTINGS,
+                          "rows": rows}))
+    else:
+        print("\n".join(markdown(rows)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -84,3 +84,12 @@ def test_curve_alone_gives_the_commands_peak(tmp_path):
     c = peer_accuracy.curve_alone(case.name, 3, Path(tmp_path))
     assert c["error"] is None and c["cpu_s"] > 0.0
     assert c["peak_amplitude"] == pytest.approx(o["peak_amplitude"], rel=peer_accuracy.CURVE_SAME_REL)
+
+
+def test_markdown_has_a_cell_per_column_and_a_dash_for_no_ratio():
+    row = {"model": "sdof soft", "tool": "pyHarm", "H_ours": 1, "H_peer": None, "cpu_ours_s": 0.1,
+           "status": "free start: diverged"}
+    lines = peer_accuracy.markdown([row])
+    cells = lines[2].strip("|").split("|")
+    assert len(cells) == len(peer_accuracy.COLUMNS) + 1
+    assert cells[3].strip() == "-" and cells[4].strip() == "0.100"
