@@ -133,6 +133,8 @@ def row(name: str, tool: str, case, ours: dict, peer: dict) -> Row:
              "cpu_curve_ours_s": ours.get("cpu_curve_s"), "time_curve_ours_s": ours.get("time_curve_s"),
              "speedup_cpu_curve_1pct": ratio("cpu_s", "cpu_curve_s"),
              "curve_status": ours.get("curve_status"),
+             "points_ours": ours.get("points"), "evaluations_ours": ours.get("evaluations"),
+             "points_peer": peer.get("points"), "evaluations_peer": peer.get("evaluations"),
              "scan_peer": peer.get("scan"), "scan_ours": ours.get("scan"),
              "status": peer.get("status") if peer.get("H") is None else "both within 1 %"}
     H = peer.get("H") or SCAN[-1]
