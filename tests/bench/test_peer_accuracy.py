@@ -93,3 +93,10 @@ def test_markdown_has_a_cell_per_column_and_a_dash_for_no_ratio():
     cells = lines[2].strip("|").split("|")
     assert len(cells) == len(peer_accuracy.COLUMNS) + 1
     assert cells[3].strip() == "-" and cells[4].strip() == "0.100"
+
+
+def test_runner_without_pyharm_exits_2_naming_the_interpreter(tmp_path, capsys):
+    missing = tmp_path / "no_python"
+    assert peer_accuracy.main(["--pyharm", str(missing), "--case", "sdof soft", "--json"]) == 2
+    err = capsys.readouterr().err
+    assert str(missing) in err and err.count("\n") == 1
