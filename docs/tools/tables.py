@@ -10,6 +10,10 @@ MAKE = {
     "validation": "make validation",
     "bench": "make docs-bench",
     "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
+    "bench_peers_1pct": "make docs-bench-peers-1pct PYHARM=...",
+    "bench_peers_1pct_chain5": "python docs/tools/record.py docs/data/bench_peers_1pct_chain5.json -- "
+                               ".venv/bin/python -m damper.bench.peer_accuracy --pyharm PYHARM "
+                               "--case 'chain5 down' --json",
     "stress": "make docs-stress",
     "accuracy": "make docs-accuracy",
     "accuracy_upd": "make docs-accuracy",
@@ -127,6 +131,13 @@ def bench(data: dict) -> str:
             out += ["Model classes (error: |first-harmonic peak / dense reference - 1|):", "",
                     *markdown(models), ""]
     return "\n".join(out) + "\n"
+
+
+def peers_1pct(data: dict, name: str = "bench_peers_1pct") -> str:
+    """The peer rows at each tool's own H for 1 % (``python -m damper.bench.peer_accuracy --json``)."""
+    from damper.bench.peer_accuracy import markdown
+
+    return "\n".join([stamp_text(data, name), "", *markdown(data.get("result", {}).get("rows", []))]) + "\n"
 
 
 def accuracy(data: dict) -> str:
