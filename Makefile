@@ -106,7 +106,7 @@ docs-bench-peers: $(STAMP) cbuild
 docs-bench-peers-1pct: $(STAMP) cbuild
 	@test -n "$(PYHARM)" || { echo "give PYHARM=python-with-pyharm"; exit 2; }
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/bench_peers_1pct.json -- \
-	  $(PY) -m damper.bench.peer_accuracy --pyharm $(PYHARM) $(foreach c,$(CASES),--case $(c)) --json
+	  $(PY) -m damper.bench.peers_1pct --pyharm $(PYHARM) $(foreach c,$(CASES),--case $(c)) --json
 # docs-accuracy: the truncation-error estimate against the true error (about 50 minutes).
 docs-accuracy: $(STAMP) cbuild
 	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/accuracy.json -- \

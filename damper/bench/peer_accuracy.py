@@ -211,39 +211,3 @@ def _fmt(v, fmt: str) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "-"
     return format(v, fmt)
-
-
-def main(argv=None) -> int:
-    """``python -m damper.bench.peer_accuracy --pyharm PYTHON [--case NAME]... [--json]``:
-    the rows of :func:`run` alone (without the rest of the hb stage)."""
-    import argparse
-    import json
-    import tempfile
-
-    from .hb_classes import PEER_SETTINGS, PEER_TIMEOUT_S, ModelOptions, case_names, run_ours
-    from .peers import available
-
-    ap = argparse.ArgumentParser(prog="python -m damper.bench.peer_accuracy", description=main.__doc__)
-    ap.add_argument("--pyharm", required=True, help="a Python interpreter with pyHarm (pip install pyharm-os)")
-    ap.add_argument("--case", action="append", default=[], help="only cases whose name contains this (repeatable)")
-    ap.add_argument("--json", action="store_true", help="print one JSON object with `rows`")
-    args = ap.parse_args(argv)
-    names = case_names(False, ModelOptions(cases=tuple(args.case)))
-    say = (lambda s: print(s, file=sys.stderr)) if args.json else print
-    with tempfile.TemporaryDirectory(prefix="peer_accuracy_") as tmp:
-        why = available("pyharm", args.pyharm, None, Path(tmp))
-        if why:
-            print(f"error: pyHarm {why}", file=sys.stderr)
-            return 2
-        rows = [r.as_dict() for r in run(names, "pyharm", args.pyharm, Path(tmp), PEER_SETTINGS, run_ours,
-                                         timeout=PEER_TIMEOUT_S, log=say)]
-    if args.json:
-        print(json.dumps({"target_rel": TARGET_REL, "scan": list(SCAN), "peer_settings": PEER_SETTINGS,
-                          "rows": rows}))
-    else:
-        print("\n".join(markdown(rows)))
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

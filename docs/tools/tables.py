@@ -12,7 +12,7 @@ MAKE = {
     "bench_peers": "make docs-bench-peers PYHARM=... NLVIB=...",
     "bench_peers_1pct": "make docs-bench-peers-1pct PYHARM=...",
     "bench_peers_1pct_chain5": "python docs/tools/record.py docs/data/bench_peers_1pct_chain5.json -- "
-                               ".venv/bin/python -m damper.bench.peer_accuracy --pyharm PYHARM "
+                               ".venv/bin/python -m damper.bench.peers_1pct --pyharm PYHARM "
                                "--case 'chain5 down' --json",
     "stress": "make docs-stress",
     "accuracy": "make docs-accuracy",
@@ -134,7 +134,7 @@ def bench(data: dict) -> str:
 
 
 def peers_1pct(data: dict, name: str = "bench_peers_1pct") -> str:
-    """The peer rows at each tool's own H for 1 % (``python -m damper.bench.peer_accuracy --json``)."""
+    """The peer rows at each tool's own H for 1 % (``python -m damper.bench.peers_1pct --json``)."""
     from damper.bench.peer_accuracy import markdown
 
     return "\n".join([stamp_text(data, name), "", *markdown(data.get("result", {}).get("rows", []))]) + "\n"

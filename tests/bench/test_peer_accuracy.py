@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from damper.bench import peer_accuracy, peers
+from damper.bench import peer_accuracy, peers, peers_1pct
 from harmonic_balance.bench_models import sdof
 
 REF = {"amplitude": 1.0}
@@ -97,6 +97,6 @@ def test_markdown_has_a_cell_per_column_and_a_dash_for_no_ratio():
 
 def test_runner_without_pyharm_exits_2_naming_the_interpreter(tmp_path, capsys):
     missing = tmp_path / "no_python"
-    assert peer_accuracy.main(["--pyharm", str(missing), "--case", "sdof soft", "--json"]) == 2
+    assert peers_1pct.main(["--pyharm", str(missing), "--case", "sdof soft", "--json"]) == 2
     err = capsys.readouterr().err
     assert str(missing) in err and err.count("\n") == 1
