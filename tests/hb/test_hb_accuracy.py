@@ -121,6 +121,63 @@ def test_richest_level_estimate_without_a_stable_order_takes_the_lower_order():
     assert abs(rec["peak_amplitude_rel"] - abs(d) / (1.02 + d)) < 1e-12
 
 
+#: Round-off allowed on an estimate that is exact for its model sequence.
+EXACT_RTOL = 1e-9
+
+
+@pytest.mark.parametrize("r", [-0.6, -0.2, -0.05])
+def test_richest_level_estimate_of_alternating_geometric_levels_is_their_remainder(r):
+    # a_k = a_inf + C r^k at irregular H: Aitken's remainder is exact for any spacing
+    a_inf, C = 5.0, 0.4
+    levels = [(H, a_inf + C * r**k, 1.0) for k, H in enumerate((7, 11, 17, 26))]
+    rec = acc.richest_error(levels)
+    assert rec["oscillating"] and rec["extrapolated"] is None
+    true = abs(levels[-1][1] / a_inf - 1)
+    assert abs(rec["peak_amplitude_rel"] / true - 1) < EXACT_RTOL
+
+
+def test_richest_level_estimate_of_a_growing_alternation_is_the_last_difference():
+    # |d2| > |d1|: no contracting geometric tail; the limit is only known to lie near
+    levels = [(3, 1.0, 1.0), (5, 1.01, 1.0), (8, 0.98, 1.0)]
+    rec = acc.richest_error(levels)
+    assert abs(rec["peak_amplitude_rel"] - 0.03 / 0.98) < 1e-15
+
+
+def test_richest_level_estimate_of_an_algebraic_sequence_is_conservative_before_its_order_is_stable():
+    # true order 3 seen through three levels only: Richardson with min(p, ASSUMED_ORDER)
+    # leaves more error than there is (never less)
+    a_inf, C, p = 1.0, 0.5, 3.0
+    levels = [(H, a_inf + C * H**-p, 1.0) for H in (5, 8, 12)]
+    rec = acc.richest_error(levels)
+    true = C * 12**-p / a_inf
+    assert not rec["order_stable"] and rec["order"] == acc.ASSUMED_ORDER
+    assert true < rec["peak_amplitude_rel"] < 3 * true
+
+
+#: The sector's reference for the oscillating-levels row: the peak at H = 80 (the
+#: bench's UPD reference), its own error ~3e-4 against 4e-4 left at H = 26.
+UPD_OSCILLATING_REFERENCE_H = 80
+
+
+def test_upd_peak_whose_levels_oscillate_has_an_estimate_within_a_factor_3():
+    # UPD-24 at CF 120 N, F0 = 30 N from H = 7: levels 7, 11, 17 fall and 26 rises again
+    from harmonic_balance.bladed_disk.accuracy import check_sector, peak_to_accuracy
+    from harmonic_balance.bladed_disk.config import load_config
+    from harmonic_balance.bladed_disk.sector import Sector
+
+    sector = Sector(load_config(None))
+    lo, hi = sector.cfg["load.band_hz"]
+    om = 2 * np.pi * np.linspace(lo, hi, 200)
+    hb, c, rec = peak_to_accuracy(sector, om, 1e-2, 7, cf=120.0, f0=30.0)
+    assert rec["oscillating"]
+    rich = check_sector(hb, UPD_OSCILLATING_REFERENCE_H)
+    xs = [acc.pad(x, hb.basis, rich.basis) for x in c.x]
+    ref = acc.peak_at(rich.__call__, lambda x, w: rich.amplitude_h1(x), xs, om, int(np.argmax(c.amplitude)),
+                      1e-10 * max(hb.f0, hb.cf), 1e-6 * c.peak_omega)[2]
+    true = abs(rec["accuracy"]["peak_amplitude"] / ref - 1.0)
+    assert 1 / ESTIMATE_FACTOR < rec["peak_amplitude_rel"] / true < ESTIMATE_FACTOR, (rec["peak_amplitude_rel"], true)
+
+
 @pytest.mark.parametrize("tol", [0.0, 0.5, 1e-7, float("nan"), -1e-2])
 def test_accuracy_outside_its_range_is_refused(tol):
     with pytest.raises(ValueError, match="accuracy"):
