@@ -298,7 +298,8 @@ def bench_rows(quick: bool, log=print) -> list[Row]:
 
 def table_lines(rows) -> list[str]:
     """The plain-text table of accuracy rows (dicts of :func:`frf_rows`): a header, a line per
-    row. ``flags``: ``R`` the ratio outside [1/3, 3], ``T`` a target's true error above it
+    row. ``flags``: ``R`` the ratio outside [1/3, 3], ``u`` a ratio not judged (the true
+    error within REFERENCE_MARGIN times the reference's own, or below TRUE_FLOOR), ``T`` a target's true error above it
     (``t`` when the engine said it was not met: the harmonic limit), ``D!`` a default row
     more than 1 % off without a warning, ``D~`` more than 1 % off with the warning."""
     def pct(v):
@@ -319,6 +320,8 @@ def flags(r: dict) -> str:
     out = []
     if r.get("ratio_ok") is False:
         out.append("R")
+    elif r.get("ratio_ok") is None and r.get("ratio") is not None:
+        out.append("u")   # the true error is within the reference's own: not judged
     if r.get("target_met") is False:
         out.append("t" if r.get("engine_met") is False else "T")
     if r.get("default") in ("FAIL", "warned"):

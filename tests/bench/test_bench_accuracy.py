@@ -109,6 +109,7 @@ def test_a_true_error_within_the_references_own_error_is_not_judged(true, judged
     assert ref_error * hb_accuracy.REFERENCE_MARGIN == pytest.approx(3e-4)
     r = hb_accuracy._row("m", "H 7", 1.0 + true, {"peak_amplitude_rel": true}, 1.0, 1.0, 7, ref_error=ref_error)
     assert r["ratio_ok"] is judged and r["reference_error"] == ref_error
+    assert r["flags"] == ("u" if judged is None else "")
 
 
 def test_accuracy_row_records_the_levels_its_estimate_came_from(quick_rows):
