@@ -35,7 +35,7 @@ A peak to an accuracy (:func:`raise_at_peak`): the curve is traced once; its pea
 is re-solved at richer sets, level after level (each padded from the previous level's
 corrected points), and the RICHEST level's error is estimated from the levels below it
 (:func:`richest_error`: Richardson with the observed order when two successive triples
-agree on it, else with the smaller of it and ASSUMED_ORDER; Aitken's geometric remainder
+agree on it, else with the smaller of it and ASSUMED_ORDER; the last difference itself
 when the levels oscillate) until it is below the target with at least MIN_LEVELS levels.
 
 The estimate is of the truncation in H only: the AFT sampling error (exact friction
@@ -347,8 +347,7 @@ def richest_error(levels) -> dict:
     ASSUMED_ORDER (a lower order means a larger error left: a sequence still outside its
     asymptotic range, as the 5-mass chain below H ~ 50, is not trusted to have reached it).
     When the last three levels oscillate (their differences change sign) there is no
-    power law to follow: the error is the geometric remainder of the alternation
-    (Aitken's delta-squared, :func:`_alternating_error`).
+    power law to follow: the error is |v_K - v_{K-1}| / |v_K|.
     """
     out = {}
     for key, col in (("amplitude", 1), ("omega", 2)):
@@ -382,27 +381,11 @@ def _richest(seq):
     stable = p is not None and p0 is not None and max(p, p0) <= ORDER_STABLE * min(p, p0)
     (H1, v1), (H2, v2) = seq[-2], seq[-1]
     if len(seq) >= 3 and (seq[-3][1] - v1) * (v1 - v2) < 0:
-        return _alternating_error(seq[-3][1], v1, v2), None, p, False
+        # oscillating levels: no power law; the limit lies between the last two, at most
+        # their difference from the richest
+        return abs(v2 - v1) / abs(v2), None, p, False
     d = (v2 - v1) / ((H2 / H1) ** _used_order(p, stable) - 1.0)
     return abs(d) / abs(v2 + d), (v2 + d if stable else None), p, stable
-
-
-def _alternating_error(v0: float, v1: float, v2: float) -> float:
-    """Relative error of ``v2``, the last of three levels whose differences change sign.
-
-    No power law fits an alternating sequence; a contracting one (|r| < 1, r = d2 / d1 the
-    ratio of the last two differences) is taken as geometric, whose remainder after v2 is
-    Aitken's delta-squared correction d2 r / (1 - r) (Aitken 1926; the first Shanks
-    transform, Shanks 1955): for r in (-1, 0) it is at most half the last difference.
-    Where the alternation does not contract (|r| >= 1), the limit is only known to lie
-    near the last two levels and the error is their difference, |d2| / |v2|.
-    """
-    d1, d2 = v1 - v0, v2 - v1
-    r = d2 / d1
-    if not -1.0 < r < 0.0:
-        return abs(d2) / abs(v2)
-    tail = d2 * r / (1.0 - r)
-    return abs(tail) / abs(v2 + tail)
 
 
 def next_level(hs: tuple, levels, error, tol: float, limit: int) -> tuple | None:
