@@ -151,7 +151,9 @@ def accuracy(data: dict) -> str:
            "Ratio: estimate / true error (the goal: between 1/3 and 3). Check: the wall time of the "
            "estimate (of a target: its peak levels); total: CPU time of the curve and its check "
            "(of a target: the curve and every level at its peak). Flags: R the "
-           "ratio outside [1/3, 3]; T a target's true error above it (t: the engine said not met, "
+           "ratio outside [1/3, 3]; u the ratio not judged: the true error is within three times the "
+           "reference's own estimated error (or below 1e-6); T a target's true error above it "
+           "(t: the engine said not met, "
            "at its harmonic limit); D~ the default setting more than 1 % off, with its warning; "
            "D! without one.", "",
            "| model | H or target | peak | estimate | true error | ratio | check [s] | total [s] | flags |",

@@ -77,7 +77,8 @@ def test_report_shows_estimate_and_true_error_of_accuracy_rows(quick_rows, tmp_p
 
 def test_accuracy_row_flags_follow_the_goals(quick_rows):
     for r in quick_rows[0]:
-        if r["ratio"] is not None and r["true_error"] >= hb_accuracy.TRUE_FLOOR:
+        floor = max(hb_accuracy.TRUE_FLOOR, hb_accuracy.REFERENCE_MARGIN * (r["reference_error"] or 0.0))
+        if r["ratio"] is not None and r["true_error"] >= floor:
             assert r["ratio_ok"] == (1 / hb_accuracy.RATIO_BAND <= r["ratio"] <= hb_accuracy.RATIO_BAND)
         if r["target"] is not None:
             assert r["target_met"] == (r["true_error"] <= r["target"]) and r["engine_met"] is not None
@@ -99,3 +100,20 @@ def test_target_row_missed_by_the_engines_limit_is_flagged_t():
     r = hb_accuracy._row("m", "tol 0.001 -> H 27", 1.01, {"peak_amplitude_rel": 0.012}, 1.0, 1.0, 27, 1e-3,
                          {"met": False})
     assert r["target_met"] is False and r["engine_met"] is False and r["flags"] == "t"
+
+
+@pytest.mark.parametrize("true, judged", [(2e-4, None), (4e-4, True)])
+def test_a_true_error_within_the_references_own_error_is_not_judged(true, judged):
+    # reference error 1e-4: below REFERENCE_MARGIN times it the true error is not measured
+    ref_error = 1e-4
+    assert ref_error * hb_accuracy.REFERENCE_MARGIN == pytest.approx(3e-4)
+    r = hb_accuracy._row("m", "H 7", 1.0 + true, {"peak_amplitude_rel": true}, 1.0, 1.0, 7, ref_error=ref_error)
+    assert r["ratio_ok"] is judged and r["reference_error"] == ref_error
+    assert r["flags"] == ("u" if judged is None else "")
+
+
+def test_accuracy_row_records_the_levels_its_estimate_came_from(quick_rows):
+    for r in quick_rows[0]:
+        hs = [lv[0] for lv in r["levels"]]
+        assert len(hs) >= 2 and hs == sorted(hs) and hs[0 if r["target"] is None else -1] == r["size"]
+        assert r["levels"][0][1] == r["peak_amplitude"] or r["target"] is not None

@@ -121,6 +121,48 @@ def test_richest_level_estimate_without_a_stable_order_takes_the_lower_order():
     assert abs(rec["peak_amplitude_rel"] - abs(d) / (1.02 + d)) < 1e-12
 
 
+#: Round-off allowed on an estimate that is exact for its model sequence.
+EXACT_RTOL = 1e-9
+
+
+@pytest.mark.parametrize("r", [-0.6, -0.2, -0.05])
+def test_richest_level_estimate_of_oscillating_levels_is_their_last_difference(r):
+    # a_k = a_inf + C r^k at irregular H: the limit lies between the last two levels, so
+    # the last difference bounds the error left (the geometric remainder is not assumed)
+    a_inf, C = 5.0, 0.4
+    levels = [(H, a_inf + C * r**k, 1.0) for k, H in enumerate((7, 11, 17, 26))]
+    rec = acc.richest_error(levels)
+    assert rec["oscillating"] and rec["extrapolated"] is None
+    last = abs(levels[-1][1] - levels[-2][1]) / abs(levels[-1][1])
+    assert abs(rec["peak_amplitude_rel"] / last - 1) < EXACT_RTOL
+    assert rec["peak_amplitude_rel"] > abs(levels[-1][1] / a_inf - 1)
+
+
+def test_richest_level_estimate_of_an_algebraic_sequence_is_conservative_before_its_order_is_stable():
+    # true order 3 seen through three levels only: Richardson with min(p, ASSUMED_ORDER)
+    # leaves more error than there is (never less)
+    a_inf, C, p = 1.0, 0.5, 3.0
+    levels = [(H, a_inf + C * H**-p, 1.0) for H in (5, 8, 12)]
+    rec = acc.richest_error(levels)
+    true = C * 12**-p / a_inf
+    assert not rec["order_stable"] and rec["order"] == acc.ASSUMED_ORDER
+    assert true < rec["peak_amplitude_rel"] < 3 * true
+
+
+#: Harmonics of the soft oscillator's reference for its run to a target (peak at H = 12):
+#: the peak moves ~1e-7 (relative) from H = 30 on, far below the 4e-6 judged.
+SOFT_REFERENCE_H = 61
+
+
+def test_richest_level_estimate_on_the_soft_sdof_oscillator_is_within_a_factor_3():
+    case = bm.sdof(1.0)
+    r = compute_frf(case.model(), 3, case.band, stability="off", accuracy=1e-2)
+    assert len(r.extra["accuracy"]["levels"]) >= acc.MIN_LEVELS
+    est = r.truncation_error["peak_amplitude_rel"]
+    true = abs(r.peak_amplitude / reference_peak(r, SOFT_REFERENCE_H) - 1.0)
+    assert 1 / ESTIMATE_FACTOR < est / true < ESTIMATE_FACTOR, (est, true)
+
+
 @pytest.mark.parametrize("tol", [0.0, 0.5, 1e-7, float("nan"), -1e-2])
 def test_accuracy_outside_its_range_is_refused(tol):
     with pytest.raises(ValueError, match="accuracy"):
