@@ -165,7 +165,8 @@ def peak_window(fun, amplitude, xs, omegas, i, tol, tol_lam, window: int = WINDO
                 k = min(near, key=lambda k: abs(k - j))
                 x0 = solved[k] + (xs[j] - xs[k])
             try:
-                solved[j] = newton(lambda z: fun(z, omegas[j])[:2], x0, tol, 40).x
+                solved[j] = newton(lambda z: fun(z, omegas[j])[:2], x0, tol, 40,
+                                   factor=getattr(fun, "factorize", None)).x
             except NewtonError:
                 solved[j] = None
         return solved[j]

@@ -64,7 +64,8 @@ def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS, *,
                 from .newton import newton
 
                 w = float(om[i])
-                a = rich.amplitude(newton(lambda z, r=rich, w=w: r(z, w)[:2], xs[i], tol, 40).x, w)
+                a = rich.amplitude(newton(lambda z, r=rich, w=w: r(z, w)[:2], xs[i], tol, 40,
+                                          factor=rich.factorize).x, w)
         except RuntimeError:
             if k == 0:
                 raise
