@@ -116,13 +116,7 @@ def test_ring_lu_backends_solve_the_same_system(sector4):
     for f in (440.0, 455.0):
         w = 2 * np.pi * f
         x = ring.stuck_guess(w)
-        R, J, _ = ring(x, w)
-        slu = SuperLUFactor()
-        slu.factor(J)
-        pard.factor(J)
-        b = rng.standard_normal(ring.size)
-        y1, y2 = slu.solve(b), pard.solve(b)
-        assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
+        _assert_solves_as_superlu(pard, ring(x, w)[1], rng)
 
 
 @pytest.mark.parametrize("blades", [3, 4])
@@ -138,13 +132,7 @@ def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades):
         w = 2 * np.pi * f
         x = ring.stuck_guess(w)
         x[ring.basis.index(1)[0] * ring.ndof:] *= scale   # larger vibration: the dampers slip
-        J = ring(x, w)[1]
-        slu = SuperLUFactor()
-        slu.factor(J)
-        blk.factor(J)
-        b = rng.standard_normal(ring.size)
-        y1, y2 = slu.solve(b), blk.solve(b)
-        assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
+        _assert_solves_as_superlu(blk, ring(x, w)[1], rng)
     assert blk.fallbacks == 0
 
 
@@ -168,3 +156,13 @@ def test_block_elimination_falls_back_to_superlu_at_a_singular_blade_block():
     b = rng.standard_normal(J.shape[0])
     assert blk.fallbacks == 1
     assert np.abs(J @ blk.solve(b) - b).max() <= LU_RTOL * np.abs(b).max()
+
+
+def _assert_solves_as_superlu(fac, J, rng):
+    """``fac`` factors J and solves a random right-hand side as SuperLU does, to LU_RTOL."""
+    slu = SuperLUFactor()
+    slu.factor(J)
+    fac.factor(J)
+    b = rng.standard_normal(J.shape[0])
+    y1, y2 = slu.solve(b), fac.solve(b)
+    assert np.abs(y1 - y2).max() <= LU_RTOL * np.abs(y1).max()
