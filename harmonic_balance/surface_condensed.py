@@ -32,9 +32,8 @@ period left it, the C core's convention for a point contact).
 Jacobian: dF/dU exact, by the forward sensitivities of the march
 (:mod:`.surface_sensitivity`: each committed step's settled set gives dw/dq and the
 friction states' sensitivities by the implicit function theorem, carried from step to
-step), one history along the n_b r directions of U, marched when the Jacobian is first
-read (the residual's ``value`` asks for it at a line search's trial points and reads it
-only at the accepted one). The forward differences of the whole march
+step), along the n_b r directions of U in the residual's own march (one history;
+the sensitivities cost about what the march does). The forward differences of the whole march
 (:meth:`CondensedSurface.jacobian_fd`, 1 + n_b r histories) are kept as its reference.
 
 Cost: every node over ``PERIODS`` periods per history; UPD-24 with 5 nodes per side
@@ -177,49 +176,44 @@ class CondensedSurface(ForceElement):
         return self._step(nodes, A, mid, end, w, depth + 1, sens)
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
-        """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
-        docstring), marched when first read (a line search's rejected trial point, whose
-        Jacobian the residual asks for but never reads, costs one history)."""
+        """Harmonics of (Q2) for input harmonics U (n_b, r); with ``jac`` their exact dF/dU
+        from the same march (module docstring)."""
         nb, r = basis.nb, self.m
         U = np.asarray(U, float).reshape(nb, r)
-        Fs, f, W, q = self._resultants(U[None], basis)
+        dq = self._directions(basis, r) if jac else None
+        Fs, f, W, q, dFs = self._resultants(U[None], basis, dq)
         F, dw, Wv = Fs[0], None, 0.0
+        dF = None if dFs is None else dFs[0].reshape(nb * r, nb * r)
         if self.C is not None:
             op = np.kron(basis.dtheta, self.C)
             dw = op @ U.ravel()
             F = F + omega * dw.reshape(nb, r)
             Wv = viscous_work(self.C, U, basis, omega)
-        out = _CondensedForce(F, None, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
-        if jac:
-            out.jacobian = lambda: self._jacobian(U, basis, omega)
-        return out
+            if dF is not None:
+                dF = dF + omega * op
+        return LocalForce(F, dF, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
 
-    def _resultants(self, Us, basis):
+    @staticmethod
+    def _directions(basis, r) -> np.ndarray:
+        """dq (n_t, r, n_b r): the samples' sensitivity to each harmonic of each input."""
+        n_t = basis.E.shape[0]
+        return np.einsum("tb,ij->tibj", basis.E, np.eye(r)).reshape(n_t, r, basis.nb * r)
+
+    def _resultants(self, Us, basis, dq=None):
         """Harmonics (n_h, n_b, r) of the resultants of input harmonics Us (n_h, n_b, r), with
-        the samples f, the friction work W and the inputs' samples q."""
+        the samples f, the friction work W, the inputs' samples q and, given the samples'
+        sensitivities dq (n_t, r, n_d), the harmonics' (n_h, n_b, r, n_d) (else None)."""
         q = np.einsum("tb,hbr->htr", basis.E, Us)
         try:
-            f, W = self.march(q)
+            out = self.march(q, dq=dq)
         except RuntimeError:
             # no node equilibrium along this motion (e.g. a trial step far off): a
             # non-finite force, which a line search rejects and a Newton start reports
-            f, W = np.full_like(q, np.nan), np.full(q.shape[0], np.nan)
-        return np.einsum("bt,htr->hbr", basis.D, f), f, W, q
-
-    def _jacobian(self, U, basis, omega) -> np.ndarray:
-        """dF/dU (n_b r, n_b r), coefficient-major (b r + j): the march's forward
-        sensitivities along every harmonic of every input, one history (module docstring)."""
-        nb, r = basis.nb, self.m
-        q = np.einsum("tb,br->tr", basis.E, U)[None]
-        dq = np.einsum("tb,ij->tibj", basis.E, np.eye(r)).reshape(basis.E.shape[0], r, nb * r)
-        try:
-            df = self.march(q, dq=dq)[2][0]                       # (n_t, r, n_b r)
-        except RuntimeError:
-            return np.full((nb * r, nb * r), np.nan)
-        dF = np.einsum("bt,trd->brd", basis.D, df).reshape(nb * r, nb * r)
-        if self.C is not None:
-            dF = dF + omega * np.kron(basis.dtheta, self.C)
-        return dF
+            nan = np.full_like(q, np.nan)
+            out = (nan, np.full(q.shape[0], np.nan)) + (() if dq is None else (nan[..., None] + dq[0, 0],))
+        Fs = np.einsum("bt,htr->hbr", basis.D, out[0])
+        dFs = None if dq is None else np.einsum("bt,htrd->hbrd", basis.D, out[2])
+        return Fs, out[0], out[1], q, dFs
 
     def jacobian_fd(self, U, basis, omega, rel: float = FD_REL) -> np.ndarray:
         """dF/dU (n_b r, n_b r) by forward differences (the base and every column one batched
@@ -235,16 +229,3 @@ class CondensedSurface(ForceElement):
         if self.C is not None:
             dF = dF + omega * np.kron(basis.dtheta, self.C)
         return dF
-
-
-class _CondensedForce(LocalForce):
-    """:class:`~.forces.LocalForce` whose ``dF`` is computed on first access (``jacobian``)."""
-
-    jacobian = None
-
-    def __getattribute__(self, name):
-        if name == "dF":
-            d = object.__getattribute__(self, "__dict__")
-            if d.get("dF") is None and d.get("jacobian") is not None:
-                d["dF"], d["jacobian"] = d["jacobian"](), None
-        return object.__getattribute__(self, name)

@@ -45,6 +45,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from scipy.sparse import diags
 
 from .massless import MasslessContacts
 
@@ -98,8 +99,8 @@ class MarchSensitivity:
         """
         nodes = self.nodes
         n_h, n_c = nodes.n_h, len(nodes.kn)
-        ds0 = np.einsum("cb,hbd->hcd", nodes.Qs, self.dw)
-        dP0 = np.einsum("cb,hbd->hcd", nodes.Qp, self.dw)
+        ds0 = nodes.Qs @ self.dw
+        dP0 = nodes.Qp @ self.dw
         Kt, KN = np.zeros((n_h, n_c)), np.zeros((n_h, n_c))
         G = np.zeros((n_h, n_c, self.dw.shape[2]))
         updates = []
@@ -118,8 +119,8 @@ class MarchSensitivity:
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
         self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
-        ds1 = np.einsum("cb,hbd->hcd", nodes.Qs, self.dw)
-        dP1 = np.einsum("cb,hbd->hcd", nodes.Qp, self.dw)
+        ds1 = nodes.Qs @ self.dw
+        dP1 = nodes.Qp @ self.dw
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
             dn1 = dP1[:, idx] * n_scale
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
@@ -130,10 +131,11 @@ class MarchSensitivity:
         nodes = self.nodes
         n_h = nodes.n_h
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
-        Qs, Qp = nodes.Qs, nodes.Qp
-        J += np.einsum("ci,hc,cj->hij", Qs, Kt, Qs) + np.einsum("ci,hc,cj->hij", Qs, KNkn, Qp)
-        J += np.einsum("ci,hc,cj->hij", Qp, kn_on, Qp)
-        b = rhs_q[None] - np.einsum("ci,hcd->hid", Qs, G)
+        Qs, Qp, QsT = nodes._Qs, nodes._Qp, nodes._QsT
+        for h in range(n_h):      # a contact touches a few DOFs: sparse products
+            J[h] += (QsT @ diags(Kt[h]) @ Qs + QsT @ diags(KNkn[h]) @ Qp
+                     + nodes._QpT @ diags(kn_on[h]) @ Qp).toarray()
+        b = rhs_q[None] - nodes.Qs.T @ G
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
         for dofs, *_ in self._order:
