@@ -45,7 +45,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy.sparse import diags
 
 from .massless import MasslessContacts
 
@@ -78,6 +77,10 @@ class MarchSensitivity:
         self.dz = [np.zeros((n_h, idx.size, ref.n_sliders, n_d)) for ref, idx, _ in nodes.groups]
         self.duc = [np.zeros((n_h, idx.size, n_d)) for _, idx, _ in nodes.groups]
         self._order = self._block_order()
+        # the products Q_a^T diag(k) Q_b of (M2) as triplets (contact, row, column, Q_a Q_b):
+        # a contact touches a few DOFs
+        self._pairs = [_pairs(Qa, Qb) for Qa, Qb in ((nodes.Qs, nodes.Qs), (nodes.Qs, nodes.Qp),
+                                                     (nodes.Qp, nodes.Qp))]
 
     def _block_order(self) -> list:
         """The march's blocks, those without slip rows (normal only) first (module docstring)."""
@@ -131,10 +134,9 @@ class MarchSensitivity:
         nodes = self.nodes
         n_h = nodes.n_h
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
-        Qs, Qp, QsT = nodes._Qs, nodes._Qp, nodes._QsT
-        for h in range(n_h):      # a contact touches a few DOFs: sparse products
-            J[h] += (QsT @ diags(Kt[h]) @ Qs + QsT @ diags(KNkn[h]) @ Qp
-                     + nodes._QpT @ diags(kn_on[h]) @ Qp).toarray()
+        for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
+            for h in range(n_h):
+                np.add.at(J[h], (i, j), v * k[h, c])
         b = rhs_q[None] - nodes.Qs.T @ G
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
@@ -147,6 +149,17 @@ class MarchSensitivity:
             dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
             solved[dofs] = True
         return dw
+
+
+def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
+    """(c, i, j, Qa[c, i] Qb[c, j]) over the nonzeros of each contact's rows."""
+    out = [], [], [], []
+    for c in range(Qa.shape[0]):
+        ia, jb = np.flatnonzero(Qa[c]), np.flatnonzero(Qb[c])
+        i, j = np.repeat(ia, jb.size), np.tile(jb, ia.size)
+        for lst, v in zip(out, (np.full(i.size, c), i, j, Qa[c, i] * Qb[c, j])):
+            lst.append(v)
+    return tuple(np.concatenate(v) if v else np.zeros(0, int) for v in out)
 
 
 class _EndState(NamedTuple):
