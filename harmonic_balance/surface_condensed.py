@@ -36,9 +36,10 @@ step), along the n_b r directions of U in the residual's own march (one history;
 the sensitivities cost about what the march does). The forward differences of the whole march
 (:meth:`CondensedSurface.jacobian_fd`, 1 + n_b r histories) are kept as its reference.
 
-Cost: every node over ``PERIODS`` periods per history; UPD-24 with 5 nodes per side
-(63 and 40 nodes), 48 samples: 2.4 s per evaluation with its Jacobian at H 3, 4.8 s
-at H 7 (docs/method/contact_surface.md).
+Cost: every node over ``PERIODS`` periods of node solves per evaluation, plus one
+linear solve of the settled set per step for the sensitivities; UPD-24 with 5 nodes per
+side (69 and 40 nodes), 48 samples at H 3: one frequency 30 s
+(docs/method/contact_surface.md).
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """
