@@ -29,14 +29,17 @@ q(0) and runs ``periods`` periods; the last one is the steady loop (a node that 
 in every cycle has forgotten the start; one that never slips keeps where the first
 period left it, the C core's convention for a point contact).
 
-Jacobian: dF/dU by forward differences of the whole march, all columns advanced
-together as histories of one batched march (1 + n_b r histories), marched only when
-the Jacobian is first read (the residual's ``value`` asks for it at a line search's
-trial points and reads it only at the accepted one).
+Jacobian: dF/dU exact, by the forward sensitivities of the march
+(:mod:`.surface_sensitivity`: each committed step's settled set gives dw/dq and the
+friction states' sensitivities by the implicit function theorem, carried from step to
+step), along the n_b r directions of U in the residual's own march (one history;
+the sensitivities cost about what the march does). The forward differences of the whole march
+(:meth:`CondensedSurface.jacobian_fd`, 1 + n_b r histories) are kept as its reference.
 
-Cost: every node over ``PERIODS`` periods per history; UPD-24 with 5 nodes per side
-(63 and 40 nodes), 48 samples: 2.4 s per evaluation with its Jacobian at H 3, 4.8 s
-at H 7 (docs/method/contact_surface.md).
+Cost: every node over ``PERIODS`` periods of node solves per evaluation, plus one
+linear solve of the settled set per step for the sensitivities; UPD-24 with 5 nodes per
+side (69 and 40 nodes), 48 samples at H 3: one frequency 30 s
+(docs/method/contact_surface.md).
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """
@@ -47,15 +50,18 @@ import numpy as np
 from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
 from .massless import MasslessContacts
+from .surface_sensitivity import MarchSensitivity
 
 #: Periods marched; the last is the loop. A node that first slips in period 2 or later
 #: (the amplitude grows through the march only at its start) would need more.
 PERIODS = 2
-#: Forward-difference step of the Jacobian relative to each input's amplitude. The
-#: march is piecewise linear in U away from a stick/slip or contact kink, and its
-#: node solve ends on an exact linear solve of the settled set (round-off ~1e-14 of
-#: the loads), so the difference quotient is exact to ~1e-14 / FD_REL.
-FD_REL = 1e-7
+#: Forward-difference step of the reference Jacobian (:meth:`CondensedSurface.jacobian_fd`)
+#: relative to each input's amplitude. The node solve stops at 1e-7 of the loads
+#: (massless.RESIDUAL_RTOL), so a step of 1e-7 differences that tolerance (measured: 20 %
+#: off the exact Jacobian in some entries); the march is piecewise linear in U (bilinear
+#: where a node re-contacts inside a step), so 1e-4 stays on one piece away from kinks and
+#: agrees with the exact Jacobian to ~1e-8 (tests/hb/test_surface_sensitivity.py).
+FD_REL = 1e-4
 #: Load steps from the prestress to the first sample (the node solve's Newton settles a
 #: step within MAX_NEWTON iterations only for moderate changes of the contact set).
 RAMP = 8
@@ -111,82 +117,112 @@ class CondensedSurface(ForceElement):
     def local_damping(self):
         return self.C
 
-    def march(self, q: np.ndarray, periods: int = PERIODS):
+    def march(self, q: np.ndarray, periods: int = PERIODS, dq=None):
         """Resultants f_q (n_h, n_t, r) [N] and the last period's friction work (n_h,) [J] of
         histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring).
+
+        With ``dq`` (n_t, r, n_d), the sensitivities of the samples along n_d directions
+        (the same for every history), also their resultants' sensitivities df (n_h, n_t,
+        r, n_d) by the march's forward sensitivities (:mod:`.surface_sensitivity`).
 
         Raises
         ------
         RuntimeError
             The node solve found no equilibrium even in a step split MAX_SPLIT times.
         """
-        n_h, n_t, _ = q.shape
+        n_h, n_t, r = q.shape
         nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
         A = nodes.split(self.A)
+        sens = None if dq is None else MarchSensitivity(nodes, self.A, self.AR, dq.shape[2])
+        dq = np.zeros((n_t, r, 0)) if dq is None else dq
         w = np.tile(self.w_static, (n_h, 1))
         f = np.empty_like(q)
-        q_prev = np.tile(self.q_static, (n_h, 1))
+        df = None if sens is None else np.empty((n_h, n_t, r, dq.shape[2]))
+        q_prev, dq_prev = np.tile(self.q_static, (n_h, 1)), np.zeros_like(dq[0])
         for a in np.linspace(0.0, 1.0, RAMP + 1)[1:-1]:   # from the prestress towards q(0)
             q_a = (1.0 - a) * q_prev + a * q[:, 0]
-            w = self._step(nodes, A, q_prev, q_a, w, 0)
-            q_prev = q_a
+            dq_a = (1.0 - a) * dq_prev + a * dq[0]
+            w = self._step(nodes, A, (q_prev, dq_prev), (q_a, dq_a), w, 0, sens)
+            q_prev, dq_prev = q_a, dq_a
         W0 = None
         for p in range(periods):
             if p == periods - 1:
                 W0 = nodes.dissipated()
             for k in range(n_t):
-                w = self._step(nodes, A, q_prev, q[:, k], w, 0)
-                q_prev = q[:, k]
+                w = self._step(nodes, A, (q_prev, dq_prev), (q[:, k], dq[k]), w, 0, sens)
+                q_prev, dq_prev = q[:, k], dq[k]
                 f[:, k] = q[:, k] @ self.RtAR.T - w @ self.RtA.T
-        return f, nodes.dissipated() - W0
+                if sens is not None and p == periods - 1:
+                    df[:, k] = (self.RtAR @ dq[k])[None] - np.einsum("rb,hbd->hrd", self.RtA, sens.dw)
+        if sens is None:
+            return f, nodes.dissipated() - W0
+        return f, nodes.dissipated() - W0, df
 
-    def _step(self, nodes, A, q0, q1, w, depth):
-        """Equilibrium (Q1) at q1 from the committed state at q0; halves the step where the
-        node solve does not settle (it commits only a settled step)."""
+    def _step(self, nodes, A, start, end, w, depth, sens=None):
+        """Equilibrium (Q1) at q_1 from the committed state at q_0 (``start``, ``end``: (q,
+        dq) pairs); halves the step where the node solve does not settle (it commits only a
+        settled step) and carries ``sens`` over each committed step."""
+        before = None if sens is None else [st.copy() for st in nodes.states]
         try:
-            return nodes.solve(A, q1 @ self.AR.T, w)
+            w1 = nodes.solve(A, end[0] @ self.AR.T, w)
         except RuntimeError:
             if depth >= MAX_SPLIT:
                 raise
-        w = self._step(nodes, A, q0, 0.5 * (q0 + q1), w, depth + 1)
-        return self._step(nodes, A, 0.5 * (q0 + q1), q1, w, depth + 1)
+        else:
+            if sens is not None:
+                sens.advance(before, w1, end[1])
+            return w1
+        mid = tuple(0.5 * (x0 + x1) for x0, x1 in zip(start, end))
+        w = self._step(nodes, A, start, mid, w, depth + 1, sens)
+        return self._step(nodes, A, mid, end, w, depth + 1, sens)
 
     def evaluate(self, U, basis: FourierBasis, omega: float, jac: bool = True) -> LocalForce:
-        """Harmonics of (Q2) for input harmonics U (n_b, r); dF/dU by differences (module
-        docstring), marched when first read (a line search's rejected trial point, whose
-        Jacobian the residual asks for but never reads, costs one history)."""
+        """Harmonics of (Q2) for input harmonics U (n_b, r); with ``jac`` their exact dF/dU
+        from the same march (module docstring)."""
         nb, r = basis.nb, self.m
         U = np.asarray(U, float).reshape(nb, r)
-        Fs, f, W, q = self._resultants(U[None], basis)
+        dq = self._directions(basis, r) if jac else None
+        Fs, f, W, q, dFs = self._resultants(U[None], basis, dq)
         F, dw, Wv = Fs[0], None, 0.0
+        dF = None if dFs is None else dFs[0].reshape(nb * r, nb * r)
         if self.C is not None:
             op = np.kron(basis.dtheta, self.C)
             dw = op @ U.ravel()
             F = F + omega * dw.reshape(nb, r)
             Wv = viscous_work(self.C, U, basis, omega)
-        out = _CondensedForce(F, None, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
-        if jac:
-            out.jacobian = lambda: self._jacobian(U, basis, omega)
-        return out
+            if dF is not None:
+                dF = dF + omega * op
+        return LocalForce(F, dF, dw, W=float(W[0]) + Wv, W_viscous=Wv, q=q[0], f=f[0])
 
-    def _resultants(self, Us, basis):
+    @staticmethod
+    def _directions(basis, r) -> np.ndarray:
+        """dq (n_t, r, n_b r): the samples' sensitivity to each harmonic of each input."""
+        n_t = basis.E.shape[0]
+        return np.einsum("tb,ij->tibj", basis.E, np.eye(r)).reshape(n_t, r, basis.nb * r)
+
+    def _resultants(self, Us, basis, dq=None):
         """Harmonics (n_h, n_b, r) of the resultants of input harmonics Us (n_h, n_b, r), with
-        the samples f, the friction work W and the inputs' samples q."""
+        the samples f, the friction work W, the inputs' samples q and, given the samples'
+        sensitivities dq (n_t, r, n_d), the harmonics' (n_h, n_b, r, n_d) (else None)."""
         q = np.einsum("tb,hbr->htr", basis.E, Us)
         try:
-            f, W = self.march(q)
+            out = self.march(q, dq=dq)
         except RuntimeError:
             # no node equilibrium along this motion (e.g. a trial step far off): a
             # non-finite force, which a line search rejects and a Newton start reports
-            f, W = np.full_like(q, np.nan), np.full(q.shape[0], np.nan)
-        return np.einsum("bt,htr->hbr", basis.D, f), f, W, q
+            nan = np.full_like(q, np.nan)
+            out = (nan, np.full(q.shape[0], np.nan)) + (() if dq is None else (nan[..., None] + dq[0, 0],))
+        Fs = np.einsum("bt,htr->hbr", basis.D, out[0])
+        dFs = None if dq is None else np.einsum("bt,htrd->hbrd", basis.D, out[2])
+        return Fs, out[0], out[1], q, dFs
 
-    def _jacobian(self, U, basis, omega) -> np.ndarray:
-        """dF/dU (n_b r, n_b r): forward differences, the base and every column one batch."""
+    def jacobian_fd(self, U, basis, omega, rel: float = FD_REL) -> np.ndarray:
+        """dF/dU (n_b r, n_b r) by forward differences (the base and every column one batched
+        march of 1 + n_b r histories): the reference the exact Jacobian is tested against."""
         nb, r = basis.nb, self.m
         cols = nb * r
         Us = np.repeat(U[None], 1 + cols, axis=0)
-        h = FD_REL * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
+        h = rel * np.maximum(np.abs(U).max(axis=0), 1e-300)   # (r,)
         for j in range(cols):
             Us[1 + j].flat[j] += h[j % r]
         Fs = self._resultants(Us, basis)[0]
@@ -194,16 +230,3 @@ class CondensedSurface(ForceElement):
         if self.C is not None:
             dF = dF + omega * np.kron(basis.dtheta, self.C)
         return dF
-
-
-class _CondensedForce(LocalForce):
-    """:class:`~.forces.LocalForce` whose ``dF`` is computed on first access (``jacobian``)."""
-
-    jacobian = None
-
-    def __getattribute__(self, name):
-        if name == "dF":
-            d = object.__getattribute__(self, "__dict__")
-            if d.get("dF") is None and d.get("jacobian") is not None:
-                d["dF"], d["jacobian"] = d["jacobian"](), None
-        return object.__getattribute__(self, name)

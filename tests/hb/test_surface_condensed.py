@@ -107,9 +107,11 @@ def test_condensed_surface_hb_dissipates_the_quasi_static_loop_at_low_H(element)
 
 
 #: Directional derivative of the resultants against the Jacobian's action: the march is
-#: piecewise linear in U, so a central difference (1e-6 of the amplitude) across no kink
-#: equals it up to round-off; measured 1.7e-6 (the transposed Jacobian: 1.1, the loop
+#: piecewise linear in U, so a central difference (STEP of the amplitude, far above the
+#: node solve's tolerance of 1e-7 of the loads, which a step of 1e-6 already feels at
+#: 3e-3) across no kink equals it up to round-off (the transposed Jacobian: 1.1, the loop
 #: slips, so dF/dU is not symmetric).
+STEP = 1e-4
 JACOBIAN_RTOL = 1e-4
 
 
@@ -122,7 +124,7 @@ def test_condensed_jacobian_acts_as_the_directional_derivative(element):
     basis, U, _ = _loop(el, q_static, surface, amp)
     res = el.evaluate(U, basis, 1.0, jac=True)
     v = np.random.default_rng(20261127).standard_normal(U.shape) * np.abs(U).max(axis=0)
-    eps = 1e-6
+    eps = STEP
     Fp = el.evaluate(U + eps * v, basis, 1.0, jac=False).F
     Fm = el.evaluate(U - eps * v, basis, 1.0, jac=False).F
     d = ((Fp - Fm) / (2 * eps)).ravel()
