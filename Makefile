@@ -43,8 +43,12 @@ ctest: cbuild
 
 # The run records its reference checks (tests/refcheck.py); the check after it fails when
 # docs/data/validation.json (the documentation's validation table) no longer lists them.
+# On PYTEST_WORKERS processes (pytest-xdist), a test file's tests on one of them, so a
+# file's module fixtures are built once; the workers' records are merged (tests/conftest.py).
+PYTEST_WORKERS ?= 2
 pytest: $(STAMP) cbuild browser
-	DAMPER_VALIDATION_JSON=build/validation.json OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q
+	DAMPER_VALIDATION_JSON=build/validation.json OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q \
+	  -n $(PYTEST_WORKERS) --dist loadfile
 	$(PY) docs/tools/validation_check.py build/validation.json docs/data/validation.json
 
 lint: $(STAMP)

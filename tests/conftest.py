@@ -30,21 +30,39 @@ def load_example():
 
 # The validation table (docs/validation.md): every refcheck.check of this run, written to
 # $DAMPER_VALIDATION_JSON with the tests that passed and the run's stamp (make validation).
+# Under pytest-xdist (make test runs `-n 2`) each worker holds the checks of its own tests:
+# it hands them to the controller (workeroutput), which merges them and writes the one file.
 _PASSED: list[str] = []
 
 
 def pytest_runtest_logreport(report):
+    # on the xdist controller too: it replays every worker's reports through this hook
     if report.when == "call" and report.passed:
         _PASSED.append(report.nodeid)
 
 
+@pytest.hookimpl(optionalhook=True)   # an xdist hook: unknown without the plugin
+def pytest_testnodedown(node, error):
+    """Controller: collect a finished worker's reference checks."""
+    import json
+
+    import refcheck
+
+    records = json.loads(getattr(node, "workeroutput", {}).get("refcheck_records", "[]"))
+    refcheck.RECORDS.extend(records)
+    refcheck.RECORDS.sort(key=lambda r: r["test"])   # stable: a test's checks keep their order
+
+
 def pytest_sessionfinish(session, exitstatus):
     import json
-    import os
     import sys
 
     import refcheck
 
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:   # an xdist worker: the controller writes the file
+        workeroutput["refcheck_records"] = json.dumps(refcheck.RECORDS)
+        return
     path = os.environ.get("DAMPER_VALIDATION_JSON")
     if not path:
         return

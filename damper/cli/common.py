@@ -105,6 +105,25 @@ def check_accuracy_option(tol) -> None:
                          f"amplitude, got {tol:g}")
 
 
+def upd_model_options(p) -> None:
+    """``--config`` and ``--json`` of every ``damper upd`` action."""
+    p.add_argument("--config", help="UPD model TOML (default: the bundled UPD-24)")
+    p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
+
+
+def accuracy_lines(out) -> list[str]:
+    """The truncation-error lines of a ``upd frf``, ``upd optimize`` or ``upd mistuning``
+    result (frequencies in Hz)."""
+    from harmonic_balance.frf_accuracy import summary_lines
+
+    rec = out.get("truncation_error")
+    if not rec:
+        return []
+    summary = {"truncation_error": rec, "accuracy": rec.get("accuracy"),
+               "truncation_warning": out.get("truncation_warning")}
+    return summary_lines(summary, hz=True)
+
+
 def _writable_parent(path: Path, flag: str) -> None:
     """The nearest existing folder above ``path`` must be a folder this user can write."""
     probe = path.parent

@@ -65,6 +65,10 @@ FEW_PERIODS = 400
 #: Share of the band a curve at FEW_PERIODS traces at least: its first loops that do not
 #: close lie near 0.56 rad/s, 5 % into the band (0.5-1.6 rad/s).
 PASSED_SHARE = 0.1
+#: Highest harmonic of these curves: loops that do not close in FEW_PERIODS come from the
+#: slider's slow drift in the time march, which a curve at H = 3 meets as one at the
+#: case's H = 7 does, for a small fraction of the cost (n_t and the Jacobians grow with H).
+HARMONICS = 3
 
 
 def test_contact_point_curve_passes_loops_that_do_not_close(monkeypatch):
@@ -72,20 +76,28 @@ def test_contact_point_curve_passes_loops_that_do_not_close(monkeypatch):
     band's end or to a stretch where every nearby state fails, which then ends it with the
     element's reason (which of the two depends on where the continuation's points fall)."""
     monkeypatch.setattr(bm, "CONTACT_POINT_PERIODS", FEW_PERIODS)
+    failed = []
+    init = IwanNotConvergedError.__init__
+
+    def counted(self, *args):   # each loop that did not close
+        failed.append(args)
+        init(self, *args)
+    monkeypatch.setattr(IwanNotConvergedError, "__init__", counted)
     case = bm.contact_point()
     lo, hi = case.band
     try:
-        r = compute_frf(case.model(), 7, case.band, stability="off")
+        r = compute_frf(case.model(), HARMONICS, case.band, stability="off")
     except FRFError as err:
         assert "periodic loop did not close" in str(err)
         reached = float(str(err).split("stopped at parameter ")[1].split()[0])
         assert reached > lo + PASSED_SHARE * (hi - lo)  # past the first failing loops
     else:
         assert r.omega[0] == pytest.approx(lo) and r.omega[-1] == pytest.approx(hi)
+    assert failed  # some loops did not close: the curve went past them
 
 
 def test_contact_point_that_never_closes_its_loop_fails_with_the_reason(monkeypatch):
     monkeypatch.setattr(bm, "CONTACT_POINT_PERIODS", 1)
     case = bm.contact_point()
     with pytest.raises(FRFError, match="periodic loop did not close"):
-        compute_frf(case.model(), 7, case.band, stability="off")
+        compute_frf(case.model(), HARMONICS, case.band, stability="off")
