@@ -47,3 +47,22 @@ def two_dof(c_prop=True, fs=0.04, P=0.05) -> Model:
     links = [FrictionLink(jenkins(0.8, fs), 0, 1, "between"),
              FrictionLink(jenkins(0.5, 2.0 * fs), 1, None, "ground")]
     return Model(LinearModel(M=M, C=C, K=K), links, {1: np.array([P, 0.0])}, response_dof=0)
+
+
+def condensed_flat_face(cache, normal_load: float, mu: float, penalty: float):
+    """A small flat face (5 x 5 grid, 15 contact nodes, planar: z and x) condensed onto its
+    rigid inputs, preloaded by ``normal_load`` [N]: (CondensedSurface, q_static (r,), surface)."""
+    from contact_core.condense import condense
+    from contact_core.spec import ContactSpec
+    from harmonic_balance import surface as sf
+    from harmonic_balance import surface_static as ss
+    from harmonic_balance.kinematics import Kinematics
+    from harmonic_balance.surface_condensed import CondensedSurface
+
+    cc = condense(ContactSpec(body="flat", width=1.2e-3, length=1.2e-3, grid=5), directions=("z", "x"),
+                  cache=cache)
+    surface = sf.build(cc, mu, penalty=penalty, tangents=("x",))
+    x = ss.preload(surface, normal_load).x
+    slips = [x[surface.d * i] for i in range(surface.n)]
+    kin = Kinematics(list(range(len(surface.inputs))), np.eye(len(surface.inputs)))
+    return CondensedSurface(surface, kin, x[surface.n_w:], x[:surface.n_w], slips), x[surface.n_w:], surface

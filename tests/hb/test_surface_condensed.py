@@ -10,14 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hbcases import condensed_flat_face
 
-from contact_core.condense import condense
-from contact_core.spec import ContactSpec
-from harmonic_balance import surface as sf
 from harmonic_balance import surface_static as ss
 from harmonic_balance.fourier import FourierBasis
-from harmonic_balance.kinematics import Kinematics
-from harmonic_balance.surface_condensed import CondensedSurface
 
 N, MU, PENALTY = 100.0, 0.5, 1e4
 #: Samples of the period (the march is exact at the samples; the loop's work is summed
@@ -34,14 +30,7 @@ ENERGY_RTOL = 2e-3
 
 @pytest.fixture(scope="module")
 def element(tmp_path_factory):
-    cc = condense(ContactSpec(body="flat", width=1.2e-3, length=1.2e-3, grid=5), directions=("z", "x"),
-                  cache=tmp_path_factory.mktemp("surface_condensed_cache"))
-    surface = sf.build(cc, MU, penalty=PENALTY, tangents=("x",))
-    state = ss.preload(surface, N)
-    x = state.x
-    slips = [x[surface.d * i] for i in range(surface.n)]
-    kin = Kinematics(list(range(len(surface.inputs))), np.eye(len(surface.inputs)))
-    return CondensedSurface(surface, kin, x[surface.n_w:], x[:surface.n_w], slips), x[surface.n_w:], surface
+    return condensed_flat_face(tmp_path_factory.mktemp("surface_condensed_cache"), N, MU, PENALTY)
 
 
 def _loop(el, q_static, surface, amp):

@@ -9,15 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hbcases import condensed_flat_face
 
-from contact_core.condense import condense
-from contact_core.spec import ContactSpec
-from harmonic_balance import surface as sf
 from harmonic_balance import surface_sensitivity as sens
-from harmonic_balance import surface_static as ss
 from harmonic_balance.fourier import FourierBasis
-from harmonic_balance.kinematics import Kinematics
-from harmonic_balance.surface_condensed import CondensedSurface
 
 N, MU, PENALTY = 100.0, 0.5, 1e4
 #: Samples of the period and harmonics (the march is exact at the samples).
@@ -34,13 +29,7 @@ JACOBIAN_RTOL = 1e-6
 
 @pytest.fixture(scope="module")
 def element(tmp_path_factory):
-    cc = condense(ContactSpec(body="flat", width=1.2e-3, length=1.2e-3, grid=5), directions=("z", "x"),
-                  cache=tmp_path_factory.mktemp("surface_sensitivity_cache"))
-    surface = sf.build(cc, MU, penalty=PENALTY, tangents=("x",))
-    x = ss.preload(surface, N).x
-    slips = [x[surface.d * i] for i in range(surface.n)]
-    kin = Kinematics(list(range(len(surface.inputs))), np.eye(len(surface.inputs)))
-    return CondensedSurface(surface, kin, x[surface.n_w:], x[:surface.n_w], slips), x[surface.n_w:], surface
+    return condensed_flat_face(tmp_path_factory.mktemp("surface_sensitivity_cache"), N, MU, PENALTY)
 
 
 def _motion(element, slide: float, rock: float):
