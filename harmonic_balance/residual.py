@@ -446,22 +446,35 @@ class CondensedResidual(_Residual):
         """Receptance on real coefficient pairs, (n_b len(rows), n_b len(cols)), + d/domega."""
         lin, b = self.model.linear, self.basis
         nr, nc = len(rows), len(cols)
-        G = np.zeros((b.nb, nr, b.nb, nc))
-        dG = np.zeros_like(G) if deriv else None
-        gs, dgs = lin.receptances(np.asarray(b.harmonics) * omega, rows, cols, deriv)
-        for k, h in enumerate(b.harmonics):
-            ic, isn = b.index(h)
-            for out, val in ((G, gs[k]), (dG, None if dgs is None else h * dgs[k])):
-                if out is None:
-                    continue
-                if isn is None:
-                    out[ic, :, ic, :] = val.real
-                    continue
-                # a = Re G f_a + Im G f_b,  b = Re G f_b - Im G f_a  (linear.py)
-                out[ic, :, ic, :], out[ic, :, isn, :] = val.real, val.imag
-                out[isn, :, ic, :], out[isn, :, isn, :] = -val.imag, val.real
+        h = np.asarray(b.harmonics)
+        gs, dgs = lin.receptances(h * omega, rows, cols, deriv)
+        ic, isn, k = self._pair_index()
         shape = (b.nb * nr, b.nb * nc)
-        return G.reshape(shape), None if dG is None else dG.reshape(shape)
+        out = []
+        for val in (gs, None if dgs is None else h[:, None, None] * dgs):
+            if val is None:
+                out.append(None)
+                continue
+            # a = Re G f_a + Im G f_b,  b = Re G f_b - Im G f_a  (linear.py), per harmonic:
+            # the 2 x 2 block [[Re, Im], [-Im, Re]] on its (cos, sin) pair, Re alone at h = 0
+            G = np.zeros((b.nb, nr, b.nb, nc))
+            G[ic, :, ic, :] = val.real
+            G[isn, :, ic[k], :] = -val.imag[k]
+            G[ic[k], :, isn, :] = val.imag[k]
+            G[isn, :, isn, :] = val.real[k]
+            out.append(G.reshape(shape))
+        return out[0], out[1]
+
+    def _pair_index(self):
+        """Coefficient indices of the retained harmonics: cos (K,), sin (K',) and the
+        positions (K',) of the harmonics that have a sine (all but h = 0)."""
+        if not hasattr(self, "_pairs"):
+            b = self.basis
+            idx = [b.index(h) for h in b.harmonics]
+            k = np.array([j for j, (_, s) in enumerate(idx) if s is not None], dtype=int)
+            self._pairs = (np.array([c for c, _ in idx], dtype=int),
+                           np.array([s for _, s in idx if s is not None], dtype=int), k)
+        return self._pairs
 
     def _linear_response(self, rows, omega: float, deriv: bool):
         """Response (n_b, len(rows)) of the linear part to F_ext, and d/domega."""
