@@ -342,18 +342,21 @@ def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
     f[:, :, 1] = kn[:, None] * np.where(on, p, 0.0)
     s = U[:, :, 0] @ E.T                                    # (n_e, n_t) slip
     dF = np.zeros((n_e, 2 * nb, 2 * nb)) if jac else None
-    if jac:  # dN/dU_p = D diag(k_n on) E, (C1)
-        dF[:, 1::2, 1::2] = (D[None] * (kn[:, None] * on)[:, None, :]) @ E
+    # sampled friction rows of every element side by side: (n_t, n_e, [dF/dU_s dF/dU_p])
+    Z = np.zeros((basis.n_t, n_e, 2 * nb)) if jac else None
     for i, el in enumerate(elements):
         kw = {"N": el.k_n * p[i], "max_periods": el.max_periods, "tol": el.tol}
         if jac:
+            dF[i, 1::2, 1::2] = el._normal_block(basis, on[i])  # dN/dU_p (C1)
             Ft, rows, dFs, dFp, _ = el.friction.periodic_jac_rows(
                 s[i] - el.slip_ref, E, EN=el._cached(basis, "EN"), **kw)
-            Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
-            dF[i, 0::2, 0::2], dF[i, 0::2, 1::2] = Dr @ dFs, Dr @ dFp
+            Z[rows, i, :nb], Z[rows, i, nb:] = dFs, dFp
         else:
             Ft = el.friction.periodic_jac_terms(s[i] - el.slip_ref, with_N=False, **kw)[0]
         f[i, :, 0] = Ft
+    if jac:  # D dF/dU of all elements in one product (rows not in ``rows`` are zero)
+        DZ = (D @ Z.reshape(basis.n_t, -1)).reshape(nb, n_e, 2 * nb).transpose(1, 0, 2)
+        dF[:, 0::2, 0::2], dF[:, 0::2, 1::2] = DZ[:, :, :nb], DZ[:, :, nb:]
     F = D @ f                                                # (n_e, n_b, 2)
     dw = None
     if any(el.beta_c != 0.0 for el in elements):
