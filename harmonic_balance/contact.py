@@ -331,7 +331,8 @@ def evaluate_many(elements, U, basis: FourierBasis, omega: float, jac: bool = Tr
 
 
 def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
-    """:func:`evaluate_many` of one-tangent contacts (m = 2), rows path of the C core."""
+    """:func:`evaluate_many` of one-tangent contacts (m = 2): with the Jacobian all friction
+    loops in one C call (``periodic_jac_many``, dense sampled rows), else one call each."""
     n_e, nb = U.shape[:2]
     E, D = basis.E, basis.D
     kn = np.array([el.k_n for el in elements])
@@ -342,21 +343,23 @@ def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
     f[:, :, 1] = kn[:, None] * np.where(on, p, 0.0)
     s = U[:, :, 0] @ E.T                                    # (n_e, n_t) slip
     dF = np.zeros((n_e, 2 * nb, 2 * nb)) if jac else None
-    # sampled friction rows of every element side by side: (n_t, n_e, [dF/dU_s dF/dU_p])
-    Z = np.zeros((basis.n_t, n_e, 2 * nb)) if jac else None
+    one_call = jac and len({(el.max_periods, el.tol) for el in elements}) == 1
+    if one_call:
+        dF[:, 0::2, 0::2], dF[:, 0::2, 1::2] = _friction_all(elements, s, kn[:, None] * p, basis, f)
     for i, el in enumerate(elements):
-        kw = {"N": el.k_n * p[i], "max_periods": el.max_periods, "tol": el.tol}
         if jac:
             dF[i, 1::2, 1::2] = el._normal_block(basis, on[i])  # dN/dU_p (C1)
+        if one_call:
+            continue
+        kw = {"N": el.k_n * p[i], "max_periods": el.max_periods, "tol": el.tol}
+        if jac:
             Ft, rows, dFs, dFp, _ = el.friction.periodic_jac_rows(
                 s[i] - el.slip_ref, E, EN=el._cached(basis, "EN"), **kw)
-            Z[rows, i, :nb], Z[rows, i, nb:] = dFs, dFp
+            Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
+            dF[i, 0::2, 0::2], dF[i, 0::2, 1::2] = Dr @ dFs, Dr @ dFp
         else:
             Ft = el.friction.periodic_jac_terms(s[i] - el.slip_ref, with_N=False, **kw)[0]
         f[i, :, 0] = Ft
-    if jac:  # D dF/dU of all elements in one product (rows not in ``rows`` are zero)
-        DZ = (D @ Z.reshape(basis.n_t, -1)).reshape(nb, n_e, 2 * nb).transpose(1, 0, 2)
-        dF[:, 0::2, 0::2], dF[:, 0::2, 1::2] = DZ[:, :, :nb], DZ[:, :, nb:]
     F = D @ f                                                # (n_e, n_b, 2)
     dw = None
     if any(el.beta_c != 0.0 for el in elements):
@@ -367,6 +370,19 @@ def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
         if jac:
             dF += omega * ops
     return F, dF, dw
+
+
+def _friction_all(elements, s, N, basis: FourierBasis, f):
+    """Friction (C2) of all elements by one C call (``periodic_jac_many``): forces into
+    f[:, :, 0] (n_e, n_t); returns D dF/dU_s and D dF/dU_p, each (n_e, n_b, n_b)."""
+    from fmu_src.element_batch import periodic_jac_many
+
+    el0 = elements[0]
+    Ft, dFs, dFp, _ = periodic_jac_many(
+        [el.friction for el in elements], s - np.array([el.slip_ref for el in elements])[:, None],
+        basis.E, N, [el._cached(basis, "EN") for el in elements], el0.max_periods, el0.tol)
+    f[:, :, 0] = Ft
+    return basis.D @ dFs, basis.D @ dFp
 
 
 class ContactForce(LocalForce):
