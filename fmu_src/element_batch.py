@@ -6,8 +6,10 @@ one numpy buffer of :data:`STATE_DTYPE` (the C ``iwan_state``), and
 ``iwan_step_batch`` advances state i to (u[i], N[i]) through the time series' own
 code, so each state gets the bits ``IwanElement.step`` would give it alone. Reached
 through :meth:`IwanElement.initial_states`, :meth:`IwanElement.step_batch` and
-:meth:`IwanElement.batch_stepper`. Symbols as in :mod:`fmu_src.element`. Only the ctypes layer (:mod:`fmu_src._clib`) is
-imported here: ``element`` imports this module, never the other way round; ``element``
+:meth:`IwanElement.batch_stepper`. Likewise :func:`periodic_jac_many` runs the
+periodic loops of many elements (e.g. a ring's contacts) in one C call. Symbols as
+in :mod:`fmu_src.element`. Only the ctypes layer (:mod:`fmu_src._clib`) is imported
+here: ``element`` imports this module, never the other way round; ``element``
 arguments are duck-typed (``._mp``, ``.N_ref``).
 """
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from ._clib import STATE_DTYPE, IwanInputError, State, StateArray, arr, check, lib, normal, vec
 
-__all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "step_batch"]
+__all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "periodic_jac_many", "step_batch"]
 
 
 def _check_states(states) -> int:
@@ -140,3 +142,48 @@ def step_batch(element, states: np.ndarray, u, N=None, out=None):
     check(lib.iwan_step_batch(element._mp, arr(states, StateArray), n, arr(u), arr(Nv), arr(F),
                               arr(kt)), "IwanElement.step_batch")
     return F, kt
+
+
+def periodic_jac_many(elements, u, Eu, N, EN, max_periods: int = 100, tol: float = 1e-12):
+    """:meth:`IwanElement.periodic_jac` of many elements in one C call (same numbers).
+
+    Parameters
+    ----------
+    elements : sequence of n_e IwanElement (each its own law)
+    u : array_like, shape (n_e, n)   displacement samples of each element [m]
+    Eu : array_like, shape (n, nb)   the shared basis (u = Eu X per element)
+    N : array_like, shape (n_e, n)   normal load samples [N]
+    EN : sequence of n_e arrays, shape (n, nb)   each element's normal-load basis
+    max_periods, tol : as :meth:`IwanElement.periodic_jac`
+
+    Returns
+    -------
+    F : (n_e, n) [N];  dFdX, dFdXN : (n_e, n, nb);  W_cycle : (n_e,) [J].
+
+    Raises the first failing element's error (IwanInputError, IwanNotConvergedError)
+    with its index.
+    """
+    n_e = len(elements)
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    Eu = np.ascontiguousarray(Eu, dtype=np.float64)
+    Nv = np.ascontiguousarray(N, dtype=np.float64)
+    if n_e == 0 or u.ndim != 2 or u.shape[0] != n_e or Nv.shape != u.shape:
+        raise IwanInputError(f"u and N must have shape ({n_e}, n) with n_e >= 1, got {u.shape} "
+                             f"and {Nv.shape}")
+    n = u.shape[1]
+    if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
+        raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
+    nb = Eu.shape[1]
+    ENs = [np.ascontiguousarray(a, dtype=np.float64) for a in EN]
+    if len(ENs) != n_e or any(a.shape != Eu.shape for a in ENs):
+        raise IwanInputError(f"EN must be {n_e} arrays of shape {Eu.shape}")
+    F, W = np.empty((n_e, n)), np.empty(n_e)
+    dFdX, dFdXN = np.empty((n_e, n, nb)), np.empty((n_e, n, nb))
+    models = (ct.POINTER(type(elements[0]._mp.contents)) * n_e)(*[el._mp for el in elements])
+    ens = (ct.POINTER(ct.c_double) * n_e)(*[a.ctypes.data_as(ct.POINTER(ct.c_double)) for a in ENs])
+    failed = ct.c_size_t()
+    status = lib.iwan_periodic_jac_many(models, n_e, n, arr(u), arr(Nv), arr(Eu), ens, nb, arr(F),
+                                        arr(dFdX), arr(dFdXN), arr(W), int(max_periods), float(tol),
+                                        ct.byref(failed))
+    check(status, f"periodic_jac_many (element {failed.value})")
+    return F, dFdX, dFdXN, W

@@ -291,6 +291,100 @@ class ContactElement(ForceElement):
         return ContactBatchStepper(self, n)
 
 
+def evaluate_many(elements, U, basis: FourierBasis, omega: float, jac: bool = True):
+    """:meth:`ContactElement.evaluate` of many elements with the same m, batched.
+
+    The sampling, the normal law (C1), the projection of the forces and the dashpots
+    (C3) are one numpy pass over all elements; the friction loop (C2) stays one C call
+    per element (``periodic_jac_rows``: each contact's own march). A one-tangent
+    contact whose Jacobian the single path would project from sparse terms
+    (:data:`TERMS_MIN_WORK`), a two-tangent or normal-only one, or an element that is
+    no ContactElement is evaluated by its own ``evaluate``. Same numbers as the
+    single path to round-off (the batched products sum in another order).
+
+    Parameters
+    ----------
+    elements : sequence of n_e ForceElement, each with ``m`` local coordinates
+    U : (n_e, n_b, m) array   local harmonics of each element
+    basis : FourierBasis
+    omega : float             [rad/s]
+    jac : bool
+
+    Returns
+    -------
+    F : (n_e, n_b, m) array            harmonics of the local forces [N]
+    dF : (n_e, n_b m, n_b m) or None   dF/dU (rows/cols c m + j), with ``jac``
+    dF_domega : (n_e, n_b m) or None   dF/domega, None when no element has one
+    """
+    U = np.asarray(U, dtype=float)
+    n_e, nb = U.shape[0], basis.nb
+    fast = [isinstance(el, ContactElement) and el.m == 2 and el.friction is not None
+            and not (jac and nb * nb * basis.n_t >= TERMS_MIN_WORK) for el in elements]
+    if not all(fast):
+        res = [el.evaluate(u, basis, omega, jac) for el, u in zip(elements, U)]
+        dws = [r.dF_domega for r in res]
+        dw = None
+        if any(v is not None for v in dws):
+            dw = np.array([np.zeros(U[0].size) if v is None else v for v in dws])
+        return (np.array([r.F for r in res]), np.array([r.dF for r in res]) if jac else None, dw)
+    return _evaluate_lines(elements, U.reshape(n_e, nb, 2), basis, float(omega), jac)
+
+
+def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
+    """:func:`evaluate_many` of one-tangent contacts (m = 2): with the Jacobian all friction
+    loops in one C call (``periodic_jac_many``, dense sampled rows), else one call each."""
+    n_e, nb = U.shape[:2]
+    E, D = basis.E, basis.D
+    kn = np.array([el.k_n for el in elements])
+    pl = U[:, :, 1] @ E.T                                   # (n_e, n_t) penetration
+    p = np.array([el.preload for el in elements])[:, None] + pl
+    on = p > 0.0
+    f = np.empty((n_e, basis.n_t, 2))
+    f[:, :, 1] = kn[:, None] * np.where(on, p, 0.0)
+    s = U[:, :, 0] @ E.T                                    # (n_e, n_t) slip
+    dF = np.zeros((n_e, 2 * nb, 2 * nb)) if jac else None
+    one_call = jac and len({(el.max_periods, el.tol) for el in elements}) == 1
+    if one_call:
+        dF[:, 0::2, 0::2], dF[:, 0::2, 1::2] = _friction_all(elements, s, kn[:, None] * p, basis, f)
+    for i, el in enumerate(elements):
+        if jac:
+            dF[i, 1::2, 1::2] = el._normal_block(basis, on[i])  # dN/dU_p (C1)
+        if one_call:
+            continue
+        kw = {"N": el.k_n * p[i], "max_periods": el.max_periods, "tol": el.tol}
+        if jac:
+            Ft, rows, dFs, dFp, _ = el.friction.periodic_jac_rows(
+                s[i] - el.slip_ref, E, EN=el._cached(basis, "EN"), **kw)
+            Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
+            dF[i, 0::2, 0::2], dF[i, 0::2, 1::2] = Dr @ dFs, Dr @ dFp
+        else:
+            Ft = el.friction.periodic_jac_terms(s[i] - el.slip_ref, with_N=False, **kw)[0]
+        f[i, :, 0] = Ft
+    F = D @ f                                                # (n_e, n_b, 2)
+    dw = None
+    if any(el.beta_c != 0.0 for el in elements):
+        ops = np.array([el._damping_operator(basis) if el.beta_c != 0.0
+                        else np.zeros((2 * nb, 2 * nb)) for el in elements])
+        dw = (ops @ U.reshape(n_e, 2 * nb, 1))[:, :, 0]
+        F += omega * dw.reshape(n_e, nb, 2)
+        if jac:
+            dF += omega * ops
+    return F, dF, dw
+
+
+def _friction_all(elements, s, N, basis: FourierBasis, f):
+    """Friction (C2) of all elements by one C call (``periodic_jac_many``): forces into
+    f[:, :, 0] (n_e, n_t); returns D dF/dU_s and D dF/dU_p, each (n_e, n_b, n_b)."""
+    from fmu_src.element_batch import periodic_jac_many
+
+    el0 = elements[0]
+    Ft, dFs, dFp, _ = periodic_jac_many(
+        [el.friction for el in elements], s - np.array([el.slip_ref for el in elements])[:, None],
+        basis.E, N, [el._cached(basis, "EN") for el in elements], el0.max_periods, el0.tol)
+    f[:, :, 0] = Ft
+    return basis.D @ dFs, basis.D @ dFp
+
+
 class ContactForce(LocalForce):
     """:class:`~.forces.LocalForce` of a ContactElement with lazy energies and samples.
 

@@ -188,6 +188,18 @@ iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const doub
                                    double *dFdXN, double *W_cycle, int max_periods, double tol,
                                    int *periods_used);
 
+/* iwan_periodic_jac of n_el independent elements in one call (each its own model and
+ * samples, one shared basis Eu (n, nb), the normal load's basis EN[e] (n, nb) per
+ * element): element e reads u[e*n ..], N[e*n ..] and writes F[e*n ..],
+ * dFdX[e*n*nb ..], dFdXN[e*n*nb ..], W_cycle[e], the same numbers as its own call.
+ * Stops at the first element whose call fails: its status, its index in *failed (n_el
+ * when all succeed). For a ring of many contacts evaluated together. */
+iwan_status iwan_periodic_jac_many(const iwan_model *const *models, size_t n_el, size_t n,
+                                   const double *u, const double *N, const double *Eu,
+                                   const double *const *EN, size_t nb, double *F, double *dFdX,
+                                   double *dFdXN, double *W_cycle, int max_periods, double tol,
+                                   size_t *failed);
+
 /* iwan_periodic_jac's Jacobian as sparse terms in the samples, for any basis (same
  * numbers as the dense rows to round-off): row t of dF/dX is
  *   dX[t] Eu[t, :] + sum_i cX[i] Eu[col[i], :]     over the terms i with row[i] == t,

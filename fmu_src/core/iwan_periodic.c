@@ -306,6 +306,30 @@ iwan_status iwan_periodic_jac_rows(const iwan_model *model, size_t n, const doub
                              max_periods, tol, periods_used);
 }
 
+iwan_status iwan_periodic_jac_many(const iwan_model *const *models, size_t n_el, size_t n,
+                                   const double *u, const double *N, const double *Eu,
+                                   const double *const *EN, size_t nb, double *F, double *dFdX,
+                                   double *dFdXN, double *W_cycle, int max_periods, double tol,
+                                   size_t *failed)
+{
+    if (!models || !u || !N || !EN || !F || !dFdX || !dFdXN || !W_cycle || !failed || n == 0
+        || nb == 0 || n > SIZE_MAX / nb)
+        return IWAN_ERR_BAD_PARAM;
+    const size_t m = n * nb;
+    for (size_t e = 0; e < n_el; ++e) {
+        int used;
+        iwan_status st = iwan_periodic_jac(models[e], n, u + e * n, N + e * n, Eu, EN[e], nb,
+                                           F + e * n, dFdX + e * m, dFdXN + e * m, W_cycle + e,
+                                           max_periods, tol, &used);
+        if (st != IWAN_OK) {
+            *failed = e;
+            return st;
+        }
+    }
+    *failed = n_el;
+    return IWAN_OK;
+}
+
 /* ------------------------------------------- exact loop of a monotone-piecewise input */
 
 iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const double *u_ext,

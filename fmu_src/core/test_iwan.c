@@ -185,6 +185,28 @@ static void test_periodic_jacobian(void)
     /* not converged within one period (N varies) */
     CHECK(iwan_periodic(&m, NT, u, N, F, NULL, NULL, &W, 1, 1e-12, &p) == IWAN_ERR_NOT_CONVERGED,
           "closure status");
+    /* two elements in one call (the second at half the amplitude): each its own call's bits;
+     * a NaN in the second one's samples is reported with its index */
+    const iwan_model *ms[2] = {&m, &m};
+    const double *ens[2] = {E, E};
+    double u2[2 * NT], N2[2 * NT], F2[2 * NT], J2[2 * NT * NB], JN2[2 * NT * NB], W2[2];
+    double Fb[NT], Jb[NT * NB], JNb[NT * NB], Wb;
+    size_t failed = 0;
+    for (int t = 0; t < NT; ++t) {
+        u2[t] = u[t]; N2[t] = N[t]; u2[NT + t] = 0.5 * u[t]; N2[NT + t] = N[t];
+    }
+    CHECK(iwan_periodic_jac_many(ms, 2, NT, u2, N2, E, ens, NB, F2, J2, JN2, W2, 50, 1e-12,
+                                 &failed) == IWAN_OK && failed == 2, "jac_many");
+    for (int e = 0; e < 2; ++e) {
+        CHECK(iwan_periodic_jac(&m, NT, u2 + e * NT, N, E, E, NB, Fb, Jb, JNb, &Wb, 50, 1e-12, &p)
+              == IWAN_OK, "jac of element %d", e);
+        CHECK(memcmp(F2 + e * NT, Fb, sizeof Fb) == 0 && memcmp(J2 + e * NT * NB, Jb, sizeof Jb) == 0
+              && memcmp(JN2 + e * NT * NB, JNb, sizeof JNb) == 0 && W2[e] == Wb,
+              "jac_many: element %d differs from its own call", e);
+    }
+    u2[NT + 3] = NAN;
+    CHECK(iwan_periodic_jac_many(ms, 2, NT, u2, N2, E, ens, NB, F2, J2, JN2, W2, 50, 1e-12,
+                                 &failed) == IWAN_ERR_NONFINITE && failed == 1, "jac_many NaN");
 }
 
 /* Reproducible uniform numbers in [0, 1) (64-bit LCG, Knuth's MMIX constants). */

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact import frictionless_statics
+from ..contact import evaluate_many, frictionless_statics
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
@@ -153,15 +153,13 @@ class MistunedRingHB:
             n_e, m, d = Q.shape
             # U_e = (I (x) Q) x_e: local harmonics (n_e, n_b, m)
             U = np.einsum("eja,eca->ecj", Q, x[G].reshape(n_e, nb, d))
-            res = [self.points[e].evaluate(u, self.basis, w, jac) for e, u in zip(idx, U)]
-            np.add.at(R, G, _back(Q, np.array([r.F for r in res])))
-            dws = [r.dF_domega for r in res]
-            if jac and any(dv is not None for dv in dws):
-                dw = np.array([np.zeros(nb * m) if dv is None else dv for dv in dws])
+            F, dF, dw = evaluate_many([self.points[e] for e in idx], U, self.basis, w, jac)
+            np.add.at(R, G, _back(Q, F))
+            if jac and dw is not None:
                 np.add.at(Rw, G, _back(Q, dw))
             if jac:
                 # (I (x) Q)^T dF (I (x) Q), dF rows/cols c m + j: Q on each harmonic's block
-                dF = np.array([r.dF for r in res]).reshape(n_e, nb * m * nb, m) @ Q
+                dF = dF.reshape(n_e, nb * m * nb, m) @ Q
                 blk = np.einsum("eja,ecjx->ecax", Q, dF.reshape(n_e, nb, m, nb * d))
                 blocks.append(blk.ravel())
         if not jac:

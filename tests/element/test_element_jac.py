@@ -163,3 +163,37 @@ def test_jacobian_terms_rebuild_the_dense_jacobian(el, case):
             assert not np.any(S)
         else:
             np.testing.assert_allclose(S @ E, dense, rtol=0, atol=TERMS_ROUND * np.abs(dense).max())
+
+
+def test_many_elements_in_one_call_are_each_elements_own_loop(el):
+    """periodic_jac_many: every element (its own law, samples and normal basis) gets
+    the bits of its own periodic_jac call."""
+    from fmu_src.element_batch import periodic_jac_many
+
+    E = basis()
+    els = [el, IwanElement.jenkins(2e5, 0.3 * N_SPHERE), IwanElement.from_curve(*cattaneo_table(6), N_ref=N_SPHERE)]
+    cases = [CASES[k] for k in ("varying N", "lift-off", "stuck, negative offset, varying N")]
+    u = np.array([E @ X for X, _ in cases])
+    N = np.array([E @ XN for _, XN in cases])
+    EN = [E, 2.0 * E, 0.5 * E]   # N = EN XN: each element's own normal basis
+    N = N * np.array([1.0, 2.0, 0.5])[:, None]
+    F, J, JN, W = periodic_jac_many(els, u, E, N, EN)
+    for i, e in enumerate(els):
+        Fi, Ji, JNi, Wi = e.periodic_jac(u[i], E, N[i], EN[i])
+        assert np.array_equal(F[i], Fi) and np.array_equal(J[i], Ji)
+        assert np.array_equal(JN[i], JNi) and W[i] == Wi
+
+
+def test_many_elements_name_the_one_that_fails(el):
+    """A NaN in one element's samples: IwanInputError naming that element, and the
+    same error as its own call."""
+    from fmu_src.element_batch import periodic_jac_many
+
+    E = basis()
+    X, XN = CASES["varying N"]
+    u = np.array([E @ X] * 3)
+    u[1, 5] = np.nan
+    with pytest.raises(IwanInputError, match=r"element 1\)"):
+        periodic_jac_many([el] * 3, u, E, np.array([E @ XN] * 3), [E] * 3)
+    with pytest.raises(IwanInputError):
+        el.periodic_jac(u[1], E, E @ XN, E)
