@@ -49,7 +49,7 @@ import numpy as np
 
 from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
-from .massless import MasslessContacts
+from .massless import FactorCache, MasslessContacts
 from .surface_sensitivity import MarchSensitivity
 
 #: Periods marched; the last is the loop. A node that first slips in period 2 or later
@@ -107,6 +107,9 @@ class CondensedSurface(ForceElement):
             self.elements.append(type(el)(el.kinematics, el.k_n, el.friction, preload=el.preload,
                                           slip_ref=float(s0), name=el.name))
         self.C = None if damping is None else np.asarray(damping, float)
+        # the node solves' and sensitivities' block factors, kept across evaluations: A is
+        # fixed and the keys are the contact states, not the motion
+        self.factors = FactorCache()
 
     def stuck_stiffness(self) -> np.ndarray:
         """Condensed stiffness (r, r) on q with every node closed and stuck [N/m]."""
@@ -133,6 +136,8 @@ class CondensedSurface(ForceElement):
         n_h, n_t, r = q.shape
         nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
         A = nodes.split(self.A)
+        if n_h == 1:
+            nodes.factors = self.factors
         sens = None if dq is None else MarchSensitivity(nodes, self.A, self.AR, dq.shape[2])
         dq = np.zeros((n_t, r, 0)) if dq is None else dq
         w = np.tile(self.w_static, (n_h, 1))

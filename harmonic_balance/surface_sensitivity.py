@@ -140,13 +140,18 @@ class MarchSensitivity:
         b = rhs_q[None] - nodes.Qs.T @ G
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
-        for dofs, *_ in self._order:
+        cache = nodes.factors if n_h == 1 else None
+        for i, (dofs, c, *_) in enumerate(self._order):
             rest = ~solved
             rest[dofs] = False
             if np.any(J[:, dofs][:, :, rest]):
                 return np.linalg.solve(J, b)            # not block-triangular: one dense solve
             rhs = b[:, dofs] - J[:, dofs][:, :, solved] @ dw[:, solved]
-            dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
+            if cache is None:
+                dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
+            else:   # the block's operator is fixed by its contacts' coefficients
+                key = ("sensitivity", i, Kt[0, c].tobytes(), KNkn[0, c].tobytes(), kn_on[0, c].tobytes())
+                dw[0, dofs] = cache.solve(key, lambda d=dofs: J[0][np.ix_(d, d)], rhs[0])
             solved[dofs] = True
         return dw
 
