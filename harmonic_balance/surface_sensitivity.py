@@ -81,6 +81,21 @@ class MarchSensitivity:
         # a contact touches a few DOFs
         self._pairs = [_pairs(Qa, Qb) for Qa, Qb in ((nodes.Qs, nodes.Qs), (nodes.Qs, nodes.Qp),
                                                      (nodes.Qp, nodes.Qp))]
+        self._triangular = self._is_triangular()
+
+    def _is_triangular(self) -> bool:
+        """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
+        the Q_s^T Q_s, Q_p^T Q_p terms stay inside a block (the blocks are their connected
+        components), so only the Coulomb coupling Q_s^T Q_p can reach a later block."""
+        nodes, seen = self.nodes, np.zeros(self.nodes.n_b, bool)
+        coupling = (np.abs(nodes.Qs).T @ np.abs(nodes.Qp)) != 0.0
+        for dofs, *_ in self._order:
+            later = ~seen
+            later[dofs] = False
+            if np.any(coupling[np.ix_(dofs, later)]):
+                return False
+            seen[dofs] = True
+        return True
 
     def _block_order(self) -> list:
         """The march's blocks, those without slip rows (normal only) first (module docstring)."""
@@ -133,6 +148,8 @@ class MarchSensitivity:
         """dw (n_h, n_w, n_d) of (M2), block by block (normal blocks first)."""
         nodes = self.nodes
         n_h = nodes.n_h
+        if n_h == 1 and nodes.factors is not None and self._triangular:
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes.Qs.T @ G[0])[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
@@ -140,19 +157,32 @@ class MarchSensitivity:
         b = rhs_q[None] - nodes.Qs.T @ G
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
-        cache = nodes.factors if n_h == 1 else None
-        for i, (dofs, c, *_) in enumerate(self._order):
+        for dofs, *_ in self._order:
             rest = ~solved
             rest[dofs] = False
             if np.any(J[:, dofs][:, :, rest]):
                 return np.linalg.solve(J, b)            # not block-triangular: one dense solve
             rhs = b[:, dofs] - J[:, dofs][:, :, solved] @ dw[:, solved]
-            if cache is None:
-                dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
-            else:   # the block's operator is fixed by its contacts' coefficients
-                key = ("sensitivity", i, Kt[0, c].tobytes(), KNkn[0, c].tobytes(), kn_on[0, c].tobytes())
-                dw[0, dofs] = cache.solve(key, lambda d=dofs: J[0][np.ix_(d, d)], rhs[0])
+            dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
             solved[dofs] = True
+        return dw
+
+    def _solve_cached(self, Kt, KNkn, kn_on, b) -> np.ndarray:
+        """dw (n_w, n_d) of (M2) for one history, block-triangular: each block's factors from
+        the nodes' FactorCache (keyed by its contacts' coefficients, which fix its operator),
+        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``)."""
+        nodes = self.nodes
+        dw = np.zeros_like(b)
+        for i, (dofs, c, Qs, Qp) in enumerate(self._order):
+            kt, kN, kp = Kt[c], KNkn[c], kn_on[c]
+
+            def build(dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
+                return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
+                        + (Qp.T * kp) @ Qp)
+            # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
+            rhs = b[dofs] - nodes._QsT[dofs] @ (KNkn[:, None] * (nodes._Qp @ dw))
+            key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
+            dw[dofs] = nodes.factors.solve(key, build, rhs)
         return dw
 
 
