@@ -117,8 +117,8 @@ class MarchSensitivity:
         """
         nodes = self.nodes
         n_h, n_c = nodes.n_h, len(nodes.kn)
-        ds0 = nodes.Qs @ self.dw
-        dP0 = nodes.Qp @ self.dw
+        ds0 = _rows(nodes._Qs, self.dw)
+        dP0 = _rows(nodes._Qp, self.dw)
         Kt, KN = np.zeros((n_h, n_c)), np.zeros((n_h, n_c))
         G = np.zeros((n_h, n_c, self.dw.shape[2]))
         updates = []
@@ -137,8 +137,8 @@ class MarchSensitivity:
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
         self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
-        ds1 = nodes.Qs @ self.dw
-        dP1 = nodes.Qp @ self.dw
+        ds1 = _rows(nodes._Qs, self.dw)
+        dP1 = _rows(nodes._Qp, self.dw)
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
             dn1 = dP1[:, idx] * n_scale
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
@@ -149,12 +149,12 @@ class MarchSensitivity:
         nodes = self.nodes
         n_h = nodes.n_h
         if n_h == 1 and nodes.factors is not None and self._triangular:
-            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes.Qs.T @ G[0])[None]
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes._QsT @ G[0])[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
                 np.add.at(J[h], (i, j), v * k[h, c])
-        b = rhs_q[None] - nodes.Qs.T @ G
+        b = rhs_q[None] - _rows(nodes._QsT, G)
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
         for dofs, *_ in self._order:
@@ -184,6 +184,12 @@ class MarchSensitivity:
             key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
             dw[dofs] = nodes.factors.solve(key, build, rhs)
         return dw
+
+
+def _rows(Q, X: np.ndarray) -> np.ndarray:
+    """Q X per history: Q sparse (a, b), X (n_h, b, n_d) -> (n_h, a, n_d) (a contact's rows
+    touch a few DOFs, so the sparse product is O(n_d) per contact, not O(n_w n_d))."""
+    return np.stack([Q @ x for x in X])
 
 
 def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
