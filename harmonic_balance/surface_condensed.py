@@ -37,9 +37,10 @@ the sensitivities cost about what the march does). The forward differences of th
 (:meth:`CondensedSurface.jacobian_fd`, 1 + n_b r histories) are kept as its reference.
 
 Cost: every node over ``PERIODS`` periods of node solves per evaluation, plus one
-linear solve of the settled set per step for the sensitivities; UPD-24 with 5 nodes per
-side (69 and 40 nodes), 48 samples at H 3: one frequency 30 s
-(docs/method/contact_surface.md).
+linear solve of the settled set per step for the sensitivities; the blocks' LU factors
+are kept by contact state (:class:`~.massless.FactorCache`, one per element, across
+evaluations), so a stick phase and the repeated period solve with factors already
+made. Measured costs (UPD-24, 5 to 20 nodes per side): docs/method/contact_surface.md.
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """
