@@ -84,14 +84,21 @@ class FactorCache:
     A march over a period meets the same settled sets again and again (every stick phase
     has one operator; the second period repeats the first's sets), so a factorization is
     reused instead of recomputed; the key is the block and the bytes of the contact
-    stiffnesses added to its fixed operator.
+    stiffnesses added to its fixed operator. The owner keeps one cache per fixed
+    operator A (a key does not name A).
+
+    Parameters
+    ----------
+    max_bytes : int
+        Bytes of factors kept; the least recently used are dropped beyond it.
     """
 
     def __init__(self, max_bytes: int = FACTOR_CACHE_BYTES):
         self.max_bytes, self.bytes, self._lu = int(max_bytes), 0, {}
 
     def solve(self, key, build, rhs: np.ndarray) -> np.ndarray:
-        """J^{-1} rhs with J = build() factorized once per key; rhs (m,) or (m, k)."""
+        """J^{-1} rhs, (m,) or (m, k), with J = build() (m, m) factorized once per ``key``
+        (hashable); rhs (m,) or (m, k)."""
         lu = self._lu.pop(key, None)
         if lu is None:
             lu = lu_factor(build(), check_finite=False)
