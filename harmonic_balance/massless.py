@@ -44,6 +44,7 @@ of A and the contacts' rows, each solved on its own (dense, batched over histori
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import lu_factor, lu_solve
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -66,6 +67,46 @@ MAX_SIDES = 4
 FD_REL = 1e-7
 #: Relative tolerance of the homogeneity test that lets two node elements share a call.
 SAME_LAW_RTOL = 1e-12
+#: Significant digits of a node's Newton slope (relative to its stuck slope) kept in the
+#: key of a cached factorization: the slope comes from a difference of the trial map whose
+#: round-off is ~1e-9 of it (eps |F| / (k ds), ds = FD_REL of the slip), so the same
+#: stick/slip state gives the same key; the rounded slope is the one used, 5e-9 from the
+#: difference, far inside Newton's tolerance.
+SLOPE_DIGITS = 8
+#: Bytes of LU factors kept by a :class:`FactorCache` (least recently used dropped first):
+#: 2 x 20 nodes per side gives blocks of ~700 DOFs, 4 MB a factor.
+FACTOR_CACHE_BYTES = 256 * 2 ** 20
+
+
+class FactorCache:
+    """LU factors of dense blocks keyed by the contact state that makes them.
+
+    A march over a period meets the same settled sets again and again (every stick phase
+    has one operator; the second period repeats the first's sets), so a factorization is
+    reused instead of recomputed; the key is the block and the bytes of the contact
+    stiffnesses added to its fixed operator. The owner keeps one cache per fixed
+    operator A (a key does not name A).
+
+    Parameters
+    ----------
+    max_bytes : int
+        Bytes of factors kept; the least recently used are dropped beyond it.
+    """
+
+    def __init__(self, max_bytes: int = FACTOR_CACHE_BYTES):
+        self.max_bytes, self.bytes, self._lu = int(max_bytes), 0, {}
+
+    def solve(self, key, build, rhs: np.ndarray) -> np.ndarray:
+        """J^{-1} rhs, (m,) or (m, k), with J = build() (m, m) factorized once per ``key``
+        (hashable); rhs (m,) or (m, k)."""
+        lu = self._lu.pop(key, None)
+        if lu is None:
+            lu = lu_factor(build(), check_finite=False)
+            self.bytes += lu[0].nbytes
+            while self.bytes > self.max_bytes and self._lu:
+                self.bytes -= self._lu.pop(next(iter(self._lu)))[0].nbytes
+        self._lu[key] = lu                           # most recent last (dict order)
+        return lu_solve(lu, rhs, check_finite=False)
 
 
 def _same_law(ref, f) -> float | None:
@@ -125,6 +166,11 @@ class MasslessContacts:
                 else:
                     groups.append([el.friction, [i], [1.0]])
         self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
+        self.kt_stuck = np.ones(n_c)                 # the slope scale of SLOPE_DIGITS
+        for ref, idx, c in self.groups:
+            self.kt_stuck[idx] = c * (np.sum(ref.k) + ref.k_res)
+        #: a FactorCache for one history (n_h = 1) with the same A in every solve, or None
+        self.factors = None
         self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
         # sparse copies for the products on all DOFs (a contact touches a few DOFs)
         self._Qs, self._Qp = csr_matrix(self.Qs), csr_matrix(self.Qp)
@@ -274,10 +320,10 @@ class MasslessContacts:
         side = np.ones((self.n_h, len(self.kn)), bool)           # True: increasing slip
         for _ in range(MAX_SIDES):
             kt = np.where(side, tan[0], tan[2])
-            for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
-                J = self._add_tangent(self._add_tangent(Ak[todo], Qs, kt[todo][:, c]),
-                                      Qp, tan[1][todo][:, c])
-                dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+            if self.factors is not None and self.n_h == 1:
+                self._cached_step(A, r, kt, tan[1], dx)
+            else:
+                self._dense_step(A, r, kt, tan[1], todo, dx)
             ds = (self._Qs @ dx.T).T
             kink = tan[0] != tan[2]
             new = np.where(ds != 0.0, ds > 0.0, side)
@@ -285,6 +331,26 @@ class MasslessContacts:
                 break
             side = np.where(kink, new, side)
         return dx
+
+    def _dense_step(self, A, r, kt, kp, todo, dx):
+        """dx of the histories in ``todo``, every block factorized afresh (batched)."""
+        for Ak, (dofs, c, Qs, Qp) in zip(A, self.blocks):
+            J = self._add_tangent(self._add_tangent(Ak[todo], Qs, kt[todo][:, c]), Qp, kp[todo][:, c])
+            dx[np.ix_(todo, dofs)] = np.linalg.solve(J, -r[np.ix_(todo, dofs)][..., None])[..., 0]
+
+    def _cached_step(self, A, r, kt, kp, dx):
+        """dx of the one history with each block's factors from ``self.factors`` (slopes
+        rounded to SLOPE_DIGITS, so that a repeated contact state finds its factors)."""
+        for b, (Ak, (dofs, c, Qs, Qp)) in enumerate(zip(A, self.blocks)):
+            ks = self.kt_stuck[c]
+            kr = np.round(kt[0, c] / ks, SLOPE_DIGITS)
+            kp_c = kp[0, c]
+
+            def build(Ak=Ak, Qs=Qs, Qp=Qp, kr=kr, ks=ks, kp_c=kp_c):
+                return self._add_tangent(self._add_tangent(Ak[:1].copy(), Qs, (kr * ks)[None]),
+                                         Qp, kp_c[None])[0]
+            key = ("newton", b, kr.tobytes(), kp_c.tobytes())
+            dx[0, dofs] = self.factors.solve(key, build, -r[0, dofs])
 
     def _residual(self, A, w, fc, rhs):
         r = fc - rhs

@@ -37,9 +37,10 @@ the sensitivities cost about what the march does). The forward differences of th
 (:meth:`CondensedSurface.jacobian_fd`, 1 + n_b r histories) are kept as its reference.
 
 Cost: every node over ``PERIODS`` periods of node solves per evaluation, plus one
-linear solve of the settled set per step for the sensitivities; UPD-24 with 5 nodes per
-side (69 and 40 nodes), 48 samples at H 3: one frequency 30 s
-(docs/method/contact_surface.md).
+linear solve of the settled set per step for the sensitivities; the blocks' LU factors
+are kept by contact state (:class:`~.massless.FactorCache`, one per element, across
+evaluations), so a stick phase and the repeated period solve with factors already
+made. Measured costs (UPD-24, 5 to 20 nodes per side): docs/method/contact_surface.md.
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """
@@ -49,7 +50,7 @@ import numpy as np
 
 from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
-from .massless import MasslessContacts
+from .massless import FactorCache, MasslessContacts
 from .surface_sensitivity import MarchSensitivity
 
 #: Periods marched; the last is the loop. A node that first slips in period 2 or later
@@ -107,6 +108,9 @@ class CondensedSurface(ForceElement):
             self.elements.append(type(el)(el.kinematics, el.k_n, el.friction, preload=el.preload,
                                           slip_ref=float(s0), name=el.name))
         self.C = None if damping is None else np.asarray(damping, float)
+        # the node solves' and sensitivities' block factors, kept across evaluations: A is
+        # fixed and the keys are the contact states, not the motion
+        self.factors = FactorCache()
 
     def stuck_stiffness(self) -> np.ndarray:
         """Condensed stiffness (r, r) on q with every node closed and stuck [N/m]."""
@@ -133,6 +137,8 @@ class CondensedSurface(ForceElement):
         n_h, n_t, r = q.shape
         nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
         A = nodes.split(self.A)
+        if n_h == 1:
+            nodes.factors = self.factors
         sens = None if dq is None else MarchSensitivity(nodes, self.A, self.AR, dq.shape[2])
         dq = np.zeros((n_t, r, 0)) if dq is None else dq
         w = np.tile(self.w_static, (n_h, 1))

@@ -81,6 +81,21 @@ class MarchSensitivity:
         # a contact touches a few DOFs
         self._pairs = [_pairs(Qa, Qb) for Qa, Qb in ((nodes.Qs, nodes.Qs), (nodes.Qs, nodes.Qp),
                                                      (nodes.Qp, nodes.Qp))]
+        self._triangular = self._is_triangular()
+
+    def _is_triangular(self) -> bool:
+        """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
+        the Q_s^T Q_s, Q_p^T Q_p terms stay inside a block (the blocks are their connected
+        components), so only the Coulomb coupling Q_s^T Q_p can reach a later block."""
+        nodes, seen = self.nodes, np.zeros(self.nodes.n_b, bool)
+        coupling = (np.abs(nodes.Qs).T @ np.abs(nodes.Qp)) != 0.0
+        for dofs, *_ in self._order:
+            later = ~seen
+            later[dofs] = False
+            if np.any(coupling[np.ix_(dofs, later)]):
+                return False
+            seen[dofs] = True
+        return True
 
     def _block_order(self) -> list:
         """The march's blocks, those without slip rows (normal only) first (module docstring)."""
@@ -102,8 +117,8 @@ class MarchSensitivity:
         """
         nodes = self.nodes
         n_h, n_c = nodes.n_h, len(nodes.kn)
-        ds0 = nodes.Qs @ self.dw
-        dP0 = nodes.Qp @ self.dw
+        ds0 = _rows(nodes._Qs, self.dw)
+        dP0 = _rows(nodes._Qp, self.dw)
         Kt, KN = np.zeros((n_h, n_c)), np.zeros((n_h, n_c))
         G = np.zeros((n_h, n_c, self.dw.shape[2]))
         updates = []
@@ -122,8 +137,8 @@ class MarchSensitivity:
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
         self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
-        ds1 = nodes.Qs @ self.dw
-        dP1 = nodes.Qp @ self.dw
+        ds1 = _rows(nodes._Qs, self.dw)
+        dP1 = _rows(nodes._Qp, self.dw)
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
             dn1 = dP1[:, idx] * n_scale
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
@@ -133,11 +148,13 @@ class MarchSensitivity:
         """dw (n_h, n_w, n_d) of (M2), block by block (normal blocks first)."""
         nodes = self.nodes
         n_h = nodes.n_h
+        if n_h == 1 and nodes.factors is not None and self._triangular:
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes._QsT @ G[0])[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
                 np.add.at(J[h], (i, j), v * k[h, c])
-        b = rhs_q[None] - nodes.Qs.T @ G
+        b = rhs_q[None] - _rows(nodes._QsT, G)
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
         for dofs, *_ in self._order:
@@ -149,6 +166,30 @@ class MarchSensitivity:
             dw[:, dofs] = np.linalg.solve(J[:, dofs][:, :, dofs], rhs)
             solved[dofs] = True
         return dw
+
+    def _solve_cached(self, Kt, KNkn, kn_on, b) -> np.ndarray:
+        """dw (n_w, n_d) of (M2) for one history, block-triangular: each block's factors from
+        the nodes' FactorCache (keyed by its contacts' coefficients, which fix its operator),
+        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``)."""
+        nodes = self.nodes
+        dw = np.zeros_like(b)
+        for i, (dofs, c, Qs, Qp) in enumerate(self._order):
+            kt, kN, kp = Kt[c], KNkn[c], kn_on[c]
+
+            def build(dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
+                return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
+                        + (Qp.T * kp) @ Qp)
+            # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
+            rhs = b[dofs] - nodes._QsT[dofs] @ (KNkn[:, None] * (nodes._Qp @ dw))
+            key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
+            dw[dofs] = nodes.factors.solve(key, build, rhs)
+        return dw
+
+
+def _rows(Q, X: np.ndarray) -> np.ndarray:
+    """Q X per history: Q sparse (a, b), X (n_h, b, n_d) -> (n_h, a, n_d) (a contact's rows
+    touch a few DOFs, so the sparse product is O(n_d) per contact, not O(n_w n_d))."""
+    return np.stack([Q @ x for x in X])
 
 
 def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
