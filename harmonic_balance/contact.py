@@ -341,25 +341,16 @@ def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
     on = p > 0.0
     f = np.empty((n_e, basis.n_t, 2))
     f[:, :, 1] = kn[:, None] * np.where(on, p, 0.0)
-    s = U[:, :, 0] @ E.T                                    # (n_e, n_t) slip
     dF = np.zeros((n_e, 2 * nb, 2 * nb)) if jac else None
     one_call = jac and len({(el.max_periods, el.tol) for el in elements}) == 1
     if one_call:
+        s = U[:, :, 0] @ E.T                                # (n_e, n_t) slip
         dF[:, 0::2, 0::2], dF[:, 0::2, 1::2] = _friction_all(elements, s, kn[:, None] * p, basis, f)
     for i, el in enumerate(elements):
         if jac:
             dF[i, 1::2, 1::2] = el._normal_block(basis, on[i])  # dN/dU_p (C1)
-        if one_call:
-            continue
-        kw = {"N": el.k_n * p[i], "max_periods": el.max_periods, "tol": el.tol}
-        if jac:
-            Ft, rows, dFs, dFp, _ = el.friction.periodic_jac_rows(
-                s[i] - el.slip_ref, E, EN=el._cached(basis, "EN"), **kw)
-            Dr = D if rows.size == basis.n_t and (rows[1:] > rows[:-1]).all() else D[:, rows]
-            dF[i, 0::2, 0::2], dF[i, 0::2, 1::2] = Dr @ dFs, Dr @ dFp
-        else:
-            Ft = el.friction.periodic_jac_terms(s[i] - el.slip_ref, with_N=False, **kw)[0]
-        f[i, :, 0] = Ft
+        if not one_call:  # the element's own friction path, into its rows of f and dF
+            el._evaluate_line(U[i], basis, p[i], f[i], dF[i] if jac else None)
     F = D @ f                                                # (n_e, n_b, 2)
     dw = None
     if any(el.beta_c != 0.0 for el in elements):

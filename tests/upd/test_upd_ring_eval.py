@@ -81,3 +81,25 @@ def test_states_cover_stick_slip_and_lift_off(ring_states):
                                                  max_periods=el.max_periods, tol=el.tol)[1]
             seen.add("stuck" if rows.size == b.n_t else "partial slip")
     assert seen == {"lift-off", "stuck", "partial slip"}
+
+
+def test_contacts_with_different_tolerances_take_their_own_path_with_the_same_numbers(ring_states):
+    """Contacts whose loop tolerances differ cannot share one C call: each takes its own
+    friction path inside evaluate_many, with its own evaluate's numbers."""
+    import copy
+
+    from harmonic_balance.contact import evaluate_many
+
+    ring, w, states = ring_states
+    (idx, G, Q), = ring._groups
+    els = [copy.copy(ring.points[e]) for e in idx]
+    els[0].tol = els[0].tol / 10.0
+    for x in states:
+        U = np.einsum("eja,eca->ecj", Q, x[G].reshape(len(idx), ring.nb, -1))
+        for jac in (True, False):
+            F, dF, dw = evaluate_many(els, U, ring.basis, w, jac)
+            F0, dF0, dw0 = per_contact(els, U, ring.basis, w, jac)
+            assert _rel(F, F0) < BATCH_RTOL
+            if jac:
+                assert _rel(dF, dF0) < BATCH_RTOL
+            assert (dw is None) == (dw0 is None) and (dw is None or _rel(dw, dw0) < BATCH_RTOL)
