@@ -166,10 +166,8 @@ class ContactElement(ForceElement):
         nb, m, E, D = basis.nb, self.m, basis.E, basis.D
         U = np.asarray(U, dtype=float).reshape(nb, m)
         pl = E @ U[:, -1]
-        p = self.preload + pl
-        on = p > 0.0
         f = np.empty((basis.n_t, m))
-        f[:, -1] = self.k_n * np.where(on, p, 0.0)
+        p, on, f[:, -1] = normal_law(self.k_n, self.preload, pl)
         dF = np.zeros((nb * m, nb * m)) if jac else None
         if jac:  # rows/cols c * m + j: the (j, k) block is dF[j::m, k::m]
             dF[m - 1::m, m - 1::m] = self._normal_block(basis, on)
@@ -291,6 +289,20 @@ class ContactElement(ForceElement):
         return ContactBatchStepper(self, n)
 
 
+def normal_law(k_n, preload, pl):
+    """The normal law (C1) on sampled penetrations: p = p_0 + p(theta), in contact where
+    p > 0, N = k_n max(p, 0). Arrays broadcast (one contact's samples, or many contacts'
+    as (n_e, n_t) with k_n and p_0 as (n_e, 1)).
+
+    Returns
+    -------
+    p : penetration [m];  on : bool, in contact;  N : normal load [N] (shapes of pl)
+    """
+    p = preload + pl
+    on = p > 0.0
+    return p, on, k_n * np.where(on, p, 0.0)
+
+
 def evaluate_many(elements, U, basis: FourierBasis, omega: float, jac: bool = True):
     """:meth:`ContactElement.evaluate` of many elements with the same m, batched.
 
@@ -337,10 +349,8 @@ def _evaluate_lines(elements, U, basis: FourierBasis, omega: float, jac: bool):
     E, D = basis.E, basis.D
     kn = np.array([el.k_n for el in elements])
     pl = U[:, :, 1] @ E.T                                   # (n_e, n_t) penetration
-    p = np.array([el.preload for el in elements])[:, None] + pl
-    on = p > 0.0
     f = np.empty((n_e, basis.n_t, 2))
-    f[:, :, 1] = kn[:, None] * np.where(on, p, 0.0)
+    p, on, f[:, :, 1] = normal_law(kn[:, None], np.array([el.preload for el in elements])[:, None], pl)
     dF = np.zeros((n_e, 2 * nb, 2 * nb)) if jac else None
     one_call = jac and len({(el.max_periods, el.tol) for el in elements}) == 1
     if one_call:
