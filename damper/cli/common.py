@@ -111,6 +111,15 @@ def upd_model_options(p) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object on stdout")
 
 
+def upd_response_options(p) -> None:
+    """``--cf``, ``--f0`` and ``--damper`` of the ``damper upd`` actions that solve the
+    forced response (``frf``, ``mistuning``)."""
+    p.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
+    p.add_argument("--f0", type=float, help="EO force amplitude on the airfoil [N] (default: config)")
+    p.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
+                   help="free: damper removed; stuck: contacts stuck (linear limits)")
+
+
 def accuracy_lines(out) -> list[str]:
     """The truncation-error lines of a ``upd frf``, ``upd optimize`` or ``upd mistuning``
     result (frequencies in Hz)."""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import accuracy_lines, upd_model_options
+from .common import accuracy_lines, upd_model_options, upd_response_options
 from .upd_mistuning import register as register_mistuning
 
 
@@ -28,8 +28,7 @@ def register(sub) -> None:
     m.set_defaults(func=run_modes)
     f = s.add_parser("frf", help="forced response of the EO excitation (nonlinear or linear limits)")
     upd_model_options(f)
-    f.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
-    f.add_argument("--f0", type=float, help="EO force amplitude on the airfoil [N] (default: config)")
+    upd_response_options(f)
     f.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (0..H kept; with "
                    "--accuracy the first one tried)")
     f.add_argument("--accuracy", type=float, metavar="TOL",
@@ -39,8 +38,6 @@ def register(sub) -> None:
                    "its estimate reported, a warning above 1 %%)")
     f.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"), help="band [Hz]")
     f.add_argument("--points", type=int, default=200, help="frequency points")
-    f.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
-                   help="free: damper removed; stuck: contacts stuck (linear limits)")
     f.add_argument("--check-steady-state", action="store_true",
                    help="time-integrate the ring at the peak from rest and from the harmonic balance's "
                    "state: says whether the curve is the state a start from rest reaches (seconds; "

@@ -5,7 +5,7 @@ other ``damper upd`` actions and the registration are in :mod:`damper.cli.upd`.
 """
 from __future__ import annotations
 
-from .common import accuracy_lines, upd_model_options
+from .common import accuracy_lines, upd_model_options, upd_response_options
 
 
 def register(s) -> None:
@@ -27,10 +27,7 @@ def register(s) -> None:
                    help="one given pattern, a factor per blade (instead of --std/--samples)")
     p.add_argument("--blades", type=int, help="number of blades N_b (default: config)")
     p.add_argument("--engine-order", type=int, help="engine order EO (default: config)")
-    p.add_argument("--damper", choices=("nonlinear", "free", "stuck"), default="nonlinear",
-                   help="free: damper removed; stuck: contacts stuck (linear limits)")
-    p.add_argument("--cf", type=float, help="centrifugal load [N] (default: config)")
-    p.add_argument("--f0", type=float, help="EO force amplitude [N] (default: config)")
+    upd_response_options(p)
     p.add_argument("--harmonics", type=int, default=7, help="highest harmonic H (with --accuracy "
                    "the first one tried)")
     p.add_argument("--accuracy", type=float, metavar="TOL",
