@@ -106,13 +106,15 @@ def _write_model(case, folder: Path) -> list[str]:
                  "--damping", _arg(case.C[0, 0]), "--contact-stiffness", _arg(link.k),
                  "--slip-force", _arg(link.fs), "--force", _arg(case.force[0])]
     else:
-        stem = folder / case.name.replace(" ", "_").replace("=", "")
-        np.savez(stem.with_suffix(".npz"), M=case.M, K=case.K, C=case.C, force=case.force,
-                 response_dof=case.response_dof)
+        # the name as the files' stem: "F=0.5" holds a dot, so no with_suffix (it would
+        # cut the name there and let two cases share a file)
+        stem = case.name.replace(" ", "_").replace("=", "")
+        npz, toml = folder / f"{stem}.npz", folder / f"{stem}.toml"
+        np.savez(npz, M=case.M, K=case.K, C=case.C, force=case.force, response_dof=case.response_dof)
         tables = [f"[[element]]\ndofs = {[j.dof_a] if j.dof_b is None else [j.dof_a, j.dof_b]}\n"
                   f"type = \"jenkins\"\nk = {j.k!r}\nfs = {j.fs!r}\n" for j in case.links]
-        stem.with_suffix(".toml").write_text("\n".join(tables))
-        model = ["--model", str(stem.with_suffix(".npz")), "--elements", str(stem.with_suffix(".toml"))]
+        toml.write_text("\n".join(tables))
+        model = ["--model", str(npz), "--elements", str(toml)]
     return ["frf", *model, "--harmonics", str(case.harmonics), "--omega", *map(_arg, case.band), "--json"]
 
 

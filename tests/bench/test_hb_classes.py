@@ -111,3 +111,19 @@ def test_smoke_row_sdof_soft(tmp_path):
     assert (r["dofs"], r["harmonics"], r["size"]) == (1, 15, 31.0)
     text = hb_classes.table(rows)
     assert "sdof soft" in text and "own error" in text
+
+
+def test_cli_files_of_cases_with_dotted_names_stay_apart(tmp_path):
+    """A case named with a decimal ("F=0.5") keeps its whole name in its files' names, so two
+    such cases never write to one file."""
+    import dataclasses
+
+    a = bm.chain3(1.0, 20.0, down=True)
+    b = dataclasses.replace(a, name="chain3 F=0.5 knl=2000")
+    c = dataclasses.replace(a, name="chain3 F=0.5 knl=20")
+    files = {}
+    for case in (b, c):
+        argv = hb_classes._write_model(case, tmp_path)
+        files[case.name] = (argv[argv.index("--model") + 1], argv[argv.index("--elements") + 1])
+    assert files[b.name][0] != files[c.name][0] and files[b.name][1] != files[c.name][1]
+    assert files[b.name][0].endswith("chain3_F0.5_knl2000.npz")
