@@ -23,9 +23,6 @@ The same residual (R1) of :mod:`.ring_hb` and the same tolerance as :mod:`.ring_
   judged by the residual alone at its end; when it lands, the Jacobian there is the
   one the step was solved with (the step stayed on its linear piece), and the tangent
   is solved on its factors: no evaluation of the Jacobian at the converged point.
-* **Start** at the tuned peak by continuation in the scatter scale (tuned ring to the
-  pattern, :data:`SCATTER_STEPS` tangent-predicted steps) from the mapped tuned
-  solution; Newton straight from that solution needs ~15 mostly damped iterations.
 * **Per-blade peaks by cubic Hermite interpolation** of every blade's amplitude a_j and
   its exact slope da_j/domega (from the tangent) between the continuation points:
   O(h^4) accurate, with no further solve. The largest of them (the worst blade, the
@@ -65,8 +62,6 @@ REFINE_STEPS, REFINE_RTOL = 3, 1e-10
 #: 3.4e-4 |x|, the steps before them mostly above: ~3 of 4 such guesses land, a miss
 #: costs the residual (~40 % of an evaluation with its Jacobian).
 LAND_RTOL = 4e-4
-#: Steps of the start's continuation in the scatter scale (tuned ring to the pattern).
-SCATTER_STEPS = 4
 #: Newton iterations of a continuation step before the step is shortened.
 STEP_ITER = 8
 #: Target of the tangent predictor's error, relative to the largest amplitude: the
@@ -159,7 +154,7 @@ class FastRingSolver:
                 break
             dx = self._step(J, -R, x, it, nr)
             if np.linalg.norm(dx) <= LAND_RTOL * np.linalg.norm(x):
-                landed = self._landed(x + dx, omega, J)
+                landed = self._landed(x + dx, omega)
                 if landed is not None:
                     self.iterations += it + 1
                     return landed
@@ -175,7 +170,7 @@ class FastRingSolver:
         raise NewtonError(f"no convergence to {self.tol:.1e} within {max_iter} iterations",
                           x, max_iter, nr)
 
-    def _landed(self, x, omega, J):
+    def _landed(self, x, omega):
         """(x, dx/domega) when x, a Newton step's end, solves the residual to tolerance
         (judged by the residual alone, without its Jacobian), else None.
 
@@ -189,7 +184,6 @@ class FastRingSolver:
             self.missed += 1
             return None
         self.landed += 1
-        self.last_J = J
         return x, self.factor.lu.solve(-Rw)
 
     def _step(self, J, b, x, it, nr):
@@ -202,41 +196,16 @@ class FastRingSolver:
         return dx
 
     def tangent(self, J, Rw) -> np.ndarray:
-        """dx/domega = -J^-1 dR/domega at a converged point (J kept as :attr:`last_J`)."""
-        self.last_J = J
+        """dx/domega = -J^-1 dR/domega at a converged point."""
         return self.factor.solve_near(J, -Rw)
 
     def start(self, omega: float):
-        """(x, dx/domega) at omega: by continuation in the scatter from the mapped tuned
-        solution (:meth:`scatter_start`), else Newton from that solution, else from the
-        reference's start (scatter homotopy with bisection, stuck guess)."""
-        try:
-            return self.scatter_start(omega)
-        except (NewtonError, SolverError):
-            pass
+        """(x, dx/domega) at omega from the mapped tuned solution, else from the
+        reference's start (scatter homotopy, stuck guess)."""
         try:
             return self.restart(omega)
         except (NewtonError, SolverError):
             return self.solve(omega, self.ref.start(omega), 40)
-
-    def scatter_start(self, omega: float):
-        """(x, dx/domega) at omega by continuation in the scatter scale lam (kappa(lam) =
-        1 + lam (kappa - 1), :meth:`.ring_hb.MistunedRingHB.set_scale`) from the mapped
-        tuned solution at lam = 0, :data:`SCATTER_STEPS` steps, each predicted by the
-        tangent dx/dlam = -J^-1 dR/dlam on the last factors. Newton from the mapped
-        solution at lam = 1 instead (:meth:`restart`) spends most of its iterations in
-        damped steps: the scatter moves the peak's amplitudes by tens of per cent."""
-        ring = self.ring
-        x = self.ref.tuned_start_shape(start_point(self.ref.tuned, omega))
-        try:
-            for k, lam in enumerate(np.linspace(0.0, 1.0, SCATTER_STEPS + 1)):
-                ring.set_scale(lam)
-                if k:   # the Jacobian does not depend on lam but through dR/dlam's term
-                    x = x + self.factor.solve_near(self.last_J, -ring.scale_derivative(x) / SCATTER_STEPS)
-                x, xp = self.solve(omega, x, 40)
-        finally:
-            ring.set_scale(1.0)
-        return x, xp
 
     def restart(self, omega: float):
         """(x, dx/domega) at omega from the mapped tuned solution (past a kink)."""

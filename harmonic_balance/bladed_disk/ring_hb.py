@@ -106,12 +106,6 @@ class MistunedRingHB:
         c = np.repeat(self.lam * (self.kappa - 1.0), self.sector.n_dof)
         self._c = np.tile(c, self.nb)
 
-    def scale_derivative(self, x: np.ndarray) -> np.ndarray:
-        """dR/dlam (size,) at x of the residual scaled by :meth:`set_scale`: the blades'
-        stiffness change (kappa - 1) K_0 x (M1), the only term lam enters, linearly."""
-        c = np.tile(np.repeat(self.kappa - 1.0, self.sector.n_dof), self.nb)
-        return c * (self._K0 @ np.asarray(x, dtype=float))
-
     def _element_operators(self) -> None:
         """Per element: global indices (n_b d,) of its DOFs' harmonics and its Q (m, d),
         stacked by shape (one batched product per group). The harmonics' operator is
