@@ -368,6 +368,7 @@ def fast_ring_frf(ring: MistunedRingHB, band, tuned: SectorHB | None = None,
     c.evaluations, c.newton_iterations = ring.evaluations - e0, solver.iterations
     c.extra |= {"factorizations": solver.factor.factorizations,
                 "refinements": solver.factor.refinements, "landed": solver.landed,
+                "fallbacks": getattr(solver.factor.lu, "fallbacks", 0),
                 "missed": solver.missed,
                 "points": int(w.size)}
     c.time_s = time.perf_counter() - t0

@@ -140,14 +140,15 @@ def test_ring_lu_backends_solve_the_same_system(sector4):
         _assert_solves_as_superlu(pard, ring(x, w)[1], rng)
 
 
+@pytest.mark.parametrize("precision", ["mixed", "double"])
 @pytest.mark.parametrize("blades", [3, 4])
-def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades):
+def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades, precision):
     """The blade-by-blade block LU on the ring's Jacobians (dampers stuck and slipping; three
     blades: the border is both neighbours' neighbour) against SuperLU, one factor object
-    refactoring the same pattern."""
+    refactoring the same pattern; single-precision factors refined in double, or double."""
     sector = Sector(load_config().with_values(disk__blades=blades, disk__engine_order=1))
     ring = MistunedRingHB(sector, PATTERN[:blades], 5)
-    blk = BlockRingFactor(blades, sector.n_dof, ring.nb)
+    blk = BlockRingFactor(blades, sector.n_dof, ring.nb, precision)
     rng = np.random.default_rng(20261128)
     for f, scale in ((440.0, 1.0), (455.0, 1.0), (448.0, 30.0)):
         w = 2 * np.pi * f
