@@ -7,8 +7,9 @@ to round-off (``tests/upd/test_upd_ring_fast.py``):
 * ``block`` (the default): :class:`BlockRingFactor`, Gaussian elimination blade by blade
   on the cyclic block-tridiagonal Jacobian with LAPACK (``getrf``/``getrs``) on each
   blade's dense block, the last blade the border that closes the ring. At 24 blades,
-  H = 7 (2520 unknowns, 205k non-zeros): ~9 ms a factorization against ~22-28 ms for
-  SuperLU with its ordering each time. Its arithmetic is fixed by the pattern, so its
+  H = 7 (2520 unknowns, 205k non-zeros): ~6 ms a factorization with single-precision
+  factors and solves refined in double (~8 ms with double factors) against ~22-28 ms
+  for SuperLU with its ordering each time. Its arithmetic is fixed by the pattern, so its
   bits are the same in a Dask worker and a serial run (one BLAS thread each).
 * ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in with
   ``DAMPER_SOLVER=pardiso``), real nonsymmetric (mtype 11): the fill-reducing ordering
