@@ -11,7 +11,8 @@ Rows:
   per-blade peaks and amplification against the full solver's.
 * ``band``: UPD-24 samples (``--samples``, std 0.02, seed 1) on the study's default band
   (the tuned friction-damped peak up to the stuck ring's, with margins) by the fast
-  solver and by the full solver on 41 and on 401 points: CPU time, evaluations, and
+  solver and by the full solver on 41 and on 401 points: CPU time, evaluations (the
+  fast solver's also its points, factorizations and residual-only evaluations), and
   the per-blade peaks' and amplification's largest differences against the 401-point
   full solver (the band's narrow resonance near the stuck peak needs that grid).
 * ``factor``: the fast solver's factorization of the ring Jacobian, SuperLU (COLAMD)
@@ -160,6 +161,10 @@ def band_rows(samples: int) -> list:
                "band_hz": [float(lo / 2 / np.pi), float(hi / 2 / np.pi)]}
         for name, (t, c) in runs.items():
             row |= {f"{name}_cpu_s": t, f"{name}_evaluations": c.evaluations}
+            if name == "fast":   # of the evaluations, those of the residual alone
+                row |= {"fast_points": c.extra["points"],
+                        "fast_factorizations": c.extra["factorizations"],
+                        "fast_residual_only": c.extra["landed"] + c.extra["missed"]}
             if name != "full401":
                 row |= {f"{name}_peak_per_blade_max_rel_diff":
                         float(np.abs(c.peak_per_blade / ref_c.peak_per_blade - 1).max()),

@@ -23,6 +23,9 @@ PEAK_RTOL = 1e-3
 WORST_RTOL = 1e-6
 #: The same linear system factored by two LU codes (round-off of a 420-unknown solve).
 LU_RTOL = 1e-9
+#: Tangents solved on two LU codes' factors of the same Jacobian (measured: 2e-11; the
+#: Jacobian's condition number magnifies round-off).
+TANGENT_RTOL = 1e-8
 PATTERN = (1.02, 0.985, 1.0, 0.995)
 
 
@@ -66,6 +69,24 @@ def test_fast_ring_equals_full_ring_with_friction(sector4):
     tol = RingSolver(ring, tuned).tol
     for w, x in zip(c.omega[::5], c.x[::5]):
         assert np.linalg.norm(ring(x, w, jac=False)) <= tol
+
+
+def test_fast_ring_tangents_are_those_of_the_converged_points(sector4):
+    """A point taken when a short Newton step lands (its residual alone checked) gets the
+    tangent of the Jacobian the step was solved with: it equals -J^-1 dR/domega with J
+    evaluated at the point itself (SuperLU) to TANGENT_RTOL, at every point."""
+    H = 3
+    tuned = SectorHB(sector4, H)
+    om = 2 * np.pi * np.linspace(430.0, 485.0, 56)
+    ring = MistunedRingHB(sector4, PATTERN, H)
+    c = fast_ring_frf(ring, (om[0], om[-1]), tuned, start_omega=frf(tuned, om).peak_omega)
+    assert c.extra["landed"] > 0
+    for w, x, xp in zip(c.omega, c.x, c.extra["tangents"]):
+        _, J, Rw = ring(x, w)
+        exact = SuperLUFactor()
+        exact.factor(J)
+        t = exact.solve(-Rw)
+        assert np.linalg.norm(xp - t) <= TANGENT_RTOL * np.linalg.norm(t)
 
 
 def test_fast_ring_sliding_limit_equals_linear_ring(sector4):
@@ -119,14 +140,15 @@ def test_ring_lu_backends_solve_the_same_system(sector4):
         _assert_solves_as_superlu(pard, ring(x, w)[1], rng)
 
 
+@pytest.mark.parametrize("precision", ["mixed", "double"])
 @pytest.mark.parametrize("blades", [3, 4])
-def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades):
+def test_block_elimination_solves_the_ring_jacobian_as_superlu(blades, precision):
     """The blade-by-blade block LU on the ring's Jacobians (dampers stuck and slipping; three
     blades: the border is both neighbours' neighbour) against SuperLU, one factor object
-    refactoring the same pattern."""
+    refactoring the same pattern; single-precision factors refined in double, or double."""
     sector = Sector(load_config().with_values(disk__blades=blades, disk__engine_order=1))
     ring = MistunedRingHB(sector, PATTERN[:blades], 5)
-    blk = BlockRingFactor(blades, sector.n_dof, ring.nb)
+    blk = BlockRingFactor(blades, sector.n_dof, ring.nb, precision)
     rng = np.random.default_rng(20261128)
     for f, scale in ((440.0, 1.0), (455.0, 1.0), (448.0, 30.0)):
         w = 2 * np.pi * f
