@@ -478,7 +478,7 @@ def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam, x_prev=N
         # a later level: three solves around the previous level's peak, its parabola's
         # vertex, checked (:func:`near_peak`); the curve's window only when that fails
         got = near_peak(fun, amplitude, pad(x_prev, basis, rich), levels, ntol, tol_lam,
-                        LEVEL_PRECISION * tol, _spacing(omegas, i))
+                        LEVEL_PRECISION * tol, spacing(omegas, i))
         if got is not None:
             return (rich, *got, guesses, i)
     # the first level looks around the curve's peak, later ones around the previous
@@ -492,7 +492,7 @@ def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam, x_prev=N
     return rich, x, w, a, n, guesses, i
 
 
-def _spacing(omegas, i) -> float:
+def spacing(omegas, i) -> float:
     """The curve's frequency step at its point i [rad/s] (the larger of its two sides)."""
     lo, hi = max(i - 1, 0), min(i + 1, len(omegas) - 1)
     return max(abs(omegas[i] - omegas[lo]), abs(omegas[hi] - omegas[i]))
