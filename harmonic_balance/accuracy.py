@@ -511,11 +511,13 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
     NEAR_BRACKET times the peak's last move between levels, at least FLAT_MAX ``tol_lam``,
     at most the curve's ``spacing``), from ``x0`` (the previous peak padded); then at the
     vertex of the parabola of the amplitude through the highest solved point and its
-    nearest neighbours on either side, until that vertex lies within the frequency
-    tolerance :func:`_flat_tolerance` (``amp_rel``) of the highest solved point, which is
-    the level's peak (successive parabolic interpolation, converging superlinearly on a
-    smooth maximum: Brent 1973, ch. 5, without the bracket's reduction that Brent's
-    stopping rule waits for). After NEAR_ITER vertices, or a vertex outside the bracket,
+    nearest neighbours on either side (successive parabolic interpolation, converging
+    superlinearly on a smooth maximum: Brent 1973, ch. 5), until the vertex lies within
+    the frequency tolerance :func:`_flat_tolerance` (``amp_rel``) of the highest solved
+    point; then that point's sides at +- the tolerance are probed, and it is the level's
+    peak once its neighbours on both sides lie within the tolerance (the bracket bounds
+    the peak, as in Brent's stopping rule, whatever the shape of the top). After NEAR_ITER
+    vertices and the probes, or a vertex outside the bracket,
     :func:`continuation.refine_max` searches the bracket to the same tolerance.
 
     Returns
