@@ -80,7 +80,7 @@ def _check_at_peak(result, rich, checks, prev, i, tol):
     """(x, omega, amplitude) of ``result``'s peak at the richer problem ``rich``: the first
     check from the curve's points around its peak (:func:`accuracy.peak_at`), a later one
     from the previous check's peak (:func:`accuracy.near_peak`: measured on the 5-mass
-    chain at H = 31, the check at H'' = 71 in 5 solves instead of 13), the curve's points
+    chain at H = 31, the check at H'' = 71 in 7 solves instead of 13), the curve's points
     again when that finds no peak."""
     om = np.asarray(result.omega)
     tol_lam = 1e-6 * abs(om[i])
