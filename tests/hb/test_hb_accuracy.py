@@ -355,3 +355,26 @@ def test_near_peak_hands_back_a_peak_outside_its_bracket():
     x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
     assert acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, 1e-7,
                          PEAK_AMP_REL, 0.05) is None
+
+
+class _OscillatorWithValue:
+    """:func:`oscillator` with ``value`` (R alone), as the HB problems offer it."""
+
+    def __call__(self, x, w):
+        return oscillator(x, w)
+
+    def value(self, x, w):
+        return oscillator(x, w)[0]
+
+
+def test_chord_steps_from_a_nearby_jacobian_reach_the_solution_and_refuse_a_far_one():
+    from harmonic_balance.newton import lu_factor
+
+    prob, w_star = _OscillatorWithValue(), oscillator_peak()[0]
+    exact = np.linalg.solve(oscillator(np.zeros(2), w_star)[1], [OSC_F, 0.0])
+    near = lu_factor(oscillator(exact, w_star * (1 + 1e-4))[1])   # 0.5 % of the half-power band c / m
+    x = acc._chord(prob, near, np.zeros(2), w_star, 1e-12)
+    assert x is not None and np.linalg.norm(x - exact) < 1e-10 * np.linalg.norm(exact)
+    far = lu_factor(oscillator(exact, w_star * 1.05)[1])        # 2.5 half-power bands away
+    assert acc._chord(prob, far, np.zeros(2), w_star, 1e-12) is None
+    assert acc._chord(oscillator, near, np.zeros(2), w_star, 1e-12) is None   # no value(): Newton's
