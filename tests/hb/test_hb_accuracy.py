@@ -378,14 +378,3 @@ def test_chord_steps_from_a_nearby_jacobian_reach_the_solution_and_refuse_a_far_
     far = lu_factor(oscillator(exact, w_star * 1.05)[1])        # 2.5 half-power bands away
     assert acc._chord(prob, far, np.zeros(2), w_star, 1e-12) is None
     assert acc._chord(oscillator, near, np.zeros(2), w_star, 1e-12) is None   # no value(): Newton's
-
-
-def test_near_peak_steps_towards_a_peak_beyond_its_first_bracket():
-    w_star, a_star = oscillator_peak()
-    # the last move (5e-4) sets the half-width 1e-3; the peak lies 2.2e-3 away: two steps
-    levels = [(3, a_star, w_star * (1 - 2.7e-3)), (5, a_star, w_star * (1 - 2.2e-3))]
-    x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
-    got = acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, 1e-7,
-                        PEAK_AMP_REL, 0.05)
-    assert got is not None and abs(got[2] / a_star - 1.0) < PEAK_AMP_REL
-    assert got[3] >= 3 + 2
