@@ -480,11 +480,6 @@ def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam, x_prev=N
         got = near_peak(fun, amplitude, pad(x_prev, basis, rich), levels, ntol, tol_lam,
                         LEVEL_PRECISION * tol, spacing(omegas, i))
         if got is not None:
-            # the curve points around the new peak start from it, should a later level
-            # fall back to the window (its guesses otherwise stay those of older levels)
-            i = int(np.argmin(np.abs(np.asarray(omegas) - got[1])))
-            for j in range(max(i - LEVEL_WINDOW, 0), min(i + LEVEL_WINDOW, len(guesses) - 1) + 1):
-                guesses[j] = got[0]
             return (rich, *got, guesses, i)
     # the first level looks around the curve's peak, later ones around the previous
     # level's (whose corrected points are the guesses), refined to LEVEL_PRECISION
@@ -525,13 +520,10 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
     vertices and the probes, or a vertex outside the bracket,
     :func:`continuation.refine_max` searches the bracket to the same tolerance.
 
-    When the middle one of the three first points is not the highest, they step by delta
-    towards the higher end, up to NEAR_EXTEND times.
-
     Returns
     -------
     (x, omega, amplitude, solves) or None when a solve fails or the peak is not bracketed
-    (the caller searches the curve's window then).
+    by the first three points (the caller searches the curve's window then).
     """
     w_p = levels[-1][2]
     move = abs(levels[-1][2] - levels[-2][2]) if len(levels) >= 2 else spacing
@@ -554,20 +546,6 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
     except NewtonError:
         return None
     pts = [(w, amplitude(x, w), x) for w, x in pts]
-    dropped = 0   # points solved and left behind by the steps below (counted in the solves)
-    for _ in range(NEAR_EXTEND):
-        if pts[1][1] > max(pts[0][1], pts[2][1]):
-            break
-        # the peak lies beyond an end: one step further that way, from the secant
-        end, inner = (pts[2], pts[1]) if pts[2][1] >= pts[1][1] else (pts[0], pts[1])
-        w = 2.0 * end[0] - inner[0]
-        try:
-            x = solve(2.0 * end[2] - inner[2], w)
-        except NewtonError:
-            return None
-        new = (w, amplitude(x, w), x)
-        pts = pts[1:] + [new] if end is pts[2] else [new] + pts[:2]
-        dropped += 1
     if not pts[1][1] > max(pts[0][1], pts[2][1]):
         return None
     flat = _flat_tolerance(tol_lam, amp_rel, [p[0] for p in pts], [p[1] for p in pts])
@@ -575,7 +553,7 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
         k = max(range(len(pts)), key=lambda j: pts[j][1])
         lo, top, hi = pts[k - 1], pts[k], pts[k + 1]
         if hi[0] - top[0] <= BRACKET_SLACK * flat and top[0] - lo[0] <= BRACKET_SLACK * flat:
-            return top[2], top[0], top[1], len(pts) + dropped   # the maximum is within flat of top
+            return top[2], top[0], top[1], len(pts)     # the maximum is within flat of top
         v = _vertex(lo, top, hi)
         if v is None or not lo[0] < v < hi[0]:
             break
@@ -596,7 +574,7 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
     branch = Branch(x=[p[2] for p in pts[k - 1:k + 2]], lam=[p[0] for p in pts[k - 1:k + 2]],
                     iterations=[0, 0, 0])
     x, w, a, n = refine_max(fun, branch, 1, amplitude, tol, flat)
-    return x, w, a, len(pts) + dropped + n
+    return x, w, a, len(pts) + n
 
 
 def _solve_with_slope(fun, x0, w, tol, factor):
@@ -647,10 +625,6 @@ def _chord(fun, lu, x, w, tol):
     return x if n <= tol else None
 
 
-#: Steps of :func:`near_peak`'s three first points beyond their end when the peak lies
-#: there (measured on the 5-mass chain from H = 12 to 30: the peak moved as far as the
-#: bracket's half-width, and the amplitude rose beyond it).
-NEAR_EXTEND = 2
 #: Parabola vertices solved by :func:`near_peak` before it hands the bracket to Brent
 #: (besides the two probes at the settled vertex's sides).
 NEAR_ITER = 4
