@@ -32,8 +32,9 @@ on the bench models and UPD-24): hence checks at 1.5 H and 2.25 H, not H + 2, wh
 difference would be too small to tell the error from.
 
 A peak to an accuracy (:func:`raise_at_peak`): the curve is traced once; its peak alone
-is re-solved at richer sets, level after level (each padded from the previous level's
-corrected points), and the RICHEST level's error is estimated from the levels below it
+is re-solved at richer sets, level after level (the first from the curve's points around
+its peak, each later one from the previous level's peak, by successive parabolas in
+frequency: :func:`near_peak`), and the RICHEST level's error is estimated from the levels below it
 (:func:`richest_error`: Richardson with the observed order when two successive triples
 agree on it, else with the smaller of it and ASSUMED_ORDER; the last difference itself
 when the levels oscillate) until it is below the target with at least MIN_LEVELS levels.
@@ -50,7 +51,7 @@ import numpy as np
 
 from .continuation import Branch, refine_max
 from .fourier import FourierBasis
-from .newton import NewtonError, newton
+from .newton import NewtonError, lu_factor, lu_solve, newton
 
 #: The check's highest harmonic is at least this multiple of H (then the next of the set's
 #: kind): close enough to cost ~2.5x a point of the curve per solve, far enough that the
@@ -430,9 +431,10 @@ def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: i
     solved), error (:func:`richest_error` of the levels, None with one level), met
     (bool), message (why not met, else None), solves (Newton solves at the levels).
 
-    Each level's starting guesses are the previous level's corrected window padded with
-    zeros (:func:`pad`), the other curve points padded from the curve; the window moves
-    with the peak.
+    The first level's starting guesses are the curve's points around its peak padded with
+    zeros (:func:`pad`); a later level starts from the previous level's peak padded
+    (:func:`near_peak`: four to seven solves), or, when that fails, from the previous
+    level's corrected window, the other curve points padded from the curve.
     """
     levels, hs, cur, x_peak, solves = [tuple(level0)], tuple(basis.harmonics), list(xs), None, 0
     error, message = None, None
@@ -445,7 +447,7 @@ def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: i
         for nxt in [nxt] + ([small] if small[-1] < nxt[-1] else []):  # noqa: B020
             try:
                 rich, x, w, a, n, guesses, i = _level(problem_at, nxt, basis, cur, levels, omegas, i,
-                                                      tol, tol_lam)
+                                                      tol, tol_lam, x_peak)
                 break
             except RuntimeError as err:
                 message = f"the peak at H = {nxt[-1]} failed ({err}); H = {hs[-1]} kept"
@@ -464,15 +466,23 @@ def raise_at_peak(problem_at, basis, xs, omegas, i, level0, tol: float, limit: i
             "message": None if met else message, "solves": solves}
 
 
-def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam):
+def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam, x_prev=None):
     """One level of :func:`raise_at_peak` at the set ``hs``: (rich basis, x, omega,
     amplitude, solves, the curve points' guesses at ``hs``, index of the highest corrected
-    point); RuntimeError when no peak is found."""
+    point); RuntimeError when no peak is found. ``x_prev``: the previous level's peak
+    solution (in ``basis``), None at the first level."""
     fun, amplitude, ntol, rich = problem_at(hs)
     guesses = [pad(x, basis, rich) for x in cur]
+    first = len(levels) == 1
+    if not first and x_prev is not None:
+        # a later level: three solves around the previous level's peak, its parabola's
+        # vertex, checked (:func:`near_peak`); the curve's window only when that fails
+        got = near_peak(fun, amplitude, pad(x_prev, basis, rich), levels, ntol, tol_lam,
+                        LEVEL_PRECISION * tol, spacing(omegas, i))
+        if got is not None:
+            return (rich, *got, guesses, i)
     # the first level looks around the curve's peak, later ones around the previous
     # level's (whose corrected points are the guesses), refined to LEVEL_PRECISION
-    first = len(levels) == 1
     x, w, a, n, window = peak_window(fun, amplitude, guesses, omegas, i, ntol, tol_lam,
                                      WINDOW if first else LEVEL_WINDOW, 0.0 if first else LEVEL_PRECISION * tol)
     for j, xj in window.items():
@@ -480,6 +490,158 @@ def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam):
             guesses[j] = xj
     i = max((j for j, xj in window.items() if xj is not None), key=lambda j: amplitude(window[j], omegas[j]))
     return rich, x, w, a, n, guesses, i
+
+
+def spacing(omegas, i) -> float:
+    """The curve's frequency step at its point i [rad/s] (the larger of its two sides)."""
+    lo, hi = max(i - 1, 0), min(i + 1, len(omegas) - 1)
+    return max(abs(omegas[i] - omegas[lo]), abs(omegas[hi] - omegas[i]))
+
+
+#: Half-width of the bracket of :func:`near_peak`, in units of the peak's last move in
+#: frequency between levels: the levels' peaks converge, so the next move is smaller
+#: (measured on UPD-24: moves of 1.9, 1.0, 0.74, 0.16 rad/s from H = 7 to 50).
+NEAR_BRACKET = 2.0
+
+
+def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
+    """The peak of a level after the first from the previous level's, by successive parabolas.
+
+    Solves at the previous level's peak frequency omega_p and at omega_p +- delta (delta =
+    NEAR_BRACKET times the peak's last move between levels, at least FLAT_MAX ``tol_lam``,
+    at most the curve's ``spacing``), from ``x0`` (the previous peak padded); then at the
+    vertex of the parabola of the amplitude through the highest solved point and its
+    nearest neighbours on either side (successive parabolic interpolation, converging
+    superlinearly on a smooth maximum: Brent 1973, ch. 5), until the vertex lies within
+    the frequency tolerance :func:`_flat_tolerance` (``amp_rel``) of the highest solved
+    point; then that point's sides at +- the tolerance are probed, and it is the level's
+    peak once its neighbours on both sides lie within the tolerance (the bracket bounds
+    the peak, as in Brent's stopping rule, whatever the shape of the top). After NEAR_ITER
+    vertices and the probes, or a vertex outside the bracket,
+    :func:`continuation.refine_max` searches the bracket to the same tolerance.
+
+    Returns
+    -------
+    (x, omega, amplitude, solves) or None when a solve fails or the peak is not bracketed
+    by the first three points (the caller searches the curve's window then).
+    """
+    w_p = levels[-1][2]
+    move = abs(levels[-1][2] - levels[-2][2]) if len(levels) >= 2 else spacing
+    delta = min(max(NEAR_BRACKET * move, FLAT_MAX * tol_lam), spacing)
+    factor = getattr(fun, "factorize", None)
+
+    lu_c = []   # the centre's LU factors, for chord steps at the other points
+
+    def solve(x, w):
+        got = _chord(fun, lu_c[0], x, w, tol) if lu_c else None
+        return got if got is not None else newton(lambda z: fun(z, w)[:2], x, tol, 40, factor=factor).x
+    try:
+        xc, dxdw, lu = _solve_with_slope(fun, x0, w_p, tol, factor)
+        # the neighbours from the branch's tangent at the centre (measured on UPD-24 at
+        # H = 50: 2 Newton iterations each instead of 4 from the centre itself)
+        pts = [(w_p - delta, solve(xc - delta * dxdw, w_p - delta)), (w_p, xc),
+               (w_p + delta, solve(xc + delta * dxdw, w_p + delta))]
+        if lu is not None:   # the points inside the bracket by chord steps (too far out there)
+            lu_c.append(lu)
+    except NewtonError:
+        return None
+    pts = [(w, amplitude(x, w), x) for w, x in pts]
+    if not pts[1][1] > max(pts[0][1], pts[2][1]):
+        return None
+    flat = _flat_tolerance(tol_lam, amp_rel, [p[0] for p in pts], [p[1] for p in pts])
+    for _ in range(NEAR_ITER + 2):
+        k = max(range(len(pts)), key=lambda j: pts[j][1])
+        lo, top, hi = pts[k - 1], pts[k], pts[k + 1]
+        if hi[0] - top[0] <= BRACKET_SLACK * flat and top[0] - lo[0] <= BRACKET_SLACK * flat:
+            return top[2], top[0], top[1], len(pts)     # the maximum is within flat of top
+        v = _vertex(lo, top, hi)
+        if v is None or not lo[0] < v < hi[0]:
+            break
+        if abs(v - top[0]) <= flat:
+            # the vertex has settled: probe top +- flat on a side still wider, so that the
+            # bracket, not the parabola, bounds the peak (a kink at lift-off or stick-slip
+            # has no parabolic top: measured on the 3D contact point at H = 12, a vertex
+            # within flat of a point 2.6e-5 below the peak)
+            up = hi[0] - top[0] > BRACKET_SLACK * flat and (v >= top[0] or top[0] - lo[0] <= BRACKET_SLACK * flat)
+            v = top[0] + (flat if up else -flat)
+        near = lo if v < top[0] else hi
+        try:
+            x = solve(top[2] + (v - top[0]) / (near[0] - top[0]) * (near[2] - top[2]), v)
+        except NewtonError:
+            break
+        pts.insert(k if v < top[0] else k + 1, (v, amplitude(x, v), x))
+    k = max(range(1, len(pts) - 1), key=lambda j: pts[j][1])
+    branch = Branch(x=[p[2] for p in pts[k - 1:k + 2]], lam=[p[0] for p in pts[k - 1:k + 2]],
+                    iterations=[0, 0, 0])
+    x, w, a, n = refine_max(fun, branch, 1, amplitude, tol, flat)
+    return x, w, a, len(pts) + n
+
+
+def _solve_with_slope(fun, x0, w, tol, factor):
+    """(x, dx/domega) at the solution of fun(., w) = 0 from x0: the slope
+    -R_x^-1 R_omega from the last evaluation (at x) and the last Newton step's LU factors
+    (of R_x one step before x: a predictor's accuracy), zeros when neither is at hand."""
+    last = {}
+
+    def f(z):
+        R, J, Rw = fun(z, w)
+        last.update(z=z, Rw=Rw)
+        return R, J
+    res = newton(f, x0, tol, 40, factor=factor)
+    lu = res.lu if res.lu is not None else (factor or lu_factor)(res.J)
+    if lu is None or not np.array_equal(last["z"], res.x):
+        return res.x, np.zeros_like(res.x), lu
+    slope = -lu_solve(lu, last["Rw"])
+    return res.x, slope if np.all(np.isfinite(slope)) else np.zeros_like(res.x), lu
+
+
+#: Chord steps (:func:`_chord`) allowed per solve, and the factor by which each must
+#: reduce |R|; a solve that misses either is Newton's.
+CHORD_ITER = 10
+CHORD_RATE = 0.5
+
+
+def _chord(fun, lu, x, w, tol):
+    """x with |R(x, w)|_2 <= tol by chord steps (Newton's with the fixed factors ``lu`` of
+    a nearby Jacobian: Kelley 2003, ch. 5; each step one residual, ``fun.value``, and a
+    back-substitution), or None when ``fun`` has no ``value`` or the steps do not contract
+    by CHORD_RATE within CHORD_ITER. Inside a peak's bracket the Jacobian changes little
+    from the centre's; measured on UPD-24 at H = 50: 3-6 chord steps (a residual each,
+    ~1/6 of a Newton iteration with its Jacobian and LU) where Newton took 2 iterations."""
+    value = getattr(fun, "value", None)
+    if value is None:
+        return None
+    R = value(x, w)
+    n = np.linalg.norm(R)
+    for _ in range(CHORD_ITER):
+        if n <= tol:
+            return x
+        x = x - lu_solve(lu, R)
+        R = value(x, w)
+        n_new = np.linalg.norm(R) if np.all(np.isfinite(R)) else np.inf
+        if not n_new <= CHORD_RATE * n:
+            return None
+        n = n_new
+    return x if n <= tol else None
+
+
+#: Parabola vertices solved by :func:`near_peak` before it hands the bracket to Brent
+#: (besides the two probes at the settled vertex's sides).
+NEAR_ITER = 4
+#: A side of the bracket counts as closed within this factor of the frequency tolerance
+#: (the probes land at exactly that tolerance; round-off in the sum).
+BRACKET_SLACK = 1.0 + 1e-9
+
+
+def _vertex(p0, p1, p2) -> float | None:
+    """Abscissa of the vertex of the parabola through three points (w, a, ...) with distinct
+    w, or None when they are collinear or the parabola opens upwards."""
+    (w0, a0), (w1, a1), (w2, a2) = p0[:2], p1[:2], p2[:2]
+    d0, d2 = (a0 - a1) / (w0 - w1), (a2 - a1) / (w2 - w1)
+    c2 = (d2 - d0) / (w2 - w0)   # Newton's form: a = a0 + d0 (w - w0) + c2 (w - w0)(w - w1)
+    if not c2 < 0:
+        return None
+    return 0.5 * (w0 + w1) - d0 / (2.0 * c2)   # where d0 + c2 (2 w - w0 - w1) = 0
 
 
 def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict, dict]:

@@ -161,7 +161,7 @@ def peak_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = P
     if 0 < i < amp.size - 1:
         def problem_at(hs):
             rich = check_sector(hb, hs[-1])
-            return (rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x),
+            return (rich, lambda x, w, r=rich: r.amplitude_h1(x),   # rich itself: its value() too
                     1e-10 * max(hb.f0, hb.cf), rich.basis)
         run = acc.raise_at_peak(problem_at, hb.basis, curve.x, np.asarray(curve.omega), i, level0,
                                 tol, limit, 1e-6 * curve.peak_omega)

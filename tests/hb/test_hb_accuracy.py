@@ -308,3 +308,73 @@ def test_upd_peak_to_accuracy_meets_its_target_against_a_direct_richer_solve():
     ref = acc.peak_at(rich.__call__, lambda x, w: rich.amplitude_h1(x), xs, om, int(np.argmax(c.amplitude)),
                       1e-10 * max(hb.f0, hb.cf), 1e-6 * c.peak_omega)[2]
     assert abs(rec["accuracy"]["peak_amplitude"] / ref - 1.0) < tol
+
+
+#: Linear oscillator of the peak-search tests: m, k [SI], damping c, force F (a resonance
+#: sharp enough that a parabola through +- 1 % of omega is not its peak already).
+OSC_M, OSC_K, OSC_C, OSC_F = 1.0, 1.0, 0.02, 1.0
+#: Relative amplitude precision asked of the level's peak search.
+PEAK_AMP_REL = 1e-6
+
+
+def oscillator(x, w):
+    """Harmonic balance of m u'' + c u' + k u = F cos(w t), u = a cos + b sin: (R, dR/dx, dR/dw)."""
+    a, b = x
+    d = OSC_K - OSC_M * w**2
+    R = np.array([d * a + OSC_C * w * b - OSC_F, d * b - OSC_C * w * a])
+    J = np.array([[d, OSC_C * w], [-OSC_C * w, d]])
+    return R, J, np.array([-2 * OSC_M * w * a + OSC_C * b, -2 * OSC_M * w * b - OSC_C * a])
+
+
+def oscillator_peak():
+    """The analytic maximum of |u| over w: (w*, |u|_max)."""
+    w = np.sqrt(OSC_K / OSC_M - OSC_C**2 / (2 * OSC_M**2))
+    return w, OSC_F / (OSC_C * np.sqrt(OSC_K / OSC_M - OSC_C**2 / (4 * OSC_M**2)))
+
+
+def test_near_peak_finds_the_analytic_maximum_from_a_nearby_previous_level():
+    w_star, a_star = oscillator_peak()
+    tol_lam = 1e-7
+    # a previous level's peak 0.3 % off, which had moved by 0.2 % from the level before
+    levels = [(3, a_star, w_star * 0.995), (5, a_star, w_star * 1.003)]
+    x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
+    got = acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, tol_lam,
+                        PEAK_AMP_REL, 0.05)
+    assert got is not None
+    x, w, a, solves = got
+    assert abs(a / a_star - 1.0) < PEAK_AMP_REL
+    assert np.linalg.norm(oscillator(x, w)[0]) < 1e-10      # a solved point, not the parabola's
+    assert abs(w - w_star) < acc.FLAT_MAX * tol_lam + np.sqrt(2 * PEAK_AMP_REL) * w_star * OSC_C
+    assert solves >= 4
+
+
+def test_near_peak_hands_back_a_peak_outside_its_bracket():
+    w_star, a_star = oscillator_peak()
+    # the previous peak 5 % off and a tiny last move: the three points do not bracket the peak
+    levels = [(3, a_star, w_star * 1.0501), (5, a_star, w_star * 1.05)]
+    x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
+    assert acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, 1e-7,
+                         PEAK_AMP_REL, 0.05) is None
+
+
+class _OscillatorWithValue:
+    """:func:`oscillator` with ``value`` (R alone), as the HB problems offer it."""
+
+    def __call__(self, x, w):
+        return oscillator(x, w)
+
+    def value(self, x, w):
+        return oscillator(x, w)[0]
+
+
+def test_chord_steps_from_a_nearby_jacobian_reach_the_solution_and_refuse_a_far_one():
+    from harmonic_balance.newton import lu_factor
+
+    prob, w_star = _OscillatorWithValue(), oscillator_peak()[0]
+    exact = np.linalg.solve(oscillator(np.zeros(2), w_star)[1], [OSC_F, 0.0])
+    near = lu_factor(oscillator(exact, w_star * (1 + 1e-4))[1])   # 0.5 % of the half-power band c / m
+    x = acc._chord(prob, near, np.zeros(2), w_star, 1e-12)
+    assert x is not None and np.linalg.norm(x - exact) < 1e-10 * np.linalg.norm(exact)
+    far = lu_factor(oscillator(exact, w_star * 1.05)[1])        # 2.5 half-power bands away
+    assert acc._chord(prob, far, np.zeros(2), w_star, 1e-12) is None
+    assert acc._chord(oscillator, near, np.zeros(2), w_star, 1e-12) is None   # no value(): Newton's
