@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from . import accuracy as acc
+from . import peak_search
 from .fourier import default_samples, parse_harmonics
 
 #: Highest harmonic the library goes to when raising H for an accuracy (the CLI passes
@@ -78,20 +79,20 @@ def check_peak(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS, *,
 
 def _check_at_peak(result, rich, checks, prev, i, tol):
     """(x, omega, amplitude) of ``result``'s peak at the richer problem ``rich``: the first
-    check from the curve's points around its peak (:func:`accuracy.peak_at`), a later one
-    from the previous check's peak (:func:`accuracy.near_peak`: measured on the 5-mass
+    check from the curve's points around its peak (:func:`peak_search.peak_at`), a later one
+    from the previous check's peak (:func:`peak_search.near_peak`: measured on the 5-mass
     chain at H = 31, the check at H'' = 71 in 7 solves instead of 13), the curve's points
     again when that finds no peak."""
     om = np.asarray(result.omega)
     tol_lam = 1e-6 * abs(om[i])
     if prev is not None:
         levels = [(result.problem.basis.H, result.peak_amplitude, result.peak_omega), checks[-1]]
-        got = acc.near_peak(rich, rich.amplitude, acc.pad(prev[0], prev[1], rich.basis), levels, tol,
+        got = peak_search.near_peak(rich, rich.amplitude, acc.pad(prev[0], prev[1], rich.basis), levels, tol,
                             tol_lam, 0.0, acc.spacing(om, i))
         if got is not None:
             return got[:3]
     xs = [acc.pad(x, result.problem.basis, rich.basis) for x in result.solutions]
-    return acc.peak_at(rich, rich.amplitude, xs, om, i, tol, tol_lam)[:3]
+    return peak_search.peak_at(rich, rich.amplitude, xs, om, i, tol, tol_lam)[:3]
 
 
 def truncation_error(result, limit: int = MAX_HARMONIC, levels: int = CHECK_LEVELS, *,

@@ -20,6 +20,7 @@ import time
 import numpy as np
 
 from .. import accuracy as acc
+from .. import peak_search
 from .hb import SectorHB, sector_basis
 from .solve import SolverError, frf
 
@@ -60,7 +61,7 @@ def truncation_error(hb: SectorHB, curve, limit: int = MAX_HARMONIC, levels: int
         rich = check_sector(hb, hs[-1])
         xs = [acc.pad(x, hb.basis, rich.basis) for x in curve.x]
         try:
-            _, wc, ac, _ = acc.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs,
+            _, wc, ac, _ = peak_search.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs,
                                        np.asarray(curve.omega), i, 1e-10 * max(hb.f0, hb.cf),
                                        1e-6 * curve.peak_omega)
         except RuntimeError as err:

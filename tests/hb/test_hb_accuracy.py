@@ -8,6 +8,7 @@ from failure_output import no_result
 from damper.cli import main
 from harmonic_balance import accuracy as acc
 from harmonic_balance import bench_models as bm
+from harmonic_balance import peak_search
 from harmonic_balance.fourier import FourierBasis
 from harmonic_balance.frf import TOL_REL, compute_frf
 from harmonic_balance.frf_accuracy import check_problem
@@ -30,7 +31,7 @@ def reference_peak(result, H_ref=REFERENCE_H) -> float:
     rich = check_problem(prob, tuple(range(H_ref + 1)))
     xs = [acc.pad(x, prob.basis, rich.basis) for x in result.solutions]
     tol = TOL_REL * rich.reference(result.peak_omega)
-    return acc.peak_at(rich, rich.amplitude, xs, np.asarray(result.omega),
+    return peak_search.peak_at(rich, rich.amplitude, xs, np.asarray(result.omega),
                        int(np.argmax(result.amplitude)), tol, 1e-6 * result.peak_omega)[2]
 
 
@@ -305,7 +306,7 @@ def test_upd_peak_to_accuracy_meets_its_target_against_a_direct_richer_solve():
     assert rec["accuracy"]["met"]
     rich = check_sector(hb, UPD_REFERENCE_H)   # the curve's peak padded straight to H = 40
     xs = [acc.pad(x, hb.basis, rich.basis) for x in c.x]
-    ref = acc.peak_at(rich.__call__, lambda x, w: rich.amplitude_h1(x), xs, om, int(np.argmax(c.amplitude)),
+    ref = peak_search.peak_at(rich.__call__, lambda x, w: rich.amplitude_h1(x), xs, om, int(np.argmax(c.amplitude)),
                       1e-10 * max(hb.f0, hb.cf), 1e-6 * c.peak_omega)[2]
     assert abs(rec["accuracy"]["peak_amplitude"] / ref - 1.0) < tol
 
@@ -338,13 +339,13 @@ def test_near_peak_finds_the_analytic_maximum_from_a_nearby_previous_level():
     # a previous level's peak 0.3 % off, which had moved by 0.2 % from the level before
     levels = [(3, a_star, w_star * 0.995), (5, a_star, w_star * 1.003)]
     x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
-    got = acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, tol_lam,
+    got = peak_search.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, tol_lam,
                         PEAK_AMP_REL, 0.05)
     assert got is not None
     x, w, a, solves = got
     assert abs(a / a_star - 1.0) < PEAK_AMP_REL
     assert np.linalg.norm(oscillator(x, w)[0]) < 1e-10      # a solved point, not the parabola's
-    assert abs(w - w_star) < acc.FLAT_MAX * tol_lam + np.sqrt(2 * PEAK_AMP_REL) * w_star * OSC_C
+    assert abs(w - w_star) < peak_search.FLAT_MAX * tol_lam + np.sqrt(2 * PEAK_AMP_REL) * w_star * OSC_C
     assert solves >= 4
 
 
@@ -353,7 +354,7 @@ def test_near_peak_hands_back_a_peak_outside_its_bracket():
     # the previous peak 5 % off and a tiny last move: the three points do not bracket the peak
     levels = [(3, a_star, w_star * 1.0501), (5, a_star, w_star * 1.05)]
     x0 = np.linalg.solve(oscillator(np.zeros(2), levels[-1][2])[1], [OSC_F, 0.0])
-    assert acc.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, 1e-7,
+    assert peak_search.near_peak(oscillator, lambda x, w: float(np.hypot(*x)), x0, levels, 1e-12, 1e-7,
                          PEAK_AMP_REL, 0.05) is None
 
 
@@ -373,8 +374,8 @@ def test_chord_steps_from_a_nearby_jacobian_reach_the_solution_and_refuse_a_far_
     prob, w_star = _OscillatorWithValue(), oscillator_peak()[0]
     exact = np.linalg.solve(oscillator(np.zeros(2), w_star)[1], [OSC_F, 0.0])
     near = lu_factor(oscillator(exact, w_star * (1 + 1e-4))[1])   # 0.5 % of the half-power band c / m
-    x = acc._chord(prob, near, np.zeros(2), w_star, 1e-12)
+    x = peak_search.chord(prob, near, np.zeros(2), w_star, 1e-12)
     assert x is not None and np.linalg.norm(x - exact) < 1e-10 * np.linalg.norm(exact)
     far = lu_factor(oscillator(exact, w_star * 1.05)[1])        # 2.5 half-power bands away
-    assert acc._chord(prob, far, np.zeros(2), w_star, 1e-12) is None
-    assert acc._chord(oscillator, near, np.zeros(2), w_star, 1e-12) is None   # no value(): Newton's
+    assert peak_search.chord(prob, far, np.zeros(2), w_star, 1e-12) is None
+    assert peak_search.chord(oscillator, near, np.zeros(2), w_star, 1e-12) is None   # no value(): Newton's
