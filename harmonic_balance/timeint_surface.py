@@ -30,7 +30,10 @@ v_b(t_n) in (T1) is the BDF2 velocity of the steps already taken (explicit).
 Start: at rest at x_a = x0 (default 0) with w from (T2) without velocities (the static
 equilibrium of the massless rows), the sliders virgin at s = s_0, as the harmonic
 balance's convention (:mod:`.contact`; x0 the frictionless prestress state whose slips
-are the s_0 of :func:`.contact.frictionless_statics`). Steady state and step-size check as
+are the s_0 of :func:`.contact.frictionless_statics`); or on a given periodic motion
+(``start``, e.g. a harmonic balance solution: the sliders stepped through its loop, the
+march continued from its state at t = 0), which the march then corrects to its own
+steady state in fewer periods. Steady state and step-size check as
 :func:`.timeint.march_curve` (all frequencies of a curve marched together, each
 stopping on its own).
 """
@@ -45,6 +48,11 @@ from .forces import LinearElement
 from .massless import MasslessContacts
 from .model import Model, _on_dofs
 from .timeint import _SS_HARMONICS, CFL, CurveSteadyState, _result, _settled_many
+
+#: Periods of a given periodic motion the node sliders are stepped through before a start
+#: on it (:func:`march_curve`'s ``start``): the first closes the loop from the virgin state,
+#: the second retraces it, so the states carry the loop's past as at a steady state.
+START_PERIODS = 2
 
 
 @dataclass
@@ -93,7 +101,8 @@ def stable_steps(M_aa, K_cond, omega_min: float, steps: int) -> int:
 class _SurfaceMarch:
     """State of :func:`march_curve`: the DOFs with mass, the nodes, their histories."""
 
-    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int, x0=None):
+    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int, x0=None,
+                 start=None):
         a, b, M, K, C, contacts = _split(model)
         nf = omegas.size
         self.a, self.b, self.r = a, b, model.response_dof
@@ -115,6 +124,9 @@ class _SurfaceMarch:
         th = 2.0 * np.pi * np.arange(ns) / ns
         self.fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                         for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})
+        if start is not None:
+            self._start_periodic(start, nf)
+            return
         # start: rest at x0, w from the static equilibrium of b (guess: x0's, else the
         # stuck linearisation)
         x0 = np.zeros(model.n) if x0 is None else np.asarray(x0, float)
@@ -126,6 +138,23 @@ class _SurfaceMarch:
         self.w = self.nodes.solve(self.nodes.split(Kbb), rhs0, guess)
         self.w_m = self.w.copy()
         self.w_mm = self.w.copy()
+
+    def _start_periodic(self, start, nf: int) -> None:
+        """Start on a given periodic motion (:func:`march_curve`'s ``start``): the sliders
+        stepped through its w over START_PERIODS periods ending at t = 0, the DOFs with mass
+        at x(0) and x(-dt), the nodes at w(0), w(-dt), w(-2 dt) (the BDF2 velocity)."""
+        X = np.asarray(start(self.ns), float)
+        if X.shape != (self.ns, self.a.size + self.b.size) or not np.all(np.isfinite(X)):
+            raise ValueError(f"start must give ({self.ns}, {self.a.size + self.b.size}) finite "
+                             f"displacements, got shape {X.shape}")
+        wb = X[:, self.b]
+        # t = -START_PERIODS T + dt ... 0: the committed states end at w(0) = X[0]
+        for k in range(1 - START_PERIODS * self.ns, 1):
+            _, _, trial = self.nodes.evaluate(np.tile(wb[k % self.ns], (nf, 1)))
+            self.nodes.commit(trial)
+        self.xa = np.tile(X[0, self.a], (nf, 1))
+        self.xa_m = np.tile(X[-1, self.a], (nf, 1))
+        self.w, self.w_m, self.w_mm = (np.tile(wb[k], (nf, 1)) for k in (0, -1, -2))
 
     def step(self, j: int) -> None:
         """Advance every history from t_j to t_(j+1): (T1), then (T2)."""
@@ -155,7 +184,7 @@ class _SurfaceMarch:
 
 
 def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: int = 3000,
-                tol: float = 1e-6, x0=None) -> SurfaceCurveSteadyState:
+                tol: float = 1e-6, x0=None, start=None) -> SurfaceCurveSteadyState:
     """March a model with massless DOFs at every frequency of ``omegas`` to periodic steady state.
 
     Parameters
@@ -170,6 +199,13 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     x0 : array_like (n,), optional
         Start at rest [m]: the DOFs with mass there, the massless ones in equilibrium
         (guess x0's); default 0 (e.g. a prestress state, its sliders virgin there).
+    start : callable, optional
+        ``start(ns)`` -> (ns, n) displacements [m] of a periodic motion at the phases
+        theta_j = 2 pi j / ns (j = 0 .. ns - 1, the march's own steps; e.g. a harmonic
+        balance solution): every frequency starts on it instead of at rest, the node
+        sliders carrying the past of START_PERIODS of its periods (``x0`` is then unused).
+        A start near the steady state settles in far fewer periods than one from rest;
+        the march's equations are the same, so the state it settles to is its own.
 
     Returns
     -------
@@ -180,7 +216,7 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
         raise ValueError(f"omegas must be a non-empty 1-D array of positive numbers, got {omegas}")
     nf = omegas.size
-    run = _SurfaceMarch(model, omegas, steps_per_period, x0)
+    run = _SurfaceMarch(model, omegas, steps_per_period, x0, start)
     ns = run.ns
     act = np.arange(nf)
     hist, prev = np.empty((nf, ns)), np.zeros((nf, _SS_HARMONICS), complex)

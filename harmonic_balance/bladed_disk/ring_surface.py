@@ -69,9 +69,37 @@ def surface_ring_model(shb) -> Model:
     return Model(LinearModel(M=M, C=C, K=K), els, {0: f_static, 1: f_eo}, model.response_dof)
 
 
+def ring_start(shb, x: np.ndarray):
+    """The ring's periodic motion of a sector solution, for :func:`march_ring_surface`'s ``start``.
+
+    Parameters
+    ----------
+    shb : SurfaceSectorHB
+    x : ndarray (n_b n,)
+        Its harmonic balance solution (sector DOFs and node DOFs).
+
+    Returns
+    -------
+    callable ``ns`` -> (ns, N_r n) [m]: sector j's DOFs are the sector's at theta + j phi
+    (the EO force's phase on blade j), sampled at theta = 2 pi k / ns.
+    """
+    from ..fourier import FourierBasis
+    from .hb import neighbour_map
+
+    basis, phi = shb.basis, shb.sector.cfg.phi
+    X = np.asarray(x, float).reshape(basis.nb, shb.model.n)
+    Xr = np.hstack([neighbour_map(basis, j * phi) @ X for j in range(shb.sector.cfg.ring_blades)])
+    return lambda ns: FourierBasis(basis.harmonics, ns).E @ Xr
+
+
 def march_ring_surface(shb, omegas, steps_per_period: int = 0, max_periods: int = 3000,
-                       tol: float = 1e-6) -> dict:
+                       tol: float = 1e-6, start=None) -> dict:
     """Steady response of blade 0's u_a on the ring with surfaces at each frequency [rad/s].
+
+    ``start``: a sector solution x of ``shb``'s harmonic balance (:func:`ring_start`); the
+    ring then starts on its motion, sliders stepped through its loop
+    (:func:`harmonic_balance.timeint_surface.march_curve`), instead of at rest at the
+    frictionless prestress state.
 
     Returns
     -------
@@ -82,7 +110,8 @@ def march_ring_surface(shb, omegas, steps_per_period: int = 0, max_periods: int 
     """
     ring = surface_ring_model(shb)
     x0, _ = frictionless_statics(ring, apply=True)
-    res = march_curve(ring, omegas, steps_per_period, max_periods, tol, x0=x0)
+    res = march_curve(ring, omegas, steps_per_period, max_periods, tol, x0=x0,
+                      start=None if start is None else ring_start(shb, start))
     mean = res.x_last.mean(axis=1, keepdims=True)
     return {"amplitude": res.amplitude_h1, "amplitude_max": np.abs(res.x_last - mean).max(axis=1),
             "periods": res.periods, "converged": res.converged,

@@ -1,0 +1,218 @@
+"""UPD-24 with contact surfaces: the HB peak, its node convergence, the ring time integration and the point model.
+===============================================================================================================
+
+Per centrifugal load CF:
+
+* the peak of the default point model (three Jenkins points of the TOML,
+  :class:`harmonic_balance.bladed_disk.hb.SectorHB`, its curve over the configuration's
+  band refined by :func:`harmonic_balance.bladed_disk.solve.frf`);
+* the peak of the sector with the damper's faces as contact surfaces
+  (:class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`, ``--nodes`` per side,
+  one harmonic count): the first-harmonic amplitude of u_a maximised over the frequency
+  by Brent's search (:func:`harmonic_balance.brent.brent_min`), each frequency a Newton
+  solve warm-started from the nearest one solved, the search started at the point
+  model's peak;
+* with ``--ti``, at the surface peak of the finest node count: the ring of the same
+  sectors and surfaces marched in time
+  (:func:`harmonic_balance.bladed_disk.ring_surface.march_ring_surface`) until its first
+  harmonic settles, started on the harmonic balance's periodic state (the sliders
+  stepped through its loop) instead of at rest, which settles in tens of periods
+  instead of hundreds; the march's equations do not know the start, so the state it
+  settles to is its own (a start from rest remains ``--ti-rest``).
+
+Writes one JSON (``--json``) with the revision, and prints a table. Full study::
+
+    python examples/upd_surface_peak.py --cf 120 --nodes 5,7,10 --harmonics 3 --ti --json out/surface_peak_120.json
+
+``--quick`` runs the path at H 3, 5 nodes, loose tolerances, two march periods (a
+smoke run, not a comparison).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from damper.cache import Store
+from damper.upd_surface import build_surfaces
+from harmonic_balance.bladed_disk import solve
+from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
+from harmonic_balance.bladed_disk.sector import Sector
+from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+from harmonic_balance.brent import brent_min
+from harmonic_balance.newton import NewtonError
+
+#: First step of the search for an interval around the surface peak, relative to the
+#: point model's peak frequency (the surfaces' stiffness differs from the points' by a few
+#: per cent), and the most doublings of it.
+BRACKET_STEP, MAX_BRACKET = 0.005, 6
+#: Print every frequency solved (``--verbose``).
+VERBOSE = False
+#: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
+#: 1e-4 in frequency moves it by far less than the 0.5 % the node study resolves.
+PEAK_XTOL = 1e-4
+
+
+def revision() -> str:
+    """The git revision of this tree (with '+' when it has uncommitted changes)."""
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                             text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "-uno"], capture_output=True,
+                               text=True, check=True).stdout.strip()
+        return rev + ("+" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def point_peak(sector: Sector, H: int, cf: float, points: int) -> dict:
+    """The default point model's refined peak over the configuration's band."""
+    p0 = time.process_time()
+    hb = SectorHB(sector, H, cf=cf)
+    band = sector.cfg["load.band_hz"]
+    c = solve.frf(hb, 2 * np.pi * np.linspace(band[0], band[1], points))
+    return {"peak_hz": c.peak_omega / (2 * np.pi), "peak_amplitude_h1": c.peak_amplitude,
+            "cpu_s": time.process_time() - p0}
+
+
+def _bracket(neg, f0: float) -> tuple[float, float, float]:
+    """An interval (lo, hi) [Hz] and its best point around a maximum of -neg: uphill from f0 in steps of
+    BRACKET_STEP f0, doubled, until the amplitude falls (Press et al., Numerical Recipes,
+    sec. 10.1); every value is kept by neg's own cache."""
+    h = BRACKET_STEP * f0
+    a, b = f0, f0 + h
+    fa, fb = neg(a), neg(b)
+    if fb > fa:
+        a, b, fa, fb, h = b, a, fb, fa, -h
+    for _ in range(MAX_BRACKET):
+        c = b + 2 * h
+        fc = neg(c)
+        if fc > fb:
+            return min(a, c), max(a, c), b
+        a, b, fa, fb, h = b, c, fb, fc, 2 * h
+    raise RuntimeError(f"no amplitude maximum within {abs(b - f0):.0f} Hz of {f0:.1f} Hz")
+
+
+def surface_peak(hb: SurfaceSectorHB, f_guess: float, xtol: float = PEAK_XTOL) -> dict:
+    """Maximum over the frequency of the first harmonic of u_a (module docstring).
+
+    Returns
+    -------
+    dict: peak_hz, peak_amplitude_h1 [m], x (the solution there), points (Hz, amplitude of
+    every frequency solved), evaluations, cpu_s.
+    """
+    p0, e0 = time.process_time(), hb.evaluations
+    solved = {}   # omega -> x
+
+    def neg_amp(f):
+        w = 2 * np.pi * f
+        if w in solved:
+            return -hb.amplitude_h1(solved[w])
+        x = None
+        if solved:   # warm start; the stuck start (and its homotopy) when that fails
+            try:
+                x = solve.solve_point(hb, w, solved[min(solved, key=lambda v: abs(v - w))], max_iter=80)
+            except NewtonError:
+                pass
+        solved[w] = x = solve.start_point(hb, w) if x is None else x
+        if VERBOSE:
+            print(f"    {f:.4f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
+        return -hb.amplitude_h1(x)
+
+    lo, hi, best = _bracket(neg_amp, f_guess)
+    f, a, _ = brent_min(neg_amp, lo, hi, xtol * f_guess, start=best)
+    pts = sorted((w / (2 * np.pi), hb.amplitude_h1(x)) for w, x in solved.items())
+    return {"peak_hz": float(f), "peak_amplitude_h1": float(-a), "x": solved[2 * np.pi * f],
+            "points": pts, "evaluations": hb.evaluations - e0, "cpu_s": time.process_time() - p0}
+
+
+def ring_check(hb: SurfaceSectorHB, x, f: float, tol: float, periods: int, rest: bool) -> dict:
+    """The ring time integration at frequency f [Hz], started on the HB state x (and from rest)."""
+    out = {}
+    for name, start in (("from_hb_state", x),) + ((("from_rest", None),) if rest else ()):
+        p0 = time.process_time()
+        r = march_ring_surface(hb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start)
+        out[name] = {"amplitude_h1": float(r["amplitude"][0]), "periods": int(r["periods"][0]),
+                     "converged": bool(r["converged"][0]), "steps_per_period": int(r["steps_per_period"]),
+                     "time_steps": int(r["time_steps"]), "cpu_s": time.process_time() - p0,
+                     "ring_dofs": int(r["ring_dofs"])}
+    return out
+
+
+def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
+    """One CF: the point peak, the surface peak per node count, the ring check."""
+    rec = {"cf": cf, "point": point_peak(sector, H, cf, args.points), "surface": []}
+    print(f"CF {cf:g} N: point model peak {rec['point']['peak_hz']:.3f} Hz, "
+          f"|u_a,1| {rec['point']['peak_amplitude_h1']:.6e} m", flush=True)
+    f_guess = rec["point"]["peak_hz"]
+    for n in nodes:
+        surfaces = build_surfaces(cfg, n, cf, Store().prepare())
+        hb = SurfaceSectorHB(sector, surfaces, H, cf=cf)
+        pk = surface_peak(hb, f_guess, args.xtol)
+        f_guess = pk["peak_hz"]
+        row = {k: v for k, v in pk.items() if k != "x"} | {
+            "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}
+        if args.ti and n == nodes[-1]:
+            row["ring"] = ring_check(hb, pk["x"], pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
+        rec["surface"].append(row)
+        print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.3f} Hz, |u_a,1| "
+              f"{pk['peak_amplitude_h1']:.6e} m, {pk['evaluations']} evaluations, "
+              f"{pk['cpu_s']:.0f} s CPU", flush=True)
+        for name, r in row.get("ring", {}).items():
+            print(f"     ring {name}: |u_a,1| {r['amplitude_h1']:.6e} m "
+                  f"({r['amplitude_h1'] / pk['peak_amplitude_h1'] - 1:+.3%} of the HB), "
+                  f"{r['periods']} periods ({'settled' if r['converged'] else 'NOT settled'}), "
+                  f"{r['cpu_s']:.0f} s CPU", flush=True)
+    s = rec["surface"]
+    if len(s) > 1:
+        rec["last_refinement_change"] = s[-1]["peak_amplitude_h1"] / s[-2]["peak_amplitude_h1"] - 1
+    rec["point_error"] = rec["point"]["peak_amplitude_h1"] / s[-1]["peak_amplitude_h1"] - 1
+    rec["point_frequency_error"] = rec["point"]["peak_hz"] / s[-1]["peak_hz"] - 1
+    print(f"  point model against the {nodes[-1]}-node surface: amplitude "
+          f"{rec['point_error']:+.2%}, frequency {rec['point_frequency_error']:+.3%}", flush=True)
+    return rec
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cf", default="120", help="centrifugal loads [N], comma-separated")
+    ap.add_argument("--nodes", default="5", help="surface nodes per side, comma-separated (increasing)")
+    ap.add_argument("--harmonics", type=int, default=3, help="harmonic count H")
+    ap.add_argument("--points", type=int, default=21, help="frequencies of the point model's curve")
+    ap.add_argument("--xtol", type=float, default=PEAK_XTOL, help="relative frequency tolerance of the peak")
+    ap.add_argument("--ti", action="store_true", help="ring time integration at the finest surface peak")
+    ap.add_argument("--ti-rest", action="store_true", help="also march the ring from rest (slow)")
+    ap.add_argument("--ti-tol", type=float, default=1e-5, help="steady-state tolerance of the march")
+    ap.add_argument("--ti-periods", type=int, default=400, help="most periods marched")
+    ap.add_argument("--json", metavar="FILE", help="write the results here")
+    ap.add_argument("--verbose", action="store_true", help="print every frequency solved")
+    ap.add_argument("--quick", action="store_true", help="H 3, 5 nodes, 2 march periods: a smoke run")
+    args = ap.parse_args(argv)
+    if args.quick:
+        args.harmonics, args.nodes, args.points, args.xtol = 3, "5", 5, 1e-2
+        args.ti_periods, args.ti_rest = 2, False
+    global VERBOSE
+    VERBOSE = args.verbose
+    cfs = [float(v) for v in args.cf.split(",")]
+    nodes = [int(v) for v in args.nodes.split(",")]
+    cfg = load_config(None)
+    sector = Sector(cfg)
+    t0 = time.perf_counter()
+    out = {"revision": revision(), "harmonics": args.harmonics, "command": " ".join(sys.argv),
+           "cases": [run_cf(cfg, sector, cf, nodes, args.harmonics, args) for cf in cfs]}
+    out["time_s"] = time.perf_counter() - t0
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(out, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
