@@ -45,7 +45,7 @@ from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB
 from harmonic_balance.brent import brent_min
 from harmonic_balance.newton import NewtonError
 
@@ -53,6 +53,9 @@ from harmonic_balance.newton import NewtonError
 #: point model's peak frequency (the surfaces' stiffness differs from the points' by a few
 #: per cent), and the most doublings of it.
 BRACKET_STEP, MAX_BRACKET = 0.005, 6
+#: Loads of the path from ``--start-cf`` to the CF (:func:`cf_path`): steps of ~10 % at
+#: 300 -> 120 N, where the condensed model's Newton takes 5-15 evaluations a step.
+CF_STEPS = 8
 #: Print every frequency solved (``--verbose``).
 VERBOSE = False
 #: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
@@ -100,8 +103,24 @@ def _bracket(neg, f0: float) -> tuple[float, float, float]:
     raise RuntimeError(f"no amplitude maximum within {abs(b - f0):.0f} Hz of {f0:.1f} Hz")
 
 
-def surface_peak(hb: SurfaceSectorHB, f_guess: float, xtol: float = PEAK_XTOL) -> dict:
+def cf_path(make, omega: float, cf: float, start_cf: float):
+    """A first solution at ``cf`` [N] reached from the stuck start at ``start_cf`` by
+    Newton at CF_STEPS loads between them (log-spaced), each warm-started from the last:
+    where the stuck start does not converge (low CF: much of the faces slips).
+    ``make(cf)``: the model at that load."""
+    x = None
+    for c in np.geomspace(start_cf, cf, CF_STEPS + 1):
+        hb = make(c)
+        x = solve.start_point(hb, omega) if x is None else solve.solve_point(hb, omega, x, max_iter=80)
+        if VERBOSE:
+            print(f"    CF {c:.1f} N at {omega / 2 / np.pi:.3f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
+    return x
+
+
+def surface_peak(hb, f_guess: float, xtol: float = PEAK_XTOL, first=None) -> dict:
     """Maximum over the frequency of the first harmonic of u_a (module docstring).
+
+    ``first(omega)``: the first solution (default :func:`solve.start_point`, the stuck start).
 
     Returns
     -------
@@ -110,6 +129,7 @@ def surface_peak(hb: SurfaceSectorHB, f_guess: float, xtol: float = PEAK_XTOL) -
     """
     p0, e0 = time.process_time(), hb.evaluations
     solved = {}   # omega -> x
+    first = first or (lambda w: solve.start_point(hb, w))
 
     def neg_amp(f):
         w = 2 * np.pi * f
@@ -121,7 +141,7 @@ def surface_peak(hb: SurfaceSectorHB, f_guess: float, xtol: float = PEAK_XTOL) -
                 x = solve.solve_point(hb, w, solved[min(solved, key=lambda v: abs(v - w))], max_iter=80)
             except NewtonError:
                 pass
-        solved[w] = x = solve.start_point(hb, w) if x is None else x
+        solved[w] = x = first(w) if x is None else x
         if VERBOSE:
             print(f"    {f:.4f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
         return -hb.amplitude_h1(x)
@@ -133,12 +153,14 @@ def surface_peak(hb: SurfaceSectorHB, f_guess: float, xtol: float = PEAK_XTOL) -
             "points": pts, "evaluations": hb.evaluations - e0, "cpu_s": time.process_time() - p0}
 
 
-def ring_check(hb: SurfaceSectorHB, x, f: float, tol: float, periods: int, rest: bool) -> dict:
-    """The ring time integration at frequency f [Hz], started on the HB state x (and from rest)."""
+def ring_check(shb: SurfaceSectorHB, x, basis, f: float, tol: float, periods: int, rest: bool) -> dict:
+    """The ring of ``shb``'s sectors marched at frequency f [Hz], started on the HB state x
+    (harmonics on ``basis``; sector DOFs, with or without the nodes) and, with ``rest``, from rest."""
     out = {}
     for name, start in (("from_hb_state", x),) + ((("from_rest", None),) if rest else ()):
         p0 = time.process_time()
-        r = march_ring_surface(hb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start)
+        r = march_ring_surface(shb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start,
+                               start_basis=basis)
         out[name] = {"amplitude_h1": float(r["amplitude"][0]), "periods": int(r["periods"][0]),
                      "converged": bool(r["converged"][0]), "steps_per_period": int(r["steps_per_period"]),
                      "time_steps": int(r["time_steps"]), "cpu_s": time.process_time() - p0,
@@ -148,19 +170,25 @@ def ring_check(hb: SurfaceSectorHB, x, f: float, tol: float, periods: int, rest:
 
 def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     """One CF: the point peak, the surface peak per node count, the ring check."""
-    rec = {"cf": cf, "point": point_peak(sector, H, cf, args.points), "surface": []}
+    rec = {"cf": cf, "model": args.model, "point": point_peak(sector, H, cf, args.points), "surface": []}
     print(f"CF {cf:g} N: point model peak {rec['point']['peak_hz']:.3f} Hz, "
           f"|u_a,1| {rec['point']['peak_amplitude_h1']:.6e} m", flush=True)
     f_guess = rec["point"]["peak_hz"]
     for n in nodes:
         surfaces = build_surfaces(cfg, n, cf, Store().prepare())
-        hb = SurfaceSectorHB(sector, surfaces, H, cf=cf)
-        pk = surface_peak(hb, f_guess, args.xtol)
+        model = CondensedSurfaceSectorHB if args.model == "condensed" else SurfaceSectorHB
+        hb = model(sector, surfaces, H, cf=cf)
+        first = None
+        if args.start_cf is not None:
+            def first(w, surfaces=surfaces, model=model):
+                return cf_path(lambda c: model(sector, surfaces, H, cf=c), w, cf, args.start_cf)
+        pk = surface_peak(hb, f_guess, args.xtol, first)
         f_guess = pk["peak_hz"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
             "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}
         if args.ti and n == nodes[-1]:
-            row["ring"] = ring_check(hb, pk["x"], pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
+            row["ring"] = ring_check(SurfaceSectorHB(sector, surfaces, 1, cf=cf), pk["x"], hb.basis,
+                                     pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
         rec["surface"].append(row)
         print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.3f} Hz, |u_a,1| "
               f"{pk['peak_amplitude_h1']:.6e} m, {pk['evaluations']} evaluations, "
@@ -187,6 +215,11 @@ def main(argv=None) -> int:
     ap.add_argument("--harmonics", type=int, default=3, help="harmonic count H")
     ap.add_argument("--points", type=int, default=21, help="frequencies of the point model's curve")
     ap.add_argument("--xtol", type=float, default=PEAK_XTOL, help="relative frequency tolerance of the peak")
+    ap.add_argument("--model", choices=("nodes", "condensed"), default="nodes",
+                    help="surface HB: node DOFs as unknowns (SurfaceSectorHB) or condensed onto the "
+                    "faces' rigid inputs (CondensedSurfaceSectorHB)")
+    ap.add_argument("--start-cf", type=float, help="reach the first solution from the stuck start at this "
+                    "CF [N] (cf_path) instead of at the CF itself")
     ap.add_argument("--ti", action="store_true", help="ring time integration at the finest surface peak")
     ap.add_argument("--ti-rest", action="store_true", help="also march the ring from rest (slow)")
     ap.add_argument("--ti-tol", type=float, default=1e-5, help="steady-state tolerance of the march")
