@@ -208,6 +208,31 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     return rec
 
 
+def table(paths) -> str:
+    """Markdown rows (the study page's table) from JSON files of this script."""
+    rows = ["| CF [N] | model, H | nodes per side | surface peak [Hz] | surface |u_a,1| [m] | change from "
+            "the previous node count | point model: peak [Hz], |u_a,1| [m], error | ring TI from the HB "
+            "state: |u_a,1| [m], TI - HB, periods | revision |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for path in paths:
+        rec = json.loads(Path(path).read_text())
+        for case in rec["cases"]:
+            prev = None
+            for s in case["surface"]:
+                change = f"{s['peak_amplitude_h1'] / prev - 1:+.2%}" if prev else "-"
+                prev = s["peak_amplitude_h1"]
+                pt = case["point"]
+                point = (f"{pt['peak_hz']:.2f}, {pt['peak_amplitude_h1']:.4e}, "
+                         f"{pt['peak_amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.1%}")
+                r = s.get("ring", {}).get("from_hb_state")
+                ring = (f"{r['amplitude_h1']:.4e}, {r['amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.2%}, "
+                        f"{r['periods']}{'' if r['converged'] else ' (not settled)'}") if r else "-"
+                rows.append(f"| {case['cf']:g} | {case.get('model', 'nodes')}, {rec['harmonics']} | "
+                            f"{s['nodes_per_side']} | {s['peak_hz']:.2f} | {s['peak_amplitude_h1']:.4e} | "
+                            f"{change} | {point} | {ring} | {rec['revision']} |")
+    return "\n".join(rows)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cf", default="120", help="centrifugal loads [N], comma-separated")
@@ -227,7 +252,12 @@ def main(argv=None) -> int:
     ap.add_argument("--json", metavar="FILE", help="write the results here")
     ap.add_argument("--verbose", action="store_true", help="print every frequency solved")
     ap.add_argument("--quick", action="store_true", help="H 3, 5 nodes, 1 march period: a smoke run")
+    ap.add_argument("--table", nargs="+", metavar="JSON", help="print the study table of these "
+                    "JSON files of this script and stop")
     args = ap.parse_args(argv)
+    if args.table:
+        print(table(args.table))
+        return 0
     if args.quick:
         args.harmonics, args.nodes, args.points, args.xtol = 3, "5", 5, 1e-2
         args.ti_periods, args.ti_rest = 1, False

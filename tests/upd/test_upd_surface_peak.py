@@ -20,7 +20,8 @@ def _example():
 
 def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_path):
     out = tmp_path / "peak.json"
-    assert _example().main(["--quick", "--cf", "600", "--ti", "--json", str(out)]) == 0
+    ex = _example()
+    assert ex.main(["--quick", "--cf", "600", "--ti", "--json", str(out)]) == 0
     rec = json.loads(out.read_text())
     case = rec["cases"][0]
     surf = case["surface"][0]
@@ -32,3 +33,5 @@ def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_pat
     ring = surf["ring"]["from_hb_state"]
     assert ring["periods"] == 1 and np.isfinite(ring["amplitude_h1"]) and ring["amplitude_h1"] > 0
     assert rec["revision"]
+    rows = ex.table([out]).splitlines()
+    assert len(rows) == 3 and rows[2].startswith("| 600 | nodes, 3 | 5 |")
