@@ -159,8 +159,12 @@ def ring_check(shb: SurfaceSectorHB, x, basis, f: float, tol: float, periods: in
     out = {}
     for name, start in (("from_hb_state", x),) + ((("from_rest", None),) if rest else ()):
         p0 = time.process_time()
-        r = march_ring_surface(shb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start,
-                               start_basis=basis)
+        try:
+            r = march_ring_surface(shb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start,
+                                   start_basis=basis)
+        except RuntimeError as err:   # a step's node solve failed: recorded, not hidden
+            out[name] = {"failed": str(err), "cpu_s": time.process_time() - p0}
+            continue
         out[name] = {"amplitude_h1": float(r["amplitude"][0]), "periods": int(r["periods"][0]),
                      "converged": bool(r["converged"][0]), "steps_per_period": int(r["steps_per_period"]),
                      "time_steps": int(r["time_steps"]), "cpu_s": time.process_time() - p0,
@@ -186,6 +190,10 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
         f_guess = pk["peak_hz"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
             "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}
+        if args.save_x:
+            np.save(f"{args.save_x}_cf{cf:g}_n{n}_H{H}.npy", pk["x"])
+        print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.4f} Hz, |u_a,1| "
+              f"{pk['peak_amplitude_h1']:.6e} m (HB; the ring follows)", flush=True)
         if args.ti and n == nodes[-1]:
             row["ring"] = ring_check(SurfaceSectorHB(sector, surfaces, 1, cf=cf), pk["x"], hb.basis,
                                      pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
@@ -194,6 +202,9 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
               f"{pk['peak_amplitude_h1']:.6e} m, {pk['evaluations']} evaluations, "
               f"{pk['cpu_s']:.0f} s CPU", flush=True)
         for name, r in row.get("ring", {}).items():
+            if "failed" in r:
+                print(f"     ring {name}: FAILED ({r['failed']})", flush=True)
+                continue
             print(f"     ring {name}: |u_a,1| {r['amplitude_h1']:.6e} m "
                   f"({r['amplitude_h1'] / pk['peak_amplitude_h1'] - 1:+.3%} of the HB), "
                   f"{r['periods']} periods ({'settled' if r['converged'] else 'NOT settled'}), "
@@ -225,8 +236,13 @@ def table(paths) -> str:
                 point = (f"{pt['peak_hz']:.2f}, {pt['peak_amplitude_h1']:.4e}, "
                          f"{pt['peak_amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.1%}")
                 r = s.get("ring", {}).get("from_hb_state")
-                ring = (f"{r['amplitude_h1']:.4e}, {r['amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.2%}, "
-                        f"{r['periods']}{'' if r['converged'] else ' (not settled)'}") if r else "-"
+                if not r:
+                    ring = "-"
+                elif "failed" in r:
+                    ring = "step failed"
+                else:
+                    ring = (f"{r['amplitude_h1']:.4e}, {r['amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.2%}, "
+                            f"{r['periods']}{'' if r['converged'] else ' (not settled)'}")
                 rows.append(f"| {case['cf']:g} | {case.get('model', 'nodes')}, {rec['harmonics']} | "
                             f"{s['nodes_per_side']} | {s['peak_hz']:.2f} | {s['peak_amplitude_h1']:.4e} | "
                             f"{change} | {point} | {ring} | {rec['revision']} |")
@@ -250,6 +266,7 @@ def main(argv=None) -> int:
     ap.add_argument("--ti-tol", type=float, default=1e-5, help="steady-state tolerance of the march")
     ap.add_argument("--ti-periods", type=int, default=400, help="most periods marched")
     ap.add_argument("--json", metavar="FILE", help="write the results here")
+    ap.add_argument("--save-x", metavar="PREFIX", help="save each HB peak's solution to PREFIX_cf.._n.._H...npy")
     ap.add_argument("--verbose", action="store_true", help="print every frequency solved")
     ap.add_argument("--quick", action="store_true", help="H 3, 5 nodes, 1 march period: a smoke run")
     ap.add_argument("--table", nargs="+", metavar="JSON", help="print the study table of these "
