@@ -220,10 +220,11 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
 
 
 def table(paths) -> str:
-    """Markdown rows (the study page's table) from JSON files of this script."""
-    rows = ["| CF [N] | model, H | nodes per side | surface peak [Hz] | surface |u_a,1| [m] | change from "
-            "the previous node count | point model: peak [Hz], |u_a,1| [m], error | ring TI from the HB "
-            "state: |u_a,1| [m], TI - HB, periods | revision |",
+    """Markdown rows (the study page's table) from JSON files of this script; amplitudes are
+    the first harmonic of u_a at the peak."""
+    rows = ["| CF [N] | model, H | nodes per side | surface peak [Hz] | surface amplitude [m] | change from "
+            "the previous node count | point model: peak [Hz], amplitude [m], error | ring TI from the HB "
+            "state: amplitude [m], TI - HB, periods | revision |",
             "|---|---|---|---|---|---|---|---|---|"]
     for path in paths:
         rec = json.loads(Path(path).read_text())
