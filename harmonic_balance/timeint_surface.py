@@ -30,7 +30,10 @@ v_b(t_n) in (T1) is the BDF2 velocity of the steps already taken (explicit).
 Start: at rest at x_a = x0 (default 0) with w from (T2) without velocities (the static
 equilibrium of the massless rows), the sliders virgin at s = s_0, as the harmonic
 balance's convention (:mod:`.contact`; x0 the frictionless prestress state whose slips
-are the s_0 of :func:`.contact.frictionless_statics`). Steady state and step-size check as
+are the s_0 of :func:`.contact.frictionless_statics`); or on a given periodic motion
+(``start``, e.g. a harmonic balance solution: its DOFs with mass prescribed over two
+periods, the nodes in equilibrium with them, the march continued from t = 0), which the march then corrects to its own
+steady state in fewer periods. Steady state and step-size check as
 :func:`.timeint.march_curve` (all frequencies of a curve marched together, each
 stopping on its own).
 """
@@ -45,6 +48,11 @@ from .forces import LinearElement
 from .massless import MasslessContacts
 from .model import Model, _on_dofs
 from .timeint import _SS_HARMONICS, CFL, CurveSteadyState, _result, _settled_many
+
+#: Periods of a given periodic motion the node sliders are stepped through before a start
+#: on it (:func:`march_curve`'s ``start``): the first closes the loop from the virgin state,
+#: the second retraces it, so the states carry the loop's past as at a steady state.
+START_PERIODS = 2
 
 
 @dataclass
@@ -93,7 +101,8 @@ def stable_steps(M_aa, K_cond, omega_min: float, steps: int) -> int:
 class _SurfaceMarch:
     """State of :func:`march_curve`: the DOFs with mass, the nodes, their histories."""
 
-    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int, x0=None):
+    def __init__(self, model: Model, omegas: np.ndarray, steps_per_period: int, x0=None,
+                 start=None):
         a, b, M, K, C, contacts = _split(model)
         nf = omegas.size
         self.a, self.b, self.r = a, b, model.response_dof
@@ -115,6 +124,9 @@ class _SurfaceMarch:
         th = 2.0 * np.pi * np.arange(ns) / ns
         self.fext = sum(np.outer(np.cos(h * th), f.real) - np.outer(np.sin(h * th), f.imag)
                         for h, f in model.forcing.items())  # (ns, n): Re(F e^{i h theta})
+        if start is not None:
+            self._start_periodic(start, nf)
+            return
         # start: rest at x0, w from the static equilibrium of b (guess: x0's, else the
         # stuck linearisation)
         x0 = np.zeros(model.n) if x0 is None else np.asarray(x0, float)
@@ -127,6 +139,38 @@ class _SurfaceMarch:
         self.w_m = self.w.copy()
         self.w_mm = self.w.copy()
 
+    def _start_periodic(self, start, nf: int) -> None:
+        """Start on a given periodic motion (:func:`march_curve`'s ``start``): its DOFs with
+        mass prescribed over START_PERIODS periods ending at t = 0, the nodes solved from
+        (T2) at every step of them (their own equilibrium: the motion's w is not used), so
+        the sliders carry that loop's past; then x_a at x(0) and x(-dt)."""
+        X = np.asarray(start(self.ns), float)
+        if X.shape != (self.ns, self.a.size + self.b.size) or not np.all(np.isfinite(X)):
+            raise ValueError(f"start must give ({self.ns}, {self.a.size + self.b.size}) finite "
+                             f"displacements, got shape {X.shape}")
+        xa = X[:, self.a]
+        k0 = 1 - START_PERIODS * self.ns
+        rhs0 = np.tile(self.fext[k0 % self.ns][self.b] - xa[k0 % self.ns] @ self.Kba.T, (nf, 1))
+        self.w = np.linalg.solve(self.Kbb + self.nodes.stuck_stiffness(),
+                                 (rhs0 - self.nodes.stuck_offset()).T).T
+        self.w_m, self.w_mm = self.w.copy(), self.w.copy()
+        # t = (k0 .. 0) dt: the committed states end at t = 0
+        for k in range(k0, 1):
+            xa_p = np.tile(xa[k % self.ns], (nf, 1))
+            va_p = np.tile(3 * xa[k % self.ns] - 4 * xa[(k - 1) % self.ns] + xa[(k - 2) % self.ns],
+                           (nf, 1)) / (2 * self.dt)
+            self._nodes_step(k % self.ns, xa_p, va_p)
+        self.xa = np.tile(xa[0], (nf, 1))
+        self.xa_m = np.tile(xa[-1], (nf, 1))
+
+    def _nodes_step(self, j1: int, xa_p: np.ndarray, va_p: np.ndarray) -> None:
+        """(T2) at step index j1 for the DOFs with mass at xa_p, va_p; shifts the w history."""
+        w = self.w
+        rhs_b = (self.fext[j1][self.b] - xa_p @ self.Kba.T - va_p @ self.Cba.T
+                 - (-4 * w + self.w_m) @ self.Cbb.T / (2 * self.dt))
+        w_p = self.nodes.solve(self.Ab, rhs_b, 2 * w - self.w_m)
+        self.w_mm, self.w_m, self.w = self.w_m, w, w_p
+
     def step(self, j: int) -> None:
         """Advance every history from t_j to t_(j+1): (T1), then (T2)."""
         dt, xa, xa_m, w = self.dt, self.xa, self.xa_m, self.w
@@ -135,11 +179,8 @@ class _SurfaceMarch:
                + (2 * xa - xa_m) @ self.Maa.T / dt**2 + xa_m @ self.Caa.T / (2 * dt))
         xa_p = (self.Ainv @ rhs[..., None])[..., 0]
         va_p = (3 * xa_p - 4 * xa + xa_m) / (2 * dt)
-        rhs_b = (self.fext[(j + 1) % self.ns][self.b] - xa_p @ self.Kba.T - va_p @ self.Cba.T
-                 - (-4 * w + self.w_m) @ self.Cbb.T / (2 * dt))
-        w_p = self.nodes.solve(self.Ab, rhs_b, 2 * w - self.w_m)
+        self._nodes_step((j + 1) % self.ns, xa_p, va_p)
         self.xa_m, self.xa = xa, xa_p
-        self.w_mm, self.w_m, self.w = self.w_m, w, w_p
 
     def response(self) -> np.ndarray:
         """The response DOF of every history at the current time, (n_h,)."""
@@ -155,7 +196,7 @@ class _SurfaceMarch:
 
 
 def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: int = 3000,
-                tol: float = 1e-6, x0=None) -> SurfaceCurveSteadyState:
+                tol: float = 1e-6, x0=None, start=None) -> SurfaceCurveSteadyState:
     """March a model with massless DOFs at every frequency of ``omegas`` to periodic steady state.
 
     Parameters
@@ -170,6 +211,15 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     x0 : array_like (n,), optional
         Start at rest [m]: the DOFs with mass there, the massless ones in equilibrium
         (guess x0's); default 0 (e.g. a prestress state, its sliders virgin there).
+    start : callable, optional
+        ``start(ns)`` -> (ns, n) displacements [m] of a periodic motion at the phases
+        theta_j = 2 pi j / ns (j = 0 .. ns - 1, the march's own steps; e.g. a harmonic
+        balance solution): every frequency starts on it instead of at rest; the DOFs with
+        mass follow it for START_PERIODS periods before t = 0 while the massless ones are
+        solved from their equilibrium (their columns are not used), so the node sliders
+        carry that motion's past (``x0`` is then unused).
+        A start near the steady state settles in far fewer periods than one from rest;
+        the march's equations are the same, so the state it settles to is its own.
 
     Returns
     -------
@@ -180,7 +230,7 @@ def march_curve(model: Model, omegas, steps_per_period: int = 256, max_periods: 
     if omegas.ndim != 1 or omegas.size == 0 or not np.all(np.isfinite(omegas) & (omegas > 0)):
         raise ValueError(f"omegas must be a non-empty 1-D array of positive numbers, got {omegas}")
     nf = omegas.size
-    run = _SurfaceMarch(model, omegas, steps_per_period, x0)
+    run = _SurfaceMarch(model, omegas, steps_per_period, x0, start)
     ns = run.ns
     act = np.arange(nf)
     hist, prev = np.empty((nf, ns)), np.zeros((nf, _SS_HARMONICS), complex)

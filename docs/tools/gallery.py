@@ -45,6 +45,7 @@ ARGS: dict[str, list[str]] = {
     "bench_upd.py": ["--quick", "--workers", "1", "--out", "{out}"],  # full: ~1 h of TI; no process pool
     "upd_cosim.py": ["--quick", "--out", "{out}"],                   # full: ~15 min of co-simulation
     "upd_surface_timeint.py": ["--quick"],                           # full: ~1 h of ring TI
+    "upd_surface_peak.py": ["--quick", "--cf", "600"],               # full: hours (peaks, ring TI)
     "bench_mistuning.py": ["--quick", "--rows", "scaling", "--out", "{out}"],  # full: N_b to 48, Dask: ~15 min
     "mistuning_confidence.py": ["--quick", "--out", "{out}"],        # full: 1000 + 4000 samples, ~30 min
 }

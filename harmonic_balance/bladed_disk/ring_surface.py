@@ -69,9 +69,48 @@ def surface_ring_model(shb) -> Model:
     return Model(LinearModel(M=M, C=C, K=K), els, {0: f_static, 1: f_eo}, model.response_dof)
 
 
+def ring_start(shb, x: np.ndarray, basis=None):
+    """The ring's periodic motion of a sector solution, for :func:`march_ring_surface`'s ``start``.
+
+    Parameters
+    ----------
+    shb : SurfaceSectorHB
+        The ring's sector model.
+    x : ndarray (n_b n_x,)
+        A harmonic balance solution on ``basis``: of ``shb`` (n_x = the sector's and node
+        DOFs) or of the sector alone (n_x = ``shb.sector.n_dof``, e.g. of
+        :class:`.surface_hb.CondensedSurfaceSectorHB`); the node DOFs are not used (the
+        march solves them).
+    basis : FourierBasis, optional
+        Default ``shb.basis``.
+
+    Returns
+    -------
+    callable ``ns`` -> (ns, N_r n) [m]: sector j's DOFs are the sector's at theta + j phi
+    (the EO force's phase on blade j), sampled at theta = 2 pi k / ns.
+    """
+    from ..fourier import FourierBasis
+    from .hb import neighbour_map
+
+    basis = shb.basis if basis is None else basis
+    phi, n = shb.sector.cfg.phi, shb.model.n
+    X = np.asarray(x, float).reshape(basis.nb, -1)
+    if X.shape[1] not in (n, shb.sector.n_dof):
+        raise ValueError(f"x has {X.shape[1]} DOFs per harmonic; the sector has {shb.sector.n_dof}, "
+                         f"with its nodes {n}")
+    X = np.hstack([X, np.zeros((basis.nb, n - X.shape[1]))])
+    Xr = np.hstack([neighbour_map(basis, j * phi) @ X for j in range(shb.sector.cfg.ring_blades)])
+    return lambda ns: FourierBasis(basis.harmonics, ns).E @ Xr
+
+
 def march_ring_surface(shb, omegas, steps_per_period: int = 0, max_periods: int = 3000,
-                       tol: float = 1e-6) -> dict:
+                       tol: float = 1e-6, start=None, start_basis=None) -> dict:
     """Steady response of blade 0's u_a on the ring with surfaces at each frequency [rad/s].
+
+    ``start``: a sector solution x on ``start_basis`` (:func:`ring_start`); the ring then
+    starts on its motion, its nodes in equilibrium along it and their sliders stepped
+    through its loop (:func:`harmonic_balance.timeint_surface.march_curve`), instead of at
+    rest at the frictionless prestress state.
 
     Returns
     -------
@@ -82,7 +121,8 @@ def march_ring_surface(shb, omegas, steps_per_period: int = 0, max_periods: int 
     """
     ring = surface_ring_model(shb)
     x0, _ = frictionless_statics(ring, apply=True)
-    res = march_curve(ring, omegas, steps_per_period, max_periods, tol, x0=x0)
+    res = march_curve(ring, omegas, steps_per_period, max_periods, tol, x0=x0,
+                      start=None if start is None else ring_start(shb, start, start_basis))
     mean = res.x_last.mean(axis=1, keepdims=True)
     return {"amplitude": res.amplitude_h1, "amplitude_max": np.abs(res.x_last - mean).max(axis=1),
             "periods": res.periods, "converged": res.converged,

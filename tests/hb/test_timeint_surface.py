@@ -165,3 +165,30 @@ def test_nodes_sharing_one_c_call_give_each_elements_own_forces(surface):
         nodes.commit(trial)
         ref = np.concatenate([o.force(w[2 * i:2 * i + 2]) for i, o in enumerate(own)])
         assert np.allclose(fc[0], ref, rtol=GROUPED_RTOL, atol=GROUPED_RTOL * np.abs(ref).max())
+
+
+#: A march started on the HB's periodic state and one from rest settle to the same state:
+#: their amplitudes differ by the settling tolerances (SETTLE_TOL each, extrapolated) and
+#: the HB's truncation does not enter (the march does not know its start).
+SETTLE_TOL, SAME_STATE_RTOL = 1e-7, 1e-5
+
+
+def test_march_started_on_the_hb_state_settles_sooner_to_the_same_state(surface):
+    surf, static = surface
+    hb = HBSweep(surf, static, force=5.0)
+    w = 0.8 * hb.omega0
+    hb.amplitude(w)
+    X = hb.x.reshape(hb.b.nb, -1)
+    rest = ts.march_curve(hb.model, [w], 256, max_periods=400, tol=SETTLE_TOL)
+    own = ts.march_curve(hb.model, [w], 256, max_periods=400, tol=SETTLE_TOL,
+                         start=lambda ns: FourierBasis(H, ns).E @ X)
+    assert rest.converged.all() and own.converged.all()
+    assert own.periods[0] < rest.periods[0]
+    assert own.amplitude[0] == pytest.approx(rest.amplitude[0], rel=SAME_STATE_RTOL)
+
+
+def test_march_refuses_a_start_of_the_wrong_shape(surface):
+    surf, static = surface
+    model, w0 = mass_on_surface(surf, static, 5.0)
+    with pytest.raises(ValueError, match="start must give"):
+        ts.march_curve(model, [w0], 256, max_periods=2, start=lambda ns: np.zeros((ns, 3)))

@@ -43,3 +43,40 @@ def test_ring_contacts_are_the_sector_nodes_on_every_sector(surface_hb):
     ring_nodes = [e for e in ring.elements if e.name.startswith(("left node", "flat node"))]
     assert len(ring_nodes) == surface_hb.sector.cfg.ring_blades * len(nodes)
     assert not any(e.kinematics.cyclic for e in ring.elements)
+
+
+#: Both sides evaluate the same trigonometric sums: round-off.
+START_ATOL = 1e-12
+
+
+def test_ring_start_puts_each_sector_at_the_sector_motion_shifted_by_its_phase(surface_hb):
+    from harmonic_balance.bladed_disk.ring_surface import ring_start
+    from harmonic_balance.fourier import FourierBasis
+
+    cfg, basis, n = surface_hb.sector.cfg, surface_hb.basis, surface_hb.model.n
+    x = np.random.default_rng(20261128).standard_normal(basis.nb * n)
+    assert basis.harmonics[0] == 0   # the series below starts with the mean
+    ns = 64
+    ring = ring_start(surface_hb, x)(ns)
+    sector = FourierBasis(basis.harmonics, ns).E @ x.reshape(basis.nb, n)
+    theta = 2 * np.pi * np.arange(ns) / ns
+    for j in range(cfg.ring_blades):
+        # sector j at theta is the sector at theta + j phi: evaluate the series there
+        shifted = np.stack([np.ones(ns)] + [f(h * (theta + j * cfg.phi)) for h in basis.harmonics[1:]
+                                            for f in (np.cos, np.sin)], axis=1)
+        want = shifted @ x.reshape(basis.nb, n)
+        assert np.allclose(ring[:, n * j:n * (j + 1)], want, atol=START_ATOL * np.abs(x).sum())
+    assert np.allclose(ring[:, :n], sector, atol=START_ATOL * np.abs(x).sum())
+
+
+def test_ring_start_from_the_sector_dofs_alone_leaves_the_nodes_to_the_march(surface_hb):
+    from harmonic_balance.bladed_disk.ring_surface import ring_start
+
+    basis, n, n_s = surface_hb.basis, surface_hb.model.n, surface_hb.sector.n_dof
+    x = np.random.default_rng(20261129).standard_normal((basis.nb, n))
+    x_sec = x[:, :n_s].ravel()
+    full, part = ring_start(surface_hb, x.ravel())(16), ring_start(surface_hb, x_sec)(16)
+    assert np.allclose(part[:, :n_s], full[:, :n_s], rtol=0, atol=START_ATOL * np.abs(x).sum())
+    assert not np.any(part[:, n_s:n])
+    with pytest.raises(ValueError, match="DOFs per harmonic"):
+        ring_start(surface_hb, x[:, :n_s - 1].ravel())

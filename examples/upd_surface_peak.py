@@ -1,0 +1,299 @@
+"""UPD-24 with contact surfaces: the HB peak, its node convergence, the ring time integration and the point model.
+===============================================================================================================
+
+Per centrifugal load CF:
+
+* the peak of the default point model (three Jenkins points of the TOML,
+  :class:`harmonic_balance.bladed_disk.hb.SectorHB`, its curve over the configuration's
+  band refined by :func:`harmonic_balance.bladed_disk.solve.frf`);
+* the peak of the sector with the damper's faces as contact surfaces
+  (:class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`, ``--nodes`` per side,
+  one harmonic count): the first-harmonic amplitude of u_a maximised over the frequency
+  by Brent's search (:func:`harmonic_balance.brent.brent_min`), each frequency a Newton
+  solve warm-started from the nearest one solved, the search started at the point
+  model's peak;
+* with ``--ti``, at the surface peak of the finest node count: the ring of the same
+  sectors and surfaces marched in time
+  (:func:`harmonic_balance.bladed_disk.ring_surface.march_ring_surface`) until its first
+  harmonic settles, started on the harmonic balance's periodic state (the sliders
+  stepped through its loop) instead of at rest, which settles in tens of periods
+  instead of hundreds; the march's equations do not know the start, so the state it
+  settles to is its own (a start from rest remains ``--ti-rest``).
+
+Writes one JSON (``--json``) with the revision, and prints a table. Full study::
+
+    python examples/upd_surface_peak.py --cf 120 --nodes 5,7,10 --harmonics 3 --ti --json out/surface_peak_120.json
+
+``--quick`` runs the path at H 3, 5 nodes, loose tolerances, one march period after the
+start's two (a smoke run, not a comparison; ``--quick --cf 600 --ti``: a few minutes).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from damper.cache import Store
+from damper.upd_surface import build_surfaces
+from harmonic_balance.bladed_disk import solve
+from harmonic_balance.bladed_disk.config import load_config
+from harmonic_balance.bladed_disk.hb import SectorHB
+from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
+from harmonic_balance.bladed_disk.sector import Sector
+from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB
+from harmonic_balance.brent import brent_min
+from harmonic_balance.newton import NewtonError
+
+#: First step of the search for an interval around the surface peak, relative to the
+#: point model's peak frequency (the surfaces' stiffness differs from the points' by a few
+#: per cent), and the most doublings of it.
+BRACKET_STEP, MAX_BRACKET = 0.005, 6
+#: Loads of the path from ``--start-cf`` to the CF (:func:`cf_path`): steps of ~10 % at
+#: 300 -> 120 N, where the condensed model's Newton takes 5-15 evaluations a step.
+CF_STEPS = 8
+#: Print every frequency solved (``--verbose``).
+VERBOSE = False
+#: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
+#: 1e-4 in frequency moves it by far less than the 0.5 % the node study resolves.
+PEAK_XTOL = 1e-4
+
+
+def revision() -> str:
+    """The git revision of this tree (with '+' when it has uncommitted changes)."""
+    try:
+        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                             text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "-uno"], capture_output=True,
+                               text=True, check=True).stdout.strip()
+        return rev + ("+" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def point_peak(sector: Sector, H: int, cf: float, points: int) -> dict:
+    """The default point model's refined peak over the configuration's band."""
+    p0 = time.process_time()
+    hb = SectorHB(sector, H, cf=cf)
+    band = sector.cfg["load.band_hz"]
+    c = solve.frf(hb, 2 * np.pi * np.linspace(band[0], band[1], points))
+    return {"peak_hz": c.peak_omega / (2 * np.pi), "peak_amplitude_h1": c.peak_amplitude,
+            "cpu_s": time.process_time() - p0}
+
+
+def _bracket(neg, f0: float) -> tuple[float, float, float]:
+    """An interval (lo, hi) [Hz] and its best point around a maximum of -neg: uphill from f0 in steps of
+    BRACKET_STEP f0, doubled, until the amplitude falls (Press et al., Numerical Recipes,
+    sec. 10.1); every value is kept by neg's own cache."""
+    h = BRACKET_STEP * f0
+    a, b = f0, f0 + h
+    fa, fb = neg(a), neg(b)
+    if fb > fa:
+        a, b, fa, fb, h = b, a, fb, fa, -h
+    for _ in range(MAX_BRACKET):
+        c = b + 2 * h
+        fc = neg(c)
+        if fc > fb:
+            return min(a, c), max(a, c), b
+        a, b, fa, fb, h = b, c, fb, fc, 2 * h
+    raise RuntimeError(f"no amplitude maximum within {abs(b - f0):.0f} Hz of {f0:.1f} Hz")
+
+
+def cf_path(make, omega: float, cf: float, start_cf: float):
+    """A first solution at ``cf`` [N] reached from the stuck start at ``start_cf`` by
+    Newton at CF_STEPS loads between them (log-spaced), each warm-started from the last:
+    where the stuck start does not converge (low CF: much of the faces slips).
+    ``make(cf)``: the model at that load."""
+    x = None
+    for c in np.geomspace(start_cf, cf, CF_STEPS + 1):
+        hb = make(c)
+        x = solve.start_point(hb, omega) if x is None else solve.solve_point(hb, omega, x, max_iter=80)
+        if VERBOSE:
+            print(f"    CF {c:.1f} N at {omega / 2 / np.pi:.3f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
+    return x
+
+
+def surface_peak(hb, f_guess: float, xtol: float = PEAK_XTOL, first=None) -> dict:
+    """Maximum over the frequency of the first harmonic of u_a (module docstring).
+
+    ``first(omega)``: the first solution (default :func:`solve.start_point`, the stuck start).
+
+    Returns
+    -------
+    dict: peak_hz, peak_amplitude_h1 [m], x (the solution there), points (Hz, amplitude of
+    every frequency solved), evaluations, cpu_s.
+    """
+    p0, e0 = time.process_time(), hb.evaluations
+    solved = {}   # omega -> x
+    first = first or (lambda w: solve.start_point(hb, w))
+
+    def neg_amp(f):
+        w = 2 * np.pi * f
+        if w in solved:
+            return -hb.amplitude_h1(solved[w])
+        x = None
+        if solved:   # warm start; the stuck start (and its homotopy) when that fails
+            try:
+                x = solve.solve_point(hb, w, solved[min(solved, key=lambda v: abs(v - w))], max_iter=80)
+            except NewtonError:
+                pass
+        solved[w] = x = first(w) if x is None else x
+        if VERBOSE:
+            print(f"    {f:.4f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
+        return -hb.amplitude_h1(x)
+
+    lo, hi, best = _bracket(neg_amp, f_guess)
+    f, a, _ = brent_min(neg_amp, lo, hi, xtol * f_guess, start=best)
+    pts = sorted((w / (2 * np.pi), hb.amplitude_h1(x)) for w, x in solved.items())
+    return {"peak_hz": float(f), "peak_amplitude_h1": float(-a), "x": solved[2 * np.pi * f],
+            "points": pts, "evaluations": hb.evaluations - e0, "cpu_s": time.process_time() - p0}
+
+
+def ring_check(shb: SurfaceSectorHB, x, basis, f: float, tol: float, periods: int, rest: bool) -> dict:
+    """The ring of ``shb``'s sectors marched at frequency f [Hz], started on the HB state x
+    (harmonics on ``basis``; sector DOFs, with or without the nodes) and, with ``rest``, from rest."""
+    out = {}
+    for name, start in (("from_hb_state", x),) + ((("from_rest", None),) if rest else ()):
+        p0 = time.process_time()
+        try:
+            r = march_ring_surface(shb, [2 * np.pi * f], max_periods=periods, tol=tol, start=start,
+                                   start_basis=basis)
+        except RuntimeError as err:   # a step's node solve failed: recorded, not hidden
+            out[name] = {"failed": str(err), "cpu_s": time.process_time() - p0}
+            continue
+        out[name] = {"amplitude_h1": float(r["amplitude"][0]), "periods": int(r["periods"][0]),
+                     "converged": bool(r["converged"][0]), "steps_per_period": int(r["steps_per_period"]),
+                     "time_steps": int(r["time_steps"]), "cpu_s": time.process_time() - p0,
+                     "ring_dofs": int(r["ring_dofs"])}
+    return out
+
+
+def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
+    """One CF: the point peak, the surface peak per node count, the ring check."""
+    rec = {"cf": cf, "model": args.model, "point": point_peak(sector, H, cf, args.points), "surface": []}
+    print(f"CF {cf:g} N: point model peak {rec['point']['peak_hz']:.3f} Hz, "
+          f"|u_a,1| {rec['point']['peak_amplitude_h1']:.6e} m", flush=True)
+    f_guess = rec["point"]["peak_hz"]
+    for n in nodes:
+        surfaces = build_surfaces(cfg, n, cf, Store().prepare())
+        model = CondensedSurfaceSectorHB if args.model == "condensed" else SurfaceSectorHB
+        hb = model(sector, surfaces, H, cf=cf)
+        first = None
+        if args.start_cf is not None:
+            def first(w, surfaces=surfaces, model=model):
+                return cf_path(lambda c: model(sector, surfaces, H, cf=c), w, cf, args.start_cf)
+        pk = surface_peak(hb, f_guess, args.xtol, first)
+        f_guess = pk["peak_hz"]
+        row = {k: v for k, v in pk.items() if k != "x"} | {
+            "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}
+        if args.save_x:
+            np.save(f"{args.save_x}_cf{cf:g}_n{n}_H{H}.npy", pk["x"])
+        print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.4f} Hz, |u_a,1| "
+              f"{pk['peak_amplitude_h1']:.6e} m (HB; the ring follows)", flush=True)
+        if args.ti and n == nodes[-1]:
+            row["ring"] = ring_check(SurfaceSectorHB(sector, surfaces, 1, cf=cf), pk["x"], hb.basis,
+                                     pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
+        rec["surface"].append(row)
+        print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.3f} Hz, |u_a,1| "
+              f"{pk['peak_amplitude_h1']:.6e} m, {pk['evaluations']} evaluations, "
+              f"{pk['cpu_s']:.0f} s CPU", flush=True)
+        for name, r in row.get("ring", {}).items():
+            if "failed" in r:
+                print(f"     ring {name}: FAILED ({r['failed']})", flush=True)
+                continue
+            print(f"     ring {name}: |u_a,1| {r['amplitude_h1']:.6e} m "
+                  f"({r['amplitude_h1'] / pk['peak_amplitude_h1'] - 1:+.3%} of the HB), "
+                  f"{r['periods']} periods ({'settled' if r['converged'] else 'NOT settled'}), "
+                  f"{r['cpu_s']:.0f} s CPU", flush=True)
+    s = rec["surface"]
+    if len(s) > 1:
+        rec["last_refinement_change"] = s[-1]["peak_amplitude_h1"] / s[-2]["peak_amplitude_h1"] - 1
+    rec["point_error"] = rec["point"]["peak_amplitude_h1"] / s[-1]["peak_amplitude_h1"] - 1
+    rec["point_frequency_error"] = rec["point"]["peak_hz"] / s[-1]["peak_hz"] - 1
+    print(f"  point model against the {nodes[-1]}-node surface: amplitude "
+          f"{rec['point_error']:+.2%}, frequency {rec['point_frequency_error']:+.3%}", flush=True)
+    return rec
+
+
+def table(paths) -> str:
+    """Markdown rows (the study page's table) from JSON files of this script; amplitudes are
+    the first harmonic of u_a at the peak."""
+    rows = ["| CF [N] | model, H | nodes per side | surface peak [Hz] | surface amplitude [m] | change from "
+            "the previous node count | point model: peak [Hz], amplitude [m], error | ring TI from the HB "
+            "state: amplitude [m], TI - HB, periods | revision |",
+            "|---|---|---|---|---|---|---|---|---|"]
+    for path in paths:
+        rec = json.loads(Path(path).read_text())
+        for case in rec["cases"]:
+            prev = None
+            for s in case["surface"]:
+                change = f"{s['peak_amplitude_h1'] / prev - 1:+.2%}" if prev else "-"
+                prev = s["peak_amplitude_h1"]
+                pt = case["point"]
+                point = (f"{pt['peak_hz']:.2f}, {pt['peak_amplitude_h1']:.4e}, "
+                         f"{pt['peak_amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.1%}")
+                r = s.get("ring", {}).get("from_hb_state")
+                if not r:
+                    ring = "-"
+                elif "failed" in r:
+                    ring = "step failed"
+                else:
+                    ring = (f"{r['amplitude_h1']:.4e}, {r['amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.2%}, "
+                            f"{r['periods']}{'' if r['converged'] else ' (not settled)'}")
+                rows.append(f"| {case['cf']:g} | {case.get('model', 'nodes')}, {rec['harmonics']} | "
+                            f"{s['nodes_per_side']} | {s['peak_hz']:.2f} | {s['peak_amplitude_h1']:.4e} | "
+                            f"{change} | {point} | {ring} | {rec['revision']} |")
+    return "\n".join(rows)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cf", default="120", help="centrifugal loads [N], comma-separated")
+    ap.add_argument("--nodes", default="5", help="surface nodes per side, comma-separated (increasing)")
+    ap.add_argument("--harmonics", type=int, default=3, help="harmonic count H")
+    ap.add_argument("--points", type=int, default=21, help="frequencies of the point model's curve")
+    ap.add_argument("--xtol", type=float, default=PEAK_XTOL, help="relative frequency tolerance of the peak")
+    ap.add_argument("--model", choices=("nodes", "condensed"), default="nodes",
+                    help="surface HB: node DOFs as unknowns (SurfaceSectorHB) or condensed onto the "
+                    "faces' rigid inputs (CondensedSurfaceSectorHB)")
+    ap.add_argument("--start-cf", type=float, help="reach the first solution from the stuck start at this "
+                    "CF [N] (cf_path) instead of at the CF itself")
+    ap.add_argument("--ti", action="store_true", help="ring time integration at the finest surface peak")
+    ap.add_argument("--ti-rest", action="store_true", help="also march the ring from rest (slow)")
+    ap.add_argument("--ti-tol", type=float, default=1e-5, help="steady-state tolerance of the march")
+    ap.add_argument("--ti-periods", type=int, default=400, help="most periods marched")
+    ap.add_argument("--json", metavar="FILE", help="write the results here")
+    ap.add_argument("--save-x", metavar="PREFIX", help="save each HB peak's solution to PREFIX_cf.._n.._H...npy")
+    ap.add_argument("--verbose", action="store_true", help="print every frequency solved")
+    ap.add_argument("--quick", action="store_true", help="H 3, 5 nodes, 1 march period: a smoke run")
+    ap.add_argument("--table", nargs="+", metavar="JSON", help="print the study table of these "
+                    "JSON files of this script and stop")
+    args = ap.parse_args(argv)
+    if args.table:
+        print(table(args.table))
+        return 0
+    if args.quick:
+        args.harmonics, args.nodes, args.points, args.xtol = 3, "5", 5, 1e-2
+        args.ti_periods, args.ti_rest = 1, False
+    global VERBOSE
+    VERBOSE = args.verbose
+    cfs = [float(v) for v in args.cf.split(",")]
+    nodes = [int(v) for v in args.nodes.split(",")]
+    cfg = load_config(None)
+    sector = Sector(cfg)
+    t0 = time.perf_counter()
+    out = {"revision": revision(), "harmonics": args.harmonics, "command": " ".join(sys.argv),
+           "cases": [run_cf(cfg, sector, cf, nodes, args.harmonics, args) for cf in cfs]}
+    out["time_s"] = time.perf_counter() - t0
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps(out, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
