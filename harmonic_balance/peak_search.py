@@ -1,6 +1,6 @@
 """Peak searches on a branch of fixed-frequency solutions: the refined maximum of an
 amplitude near given points (a window of padded curve points, or the previous harmonic
-level's peak), used by the truncation checks of :mod:`.accuracy`.
+level's peak), used by the truncation checks of :mod:`harmonic_balance.accuracy`.
 
 Symbols: omega [rad/s] the frequency, x the harmonic balance unknowns at it, a(x, omega)
 the amplitude whose maximum is sought, tol_lam the tolerance on the peak frequency.
