@@ -154,7 +154,7 @@ def surface_peak(hb, f_guess: float, xtol: float = PEAK_XTOL, first=None) -> dic
             "points": pts, "evaluations": hb.evaluations - e0, "cpu_s": time.process_time() - p0}
 
 
-def surface_point(hb, f: float, xtol: float = PEAK_XTOL, first=None) -> dict:
+def surface_point(hb, f: float, first=None) -> dict:
     """The surface model solved at the one frequency f [Hz] (``--quick``: the path of
     :func:`surface_peak` without its search, which takes ~10 frequencies of ~200
     evaluations each); the same record, its one point as the "peak"."""
@@ -199,7 +199,7 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
         if args.start_cf is not None:
             def first(w, surfaces=surfaces, model=model):
                 return cf_path(lambda c: model(sector, surfaces, H, cf=c), w, cf, args.start_cf)
-        pk = (surface_point if args.quick else surface_peak)(hb, f_guess, args.xtol, first)
+        pk = surface_point(hb, f_guess, first) if args.quick else surface_peak(hb, f_guess, args.xtol, first)
         f_guess = pk["peak_hz"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
             "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}

@@ -50,7 +50,7 @@ import math
 import numpy as np
 
 from .fourier import FourierBasis
-from .peak_search import WINDOW, near_peak, peak_window
+from .peak_search import WINDOW, near_peak, peak_window, spacing
 
 #: The check's highest harmonic is at least this multiple of H (then the next of the set's
 #: kind): close enough to cost ~2.5x a point of the curve per solve, far enough that the
@@ -397,12 +397,6 @@ def _level(problem_at, hs, basis, cur, levels, omegas, i, tol, tol_lam, x_prev=N
             guesses[j] = xj
     i = max((j for j, xj in window.items() if xj is not None), key=lambda j: amplitude(window[j], omegas[j]))
     return rich, x, w, a, n, guesses, i
-
-
-def spacing(omegas, i) -> float:
-    """The curve's frequency step at its point i [rad/s] (the larger of its two sides)."""
-    lo, hi = max(i - 1, 0), min(i + 1, len(omegas) - 1)
-    return max(abs(omegas[i] - omegas[lo]), abs(omegas[hi] - omegas[i]))
 
 
 def peak_records(run: dict, tol: float, H_curve: int, method: str) -> tuple[dict, dict]:

@@ -87,8 +87,8 @@ def _check_at_peak(result, rich, checks, prev, i, tol):
     tol_lam = 1e-6 * abs(om[i])
     if prev is not None:
         levels = [(result.problem.basis.H, result.peak_amplitude, result.peak_omega), checks[-1]]
-        got = peak_search.near_peak(rich, rich.amplitude, acc.pad(prev[0], prev[1], rich.basis), levels, tol,
-                            tol_lam, 0.0, acc.spacing(om, i))
+        got = peak_search.near_peak(rich, rich.amplitude, acc.pad(prev[0], prev[1], rich.basis), levels,
+                                    tol, tol_lam, 0.0, peak_search.spacing(om, i))
         if got is not None:
             return got[:3]
     xs = [acc.pad(x, result.problem.basis, rich.basis) for x in result.solutions]

@@ -108,20 +108,27 @@ def flat_tolerance(tol_lam, amp_rel, ws, amps) -> float:
 FLAT_MAX = 10.0
 
 
+def spacing(omegas, i) -> float:
+    """The curve's frequency step at its point i [rad/s] (the larger of its two sides)."""
+    lo, hi = max(i - 1, 0), min(i + 1, len(omegas) - 1)
+    return max(abs(omegas[i] - omegas[lo]), abs(omegas[hi] - omegas[i]))
+
+
 #: Half-width of the bracket of :func:`near_peak`, in units of the peak's last move in
 #: frequency between levels: the levels' peaks converge, so the next move is smaller
 #: (measured on UPD-24: moves of 1.9, 1.0, 0.74, 0.16 rad/s from H = 7 to 50).
 NEAR_BRACKET = 2.0
 
 
-def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
+def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, curve_step):
     """The peak of a level after the first from the previous level's, by successive parabolas.
 
     Solves at the previous level's peak frequency omega_p and at omega_p +- delta (delta =
     NEAR_BRACKET times the peak's last move between levels, at least FLAT_MAX ``tol_lam``,
-    at most the curve's ``spacing``), from ``x0`` (the previous peak padded); then at the
-    vertex of the parabola of the amplitude through the highest solved point and its
-    nearest neighbours on either side (successive parabolic interpolation, converging
+    at most the curve's step ``curve_step`` [rad/s], :func:`spacing`), from ``x0`` (the
+    previous peak padded); then at the vertex of the parabola of the amplitude through the
+    highest solved point and its nearest neighbours on either side (successive parabolic
+    interpolation, converging
     superlinearly on a smooth maximum: Brent 1973, ch. 5), until the vertex lies within
     the frequency tolerance :func:`flat_tolerance` (``amp_rel``) of the highest solved
     point; then that point's sides at +- the tolerance are probed, and it is the level's
@@ -136,8 +143,8 @@ def near_peak(fun, amplitude, x0, levels, tol, tol_lam, amp_rel, spacing):
     by the first three points (the caller searches the curve's window then).
     """
     w_p = levels[-1][2]
-    move = abs(levels[-1][2] - levels[-2][2]) if len(levels) >= 2 else spacing
-    delta = min(max(NEAR_BRACKET * move, FLAT_MAX * tol_lam), spacing)
+    move = abs(levels[-1][2] - levels[-2][2]) if len(levels) >= 2 else curve_step
+    delta = min(max(NEAR_BRACKET * move, FLAT_MAX * tol_lam), curve_step)
     factor = getattr(fun, "factorize", None)
 
     lu_c = []   # the centre's LU factors, for chord steps at the other points

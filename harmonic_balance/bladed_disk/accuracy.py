@@ -62,8 +62,8 @@ def truncation_error(hb: SectorHB, curve, limit: int = MAX_HARMONIC, levels: int
         xs = [acc.pad(x, hb.basis, rich.basis) for x in curve.x]
         try:
             _, wc, ac, _ = peak_search.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs,
-                                       np.asarray(curve.omega), i, 1e-10 * max(hb.f0, hb.cf),
-                                       1e-6 * curve.peak_omega)
+                                               np.asarray(curve.omega), i, 1e-10 * max(hb.f0, hb.cf),
+                                               1e-6 * curve.peak_omega)
         except RuntimeError as err:
             if k == 0:
                 return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
