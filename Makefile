@@ -9,6 +9,8 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 CBUILD := build/c
 C_SOURCES := $(wildcard fmu_src/core/*.c fmu_src/core/*.h) fmu_src/core/cflags.txt
+# the compiled extensions pip builds (pyproject.toml): the friction law and the ring's block LU
+EXT_SOURCES := $(C_SOURCES) $(wildcard harmonic_balance/bladed_disk/*.c harmonic_balance/bladed_disk/*.h)
 C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in) CMakeLists.txt $(wildcard fmu_src/*/CMakeLists.txt)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
@@ -19,7 +21,7 @@ $(PY):
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install -q --upgrade pip
 
-$(STAMP): pyproject.toml $(C_SOURCES) | $(PY)
+$(STAMP): pyproject.toml $(EXT_SOURCES) | $(PY)
 	$(PY) -m pip install -q -e '.[dev]' > $(VENV)/install.log 2>&1 || (cat $(VENV)/install.log; exit 1)
 	@# Fast sparse solver without root (MKL PARDISO from pip), best effort: scipy otherwise.
 	@$(PY) -m pip install -q -e '.[fast]' >> $(VENV)/install.log 2>&1 \

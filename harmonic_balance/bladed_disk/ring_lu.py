@@ -35,6 +35,8 @@ from scipy.sparse.linalg import splu
 
 from contact_core import linsolve
 
+from . import ring_lu_c
+
 
 def ring_backend() -> str:
     """``DAMPER_SOLVER``: 'pardiso' (an error if it does not load), 'scipy' or 'superlu'
@@ -182,11 +184,15 @@ class BlockRingFactor:
     blades, n_dof, nb : int   N_b, DOFs per sector and coefficients per DOF; unknowns
         ordered coefficient-major over the ring (:mod:`.ring_hb`), N_b >= 3
     precision : 'mixed' or 'double'   of the factors (above)
+    kernel : 'c', 'numpy' or None   the elimination and the refined solves as one compiled
+        call each (``ring_lu.c``, the default when it is built) or in numpy here (the
+        reference the compiled one is tested against): the same steps, the same LAPACK
     """
 
     name = "block"
 
-    def __init__(self, blades: int, n_dof: int, nb: int, precision: str = "mixed"):
+    def __init__(self, blades: int, n_dof: int, nb: int, precision: str = "mixed",
+                 kernel: str | None = None):
         if blades < 3:
             raise ValueError(f"block elimination needs >= 3 blades, not {blades}")
         self.N, self.m = int(blades), int(n_dof) * int(nb)
@@ -201,6 +207,11 @@ class BlockRingFactor:
         self.dt = np.float32 if single else np.float64
         self._rf = sgetrf if single else dgetrf
         self.refine = MIXED_REFINE if single else BLOCK_REFINE
+        kernel = kernel or ("c" if ring_lu_c.lib is not None else "numpy")
+        if kernel not in ("c", "numpy") or (kernel == "c" and ring_lu_c.lib is None):
+            raise ValueError(f"kernel {kernel!r}: give 'numpy', or 'c' once ring_lu.c is "
+                             "built (pip install -e .)")
+        self.kernel = kernel
 
     # ------------------------------------------------------------ pattern
     def _analyse(self, J) -> None:
@@ -234,6 +245,12 @@ class BlockRingFactor:
         self.w_lc, self.w_uc = pos(self.wc, self.lc), pos(self.wc, self.uc)
         self.v_lr = pos(self.vr, self.lr)
         self.at_lr_uc = (self.uc[None, :] * m + self.lr[:, None]).ravel()   # (lr, uc), column-major
+        if self.kernel == "c":
+            sets = dict(uc=self.uc, lr=self.lr, lc=self.lc, wc=self.wc, vr=self.vr,
+                        w_lc=self.w_lc, w_uc=self.w_uc, v_lr=self.v_lr)
+            self.compiled = ring_lu_c.CompiledBlocks(N, m, sets, self.dt)
+            self.c_index = [np.ascontiguousarray(a, dtype=np.int32)
+                            for a in (self.perm, J.indptr, J.indices)]
         self.pattern = (J.shape, J.indptr.tobytes(), J.indices.tobytes())
 
     # ------------------------------------------------------------ factor, solve
@@ -241,6 +258,8 @@ class BlockRingFactor:
         """Block factors of J (the ring's CSC pattern), or SuperLU's where a blade's
         block is singular; RuntimeError when J is."""
         J = J.tocsc()
+        if J.dtype != np.float64:   # the compiled solve's residual reads float64
+            J = J.astype(np.float64)
         if self.pattern is None or self.pattern[0] != J.shape or not (
                 np.array_equal(np.frombuffer(self.pattern[1], J.indptr.dtype), J.indptr)
                 and np.array_equal(np.frombuffer(self.pattern[2], J.indices.dtype), J.indices)):
@@ -248,6 +267,11 @@ class BlockRingFactor:
         self.J, self.use_fallback = J, False
         if not (self.uc.size and self.lc.size):   # blades not coupled: nothing to eliminate by
             self._fall_back()
+            return
+        if self.kernel == "c":
+            self.buf[self.dest] = J.data
+            if not self.compiled.factor(self.buf):
+                self._fall_back()
             return
         try:
             self._eliminate(J)
@@ -339,6 +363,14 @@ class BlockRingFactor:
         """x with J x = b (refined; SuperLU when the block factors stay inaccurate)."""
         b = np.asarray(b, dtype=float)
         if self.use_fallback:
+            return self.fallback.solve(b)
+        if self.kernel == "c":
+            perm, indptr, indices = self.c_index
+            x = self.compiled.solve(perm, self.J, indptr, indices, np.ascontiguousarray(b),
+                                    self.refine, BLOCK_RTOL)
+            if x is not None:
+                return x
+            self._fall_back()
             return self.fallback.solve(b)
         x = self._solve_blocks(b)
         nb = np.linalg.norm(b)
