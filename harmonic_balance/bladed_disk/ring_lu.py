@@ -269,8 +269,7 @@ class BlockRingFactor:
             self._fall_back()
             return
         if self.kernel == "c":
-            self.buf[self.dest] = J.data
-            if not self.compiled.factor(self.buf):
+            if not self.compiled.factor(np.ascontiguousarray(J.data), self.dest, self.buf):
                 self._fall_back()
             return
         try:

@@ -59,9 +59,12 @@ static size_t FN(factor_work_)(const ring_pattern *p)
            + (size_t)p->nvr * p->kl + (size_t)k * (p->kl + p->ku) + (size_t)r * c;
 }
 
-/* The factors of the ring (the buffers above); 0, 1 at a singular block, -1 no memory. */
-int FN(ringlu_factor)(const ring_pattern *p, const REAL *buf, REAL *lus, int *piv, REAL *g,
-                      REAL *gl, REAL *vs, REAL *vl)
+/* The factors of the ring (the buffers above) from J's nnz stored values `data`, entry k
+ * scattered to buf[dest[k]] first (buf's other entries stay zero); 0, 1 at a singular
+ * block, -1 no memory. */
+int FN(ringlu_factor)(const ring_pattern *p, size_t nnz, const long long *dest,
+                      const double *data, REAL *buf, REAL *lus, int *piv, REAL *g, REAL *gl,
+                      REAL *vs, REAL *vl)
 {
     const int N = p->N, m = p->m, ku = p->ku, kl = p->kl, nlr = p->nlr, nvr = p->nvr;
     const int ng = kl + ku, nwc = p->nwc;
@@ -75,6 +78,8 @@ int FN(ringlu_factor)(const ring_pattern *p, const REAL *buf, REAL *lus, int *pi
     REAL *prod = gat + (size_t)(ku > kl ? ku : kl) * ng;
     int info = 0;
 
+    for (size_t k = 0; k < nnz; ++k)
+        buf[dest[k]] = (REAL)data[k];
     for (int a = 0; a < nlr; ++a)                   /* W_0 = J_0,N-1 on rows lr */
         for (int c = 0; c < kl; ++c)
             rhs[p->lr[a] + (size_t)c * m] = L[(size_t)a * kl + c];

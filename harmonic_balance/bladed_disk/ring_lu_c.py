@@ -69,7 +69,9 @@ def _load():
         R = np.ctypeslib.ndpointer(dt, flags="C_CONTIGUOUS")
         f = getattr(lib, "ringlu_factor" + sfx)
         f.restype = ct.c_int
-        f.argtypes = [ct.POINTER(RingPattern), R, R, _I, R, R, R, R]
+        f.argtypes = [ct.POINTER(RingPattern), ct.c_size_t,
+                      np.ctypeslib.ndpointer(np.int64, flags="C_CONTIGUOUS"), _D, R, R, _I, R,
+                      R, R, R]
         s = getattr(lib, "ringlu_solve" + sfx)
         s.restype = ct.c_int
         s.argtypes = [ct.POINTER(RingPattern), R, _I, R, R, R, R, R, _I, _D, _I, _I, _D,
@@ -102,11 +104,12 @@ class CompiledBlocks:
         self.g, self.gl = e(N - 2, p.kl + p.ku, m), e(p.nwc, m)
         self.vs, self.vl = e(N - 2, p.ku, p.nvr), e(m, p.nvr)
 
-    def factor(self, buf: np.ndarray) -> bool:
-        """Factor the blocks scattered in ``buf`` (:meth:`.BlockRingFactor._analyse`'s
-        layout); False at a singular blade block. MemoryError when C's work space fails."""
-        st = self._factor(ct.byref(self.p), buf, self.lus, self.piv, self.g, self.gl, self.vs,
-                          self.vl)
+    def factor(self, data: np.ndarray, dest: np.ndarray, buf: np.ndarray) -> bool:
+        """Factor J, its stored values ``data`` (float64) scattered to ``buf[dest]``
+        (:meth:`.BlockRingFactor._analyse`'s layout, the rest of ``buf`` zero); False at
+        a singular blade block. MemoryError when C's work space fails."""
+        st = self._factor(ct.byref(self.p), data.size, dest, data, buf, self.lus, self.piv,
+                          self.g, self.gl, self.vs, self.vl)
         if st < 0:
             raise MemoryError("no memory for the ring's block elimination")
         self.buf = buf
