@@ -17,11 +17,12 @@ Rows:
   full solver (the band's narrow resonance near the stuck peak needs that grid).
 * ``factor``: the fast solver's factorization of the ring Jacobian, SuperLU (COLAMD)
   against the block elimination over the blades (``ring_lu.BlockRingFactor``, the
-  default), alternately on the same ``--samples`` patterns (std 0.02, seed 1) of the
-  study's default band, N_b = ``--factor-blades`` (default 24; EO = N_b / 4): CPU time
-  per sample, factorizations, the CPU time of one factorization of the sample's peak
-  Jacobian, and the largest differences of the per-blade peaks and the amplification
-  between the two.
+  default) with its numpy loop (``block_numpy``) and compiled (``block``), in turn on
+  the same ``--samples`` patterns (std 0.02, seed 1) of the study's default band, N_b =
+  ``--factor-blades`` (default 24; EO = N_b / 4): CPU time per sample, factorizations,
+  the CPU time of one factorization of the sample's peak Jacobian and of one refined
+  solve with it, and the largest differences of the per-blade peaks and the
+  amplification against SuperLU's (``block_numpy_...`` those of the numpy loop).
 * ``precond``: GMRES on the mistuned Jacobian preconditioned by the tuned ring's (the
   cyclic solution's) LU, iterations against the scatter, and the direct sparse LU's
   time: why the solver factors the mistuned Jacobian instead.
@@ -90,6 +91,18 @@ POINTS, H = 41, 7
 
 def sector_of(nb: int) -> Sector:
     return Sector(load_config().with_values(disk__blades=nb, disk__engine_order=nb // 4))
+
+
+def solve_ms(J, factor) -> float:
+    """CPU time of one solve with ``factor``'s factors of J (a fixed right-hand side) [ms],
+    the mean over >= 1 s of repeats."""
+    factor.factor(J)
+    b = np.random.default_rng(20261128).standard_normal(J.shape[0])
+    t, k = time.process_time(), 0
+    while time.process_time() - t < 1.0 or k == 0:
+        factor.solve(b)
+        k += 1
+    return (time.process_time() - t) / k * 1e3
 
 
 def lu_ms(J, factor=None) -> float:
@@ -175,9 +188,9 @@ def band_rows(samples: int) -> list:
 
 
 def factor_rows(samples: int, blades: int = 24) -> list:
-    """The ``factor`` rows (module docstring): SuperLU and the block LU alternately."""
+    """The ``factor`` rows (module docstring): SuperLU and the block LU's two kernels in turn."""
     from damper.mistuning import SampleModel, Study, tuned_reference
-    from harmonic_balance.bladed_disk.ring_lu import make_factor
+    from harmonic_balance.bladed_disk import ring_lu
 
     study = Study(std=0.02, samples=samples, seed=1, blades=blades, engine_order=max(1, blades // 4))
     ref = tuned_reference(study, study.load())
@@ -189,8 +202,9 @@ def factor_rows(samples: int, blades: int = 24) -> list:
             kappa = draw_factors(blades, 0.02, 1, i)
             row = {"case": "ring factorization", "blades": blades, "pattern": i}
             curves = {}
-            for name in ("superlu", "block"):
-                os.environ["DAMPER_SOLVER"] = name
+            for name in ("superlu", "block_numpy", "block"):
+                os.environ["DAMPER_SOLVER"] = name.split("_")[0]
+                ring_lu.BLOCK_KERNEL = "numpy" if name == "block_numpy" else None
                 ring = MistunedRingHB(model.sector, kappa, H, cf=study.cf, f0=study.f0)
                 model.tuned = model.tuned or SectorHB(ring.sector, H, cf=ring.cf, f0=ring.f0,
                                                       mu=ring.mu, n_t=ring.basis.n_t)
@@ -198,16 +212,23 @@ def factor_rows(samples: int, blades: int = 24) -> list:
                 c = fast_ring_frf(ring, (lo, hi), model.tuned, start_omega=start)
                 curves[name] = c
                 J = ring(c.peak_x, c.peak_omega)[1]
+                blocks = (blades, ring.sector.n_dof, ring.nb)
                 row |= {f"{name}_cpu_s": time.process_time() - c0, f"{name}_evaluations": c.evaluations,
                         f"{name}_factorizations": c.extra["factorizations"],
-                        f"{name}_factor_ms": lu_ms(J, make_factor(name, (blades, ring.sector.n_dof, ring.nb)))}
-            a, b = curves["superlu"], curves["block"]
+                        f"{name}_factor_ms": lu_ms(J, ring_lu.make_factor(name.split("_")[0], blocks)),
+                        f"{name}_solve_ms": solve_ms(J, ring_lu.make_factor(name.split("_")[0], blocks))}
+            a = curves["superlu"]
             row |= {"speedup": row["superlu_cpu_s"] / row["block_cpu_s"],
-                    "peak_per_blade_max_rel_diff": float(np.abs(b.peak_per_blade / a.peak_per_blade - 1).max()),
-                    "amplification_rel_diff": b.peak / a.peak - 1}
+                    "speedup_over_numpy": row["block_numpy_cpu_s"] / row["block_cpu_s"]}
+            for name, pre in (("block_numpy", "block_numpy_"), ("block", "")):
+                b = curves[name]
+                rel = np.abs(b.peak_per_blade / a.peak_per_blade - 1)
+                row |= {f"{pre}peak_per_blade_max_rel_diff": float(rel.max()),
+                        f"{pre}amplification_rel_diff": b.peak / a.peak - 1}
             rows.append(row)
             print(_fmt(row), flush=True)
     finally:
+        ring_lu.BLOCK_KERNEL = None
         if before is None:
             os.environ.pop("DAMPER_SOLVER", None)
         else:

@@ -6,11 +6,14 @@ to round-off (``tests/upd/test_upd_ring_fast.py``):
 
 * ``block`` (the default): :class:`BlockRingFactor`, Gaussian elimination blade by blade
   on the cyclic block-tridiagonal Jacobian with LAPACK (``getrf``/``getrs``) on each
-  blade's dense block, the last blade the border that closes the ring. At 24 blades,
-  H = 7 (2520 unknowns, 205k non-zeros): ~6 ms a factorization with single-precision
-  factors and solves refined in double (~8 ms with double factors) against ~22-28 ms
-  for SuperLU with its ordering each time. Its arithmetic is fixed by the pattern, so its
-  bits are the same in a Dask worker and a serial run (one BLAS thread each).
+  blade's dense block, the last blade the border that closes the ring; the loop over
+  the blades and the refined solve are one compiled call each (``ring_lu.c`` through
+  :mod:`.ring_lu_c`, scipy's LAPACK and BLAS), with this module's numpy loop as the
+  reference and the fallback when the library is not built. At 24 blades, H = 7 (2520
+  unknowns, 205k non-zeros): ~5 ms a factorization with single-precision factors and
+  solves refined in double (~7 ms with double factors) against ~22-28 ms for SuperLU
+  with its ordering each time. Its arithmetic is fixed by the pattern, so its bits are
+  the same in a Dask worker and a serial run (one BLAS thread each).
 * ``pardiso``: MKL PARDISO (pypardiso's library, the ``fast`` extra; opt-in with
   ``DAMPER_SOLVER=pardiso``), real nonsymmetric (mtype 11): the fill-reducing ordering
   and the symbolic factorization (phase 11, METIS) once for the pattern, then the
@@ -138,6 +141,9 @@ class PardisoFactor:
 #: only, so a nearly singular blade block (a blade's own resonance with its neighbours
 #: held) would lose digits that SuperLU's global pivoting keeps.
 BLOCK_RTOL, BLOCK_REFINE = 1e-10, 2
+#: The block elimination's kernel when none is given: None for the compiled one where it is
+#: built (else numpy), or 'c' / 'numpy' (``examples/bench_mistuning.py`` compares them).
+BLOCK_KERNEL = None
 #: Refinement steps allowed with single-precision factors (``precision="mixed"``): each
 #: step gains ~-log10(cond(J) 6e-8) digits, 2-3 steps reach BLOCK_RTOL on UPD-24.
 MIXED_REFINE = 6
@@ -185,8 +191,9 @@ class BlockRingFactor:
         ordered coefficient-major over the ring (:mod:`.ring_hb`), N_b >= 3
     precision : 'mixed' or 'double'   of the factors (above)
     kernel : 'c', 'numpy' or None   the elimination and the refined solves as one compiled
-        call each (``ring_lu.c``, the default when it is built) or in numpy here (the
-        reference the compiled one is tested against): the same steps, the same LAPACK
+        call each (``ring_lu.c``) or in numpy here (the reference the compiled one is
+        tested against): the same steps on scipy's LAPACK, the products by scipy's BLAS
+        or numpy's, so the same solutions to round-off; None: :data:`BLOCK_KERNEL`
     """
 
     name = "block"
@@ -207,7 +214,7 @@ class BlockRingFactor:
         self.dt = np.float32 if single else np.float64
         self._rf = sgetrf if single else dgetrf
         self.refine = MIXED_REFINE if single else BLOCK_REFINE
-        kernel = kernel or ("c" if ring_lu_c.lib is not None else "numpy")
+        kernel = kernel or BLOCK_KERNEL or ("c" if ring_lu_c.lib is not None else "numpy")
         if kernel not in ("c", "numpy") or (kernel == "c" and ring_lu_c.lib is None):
             raise ValueError(f"kernel {kernel!r}: give 'numpy', or 'c' once ring_lu.c is "
                              "built (pip install -e .)")

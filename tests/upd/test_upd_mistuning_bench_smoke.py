@@ -28,4 +28,5 @@ def test_bench_factor_rows_block_and_superlu_give_the_same_sample(tmp_path, load
     (row,) = json.loads((tmp_path / "bench_mistuning.json").read_text())
     assert row["blades"] == 4
     assert row["peak_per_blade_max_rel_diff"] <= FACTOR_PEAK_RTOL
+    assert row["block_numpy_peak_per_blade_max_rel_diff"] <= FACTOR_PEAK_RTOL
     assert row["block_factor_ms"] > 0 and row["superlu_factor_ms"] > 0
