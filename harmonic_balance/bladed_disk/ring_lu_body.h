@@ -145,23 +145,31 @@ int FN(ringlu_factor)(const ring_pattern *p, size_t nnz, const long long *dest,
     return info ? 1 : 0;
 }
 
-/* y (n_r) -= A x on A's columns cols (A (n_r x *), ld lda); x indexed by cols */
+/* y -= A x[cols], the product summed first (A (n_r x n_c), ld lda; x read at cols, or
+ * 0 .. n_c - 1 when cols is NULL; y (n_r), or y[rows] when rows is given); acc: n_r work */
 static void FN(submv_)(const REAL *a, int lda, int n_r, const int *cols, int n_c,
-                       const REAL *x, REAL *y, const int *rows)
+                       const REAL *x, REAL *y, const int *rows, REAL *acc)
 {
+    memset(acc, 0, n_r * sizeof(REAL));
     for (int c = 0; c < n_c; ++c) {
         const REAL xc = x[cols ? cols[c] : c];
         const REAL *ac = a + (size_t)c * lda;
-        for (int r = 0; r < n_r; ++r)
-            y[rows ? rows[r] : r] -= ac[r] * xc;
+        for (int r = 0; r < n_r; ++r)   /* contiguous, no branch: vectorised */
+            acc[r] += ac[r] * xc;
     }
+    if (rows)
+        for (int r = 0; r < n_r; ++r)
+            y[rows[r]] -= acc[r];
+    else
+        for (int r = 0; r < n_r; ++r)
+            y[r] -= acc[r];
 }
 
 /* x (N m, blade-major) from y (overwritten): the forward and backward sweeps of
- * _solve_blocks. z: work (N m). */
+ * _solve_blocks. z: work (N m); acc: work (m). */
 static void FN(sweep_)(const ring_pattern *p, REAL *lus, int *piv, const REAL *buf,
                        const REAL *g, const REAL *gl, const REAL *vs, const REAL *vl,
-                       REAL *y, REAL *z, REAL *x)
+                       REAL *y, REAL *z, REAL *x, REAL *acc)
 {
     const int N = p->N, m = p->m, ku = p->ku, kl = p->kl, nlr = p->nlr, nvr = p->nvr;
     const size_t mm = (size_t)m * m;
@@ -181,23 +189,23 @@ static void FN(sweep_)(const ring_pattern *p, REAL *lus, int *piv, const REAL *b
                 s += Li1[(size_t)a * kl + c] * zi[p->lc[c]];
             yi1[p->lr[a]] -= s;
         }
-        FN(submv_)(vs + (size_t)i * nvr * ku, nvr, nvr, p->uc, ku, zi, yb, p->vr);
+        FN(submv_)(vs + (size_t)i * nvr * ku, nvr, nvr, p->uc, ku, zi, yb, p->vr, acc);
     }
     REAL *zl = z + (size_t)(N - 2) * m;
     memcpy(zl, y + (size_t)(N - 2) * m, m * sizeof(REAL));
     FN(getrs_)(m, 1, lus + (size_t)(N - 2) * mm, piv + (size_t)(N - 2) * m, zl);
-    FN(submv_)(vl, nvr, nvr, NULL, m, zl, yb, p->vr);
+    FN(submv_)(vl, nvr, nvr, NULL, m, zl, yb, p->vr, acc);
     REAL *xb = x + (size_t)(N - 1) * m, *xl = x + (size_t)(N - 2) * m;
     memcpy(xb, yb, m * sizeof(REAL));
     FN(getrs_)(m, 1, lus + (size_t)(N - 1) * mm, piv + (size_t)(N - 1) * m, xb);
     memcpy(xl, zl, m * sizeof(REAL));
-    FN(submv_)(gl, m, m, p->wc, p->nwc, xb, xl, NULL);
+    FN(submv_)(gl, m, m, p->wc, p->nwc, xb, xl, NULL, acc);
     for (int i = N - 3; i >= 0; --i) {         /* backward: x_i = z_i - D~_i^-1 (W_i x_b + U_i x_i+1) */
         const REAL *gi = g + (size_t)i * m * ng;
         REAL *xi = x + (size_t)i * m;
         memcpy(xi, z + (size_t)i * m, m * sizeof(REAL));
-        FN(submv_)(gi, m, m, p->lc, kl, xb, xi, NULL);
-        FN(submv_)(gi + (size_t)m * kl, m, m, p->uc, ku, x + (size_t)(i + 1) * m, xi, NULL);
+        FN(submv_)(gi, m, m, p->lc, kl, xb, xi, NULL, acc);
+        FN(submv_)(gi + (size_t)m * kl, m, m, p->uc, ku, x + (size_t)(i + 1) * m, xi, NULL, acc);
     }
 }
 
@@ -210,7 +218,7 @@ int FN(ringlu_solve)(const ring_pattern *p, REAL *lus, int *piv, const REAL *buf
                      const double *b, int refine, double rtol, double *x)
 {
     const size_t n = (size_t)p->N * p->m;
-    REAL *w = malloc(3 * n * sizeof(REAL));
+    REAL *w = malloc((3 * n + (size_t)p->m) * sizeof(REAL));
     double *r = malloc(n * sizeof(double)), *Ax = malloc(n * sizeof(double));
     int status = 1;
     if (!w || !r || !Ax) {
@@ -234,7 +242,7 @@ int FN(ringlu_solve)(const ring_pattern *p, REAL *lus, int *piv, const REAL *buf
         }
         for (size_t j = 0; j < n; ++j)
             w[j] = (REAL)rhs[perm[j]];
-        FN(sweep_)(p, lus, piv, buf, g, gl, vs, vl, w, w + n, w + 2 * n);
+        FN(sweep_)(p, lus, piv, buf, g, gl, vs, vl, w, w + n, w + 2 * n, w + 3 * n);
         for (size_t j = 0; j < n; ++j)
             x[perm[j]] = k ? x[perm[j]] + (double)w[2 * n + j] : (double)w[2 * n + j];
     }
