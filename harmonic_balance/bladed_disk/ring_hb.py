@@ -17,7 +17,10 @@ the reference of the tests). Here A is sparse and each contact point's Jacobian 
 UPD-24), so the Jacobian has O(N_b) non-zeros: blade blocks coupled to their
 neighbours only. Its sparsity pattern is fixed: the assembly is one ``bincount`` of
 the element blocks and A's entries into that pattern (no COO -> CSC conversion per
-evaluation), and the Newton steps use a sparse LU (:mod:`.ring_solve`).
+evaluation), and the Newton steps use a sparse LU (:mod:`.ring_solve`). Where the
+compiled kernel is built (:mod:`.ring_lu_c`) A's values are summed in the pattern
+and the contact blocks projected and added there in one C call, in the bincount's
+order (the same sums; the projections' products to round-off).
 
 The sliders start at the ring's own frictionless prestress state (as :mod:`.hb`).
 Time samples: n_t a multiple of N_r = N_b / gcd(N_b, EO) (:func:`.hb.sector_basis`), so
@@ -33,6 +36,7 @@ from ..contact import evaluate_many, frictionless_statics
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
+from . import ring_lu_c
 from .hb import contact_elements, loads, neighbour_map, sector_basis
 from .mistuning import LinearRing, blade_stiffness, check_factors, ring_forcing, ring_structure
 from .sector import Sector
@@ -138,6 +142,26 @@ class MistunedRingHB:
         self._nnz = uniq.size
         self._indices = (uniq % self.size).astype(np.int32)
         self._indptr = np.searchsorted(uniq // self.size, np.arange(self.size + 1)).astype(np.int32)
+        # the compiled assembly: A's four parts on the pattern, each block entry's place
+        ends = np.cumsum([0] + [c.data.size for c in coo])
+        self._lin_nnz = [np.bincount(self._inv[a:b], weights=d, minlength=self._nnz)
+                         for a, b, d in zip(ends[:-1], ends[1:], self._lin_data)]
+        self._blk_pos, at = [], ends[-1]
+        for _, G, _ in self._groups:
+            n = G.shape[0] * G.shape[1] ** 2
+            k = G.shape[1]   # each block's places column by column (ring_assemble.c)
+            pos = self._inv[at:at + n].astype(np.int32).reshape(-1, k, k).transpose(0, 2, 1)
+            self._blk_pos.append(np.ascontiguousarray(pos))
+            at += n
+        self._cK0 = (None, None)
+
+    def _linear_values(self, w: float) -> np.ndarray:
+        """A(omega)'s values on the Jacobian's pattern (nnz,), summed as the bincount of
+        :meth:`__call__` sums them (K, the scaled K0, M, C in turn; an absent part adds 0)."""
+        if self._cK0[0] != self.lam:
+            self._cK0 = (self.lam, self._c[self._indices] * self._lin_nnz[1])
+        K, _, M, C = self._lin_nnz
+        return K + self._cK0[1] + -w * w * M + w * C
 
     # ------------------------------------------------------------ residual
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True, rate: bool = False):
@@ -150,7 +174,9 @@ class MistunedRingHB:
         R = self._K @ x + self._c * (self._K0 @ x) - w * w * Mx + w * Cx - self.Fext
         Rw = -2.0 * w * Mx + Cx
         blocks, nb = [], self.nb
-        for idx, G, Q in self._groups:
+        compiled = jac and ring_lu_c.lib is not None
+        data = self._linear_values(w) if compiled else None
+        for (idx, G, Q), pos in zip(self._groups, self._blk_pos):
             n_e, m, d = Q.shape
             # U_e = (I (x) Q) x_e: local harmonics (n_e, n_b, m)
             U = np.einsum("eja,eca->ecj", Q, x[G].reshape(n_e, nb, d))
@@ -158,16 +184,19 @@ class MistunedRingHB:
             np.add.at(R, G, _back(Q, F))
             if (jac or rate) and dw is not None:
                 np.add.at(Rw, G, _back(Q, dw))
-            if jac:
+            if compiled:
+                ring_lu_c.add_blocks(Q, dF, pos, data)
+            elif jac:
                 # (I (x) Q)^T dF (I (x) Q), dF rows/cols c m + j: Q on each harmonic's block
                 dF = dF.reshape(n_e, nb * m * nb, m) @ Q
                 blk = np.einsum("eja,ecjx->ecax", Q, dF.reshape(n_e, nb, m, nb * d))
                 blocks.append(blk.ravel())
         if not jac:
             return (R, Rw) if rate else R
-        K, K0, M, C = self._lin_data
-        wts = np.concatenate([K, self._c[self._K0_rows] * K0, -w * w * M, w * C] + blocks)
-        data = np.bincount(self._inv, weights=wts, minlength=self._nnz)
+        if not compiled:
+            K, K0, M, C = self._lin_data
+            wts = np.concatenate([K, self._c[self._K0_rows] * K0, -w * w * M, w * C] + blocks)
+            data = np.bincount(self._inv, weights=wts, minlength=self._nnz)
         J = sp.csc_matrix((data, self._indices, self._indptr), shape=(self.size, self.size))
         return R, J, Rw
 

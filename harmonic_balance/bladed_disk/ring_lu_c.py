@@ -1,4 +1,5 @@
-"""The compiled block elimination of the ring (``ring_lu.c``), through ctypes.
+"""The compiled block elimination of the ring (``ring_lu.c``) and the assembly of its
+Jacobian's contact blocks (``ring_assemble.c``), through ctypes.
 
 One C call factors the ring's Jacobian (the loop over the blades of
 :class:`.ring_lu.BlockRingFactor`, LAPACK ``getrf``/``getrs`` and BLAS ``gemm`` on each
@@ -76,11 +77,30 @@ def _load():
         s.restype = ct.c_int
         s.argtypes = [ct.POINTER(RingPattern), R, _I, R, R, R, R, R, _I, _D, _I, _I, _D,
                       ct.c_int, ct.c_double, _D]
+    lib.ring_add_blocks.restype = None
+    lib.ring_add_blocks.argtypes = [ct.c_int] * 4 + [_D, _D, _I, _D, _D]
     return lib
 
 
 #: The loaded library, or None (not built).
 lib = _load()
+
+
+def add_blocks(Q: np.ndarray, dF: np.ndarray, pos: np.ndarray, data: np.ndarray) -> None:
+    """``data[pos] +=`` each contact's block (I (x) Q_e)^T dF_e (I (x) Q_e) (ring_assemble.c).
+
+    Parameters
+    ----------
+    Q : (n_e, m, d) float64          the contacts' local coordinates on their DOFs
+    dF : (n_e, n_b m, n_b m) float64  their local Jacobians (rows/cols c m + j)
+    pos : (n_e, n_b d, n_b d) int32   where each block entry goes in ``data``, [e, col, row]
+    data : (nnz,) float64             the Jacobian's CSC values, added to in place
+    """
+    n_e, m, d = Q.shape
+    nb = dF.shape[1] // m
+    work = np.empty(nb * m * nb * d)
+    lib.ring_add_blocks(n_e, nb, m, d, np.ascontiguousarray(Q), np.ascontiguousarray(dF), pos,
+                        data, work)
 
 
 class CompiledBlocks:
