@@ -98,7 +98,7 @@ def add_blocks(Q: np.ndarray, dF: np.ndarray, pos: np.ndarray, data: np.ndarray)
     """
     n_e, m, d = Q.shape
     nb = dF.shape[1] // m
-    work = np.empty(nb * m * nb * d)
+    work = np.empty((nb * m + nb * d) * nb * d)
     lib.ring_add_blocks(n_e, nb, m, d, np.ascontiguousarray(Q), np.ascontiguousarray(dF), pos,
                         data, work)
 
