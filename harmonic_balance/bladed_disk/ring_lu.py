@@ -177,8 +177,8 @@ class BlockRingFactor:
     solve in double (mixed-precision iterative refinement, Buttari et al. 2007): the
     residual r = b - J x in float64, the correction from the float32 factors, until
     |r| <= :data:`BLOCK_RTOL` |b| (:data:`MIXED_REFINE` steps at most). The
-    factorization, flop-bound, costs ~25 % less (6.1-6.2 against 8.2-8.4 ms at 24
-    UPD-24 blades), a solve ~1 ms more (2-3 refinement steps); the solutions are those
+    factorization, flop-bound, costs ~25 % less (~5 against ~7 ms at 24 UPD-24 blades,
+    compiled), a solve ~0.8 ms more (2-3 refinement steps); the solutions are those
     of the double factors to the same residual. ``"double"``: float64 factors.
 
     A solve is checked and refined (:data:`BLOCK_RTOL`, :data:`BLOCK_REFINE` or
@@ -370,6 +370,8 @@ class BlockRingFactor:
         b = np.asarray(b, dtype=float)
         if self.use_fallback:
             return self.fallback.solve(b)
+        if b.shape != (self.N * self.m,):   # the block sweeps take one right-hand side
+            raise ValueError(f"b of shape {b.shape}: give one vector of {self.N * self.m}")
         if self.kernel == "c":
             perm, indptr, indices = self.c_index
             x = self.compiled.solve(perm, self.J, indptr, indices, np.ascontiguousarray(b),

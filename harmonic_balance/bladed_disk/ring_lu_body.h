@@ -59,6 +59,46 @@ static size_t FN(factor_work_)(const ring_pattern *p)
            + (size_t)p->nvr * p->kl + (size_t)k * (p->kl + p->ku) + (size_t)r * c;
 }
 
+/* Blade N - 2, whose neighbours are both in the border, and the border's Schur complement
+ * S (ringlu_factor's last steps): W, V of that blade into gl, vl; 0 or LAPACK's info. */
+static int FN(border_)(const ring_pattern *p, const REAL *D, const REAL *U, const REAL *L,
+                       const REAL *rhs, const REAL *V, const REAL *SV, REAL *prod, REAL *lus,
+                       int *piv, REAL *gl, REAL *vl)
+{
+    const int N = p->N, m = p->m, ku = p->ku, kl = p->kl, nlr = p->nlr, nvr = p->nvr;
+    const int nwc = p->nwc;
+    const size_t mm = (size_t)m * m;
+    int info;
+    REAL *lu = lus + (size_t)(N - 2) * mm, *S = lu + mm;
+    const REAL *UN2 = U + (size_t)(N - 2) * m * ku, *LN1 = L + (size_t)(N - 1) * nlr * kl;
+    memset(gl, 0, (size_t)m * nwc * sizeof(REAL));
+    memset(vl, 0, (size_t)nvr * m * sizeof(REAL));
+    for (int c = 0; c < kl; ++c)
+        memcpy(gl + (size_t)p->w_lc[c] * m, rhs + (size_t)c * m, m * sizeof(REAL));
+    for (int c = 0; c < ku; ++c)
+        for (int r = 0; r < m; ++r)
+            gl[r + (size_t)p->w_uc[c] * m] += UN2[r + (size_t)c * m];
+    for (int c = 0; c < ku; ++c)
+        memcpy(vl + (size_t)p->uc[c] * nvr, V + (size_t)c * nvr, nvr * sizeof(REAL));
+    for (int a = 0; a < nlr; ++a)
+        for (int c = 0; c < kl; ++c)
+            vl[p->v_lr[a] + (size_t)p->lc[c] * nvr] += LN1[(size_t)a * kl + c];
+    info = FN(getrf_)(m, lu, piv + (size_t)(N - 2) * m);
+    if (!info) {
+        FN(getrs_)(m, nwc, lu, piv + (size_t)(N - 2) * m, gl);
+        memcpy(S, D + (N - 1) * mm, mm * sizeof(REAL));
+        for (int c = 0; c < kl; ++c)
+            for (int a = 0; a < nvr; ++a)
+                S[p->vr[a] + (size_t)p->lc[c] * m] -= SV[a + (size_t)c * nvr];
+        FN(gemm_)('N', nvr, nwc, m, 1, vl, nvr, gl, 0, prod);
+        for (int c = 0; c < nwc; ++c)
+            for (int a = 0; a < nvr; ++a)
+                S[p->vr[a] + (size_t)p->wc[c] * m] -= prod[a + (size_t)c * nvr];
+        info = FN(getrf_)(m, S, piv + (size_t)(N - 1) * m);
+    }
+    return info;
+}
+
 /* The factors of the ring (the buffers above) from J's nnz stored values `data`, entry k
  * scattered to buf[dest[k]] first (buf's other entries stay zero); 0, 1 at a singular
  * block, -1 no memory. */
@@ -67,7 +107,7 @@ int FN(ringlu_factor)(const ring_pattern *p, size_t nnz, const long long *dest,
                       REAL *vs, REAL *vl)
 {
     const int N = p->N, m = p->m, ku = p->ku, kl = p->kl, nlr = p->nlr, nvr = p->nvr;
-    const int ng = kl + ku, nwc = p->nwc;
+    const int ng = kl + ku;
     const size_t mm = (size_t)m * m;
     const REAL *D = buf, *U = buf + N * mm, *L = U + (size_t)N * m * ku;
     REAL *work = calloc(FN(factor_work_)(p), sizeof(REAL));
@@ -112,35 +152,8 @@ int FN(ringlu_factor)(const ring_pattern *p, size_t nnz, const long long *dest,
         FN(gemm_)('N', nvr, ku, ku, -1, V, nvr, gat, 0, V2);
         REAL *t = V; V = V2; V2 = t;
     }
-    if (!info) {   /* blade N - 2: the border is both its neighbours */
-        REAL *lu = lus + (size_t)(N - 2) * mm, *S = lu + mm;
-        const REAL *UN2 = U + (size_t)(N - 2) * m * ku, *LN1 = L + (size_t)(N - 1) * nlr * kl;
-        memset(gl, 0, (size_t)m * nwc * sizeof(REAL));
-        memset(vl, 0, (size_t)nvr * m * sizeof(REAL));
-        for (int c = 0; c < kl; ++c)
-            memcpy(gl + (size_t)p->w_lc[c] * m, rhs + (size_t)c * m, m * sizeof(REAL));
-        for (int c = 0; c < ku; ++c)
-            for (int r = 0; r < m; ++r)
-                gl[r + (size_t)p->w_uc[c] * m] += UN2[r + (size_t)c * m];
-        for (int c = 0; c < ku; ++c)
-            memcpy(vl + (size_t)p->uc[c] * nvr, V + (size_t)c * nvr, nvr * sizeof(REAL));
-        for (int a = 0; a < nlr; ++a)
-            for (int c = 0; c < kl; ++c)
-                vl[p->v_lr[a] + (size_t)p->lc[c] * nvr] += LN1[(size_t)a * kl + c];
-        info = FN(getrf_)(m, lu, piv + (size_t)(N - 2) * m);
-        if (!info) {
-            FN(getrs_)(m, nwc, lu, piv + (size_t)(N - 2) * m, gl);
-            memcpy(S, D + (N - 1) * mm, mm * sizeof(REAL));
-            for (int c = 0; c < kl; ++c)
-                for (int a = 0; a < nvr; ++a)
-                    S[p->vr[a] + (size_t)p->lc[c] * m] -= SV[a + (size_t)c * nvr];
-            FN(gemm_)('N', nvr, nwc, m, 1, vl, nvr, gl, 0, prod);
-            for (int c = 0; c < nwc; ++c)
-                for (int a = 0; a < nvr; ++a)
-                    S[p->vr[a] + (size_t)p->wc[c] * m] -= prod[a + (size_t)c * nvr];
-            info = FN(getrf_)(m, S, piv + (size_t)(N - 1) * m);
-        }
-    }
+    if (!info)
+        info = FN(border_)(p, D, U, L, rhs, V, SV, prod, lus, piv, gl, vl);
     free(work);
     return info ? 1 : 0;
 }

@@ -88,3 +88,13 @@ def test_compiled_assembly_equals_the_bincount_assembly(ring, monkeypatch):
         assert np.array_equal(J0.indices, J1.indices) and np.array_equal(J0.indptr, J1.indptr)
         assert np.array_equal(R0, R1) and np.array_equal(W0, W1)
         assert np.abs(J1.data - J0.data).max() <= ASSEMBLY_RTOL * np.abs(J0.data).max()
+
+
+@pytest.mark.parametrize("kernel", ["c", "numpy"])
+def test_block_solve_refuses_a_matrix_of_right_hand_sides(ring, kernel):
+    """The sweeps take one vector; a matrix would be read as a wrong vector by the C call."""
+    J = next(_jacobians(ring))
+    blk = BlockRingFactor(ring.blades, ring.ndof // ring.blades, ring.nb, kernel=kernel)
+    blk.factor(J)
+    with pytest.raises(ValueError, match="give one vector"):
+        blk.solve(np.ones((J.shape[0], 2)))
