@@ -44,7 +44,8 @@ of A and the contacts' rows, each solved on its own (dense, batched over histori
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg import lu_factor
+from scipy.linalg.lapack import dgetrf, dgetrs
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -101,12 +102,16 @@ class FactorCache:
         (hashable); rhs (m,) or (m, k)."""
         lu = self._lu.pop(key, None)
         if lu is None:
-            lu = lu_factor(build(), check_finite=False)
+            # LAPACK directly (the getrf and getrs that lu_factor and lu_solve call, the same
+            # bits): their wrappers' checks cost more than the solve of a small block
+            J = build()
+            lu, piv, info = dgetrf(J)
+            lu = (lu, piv) if info == 0 else lu_factor(J, check_finite=False)  # its warning
             self.bytes += lu[0].nbytes
             while self.bytes > self.max_bytes and self._lu:
                 self.bytes -= self._lu.pop(next(iter(self._lu)))[0].nbytes
         self._lu[key] = lu                           # most recent last (dict order)
-        return lu_solve(lu, rhs, check_finite=False)
+        return dgetrs(lu[0], lu[1], rhs)[0]
 
 
 def _same_law(ref, f) -> float | None:
@@ -118,6 +123,48 @@ def _same_law(ref, f) -> float | None:
             and np.allclose(f.fs, ref.fs, rtol=SAME_LAW_RTOL, atol=0.0)
             and np.isclose(f.k_res, c * ref.k_res, rtol=SAME_LAW_RTOL, atol=0.0))
     return c if same else None
+
+
+class Rows:
+    """Products with the contact rows Q (n_c, n_b) of the massless DOFs, per history.
+
+    A node contact's row has one entry (its node coordinate), and a DOF belongs to one
+    contact of a kind, so Q X is a gather and Q^T Y a scatter: far cheaper than a sparse
+    product's dispatch for the small blocks of a march, with the same bits (one product
+    per entry, no sum). Other patterns take sparse products.
+
+    Parameters
+    ----------
+    Q : ndarray (n_c, n_b)
+    """
+
+    def __init__(self, Q: np.ndarray):
+        Q = np.asarray(Q, float)
+        self.n_b = Q.shape[1]
+        self.csr = csr_matrix(Q)
+        self.csrT = self.csr.T.tocsr()
+        self.nz = np.flatnonzero(np.any(Q != 0, axis=1))
+        self.col = np.argmax(Q != 0, axis=1)[self.nz]
+        self.val = Q[self.nz, self.col]
+        self.gather = (np.all(np.count_nonzero(Q, axis=1) <= 1)
+                       and np.unique(self.col).size == self.col.size)
+        self.n_c = Q.shape[0]
+
+    def rows(self, X: np.ndarray) -> np.ndarray:
+        """Q X per history: X (n_h, n_b, ...) -> (n_h, n_c, ...)."""
+        if not self.gather:
+            return np.stack([self.csr @ x for x in X])
+        out = np.zeros((X.shape[0], self.n_c) + X.shape[2:])
+        out[:, self.nz] = X[:, self.col] * self.val.reshape((-1,) + (1,) * (X.ndim - 2))
+        return out
+
+    def cols(self, Y: np.ndarray) -> np.ndarray:
+        """Q^T Y per history: Y (n_h, n_c, ...) -> (n_h, n_b, ...)."""
+        if not self.gather:
+            return np.stack([self.csrT @ y for y in Y])
+        out = np.zeros((Y.shape[0], self.n_b) + Y.shape[2:])
+        out[:, self.col] = Y[:, self.nz] * self.val.reshape((-1,) + (1,) * (Y.ndim - 2))
+        return out
 
 
 class MasslessContacts:
@@ -172,9 +219,8 @@ class MasslessContacts:
         #: a FactorCache for one history (n_h = 1) with the same A in every solve, or None
         self.factors = None
         self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
-        # sparse copies for the products on all DOFs (a contact touches a few DOFs)
-        self._Qs, self._Qp = csr_matrix(self.Qs), csr_matrix(self.Qp)
-        self._QsT, self._QpT = self._Qs.T.tocsr(), self._Qp.T.tocsr()
+        # the products on all DOFs (a contact touches a few DOFs)
+        self.rows_s, self.rows_p = Rows(self.Qs), Rows(self.Qp)
         self.states = []
         for ref, idx, c in self.groups:
             N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
@@ -236,27 +282,29 @@ class MasslessContacts:
             (the one-sided slopes of the trial map, module docstring)
         trial : list of state buffers (the states at w, to :meth:`commit`)
         """
-        P = (self._Qp @ w.T).T + self.p0              # (n_h, n_c) penetration
+        P = self.rows_p.rows(w) + self.p0             # (n_h, n_c) penetration
         on = P > 0.0
         N = self.kn * np.where(on, P, 0.0)
-        S = (self._Qs @ w.T).T - self.s0
+        S = self.rows_s.rows(w) - self.s0
         Ft, kt, ktm, trial = np.zeros_like(P), np.zeros_like(P), np.zeros_like(P), []
         for (ref, idx, c), st in zip(self.groups, self.states):
-            tr = st.copy()
             s, n1 = S[:, idx].ravel(), ((self.kn[idx] * P[:, idx]) / c).ravel()
-            # unclamped k_n p: the C core treats N <= 0 as lift-off (as ContactElement)
-            F1 = ref.step_batch(tr, s, n1)[0].copy()
             # the trial map's slope dF/ds at this N by a forward difference (exact on the
             # piecewise-linear map away from a kink within ds): with N changing along the
             # step's straight path the element's own tangent (for continued motion) is not it
             ds = FD_REL * (np.abs(s) + np.abs(n1) * np.sum(ref.fs) / (ref.N_ref * np.sum(ref.k)) + 1e-300)
-            F2 = ref.step_batch(st.copy(), s + ds, n1)[0].copy()
-            F0 = ref.step_batch(st.copy(), s - ds, n1)[0]
+            # the trial at s, s + ds and s - ds from copies of the committed states in one
+            # C call (each state steps alone: the bits of three calls); unclamped k_n p:
+            # the C core treats N <= 0 as lift-off (as ContactElement)
+            n = s.size
+            three = np.concatenate((st, st, st))
+            F = ref.step_batch(three, np.concatenate((s, s + ds, s - ds)), np.concatenate((n1, n1, n1)))[0]
+            F1, F2, F0 = F[:n], F[n:2 * n], F[2 * n:]
             Ft[:, idx] = c * F1.reshape(self.n_h, -1)
             kt[:, idx] = c * ((F2 - F1) / ds).reshape(self.n_h, -1)
             ktm[:, idx] = c * ((F1 - F0) / ds).reshape(self.n_h, -1)
-            trial.append(tr)
-        fc = (self._QsT @ Ft.T + self._QpT @ N.T).T
+            trial.append(three[:n].copy())
+        fc = self.rows_s.cols(Ft) + self.rows_p.cols(N)
         return fc, (kt, self.kn * on, ktm), trial
 
     def commit(self, trial) -> None:
@@ -324,7 +372,7 @@ class MasslessContacts:
                 self._cached_step(A, r, kt, tan[1], dx)
             else:
                 self._dense_step(A, r, kt, tan[1], todo, dx)
-            ds = (self._Qs @ dx.T).T
+            ds = self.rows_s.rows(dx)
             kink = tan[0] != tan[2]
             new = np.where(ds != 0.0, ds > 0.0, side)
             if not np.any(kink & (new != side)):

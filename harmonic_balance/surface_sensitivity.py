@@ -117,8 +117,8 @@ class MarchSensitivity:
         """
         nodes = self.nodes
         n_h, n_c = nodes.n_h, len(nodes.kn)
-        ds0 = _rows(nodes._Qs, self.dw)
-        dP0 = _rows(nodes._Qp, self.dw)
+        ds0 = nodes.rows_s.rows(self.dw)
+        dP0 = nodes.rows_p.rows(self.dw)
         Kt, KN = np.zeros((n_h, n_c)), np.zeros((n_h, n_c))
         G = np.zeros((n_h, n_c, self.dw.shape[2]))
         updates = []
@@ -137,8 +137,8 @@ class MarchSensitivity:
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
         self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
-        ds1 = _rows(nodes._Qs, self.dw)
-        dP1 = _rows(nodes._Qp, self.dw)
+        ds1 = nodes.rows_s.rows(self.dw)
+        dP1 = nodes.rows_p.rows(self.dw)
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
             dn1 = dP1[:, idx] * n_scale
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
@@ -149,12 +149,12 @@ class MarchSensitivity:
         nodes = self.nodes
         n_h = nodes.n_h
         if n_h == 1 and nodes.factors is not None and self._triangular:
-            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes._QsT @ G[0])[None]
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes.rows_s.cols(G[:1])[0])[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
                 np.add.at(J[h], (i, j), v * k[h, c])
-        b = rhs_q[None] - _rows(nodes._QsT, G)
+        b = rhs_q[None] - nodes.rows_s.cols(G)
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
         for dofs, *_ in self._order:
@@ -180,16 +180,10 @@ class MarchSensitivity:
                 return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
                         + (Qp.T * kp) @ Qp)
             # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
-            rhs = b[dofs] - nodes._QsT[dofs] @ (KNkn[:, None] * (nodes._Qp @ dw))
+            rhs = b[dofs] - nodes.rows_s.cols((KNkn[:, None] * nodes.rows_p.rows(dw[None])[0])[None])[0, dofs]
             key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
             dw[dofs] = nodes.factors.solve(key, build, rhs)
         return dw
-
-
-def _rows(Q, X: np.ndarray) -> np.ndarray:
-    """Q X per history: Q sparse (a, b), X (n_h, b, n_d) -> (n_h, a, n_d) (a contact's rows
-    touch a few DOFs, so the sparse product is O(n_d) per contact, not O(n_w n_d))."""
-    return np.stack([Q @ x for x in X])
 
 
 def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
