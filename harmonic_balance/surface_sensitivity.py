@@ -82,6 +82,11 @@ class MarchSensitivity:
         self._pairs = [_pairs(Qa, Qb) for Qa, Qb in ((nodes.Qs, nodes.Qs), (nodes.Qs, nodes.Qp),
                                                      (nodes.Qp, nodes.Qp))]
         self._triangular = self._is_triangular()
+        # per block of _order, the entries of Q_s^T k Q_s, Q_s^T k Q_p, Q_p^T k Q_p (each
+        # contact row one entry, a DOF one contact of a kind: no two on one entry), or None
+        single = nodes.rows_s.gather and nodes.rows_p.gather
+        self._entries = [[_entries(Qa, Qb) for Qa, Qb in ((Qs, Qs), (Qs, Qp), (Qp, Qp))]
+                         for _, _, Qs, Qp in self._order] if single else None
 
     def _is_triangular(self) -> bool:
         """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
@@ -176,14 +181,27 @@ class MarchSensitivity:
         for i, (dofs, c, Qs, Qp) in enumerate(self._order):
             kt, kN, kp = Kt[c], KNkn[c], kn_on[c]
 
-            def build(dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
-                return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
-                        + (Qp.T * kp) @ Qp)
+            def build(i=i, dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
+                if self._entries is None:
+                    return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
+                            + (Qp.T * kp) @ Qp)
+                # the three products' entries, one per contact and term: the dense sum's bits
+                J = self.A[np.ix_(dofs, dofs)]
+                for (c, r, col, qa, qb), k in zip(self._entries[i], (kt, kN, kp)):
+                    J[r, col] += (qa * k[c]) * qb
+                return J
             # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
             rhs = b[dofs] - nodes.rows_s.cols((KNkn[:, None] * nodes.rows_p.rows(dw[None])[0])[None])[0, dofs]
             key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
             dw[dofs] = nodes.factors.solve(key, build, rhs)
         return dw
+
+
+def _entries(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
+    """(c, i, j, Qa[c, i], Qb[c, j]) of Qa^T diag(k) Qb for rows of one entry each."""
+    c = np.flatnonzero(np.any(Qa != 0, axis=1) & np.any(Qb != 0, axis=1))
+    i, j = np.argmax(Qa[c] != 0, axis=1), np.argmax(Qb[c] != 0, axis=1)
+    return c, i, j, Qa[c, i], Qb[c, j]
 
 
 def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
