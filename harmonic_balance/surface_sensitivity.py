@@ -85,8 +85,14 @@ class MarchSensitivity:
         # per block of _order, the entries of Q_s^T k Q_s, Q_s^T k Q_p, Q_p^T k Q_p (each
         # contact row one entry, a DOF one contact of a kind: no two on one entry), or None
         single = nodes.rows_s.gather and nodes.rows_p.gather
+        self._index = [next(b for b, blk in enumerate(nodes.blocks) if blk is o) for o in self._order]
         self._entries = [[_entries(Qa, Qb) for Qa, Qb in ((Qs, Qs), (Qs, Qp), (Qp, Qp))]
                          for _, _, Qs, Qp in self._order] if single else None
+        self._A_blocks = [self.A[np.ix_(dofs, dofs)] for dofs, *_ in self._order]
+        # blocks whose operator is A's block plus a diagonal (no Coulomb coupling inside)
+        self._diagonal = [self._entries is not None and self._entries[i][1][0].size == 0
+                          and all(np.array_equal(t[1], t[2]) for t in self._entries[i])
+                          for i in range(len(self._order))]
 
     def _is_triangular(self) -> bool:
         """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
@@ -193,7 +199,14 @@ class MarchSensitivity:
             # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
             rhs = b[dofs] - nodes.rows_s.cols((KNkn[:, None] * nodes.rows_p.rows(dw[None])[0])[None])[0, dofs]
             key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
-            dw[dofs] = nodes.factors.solve(key, build, rhs)
+            b_n = self._index[i]
+            d = None if not self._diagonal[i] else nodes.block_diagonal(b_n, kt, kp)
+            if d is None:
+                dw[dofs] = nodes.factors.solve(key, build, rhs)
+            else:    # the node solve's reference inverse, updated on the diagonal
+                d_ref = nodes.block_diagonal(b_n, nodes.kt_stuck[c], nodes.kn[c])
+                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i],
+                                                        d, d_ref, rhs)
         return dw
 
 
