@@ -79,6 +79,10 @@ SLOPE_DIGITS = 8
 #: new factorization costs less than the update's products (measured on UPD-24: blocks
 #: of 63 DOFs at 5 nodes per side, 180-714 at 10 and 20).
 DIAGONAL_UPDATE_MIN = 100
+#: Inverses kept per block as references of the diagonal updates, and the share of a
+#: block's entries beyond which an operator is inverted as a new reference instead of
+#: updated (the update's small system then costs a sizable part of an inversion).
+MAX_REFERENCES, REFERENCE_SHARE = 4, 0.25
 #: Bytes of LU factors kept by a :class:`FactorCache` (least recently used dropped first):
 #: 2 x 20 nodes per side gives blocks of ~700 DOFs, 4 MB a factor.
 FACTOR_CACHE_BYTES = 256 * 2 ** 20
@@ -100,7 +104,7 @@ class FactorCache:
     """
 
     def __init__(self, max_bytes: int = FACTOR_CACHE_BYTES):
-        self.max_bytes, self.bytes, self._lu, self._inv = int(max_bytes), 0, {}, {}
+        self.max_bytes, self.bytes, self._lu, self._inv, self._count = int(max_bytes), 0, {}, {}, 0
 
     def solve(self, key, build, rhs: np.ndarray) -> np.ndarray:
         """J^{-1} rhs, (m,) or (m, k), with J = build() (m, m) factorized once per ``key``
@@ -119,28 +123,41 @@ class FactorCache:
         return dgetrs(lu[0], lu[1], rhs)[0]
 
 
-    def solve_diagonal(self, block, key, A, d, d_ref, rhs) -> np.ndarray:
-        """(A + diag(d))^{-1} rhs, (m,) or (m, k), for a block whose operators all differ from
-        its reference A + diag(d_ref) (m, m) on the diagonal alone (contact stiffnesses on
-        node coordinates), by the Woodbury identity on the reference's inverse (kept per
-        ``block``, hashable): with e the entries where d differs, D = diag(d - d_ref)[e],
-        Z = (A + diag(d_ref))^{-1}[:, e],
+    def solve_diagonal(self, block, key, A, d, rhs) -> np.ndarray:
+        """(A + diag(d))^{-1} rhs, (m,) or (m, k), for a block (hashable ``block``, fixed A
+        (m, m)) whose operators differ from each other on the diagonal alone (contact
+        stiffnesses on node coordinates), by the Woodbury identity on the inverse of a
+        reference A + diag(d_r) met before: with e the entries where d differs from d_r,
+        D = diag(d - d_r)[e], Z = (A + diag(d_r))^{-1}[:, e],
 
-            x = x_0 - Z (I + D Z[e])^{-1} D x_0[e],   x_0 = (A + diag(d_ref))^{-1} rhs
+            x = x_0 - Z (I + D Z[e])^{-1} D x_0[e],   x_0 = (A + diag(d_r))^{-1} rhs
 
-        whose small matrix is factorized once per ``key`` (which must fix d). A block of
-        m unknowns with n_e changed entries costs O(m^2 + n_e^3) instead of a new O(m^3)
-        factorization; the result is the direct solve's to round-off."""
-        inv = self._inv.get(block)
-        if inv is None:
-            inv = self._inv[block] = np.linalg.inv(A + np.diag(d_ref))
+        whose small matrix is factorized once per ``key`` (which must fix d). The reference
+        is the block's kept one (up to MAX_REFERENCES) closest to d; where even that one
+        differs in more than REFERENCE_SHARE of the entries (a phase of gross slip or
+        lift-off), A + diag(d) becomes a new reference. A block of m unknowns with n_e
+        changed entries costs O(m^2 + n_e^3) instead of a new O(m^3) factorization; the
+        result is the direct solve's to round-off."""
+        refs = self._inv.setdefault(block, {})
+        best, e = None, None
+        for r, (d_r, _) in refs.items():
+            e_r = np.flatnonzero(d != d_r)
+            if e is None or e_r.size < e.size:
+                best, e = r, e_r
+        if best is None or e.size > REFERENCE_SHARE * d.size:
+            best, e = self._count, np.zeros(0, int)
+            self._count += 1
+            refs[best] = (d.copy(), np.linalg.inv(A + np.diag(d)))
+            if len(refs) > MAX_REFERENCES:
+                refs.pop(next(iter(refs)))
+        d_r, inv = refs.pop(best)
+        refs[best] = (d_r, inv)                        # most recent last (dict order)
         x0 = inv @ rhs
-        e = np.flatnonzero(d != d_ref)
         if e.size == 0:
             return x0
-        delta = d[e] - d_ref[e]
+        delta = d[e] - d_r[e]
         Z = inv[:, e]
-        y = self.solve(key, lambda: np.eye(e.size) + delta[:, None] * Z[e],
+        y = self.solve((best,) + key, lambda: np.eye(e.size) + delta[:, None] * Z[e],
                        delta.reshape((-1,) + (1,) * (rhs.ndim - 1)) * x0[e])
         return x0 - Z @ y
 
@@ -462,8 +479,7 @@ class MasslessContacts:
             if d is None:
                 dx[0, dofs] = self.factors.solve(key, build, -r[0, dofs])
             else:
-                d_ref = self.block_diagonal(b, ks, self.kn[c])
-                dx[0, dofs] = self.factors.solve_diagonal(("block", b), key, Ak[0], d, d_ref, -r[0, dofs])
+                dx[0, dofs] = self.factors.solve_diagonal(("block", b), key, Ak[0], d, -r[0, dofs])
 
     def _residual(self, A, w, fc, rhs):
         r = fc - rhs

@@ -203,10 +203,8 @@ class MarchSensitivity:
             d = None if not self._diagonal[i] else nodes.block_diagonal(b_n, kt, kp)
             if d is None:
                 dw[dofs] = nodes.factors.solve(key, build, rhs)
-            else:    # the node solve's reference inverse, updated on the diagonal
-                d_ref = nodes.block_diagonal(b_n, nodes.kt_stuck[c], nodes.kn[c])
-                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i],
-                                                        d, d_ref, rhs)
+            else:    # the node solve's reference inverses, updated on the diagonal
+                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i], d, rhs)
         return dw
 
 
