@@ -374,7 +374,8 @@ class MasslessContacts:
             # C call (each state steps alone: the bits of three calls); unclamped k_n p:
             # the C core treats N <= 0 as lift-off (as ContactElement)
             n = s.size
-            three = np.tile(st.view(np.uint8), 3).view(st.dtype)   # bytes: no field promotion
+            raw = st.view(np.uint8)                   # bytes: no field promotion
+            three = np.concatenate((raw, raw, raw)).view(st.dtype)
             F = ref.step_batch(three, np.concatenate((s, s + ds, s - ds)), np.concatenate((n1, n1, n1)))[0]
             F1, F2, F0 = F[:n], F[n:2 * n], F[2 * n:]
             Ft[:, idx] = c * F1.reshape(self.n_h, -1)

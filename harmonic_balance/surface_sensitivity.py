@@ -147,7 +147,7 @@ class MarchSensitivity:
             G[:, idx] = -(c * closed)[..., None] * (np.einsum("s,hgsd->hgd", k, gz) + ref.k_res * gc)
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
-        self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
+        self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, dq1, G)
         ds1 = nodes.rows_s.rows(self.dw)
         dP1 = nodes.rows_p.rows(self.dw)
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
@@ -155,12 +155,14 @@ class MarchSensitivity:
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
             self.duc[g] = e.a_c[..., None] * ds1[:, idx] + e.b_c[..., None] * dn1 + gc
 
-    def _solve(self, Kt, KNkn, kn_on, rhs_q, G) -> np.ndarray:
+    def _solve(self, Kt, KNkn, kn_on, dq1, G) -> np.ndarray:
         """dw (n_h, n_w, n_d) of (M2), block by block (normal blocks first)."""
         nodes = self.nodes
         n_h = nodes.n_h
+        rhs_q = self.AR @ dq1
         if n_h == 1 and nodes.factors is not None and self._triangular:
-            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes.rows_s.cols(G[:1])[0])[None]
+            b = rhs_q - nodes.rows_s.cols(G[:1])[0]
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], b, dq1)[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
@@ -178,10 +180,12 @@ class MarchSensitivity:
             solved[dofs] = True
         return dw
 
-    def _solve_cached(self, Kt, KNkn, kn_on, b) -> np.ndarray:
+    def _solve_cached(self, Kt, KNkn, kn_on, b, dq1) -> np.ndarray:
         """dw (n_w, n_d) of (M2) for one history, block-triangular: each block's factors from
         the nodes' FactorCache (keyed by its contacts' coefficients, which fix its operator),
-        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``)."""
+        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``).
+        A normal block's right-hand side is (A R)[dofs] dq1 (no slip rows, no coupling), so
+        it is solved for the r columns of A R and multiplied by dq1 (r, n_d) after."""
         nodes = self.nodes
         dw = np.zeros_like(b)
         for i, (dofs, c, Qs, Qp) in enumerate(self._order):
@@ -203,7 +207,10 @@ class MarchSensitivity:
             d = None if not self._diagonal[i] else nodes.block_diagonal(b_n, kt, kp)
             if d is None:
                 dw[dofs] = nodes.factors.solve(key, build, rhs)
-            else:    # the node solve's reference inverses, updated on the diagonal
+            elif not Qs.any():    # the node solve's reference inverses, updated on the diagonal
+                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i], d,
+                                                        self.AR[dofs]) @ dq1
+            else:
                 dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i], d, rhs)
         return dw
 
