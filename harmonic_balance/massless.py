@@ -25,7 +25,7 @@ k_t) share one C call: their slip radii fs_j N / (c k_j N_ref) are the reference
 at N / c, so F_c(u, N) = c F_1(u, N / c), with the same slider positions z.
 
 Newton's tangent is the slope of each node's trial map s -> F_t at its N (one-sided
-differences of three C calls: with N changing along the step's straight path, the
+differences of three trials, one C call: with N changing along the step's straight path, the
 element's own tangent, for continued motion, differs from it where a slider slipped
 inside the step; at a kink, the slope of the side the node moves to) in s and k_n
 (closed) or 0 (open) in p; the term dF_t/dN k_n (a
@@ -40,6 +40,10 @@ The massless DOFs fall apart into independent blocks (each face of each sector: 
 face's nodes couple through its bodies' stiffness only, the rigid inputs belong to
 the DOFs with mass; x and z are uncoupled): the connected components of the pattern
 of A and the contacts' rows, each solved on its own (dense, batched over histories).
+With one history and a :class:`FactorCache` a block's factors are kept by contact
+state; a large block, whose contacts add to its diagonal only (a node coordinate per
+row), is solved by low-rank (Woodbury) updates of a few kept inverses instead of a new
+factorization per contact state (:meth:`FactorCache.solve_diagonal`).
 """
 from __future__ import annotations
 
