@@ -79,9 +79,10 @@ SAME_LAW_RTOL = 1e-12
 #: difference, far inside Newton's tolerance.
 SLOPE_DIGITS = 8
 #: Blocks of at least this many DOFs whose contacts add to the diagonal only are solved
-#: by diagonal updates of one inverse (:meth:`FactorCache.solve_diagonal`): below it a
-#: new factorization costs less than the update's products (measured on UPD-24: blocks
-#: of 63 DOFs at 5 nodes per side, 180-714 at 10 and 20).
+#: by diagonal updates of kept inverses (:meth:`FactorCache.solve_diagonal`). On UPD-24
+#: the blocks of 63 DOFs (5 nodes per side) cost the same either way within ~10 %, and
+#: the cached factors keep a fresh solve's bits; those of 168-714 DOFs (10 and 20 nodes
+#: per side) are several times cheaper updated.
 DIAGONAL_UPDATE_MIN = 100
 #: Inverses kept per block as references of the diagonal updates, and the share of a
 #: block's entries beyond which an operator is inverted as a new reference instead of
