@@ -25,7 +25,7 @@ k_t) share one C call: their slip radii fs_j N / (c k_j N_ref) are the reference
 at N / c, so F_c(u, N) = c F_1(u, N / c), with the same slider positions z.
 
 Newton's tangent is the slope of each node's trial map s -> F_t at its N (one-sided
-differences of three C calls: with N changing along the step's straight path, the
+differences of three trials, one C call: with N changing along the step's straight path, the
 element's own tangent, for continued motion, differs from it where a slider slipped
 inside the step; at a kink, the slope of the side the node moves to) in s and k_n
 (closed) or 0 (open) in p; the term dF_t/dN k_n (a
@@ -40,11 +40,16 @@ The massless DOFs fall apart into independent blocks (each face of each sector: 
 face's nodes couple through its bodies' stiffness only, the rigid inputs belong to
 the DOFs with mass; x and z are uncoupled): the connected components of the pattern
 of A and the contacts' rows, each solved on its own (dense, batched over histories).
+With one history and a :class:`FactorCache` a block's factors are kept by contact
+state; a large block, whose contacts add to its diagonal only (a node coordinate per
+row), is solved by low-rank (Woodbury) updates of a few kept inverses instead of a new
+factorization per contact state (:meth:`FactorCache.solve_diagonal`).
 """
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import lu_factor, lu_solve
+from scipy.linalg import lu_factor
+from scipy.linalg.lapack import dgetrf, dgetrs
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import connected_components
 
@@ -73,6 +78,16 @@ SAME_LAW_RTOL = 1e-12
 #: stick/slip state gives the same key; the rounded slope is the one used, 5e-9 from the
 #: difference, far inside Newton's tolerance.
 SLOPE_DIGITS = 8
+#: Blocks of at least this many DOFs whose contacts add to the diagonal only are solved
+#: by diagonal updates of kept inverses (:meth:`FactorCache.solve_diagonal`). On UPD-24
+#: the blocks of 63 DOFs (5 nodes per side) cost the same either way within ~10 %, and
+#: the cached factors keep a fresh solve's bits; those of 168-714 DOFs (10 and 20 nodes
+#: per side) are several times cheaper updated.
+DIAGONAL_UPDATE_MIN = 100
+#: Inverses kept per block as references of the diagonal updates, and the share of a
+#: block's entries beyond which an operator is inverted as a new reference instead of
+#: updated (the update's small system then costs a sizable part of an inversion).
+MAX_REFERENCES, REFERENCE_SHARE = 4, 0.25
 #: Bytes of LU factors kept by a :class:`FactorCache` (least recently used dropped first):
 #: 2 x 20 nodes per side gives blocks of ~700 DOFs, 4 MB a factor.
 FACTOR_CACHE_BYTES = 256 * 2 ** 20
@@ -94,19 +109,74 @@ class FactorCache:
     """
 
     def __init__(self, max_bytes: int = FACTOR_CACHE_BYTES):
-        self.max_bytes, self.bytes, self._lu = int(max_bytes), 0, {}
+        self.max_bytes, self.bytes, self._lu, self._inv, self._count = int(max_bytes), 0, {}, {}, 0
 
     def solve(self, key, build, rhs: np.ndarray) -> np.ndarray:
         """J^{-1} rhs, (m,) or (m, k), with J = build() (m, m) factorized once per ``key``
         (hashable); rhs (m,) or (m, k)."""
         lu = self._lu.pop(key, None)
         if lu is None:
-            lu = lu_factor(build(), check_finite=False)
+            # LAPACK directly (the getrf and getrs that lu_factor and lu_solve call, the same
+            # bits): their wrappers' checks cost more than the solve of a small block
+            J = build()
+            lu, piv, info = dgetrf(J)
+            lu = (lu, piv) if info == 0 else lu_factor(J, check_finite=False)  # its warning
             self.bytes += lu[0].nbytes
             while self.bytes > self.max_bytes and self._lu:
                 self.bytes -= self._lu.pop(next(iter(self._lu)))[0].nbytes
         self._lu[key] = lu                           # most recent last (dict order)
-        return lu_solve(lu, rhs, check_finite=False)
+        return dgetrs(lu[0], lu[1], rhs)[0]
+
+
+    def solve_diagonal(self, block, key, A, d, rhs) -> np.ndarray:
+        """(A + diag(d))^{-1} rhs, (m,) or (m, k), for a block (hashable ``block``, fixed A
+        (m, m)) whose operators differ from each other on the diagonal alone (contact
+        stiffnesses on node coordinates), by the Woodbury identity on the inverse of a
+        reference A + diag(d_r) met before: with e the entries where d differs from d_r,
+        D = diag(d - d_r)[e], Z = (A + diag(d_r))^{-1}[:, e],
+
+            x = x_0 - Z (I + D Z[e])^{-1} D x_0[e],   x_0 = (A + diag(d_r))^{-1} rhs
+
+        whose small matrix is factorized once per ``key`` (which must fix d). The reference
+        is the block's kept one (up to MAX_REFERENCES) closest to d; where even that one
+        differs in more than REFERENCE_SHARE of the entries (a phase of gross slip or
+        lift-off), A + diag(d) becomes a new reference. A block of m unknowns with n_e
+        changed entries costs O(m^2 + n_e^3) instead of a new O(m^3) factorization; the
+        result is the direct solve's to round-off."""
+        refs = self._inv.setdefault(block, {})
+        best, e = None, None
+        for r, (d_r, _) in refs.items():
+            e_r = np.flatnonzero(d != d_r)
+            if e is None or e_r.size < e.size:
+                best, e = r, e_r
+        if best is None or e.size > REFERENCE_SHARE * d.size:
+            best, e = self._count, np.zeros(0, int)
+            self._count += 1
+            refs[best] = (d.copy(), np.linalg.inv(A + np.diag(d)))
+            if len(refs) > MAX_REFERENCES:
+                refs.pop(next(iter(refs)))
+        d_r, inv = refs.pop(best)
+        refs[best] = (d_r, inv)                        # most recent last (dict order)
+        x0 = inv @ rhs
+        if e.size == 0:
+            return x0
+        delta = d[e] - d_r[e]
+        Z = inv[:, e]
+        y = self.solve((best,) + key, lambda: np.eye(e.size) + delta[:, None] * Z[e],
+                       delta.reshape((-1,) + (1,) * (rhs.ndim - 1)) * x0[e])
+        return x0 - Z @ y
+
+
+def _diagonal_entries(Qs: np.ndarray, Qp: np.ndarray):
+    """(rows, columns, Q^2) of the nonzeros of a block's Q_s and Q_p, or None unless each
+    row has at most one (Q^T diag(k) Q diagonal)."""
+    out = []
+    for Q in (Qs, Qp):
+        if np.any(np.count_nonzero(Q, axis=1) > 1):
+            return None
+        rows, cols = np.nonzero(Q)
+        out.append((rows, cols, Q[rows, cols] ** 2))
+    return out
 
 
 def _same_law(ref, f) -> float | None:
@@ -118,6 +188,48 @@ def _same_law(ref, f) -> float | None:
             and np.allclose(f.fs, ref.fs, rtol=SAME_LAW_RTOL, atol=0.0)
             and np.isclose(f.k_res, c * ref.k_res, rtol=SAME_LAW_RTOL, atol=0.0))
     return c if same else None
+
+
+class Rows:
+    """Products with the contact rows Q (n_c, n_b) of the massless DOFs, per history.
+
+    A node contact's row has one entry (its node coordinate), and a DOF belongs to one
+    contact of a kind, so Q X is a gather and Q^T Y a scatter: far cheaper than a sparse
+    product's dispatch for the small blocks of a march, with the same bits (one product
+    per entry, no sum). Other patterns take sparse products.
+
+    Parameters
+    ----------
+    Q : ndarray (n_c, n_b)
+    """
+
+    def __init__(self, Q: np.ndarray):
+        Q = np.asarray(Q, float)
+        self.n_b = Q.shape[1]
+        self.csr = csr_matrix(Q)
+        self.csrT = self.csr.T.tocsr()
+        self.nz = np.flatnonzero(np.any(Q != 0, axis=1))
+        self.col = np.argmax(Q != 0, axis=1)[self.nz]
+        self.val = Q[self.nz, self.col]
+        self.gather = (np.all(np.count_nonzero(Q, axis=1) <= 1)
+                       and np.unique(self.col).size == self.col.size)
+        self.n_c = Q.shape[0]
+
+    def rows(self, X: np.ndarray) -> np.ndarray:
+        """Q X per history: X (n_h, n_b, ...) -> (n_h, n_c, ...)."""
+        if not self.gather:
+            return np.stack([self.csr @ x for x in X])
+        out = np.zeros((X.shape[0], self.n_c) + X.shape[2:])
+        out[:, self.nz] = X[:, self.col] * self.val.reshape((-1,) + (1,) * (X.ndim - 2))
+        return out
+
+    def cols(self, Y: np.ndarray) -> np.ndarray:
+        """Q^T Y per history: Y (n_h, n_c, ...) -> (n_h, n_b, ...)."""
+        if not self.gather:
+            return np.stack([self.csrT @ y for y in Y])
+        out = np.zeros((Y.shape[0], self.n_b) + Y.shape[2:])
+        out[:, self.col] = Y[:, self.nz] * self.val.reshape((-1,) + (1,) * (Y.ndim - 2))
+        return out
 
 
 class MasslessContacts:
@@ -166,15 +278,17 @@ class MasslessContacts:
                 else:
                     groups.append([el.friction, [i], [1.0]])
         self.groups = [(ref, np.array(idx), np.array(c)) for ref, idx, c in groups]
+        # each law's slip radius per unit load, sum fs / (N_ref sum k) (the scale of the
+        # trial map's difference step)
+        self._radius = [(np.sum(ref.fs), ref.N_ref * np.sum(ref.k)) for ref, _, _ in self.groups]
         self.kt_stuck = np.ones(n_c)                 # the slope scale of SLOPE_DIGITS
         for ref, idx, c in self.groups:
             self.kt_stuck[idx] = c * (np.sum(ref.k) + ref.k_res)
         #: a FactorCache for one history (n_h = 1) with the same A in every solve, or None
         self.factors = None
         self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
-        # sparse copies for the products on all DOFs (a contact touches a few DOFs)
-        self._Qs, self._Qp = csr_matrix(self.Qs), csr_matrix(self.Qp)
-        self._QsT, self._QpT = self._Qs.T.tocsr(), self._Qp.T.tocsr()
+        # the products on all DOFs (a contact touches a few DOFs)
+        self.rows_s, self.rows_p = Rows(self.Qs), Rows(self.Qp)
         self.states = []
         for ref, idx, c in self.groups:
             N0 = np.where(self.p0[idx] > 0, self.kn[idx] * self.p0[idx], ref.N_ref) / c
@@ -190,6 +304,20 @@ class MasslessContacts:
             c = np.flatnonzero(np.any(self.Qs[:, dofs] != 0, axis=1)
                                | np.any(self.Qp[:, dofs] != 0, axis=1))
             self.blocks.append((dofs, c, self.Qs[np.ix_(c, dofs)], self.Qp[np.ix_(c, dofs)]))
+        self._diagonal = [_diagonal_entries(Qs, Qp) for _, _, Qs, Qp in self.blocks]
+
+    def block_diagonal(self, b: int, kt: np.ndarray, kp: np.ndarray):
+        """The contacts' part of block b's operator, Q_s^T diag(kt) Q_s + Q_p^T diag(kp) Q_p,
+        as its diagonal (m_b,) when it is diagonal and the block has at least
+        DIAGONAL_UPDATE_MIN DOFs, else None; kt, kp (n_c,) of the block's contacts."""
+        entries = self._diagonal[b]
+        if entries is None or self.blocks[b][0].size < DIAGONAL_UPDATE_MIN:
+            return None
+        (rs, cs, qs2), (rp, cp, qp2) = entries
+        d = np.zeros(self.blocks[b][0].size)
+        np.add.at(d, cs, kt[rs] * qs2)
+        np.add.at(d, cp, kp[rp] * qp2)
+        return d
 
     @staticmethod
     def _add_tangent(J, Q, k):
@@ -236,27 +364,30 @@ class MasslessContacts:
             (the one-sided slopes of the trial map, module docstring)
         trial : list of state buffers (the states at w, to :meth:`commit`)
         """
-        P = (self._Qp @ w.T).T + self.p0              # (n_h, n_c) penetration
+        P = self.rows_p.rows(w) + self.p0             # (n_h, n_c) penetration
         on = P > 0.0
         N = self.kn * np.where(on, P, 0.0)
-        S = (self._Qs @ w.T).T - self.s0
+        S = self.rows_s.rows(w) - self.s0
         Ft, kt, ktm, trial = np.zeros_like(P), np.zeros_like(P), np.zeros_like(P), []
-        for (ref, idx, c), st in zip(self.groups, self.states):
-            tr = st.copy()
+        for (ref, idx, c), st, radius in zip(self.groups, self.states, self._radius):
             s, n1 = S[:, idx].ravel(), ((self.kn[idx] * P[:, idx]) / c).ravel()
-            # unclamped k_n p: the C core treats N <= 0 as lift-off (as ContactElement)
-            F1 = ref.step_batch(tr, s, n1)[0].copy()
             # the trial map's slope dF/ds at this N by a forward difference (exact on the
             # piecewise-linear map away from a kink within ds): with N changing along the
             # step's straight path the element's own tangent (for continued motion) is not it
-            ds = FD_REL * (np.abs(s) + np.abs(n1) * np.sum(ref.fs) / (ref.N_ref * np.sum(ref.k)) + 1e-300)
-            F2 = ref.step_batch(st.copy(), s + ds, n1)[0].copy()
-            F0 = ref.step_batch(st.copy(), s - ds, n1)[0]
+            ds = FD_REL * (np.abs(s) + np.abs(n1) * radius[0] / radius[1] + 1e-300)
+            # the trial at s, s + ds and s - ds from copies of the committed states in one
+            # C call (each state steps alone: the bits of three calls); unclamped k_n p:
+            # the C core treats N <= 0 as lift-off (as ContactElement)
+            n = s.size
+            raw = st.view(np.uint8)                   # bytes: no field promotion
+            three = np.concatenate((raw, raw, raw)).view(st.dtype)
+            F = ref.step_batch(three, np.concatenate((s, s + ds, s - ds)), np.concatenate((n1, n1, n1)))[0]
+            F1, F2, F0 = F[:n], F[n:2 * n], F[2 * n:]
             Ft[:, idx] = c * F1.reshape(self.n_h, -1)
             kt[:, idx] = c * ((F2 - F1) / ds).reshape(self.n_h, -1)
             ktm[:, idx] = c * ((F1 - F0) / ds).reshape(self.n_h, -1)
-            trial.append(tr)
-        fc = (self._QsT @ Ft.T + self._QpT @ N.T).T
+            trial.append(three[:n].copy())
+        fc = self.rows_s.cols(Ft) + self.rows_p.cols(N)
         return fc, (kt, self.kn * on, ktm), trial
 
     def commit(self, trial) -> None:
@@ -324,7 +455,7 @@ class MasslessContacts:
                 self._cached_step(A, r, kt, tan[1], dx)
             else:
                 self._dense_step(A, r, kt, tan[1], todo, dx)
-            ds = (self._Qs @ dx.T).T
+            ds = self.rows_s.rows(dx)
             kink = tan[0] != tan[2]
             new = np.where(ds != 0.0, ds > 0.0, side)
             if not np.any(kink & (new != side)):
@@ -350,7 +481,11 @@ class MasslessContacts:
                 return self._add_tangent(self._add_tangent(Ak[:1].copy(), Qs, (kr * ks)[None]),
                                          Qp, kp_c[None])[0]
             key = ("newton", b, kr.tobytes(), kp_c.tobytes())
-            dx[0, dofs] = self.factors.solve(key, build, -r[0, dofs])
+            d = self.block_diagonal(b, kr * ks, kp_c)
+            if d is None:
+                dx[0, dofs] = self.factors.solve(key, build, -r[0, dofs])
+            else:
+                dx[0, dofs] = self.factors.solve_diagonal(("block", b), key, Ak[0], d, -r[0, dofs])
 
     def _residual(self, A, w, fc, rhs):
         r = fc - rhs

@@ -40,7 +40,10 @@ Cost: every node over ``PERIODS`` periods of node solves per evaluation, plus on
 linear solve of the settled set per step for the sensitivities; the blocks' LU factors
 are kept by contact state (:class:`~.massless.FactorCache`, one per element, across
 evaluations), so a stick phase and the repeated period solve with factors already
-made. Measured costs (UPD-24, 5 to 20 nodes per side): docs/method/contact_surface.md.
+made; blocks of 100 DOFs and more are solved by diagonal updates of a few kept inverses
+(the node solve's and the sensitivities' operators differ only in the nodes' contact
+stiffnesses), and a normal block's sensitivities for the r columns of A R only.
+Measured costs (UPD-24, 5 to 20 nodes per side): docs/method/contact_surface.md.
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """

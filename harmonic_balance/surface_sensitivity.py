@@ -82,6 +82,17 @@ class MarchSensitivity:
         self._pairs = [_pairs(Qa, Qb) for Qa, Qb in ((nodes.Qs, nodes.Qs), (nodes.Qs, nodes.Qp),
                                                      (nodes.Qp, nodes.Qp))]
         self._triangular = self._is_triangular()
+        # per block of _order, the entries of Q_s^T k Q_s, Q_s^T k Q_p, Q_p^T k Q_p (each
+        # contact row one entry, a DOF one contact of a kind: no two on one entry), or None
+        single = nodes.rows_s.gather and nodes.rows_p.gather
+        self._index = [next(b for b, blk in enumerate(nodes.blocks) if blk is o) for o in self._order]
+        self._entries = [[_entries(Qa, Qb) for Qa, Qb in ((Qs, Qs), (Qs, Qp), (Qp, Qp))]
+                         for _, _, Qs, Qp in self._order] if single else None
+        self._A_blocks = [self.A[np.ix_(dofs, dofs)] for dofs, *_ in self._order]
+        # blocks whose operator is A's block plus a diagonal (no Coulomb coupling inside)
+        self._diagonal = [self._entries is not None and self._entries[i][1][0].size == 0
+                          and all(np.array_equal(t[1], t[2]) for t in self._entries[i])
+                          for i in range(len(self._order))]
 
     def _is_triangular(self) -> bool:
         """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
@@ -117,8 +128,8 @@ class MarchSensitivity:
         """
         nodes = self.nodes
         n_h, n_c = nodes.n_h, len(nodes.kn)
-        ds0 = _rows(nodes._Qs, self.dw)
-        dP0 = _rows(nodes._Qp, self.dw)
+        ds0 = nodes.rows_s.rows(self.dw)
+        dP0 = nodes.rows_p.rows(self.dw)
         Kt, KN = np.zeros((n_h, n_c)), np.zeros((n_h, n_c))
         G = np.zeros((n_h, n_c, self.dw.shape[2]))
         updates = []
@@ -136,25 +147,27 @@ class MarchSensitivity:
             G[:, idx] = -(c * closed)[..., None] * (np.einsum("s,hgsd->hgd", k, gz) + ref.k_res * gc)
             updates.append((e, gz, gc, n_scale))
         on = (w1 @ nodes.Qp.T + nodes.p0) > 0.0
-        self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, self.AR @ dq1, G)
-        ds1 = _rows(nodes._Qs, self.dw)
-        dP1 = _rows(nodes._Qp, self.dw)
+        self.dw = self._solve(Kt, KN * nodes.kn, nodes.kn * on, dq1, G)
+        ds1 = nodes.rows_s.rows(self.dw)
+        dP1 = nodes.rows_p.rows(self.dw)
         for g, ((_, idx, _), (e, gz, gc, n_scale)) in enumerate(zip(nodes.groups, updates)):
             dn1 = dP1[:, idx] * n_scale
             self.dz[g] = e.a[..., None] * ds1[:, idx, None] + e.b[..., None] * dn1[:, :, None] + gz
             self.duc[g] = e.a_c[..., None] * ds1[:, idx] + e.b_c[..., None] * dn1 + gc
 
-    def _solve(self, Kt, KNkn, kn_on, rhs_q, G) -> np.ndarray:
+    def _solve(self, Kt, KNkn, kn_on, dq1, G) -> np.ndarray:
         """dw (n_h, n_w, n_d) of (M2), block by block (normal blocks first)."""
         nodes = self.nodes
         n_h = nodes.n_h
+        rhs_q = self.AR @ dq1
         if n_h == 1 and nodes.factors is not None and self._triangular:
-            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], rhs_q - nodes._QsT @ G[0])[None]
+            b = rhs_q - nodes.rows_s.cols(G[:1])[0]
+            return self._solve_cached(Kt[0], KNkn[0], kn_on[0], b, dq1)[None]
         J = np.broadcast_to(self.A, (n_h,) + self.A.shape).copy()
         for (c, i, j, v), k in zip(self._pairs, (Kt, KNkn, kn_on)):
             for h in range(n_h):
                 np.add.at(J[h], (i, j), v * k[h, c])
-        b = rhs_q[None] - _rows(nodes._QsT, G)
+        b = rhs_q[None] - nodes.rows_s.cols(G)
         dw = np.zeros_like(b)
         solved = np.zeros(nodes.n_b, bool)
         for dofs, *_ in self._order:
@@ -167,29 +180,46 @@ class MarchSensitivity:
             solved[dofs] = True
         return dw
 
-    def _solve_cached(self, Kt, KNkn, kn_on, b) -> np.ndarray:
+    def _solve_cached(self, Kt, KNkn, kn_on, b, dq1) -> np.ndarray:
         """dw (n_w, n_d) of (M2) for one history, block-triangular: each block's factors from
         the nodes' FactorCache (keyed by its contacts' coefficients, which fix its operator),
-        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``)."""
+        the earlier blocks entering through the Coulomb coupling alone (``_is_triangular``).
+        A normal block's right-hand side is (A R)[dofs] dq1 (no slip rows, no coupling), so
+        it is solved for the r columns of A R and multiplied by dq1 (r, n_d) after."""
         nodes = self.nodes
         dw = np.zeros_like(b)
         for i, (dofs, c, Qs, Qp) in enumerate(self._order):
             kt, kN, kp = Kt[c], KNkn[c], kn_on[c]
 
-            def build(dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
-                return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
-                        + (Qp.T * kp) @ Qp)
+            def build(i=i, dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
+                if self._entries is None:
+                    return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
+                            + (Qp.T * kp) @ Qp)
+                # the three products' entries, one per contact and term: the dense sum's bits
+                J = self.A[np.ix_(dofs, dofs)]
+                for (c, r, col, qa, qb), k in zip(self._entries[i], (kt, kN, kp)):
+                    J[r, col] += (qa * k[c]) * qb
+                return J
             # dw is zero but on the blocks solved: J[dofs, solved] dw = (Q_s^T K_N k_n Q_p dw)[dofs]
-            rhs = b[dofs] - nodes._QsT[dofs] @ (KNkn[:, None] * (nodes._Qp @ dw))
+            rhs = b[dofs] - nodes.rows_s.cols((KNkn[:, None] * nodes.rows_p.rows(dw[None])[0])[None])[0, dofs]
             key = ("sensitivity", i, kt.tobytes(), kN.tobytes(), kp.tobytes())
-            dw[dofs] = nodes.factors.solve(key, build, rhs)
+            b_n = self._index[i]
+            d = None if not self._diagonal[i] else nodes.block_diagonal(b_n, kt, kp)
+            if d is None:
+                dw[dofs] = nodes.factors.solve(key, build, rhs)
+            elif not Qs.any():    # the node solve's reference inverses, updated on the diagonal
+                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i], d,
+                                                        self.AR[dofs]) @ dq1
+            else:
+                dw[dofs] = nodes.factors.solve_diagonal(("block", b_n), key, self._A_blocks[i], d, rhs)
         return dw
 
 
-def _rows(Q, X: np.ndarray) -> np.ndarray:
-    """Q X per history: Q sparse (a, b), X (n_h, b, n_d) -> (n_h, a, n_d) (a contact's rows
-    touch a few DOFs, so the sparse product is O(n_d) per contact, not O(n_w n_d))."""
-    return np.stack([Q @ x for x in X])
+def _entries(Qa: np.ndarray, Qb: np.ndarray) -> tuple:
+    """(c, i, j, Qa[c, i], Qb[c, j]) of Qa^T diag(k) Qb for rows of one entry each."""
+    c = np.flatnonzero(np.any(Qa != 0, axis=1) & np.any(Qb != 0, axis=1))
+    i, j = np.argmax(Qa[c] != 0, axis=1), np.argmax(Qb[c] != 0, axis=1)
+    return c, i, j, Qa[c, i], Qb[c, j]
 
 
 def _pairs(Qa: np.ndarray, Qb: np.ndarray) -> tuple:

@@ -96,3 +96,28 @@ def test_cached_factors_give_the_fresh_solves_forces_and_jacobian(element, slide
     for lf in cached:
         assert np.abs(lf.F - fresh.F).max() <= CACHE_RTOL * np.abs(fresh.F).max()
         assert np.abs(lf.dF - fresh.dF).max() <= CACHE_RTOL * np.abs(fresh.dF).max()
+
+
+@pytest.mark.parametrize("slide, rock", [(1.2, 0.3), (2.0, 1.0)], ids=["slipping", "rocking"])
+def test_diagonal_updates_give_the_fresh_solves_forces_and_jacobian(element, slide, rock, monkeypatch):
+    """Every block solved by diagonal updates of reference inverses (the path of blocks of
+    DIAGONAL_UPDATE_MIN DOFs and more, UPD-24 at 10 nodes per side and up), here forced on
+    the small face: the fresh dense solves' forces and Jacobian to round-off."""
+    from harmonic_balance import massless
+    from harmonic_balance.massless import FactorCache
+
+    el = element[0]
+    basis, U = _motion(element, slide, rock)
+    factors = el.factors
+    try:
+        el.factors = None
+        fresh = el.evaluate(U, basis, 1.0, jac=True)
+        monkeypatch.setattr(massless, "DIAGONAL_UPDATE_MIN", 1)
+        el.factors = updates = FactorCache()
+        updated = [el.evaluate(U, basis, 1.0, jac=True) for _ in range(2)]   # cold, then warm
+    finally:
+        el.factors = factors
+    assert updates._inv                                     # the updates' path was taken
+    for lf in updated:
+        assert np.abs(lf.F - fresh.F).max() <= CACHE_RTOL * np.abs(fresh.F).max()
+        assert np.abs(lf.dF - fresh.dF).max() <= CACHE_RTOL * np.abs(fresh.dF).max()
