@@ -46,7 +46,7 @@ from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB
+from harmonic_balance.bladed_disk.surface_hb import DASHPOTS, CondensedSurfaceSectorHB, SurfaceSectorHB
 from harmonic_balance.brent import brent_min
 from harmonic_balance.newton import NewtonError
 
@@ -187,28 +187,38 @@ def ring_check(shb: SurfaceSectorHB, x, basis, f: float, tol: float, periods: in
 
 def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     """One CF: the point peak, the surface peak per node count, the ring check."""
-    rec = {"cf": cf, "model": args.model, "point": point_peak(sector, H, cf, args.points), "surface": []}
+    rec = {"cf": cf, "model": args.model, "dashpots": args.dashpots,
+           "point": point_peak(sector, H, cf, args.points), "surface": []}
     print(f"CF {cf:g} N: point model peak {rec['point']['peak_hz']:.3f} Hz, "
           f"|u_a,1| {rec['point']['peak_amplitude_h1']:.6e} m", flush=True)
     f_guess = rec["point"]["peak_hz"]
     for n in nodes:
         surfaces = build_surfaces(cfg, n, cf, Store().prepare())
-        model = CondensedSurfaceSectorHB if args.model == "condensed" else SurfaceSectorHB
-        hb = model(sector, surfaces, H, cf=cf)
+        def model(c, surfaces=surfaces):
+            if args.model == "condensed":
+                return CondensedSurfaceSectorHB(sector, surfaces, H, cf=c)
+            return SurfaceSectorHB(sector, surfaces, H, cf=c, dashpots=args.dashpots)
+        hb = model(cf)
         first = None
         if args.start_cf is not None:
-            def first(w, surfaces=surfaces, model=model):
-                return cf_path(lambda c: model(sector, surfaces, H, cf=c), w, cf, args.start_cf)
-        pk = surface_point(hb, f_guess, first) if args.quick else surface_peak(hb, f_guess, args.xtol, first)
+            def first(w, model=model):
+                return cf_path(model, w, cf, args.start_cf)
+        if args.quick or args.at is not None:
+            pk = surface_point(hb, f_guess if args.at is None else args.at, first)
+        else:
+            pk = surface_peak(hb, f_guess, args.xtol, first)
         f_guess = pk["peak_hz"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
-            "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size}
+            "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size,
+            "searched": not (args.quick or args.at is not None)}
         if args.save_x:
             np.save(f"{args.save_x}_cf{cf:g}_n{n}_H{H}.npy", pk["x"])
         print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.4f} Hz, |u_a,1| "
               f"{pk['peak_amplitude_h1']:.6e} m (HB; the ring follows)", flush=True)
         if args.ti and n == nodes[-1]:
-            row["ring"] = ring_check(SurfaceSectorHB(sector, surfaces, 1, cf=cf), pk["x"], hb.basis,
+            # the ring has the model's dashpots: the condensed model's act on the faces' inputs
+            ring_hb = SurfaceSectorHB(sector, surfaces, 1, cf=cf, dashpots=args.dashpots)
+            row["ring"] = ring_check(ring_hb, pk["x"], hb.basis,
                                      pk["peak_hz"], args.ti_tol, args.ti_periods, args.ti_rest)
         rec["surface"].append(row)
         print(f"  {n:>2} nodes per side: peak {pk['peak_hz']:.3f} Hz, |u_a,1| "
@@ -257,8 +267,12 @@ def table(paths) -> str:
                 else:
                     ring = (f"{r['amplitude_h1']:.4e}, {r['amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.2%}, "
                             f"{r['periods']}{'' if r['converged'] else ' (not settled)'}")
-                rows.append(f"| {case['cf']:g} | {case.get('model', 'nodes')}, {rec['harmonics']} | "
-                            f"{s['nodes_per_side']} | {s['peak_hz']:.2f} | {s['peak_amplitude_h1']:.4e} | "
+                model = case.get("model", "nodes")
+                if model == "nodes" and case.get("dashpots") == "inputs":
+                    model += " (dashpots on the inputs)"
+                at = "" if s.get("searched", True) else " (fixed)"
+                rows.append(f"| {case['cf']:g} | {model}, {rec['harmonics']} | "
+                            f"{s['nodes_per_side']} | {s['peak_hz']:.2f}{at} | {s['peak_amplitude_h1']:.4e} | "
                             f"{change} | {point} | {ring} | {rec['revision']} |")
     return "\n".join(rows)
 
@@ -273,6 +287,12 @@ def main(argv=None) -> int:
     ap.add_argument("--model", choices=("nodes", "condensed"), default="nodes",
                     help="surface HB: node DOFs as unknowns (SurfaceSectorHB) or condensed onto the "
                     "faces' rigid inputs (CondensedSurfaceSectorHB)")
+    ap.add_argument("--dashpots", choices=DASHPOTS, default=None,
+                    help="where the bodies' damping acts (SurfaceSectorHB): on their deformation (the "
+                    "node-DOF model's default) or on the faces' rigid inputs (the condensed model's, "
+                    "its only choice); the ring time integration takes the same")
+    ap.add_argument("--at", type=float, metavar="HZ", help="solve the surface model at this one "
+                    "frequency [Hz] instead of searching its peak (a comparison at a fixed frequency)")
     ap.add_argument("--start-cf", type=float, help="reach the first solution from the stuck start at this "
                     "CF [N] (cf_path) instead of at the CF itself")
     ap.add_argument("--ti", action="store_true", help="ring time integration at the finest surface peak")
@@ -286,6 +306,12 @@ def main(argv=None) -> int:
     ap.add_argument("--table", nargs="+", metavar="JSON", help="print the study table of these "
                     "JSON files of this script and stop")
     args = ap.parse_args(argv)
+    if args.dashpots is None:
+        args.dashpots = "inputs" if args.model == "condensed" else "bodies"
+    if args.model == "condensed" and args.dashpots != "inputs":
+        ap.error("the condensed model's dashpots act on the faces' rigid inputs: --dashpots inputs")
+    if args.at is not None and not args.at > 0:
+        ap.error(f"--at must be a positive frequency [Hz], not {args.at:g}")
     if args.table:
         print(table(args.table))
         return 0

@@ -17,10 +17,14 @@ penetration p and slip s per point; the only copy of the geometry):
   (:meth:`contact_core.bodies.FlatFace.rigid`); its rows on blade j+1's platform
   enter through ``Q_next`` and the phase phi, as for the point model.
 
-The bodies' dashpots are beta_c times the surface's stiffness (the point model's
-beta_c k of its stuck contact, here the bodies' series stiffness), on the linear
-element; the node contacts have none (their penalty is a numerical device, not a
-physical stiffness).
+Dashpots (``dashpots``): ``"bodies"`` puts beta_c times the surface's stiffness on
+the linear element (the point model's beta_c k of its stuck contact, here the bodies'
+series stiffness: they act on the bodies' deformation only, not on a node's slip);
+``"inputs"`` puts beta_c times the surface's condensed stuck stiffness on its rigid
+inputs (:func:`input_dashpots`: the whole relative motion of the faces, slip included),
+the convention of :class:`CondensedSurfaceSectorHB`, so that a node-DOF model and its
+ring time integration are the condensed model's. The node contacts have none (their
+penalty is a numerical device, not a physical stiffness).
 
 Symbols as in :mod:`harmonic_balance.surface` and :mod:`.hb`.
 """
@@ -39,6 +43,8 @@ from .sector import Sector
 
 #: Face names and the sector points whose rows give their inputs.
 FACES = {"left": ("left",), "flat": ("right1", "right2")}
+#: Where the bodies' dashpots act (:class:`SurfaceSectorHB`'s ``dashpots``).
+DASHPOTS = ("bodies", "inputs")
 
 
 def face_inputs(sector: Sector, face: str):
@@ -58,7 +64,8 @@ def face_inputs(sector: Sector, face: str):
     return G[:, :n], G[:, n:]
 
 
-def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c: float, name: str):
+def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c: float, name: str,
+                     C_inputs=None):
     """The surface's linear element (stiffness and dashpots) and node contacts in a sector model.
 
     Parameters
@@ -76,8 +83,10 @@ def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c:
     phi : float
         Interblade phase [rad].
     beta_c : float
-        Dashpots beta_c K of the surface [s].
+        Dashpots beta_c K of the surface [s] (0: none on the bodies).
     name : str
+    C_inputs : ndarray (r, r), optional
+        Dashpots on the rigid inputs [N s/m] (:func:`input_dashpots`).
     """
     n_w = surface.n_w
     used = np.flatnonzero(np.any(G != 0.0, axis=0))
@@ -97,8 +106,23 @@ def surface_elements(surface, offset: int, G, G_next, right, phi: float, beta_c:
         Qn[n_w:, n_w:] = Gn[:, used]
     kin = Kinematics(dofs, Q, Q_next=Qn, phase=phi if cyclic else 0.0)
     els = [LinearElement(kin, surface.K, beta_c * surface.K if beta_c else None, name=f"{name} bodies")]
+    if C_inputs is not None:     # dashpots on the rigid inputs alone (rows n_w.. of Q)
+        r = G.shape[0]
+        kin_q = Kinematics(dofs, Q[n_w:], Q_next=None if Qn is None else Qn[n_w:],
+                           phase=phi if cyclic else 0.0)
+        els.append(LinearElement(kin_q, np.zeros((r, r)), C_inputs, name=f"{name} dashpots"))
     els += node_contacts(surface, offset, name)
     return els
+
+
+def input_dashpots(surface, beta_c: float) -> np.ndarray:
+    """beta_c times the surface's condensed stiffness on its rigid inputs with every node
+    closed and stuck, (r, r) [N s/m] (:meth:`.surface_condensed.CondensedSurface.stuck_stiffness`)."""
+    from ..surface_condensed import CondensedSurface
+
+    r = surface.K.shape[0] - surface.n_w
+    cs = CondensedSurface(surface, None, np.zeros(r), np.zeros(surface.n_w), np.zeros(surface.n))
+    return beta_c * cs.stuck_stiffness()
 
 
 def node_contacts(surface, offset: int, name: str) -> list:
@@ -130,20 +154,25 @@ class SurfaceSectorHB(SectorHB):
         Planar surfaces of the cylinder and the flat (:func:`build_surfaces`).
     H, cf, f0, mu, n_t
         As :class:`~.hb.SectorHB` (mu is the surfaces' own).
+    dashpots : {"bodies", "inputs"}
+        Where the bodies' damping acts (module docstring): on their deformation, or on
+        the faces' rigid inputs as in :class:`CondensedSurfaceSectorHB`.
     """
 
     def __init__(self, sector: Sector, surfaces: dict, H: int = 7, cf=None, f0=None, mu=None,
-                 n_t: int = 0):
+                 n_t: int = 0, dashpots: str = "bodies"):
         for face in FACES:
             if surfaces[face].tangents != ("x",):
                 raise ValueError(f"the {face} surface must be planar (tangents ('x',))")
-        self.surfaces = surfaces
+        if dashpots not in DASHPOTS:
+            raise ValueError(f"dashpots must be one of {DASHPOTS}, not {dashpots!r}")
+        self.surfaces, self.dashpots = surfaces, dashpots
         super().__init__(sector, H, cf, f0, mu, n_t)
 
     def with_harmonics(self, H: int, n_t: int = 0) -> SurfaceSectorHB:
         """The same sector, surfaces and loads with harmonics 0..H (``n_t`` AFT samples)."""
         return SurfaceSectorHB(self.sector, self.surfaces, H, cf=self.cf, f0=self.f0, mu=self.mu,
-                               n_t=n_t)
+                               n_t=n_t, dashpots=self.dashpots)
 
     def _build_model(self) -> Model:
         sec = self.sector
@@ -154,15 +183,20 @@ class SurfaceSectorHB(SectorHB):
             P[:n, :n] = A
         els = [e for e in (coupling_element(sec),) if e is not None]
         offset = n
+        on_inputs = getattr(self, "dashpots", "bodies") == "inputs" and sec.beta_c
         for face, surf in self.surfaces.items():
             G, G_next = face_inputs(sec, face)
+            beta_bodies = 0.0 if on_inputs else sec.beta_c
+            C_q = input_dashpots(surf, sec.beta_c) if on_inputs else None
             if np.any(G_next != 0.0):   # the flat: its inputs use blade j+1 (phase phi)
                 els += surface_elements(surf, offset, G, G_next, list(sec.blade.right), sec.cfg.phi,
-                                        sec.beta_c, face)
+                                        beta_bodies, face, C_q)
             else:                       # the cylinder: linear structure (cheaper, exact)
                 Ks = linear_part(surf, offset, G, n + n_w)
                 pad[2] += Ks
-                pad[1] += sec.beta_c * Ks
+                pad[1] += beta_bodies * Ks
+                if C_q is not None:
+                    pad[1][:n, :n] += G.T @ C_q @ G
                 els += node_contacts(surf, offset, face)
             offset += surf.n_w
         f_static, f_eo = np.zeros(n + n_w), np.zeros(n + n_w, dtype=complex)

@@ -130,3 +130,39 @@ def test_condensed_surface_sector_agrees_with_the_node_dof_sector(surfaces):
             W_harm += harmonic_work(U, lf.F, cond.basis)
             W_march += lf.W
     assert W_march > 0.0 and W_harm == pytest.approx(W_march, rel=MARCH_WORK_RTOL)
+
+
+#: Two exact linearisations of the same stuck sector (dense solves of ~500 unknowns and the
+#: march's forward sensitivities, whose node solve stops at 1e-7 of the loads but is linear
+#: while every node sticks): round-off and that tolerance, far below the 1e-2 that the
+#: dashpots' placement makes.
+STUCK_LINEAR_RTOL = 1e-6
+
+
+def _stuck_h1(hb, omega):
+    """First harmonic (complex, sector DOFs) of one Newton step from the prestress without
+    vibration: the stuck linear response (every node in contact sticks there)."""
+    x0 = hb.static_guess()
+    R, J, _ = hb.residual(x0, omega, True)
+    X = (x0 - np.linalg.solve(J, R)).reshape(hb.nb, hb.ndof)[:, :hb.sector.n_dof]
+    ic, isn = hb.basis.index(1)
+    return X[ic] - 1j * X[isn]
+
+
+def test_node_dof_sector_with_input_dashpots_is_the_condensed_sector_when_stuck(surfaces):
+    """dashpots="inputs" gives the node-DOF sector the condensed model's damping: their stuck
+    linear responses agree near the stuck resonance, where the dashpots set the amplitude
+    (with every node stuck the bodies' dashpots give the same: the faces' relative motion
+    is then the bodies' deformation; the placements differ where nodes slip)."""
+    from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
+
+    sector = Sector(load_config(None))
+    omega = 2 * np.pi * 476.0       # near the stuck sector's resonance
+    cond = _stuck_h1(CondensedSurfaceSectorHB(sector, surfaces, H=1, cf=600.0, n_t=16), omega)
+    same = _stuck_h1(SurfaceSectorHB(sector, surfaces, H=1, cf=600.0, dashpots="inputs"), omega)
+    assert np.abs(same - cond).max() < STUCK_LINEAR_RTOL * np.abs(cond).max()
+
+
+def test_unknown_dashpot_placement_is_refused(surfaces):
+    with pytest.raises(ValueError, match="dashpots must be one of"):
+        SurfaceSectorHB(Sector(load_config(None)), surfaces, H=1, cf=600.0, dashpots="nodes")

@@ -34,4 +34,12 @@ def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_pat
     assert ring["periods"] == 1 and np.isfinite(ring["amplitude_h1"]) and ring["amplitude_h1"] > 0
     assert rec["revision"]
     rows = ex.table([out]).splitlines()
-    assert len(rows) == 3 and rows[2].startswith("| 600 | nodes, 1 | 5 |")
+    assert len(rows) == 3 and rows[2].startswith("| 600 | nodes, 1 | 5 |") and "(fixed)" in rows[2]
+
+
+@pytest.mark.parametrize("extra", [["--model", "condensed", "--dashpots", "bodies"], ["--at", "-5"]])
+def test_contradictory_options_are_refused_before_any_solve(extra, capsys):
+    with pytest.raises(SystemExit) as exc:
+        _example().main(["--quick"] + extra)
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and ("--dashpots inputs" in err or "--at must be" in err)
