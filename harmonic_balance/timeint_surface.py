@@ -45,7 +45,7 @@ import numpy as np
 
 from .contact import ContactElement
 from .forces import LinearElement
-from .massless import MasslessContacts
+from .massless import MAX_NEWTON_UNSPLIT, MasslessContacts
 from .model import Model, _on_dofs
 from .timeint import _SS_HARMONICS, CFL, CurveSteadyState, _result, _settled_many
 
@@ -135,7 +135,7 @@ class _SurfaceMarch:
         rhs0 = np.tile(self.fext[0][b], (nf, 1)) - self.xa @ self.Kba.T
         guess = np.tile(x0[b], (nf, 1)) if np.any(x0 != 0.0) else np.linalg.solve(
             Kbb + self.nodes.stuck_stiffness(), (rhs0 - self.nodes.stuck_offset()).T).T
-        self.w = self.nodes.solve(self.nodes.split(Kbb), rhs0, guess)
+        self.w = self.nodes.solve(self.nodes.split(Kbb), rhs0, guess, MAX_NEWTON_UNSPLIT)
         self.w_m = self.w.copy()
         self.w_mm = self.w.copy()
 
@@ -168,7 +168,7 @@ class _SurfaceMarch:
         w = self.w
         rhs_b = (self.fext[j1][self.b] - xa_p @ self.Kba.T - va_p @ self.Cba.T
                  - (-4 * w + self.w_m) @ self.Cbb.T / (2 * self.dt))
-        w_p = self.nodes.solve(self.Ab, rhs_b, 2 * w - self.w_m)
+        w_p = self.nodes.solve(self.Ab, rhs_b, 2 * w - self.w_m, MAX_NEWTON_UNSPLIT)
         self.w_mm, self.w_m, self.w = self.w_m, w, w_p
 
     def step(self, j: int) -> None:
