@@ -183,7 +183,7 @@ class SurfaceSectorHB(SectorHB):
             P[:n, :n] = A
         els = [e for e in (coupling_element(sec),) if e is not None]
         offset = n
-        on_inputs = getattr(self, "dashpots", "bodies") == "inputs" and sec.beta_c
+        on_inputs = self.dashpots == "inputs" and sec.beta_c
         for face, surf in self.surfaces.items():
             G, G_next = face_inputs(sec, face)
             beta_bodies = 0.0 if on_inputs else sec.beta_c
@@ -232,6 +232,9 @@ class CondensedSurfaceSectorHB(SectorHB):
 
     Parameters as :class:`SurfaceSectorHB`.
     """
+
+    #: Where the bodies' dashpots act (:data:`DASHPOTS`): here always on the rigid inputs.
+    dashpots = "inputs"
 
     def __init__(self, sector: Sector, surfaces: dict, H: int = 7, cf=None, f0=None, mu=None,
                  n_t: int = 0):
