@@ -133,7 +133,6 @@ class FactorCache:
         self._lu[key] = lu                           # most recent last (dict order)
         return dgetrs(lu[0], lu[1], rhs)[0]
 
-
     def solve_diagonal(self, block, key, A, d, rhs) -> np.ndarray:
         """(A + diag(d))^{-1} rhs, (m,) or (m, k), for a block (hashable ``block``, fixed A
         (m, m)) whose operators differ from each other on the diagonal alone (contact
@@ -223,18 +222,18 @@ class Rows:
 
     def rows(self, X: np.ndarray) -> np.ndarray:
         """Q X per history: X (n_h, n_b, ...) -> (n_h, n_c, ...)."""
-        if not self.gather:
-            return np.stack([self.csr @ x for x in X])
-        out = np.zeros((X.shape[0], self.n_c) + X.shape[2:])
-        out[:, self.nz] = X[:, self.col] * self.val.reshape((-1,) + (1,) * (X.ndim - 2))
-        return out
+        return self._product(X, self.csr, self.n_c, self.col, self.nz)
 
     def cols(self, Y: np.ndarray) -> np.ndarray:
         """Q^T Y per history: Y (n_h, n_c, ...) -> (n_h, n_b, ...)."""
+        return self._product(Y, self.csrT, self.n_b, self.nz, self.col)
+
+    def _product(self, X, sparse, n_out: int, src, dst) -> np.ndarray:
+        """out[:, dst] = X[:, src] * val (the one entry of each row), else the sparse product."""
         if not self.gather:
-            return np.stack([self.csrT @ y for y in Y])
-        out = np.zeros((Y.shape[0], self.n_b) + Y.shape[2:])
-        out[:, self.col] = Y[:, self.nz] * self.val.reshape((-1,) + (1,) * (Y.ndim - 2))
+            return np.stack([sparse @ x for x in X])
+        out = np.zeros((X.shape[0], n_out) + X.shape[2:])
+        out[:, dst] = X[:, src] * self.val.reshape((-1,) + (1,) * (X.ndim - 2))
         return out
 
 

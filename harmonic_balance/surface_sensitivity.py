@@ -191,12 +191,11 @@ class MarchSensitivity:
         for i, (dofs, c, Qs, Qp) in enumerate(self._order):
             kt, kN, kp = Kt[c], KNkn[c], kn_on[c]
 
-            def build(i=i, dofs=dofs, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
+            def build(i=i, Qs=Qs, Qp=Qp, kt=kt, kN=kN, kp=kp):
                 if self._entries is None:
-                    return (self.A[np.ix_(dofs, dofs)] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp
-                            + (Qp.T * kp) @ Qp)
+                    return self._A_blocks[i] + (Qs.T * kt) @ Qs + (Qs.T * kN) @ Qp + (Qp.T * kp) @ Qp
                 # the three products' entries, one per contact and term: the dense sum's bits
-                J = self.A[np.ix_(dofs, dofs)]
+                J = self._A_blocks[i].copy()
                 for (c, r, col, qa, qb), k in zip(self._entries[i], (kt, kN, kp)):
                     J[r, col] += (qa * k[c]) * qb
                 return J
