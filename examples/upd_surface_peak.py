@@ -235,6 +235,10 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     s = rec["surface"]
     if len(s) > 1:
         rec["last_refinement_change"] = s[-1]["peak_amplitude_h1"] / s[-2]["peak_amplitude_h1"] - 1
+    if args.at is not None:   # a fixed frequency is no peak: nothing to hold the point peak against
+        print(f"  point model against the surface: not compared (the surface solved at {args.at:g} Hz "
+              "only, not at its peak)", flush=True)
+        return rec
     rec["point_error"] = rec["point"]["peak_amplitude_h1"] / s[-1]["peak_amplitude_h1"] - 1
     rec["point_frequency_error"] = rec["point"]["peak_hz"] / s[-1]["peak_hz"] - 1
     print(f"  point model against the {nodes[-1]}-node surface: amplitude "
@@ -257,8 +261,9 @@ def table(paths) -> str:
                 change = f"{s['peak_amplitude_h1'] / prev - 1:+.2%}" if prev else "-"
                 prev = s["peak_amplitude_h1"]
                 pt = case["point"]
-                point = (f"{pt['peak_hz']:.2f}, {pt['peak_amplitude_h1']:.4e}, "
-                         f"{pt['peak_amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.1%}")
+                error = (f"{pt['peak_amplitude_h1'] / s['peak_amplitude_h1'] - 1:+.1%}"
+                         if case.get("point_error") is not None else "-")
+                point = f"{pt['peak_hz']:.2f}, {pt['peak_amplitude_h1']:.4e}, {error}"
                 r = s.get("ring", {}).get("from_hb_state")
                 if not r:
                     ring = "-"

@@ -43,3 +43,15 @@ def test_contradictory_options_are_refused_before_any_solve(extra, capsys):
         _example().main(["--quick"] + extra)
     err = capsys.readouterr().err
     assert exc.value.code == 2 and ("--dashpots inputs" in err or "--at must be" in err)
+
+
+def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path):
+    """--at solves one frequency, not the surface's peak: no point-model error is reported."""
+    out = tmp_path / "at.json"
+    ex = _example()
+    assert ex.main(["--quick", "--cf", "600", "--at", "470", "--json", str(out)]) == 0
+    case = json.loads(out.read_text())["cases"][0]
+    assert case["surface"][0]["peak_hz"] == 470.0 and not case["surface"][0]["searched"]
+    assert "point_error" not in case
+    row = ex.table([out]).splitlines()[2]
+    assert "470.00 (fixed)" in row and row.split(" | ")[6].endswith(", -")
