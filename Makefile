@@ -15,7 +15,7 @@ C_ALL     := $(C_SOURCES) $(wildcard fmu_src/*/*.c fmu_src/*/*.h fmu_src/*/*.in)
 # System cmake, not the one fmpy's dependencies put in the venv.
 CMAKE  ?= cmake
 
-.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale docs validation docs-bench docs-bench-peers docs-bench-peers-1pct docs-stress
+.PHONY: demo test pytest ctest cbuild lint bench accel browser clean locale docs validation docs-bench docs-bench-surface docs-bench-peers docs-bench-peers-1pct docs-stress
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -100,6 +100,10 @@ validation: $(STAMP) cbuild
 	  OPENBLAS_NUM_THREADS=1 $(PY) -m pytest -q -p no:cacheprovider $$(grep -rl --include='test_*.py' 'from refcheck import' tests)
 docs-bench: $(STAMP) cbuild
 	nice $(PY) docs/tools/record.py docs/data/bench.json -- $(VENV)/bin/damper bench --json --out out/bench
+# docs-bench-surface: the surface stage by itself (20 nodes per side at H 7: minutes).
+docs-bench-surface: $(STAMP) cbuild
+	OPENBLAS_NUM_THREADS=1 nice $(PY) docs/tools/record.py docs/data/bench_surface.json -- \
+	  $(VENV)/bin/damper bench --stage surface --json --out out/bench_surface
 # docs-bench-peers: the hb stage against pyHarm and NLvib (PYHARM = a Python with pyharm-os,
 # NLVIB = a checkout of maltekrack/NLvib, GNU Octave on the PATH; about 45 minutes).
 docs-bench-peers: $(STAMP) cbuild

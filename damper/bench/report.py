@@ -16,6 +16,8 @@ import json
 import math
 from pathlib import Path
 
+from . import surface_cost
+
 #: What each stage's size and error mean (axis labels and the report's captions).
 LEGEND = {
     "contact": ("grid (nodes per side)", "max(|a/a_H - 1|, |p0/p0_H - 1|) against Hertz"),
@@ -26,6 +28,7 @@ LEGEND = {
            "|amplitude / time-integration amplitude - 1| at 1.1 rad/s; model rows: "
            "|first-harmonic peak / dense reference - 1|"),
     "solvers": ("contact nodes (grid^2)", "largest relative difference of k_n, k_t against the first solver"),
+    "surface": ("nodes per side of each face", "none (cost rows: the plot is time against nodes per side)"),
 }
 
 
@@ -37,6 +40,9 @@ def _plot(stage: str, rows: list[dict]) -> str:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    if all(r["error"] is None for r in rows):
+        _plot_cost(ax, stage, rows)
+        return _png(fig, plt)
     floor = 1e-16  # an exact result (error 0) is drawn at round-off
     # model rows (a "tool" key) are one series per tool, marks only, labelled by model
     for case in dict.fromkeys(r.get("tool", r["case"]) for r in rows):
@@ -62,6 +68,25 @@ def _plot(stage: str, rows: list[dict]) -> str:
     ax.set_title(f"{stage} (labels: {size_label}; star: default)", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
+    return _png(fig, plt)
+
+
+def _plot_cost(ax, stage: str, rows: list[dict]) -> None:
+    """A stage of cost rows alone (no error): time against size, one line per case."""
+    for case in dict.fromkeys(r["case"] for r in rows):
+        pts = sorted((r["size"], r["time_s"]) for r in rows if r["case"] == case and r["time_s"])
+        if pts:
+            ax.plot(*zip(*pts), "o-", label=case)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(LEGEND.get(stage, ("size", ""))[0], fontsize=8)
+    ax.set_ylabel("time [s]")
+    ax.set_title(f"{stage}: cost", fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+
+
+def _png(fig, plt) -> str:
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=100)
@@ -151,6 +176,13 @@ def write(out: Path, result: dict) -> tuple[Path, Path]:
                          f"<td>{_fmt(r['error'])}</td><td>{_fmt(r['time_s'])}</td><td>{_fmt(r['memory_mb'])}</td>"
                          f"<td>{'yes' if r['cached'] else 'no'}</td><td>{'*' if r.get('default') else ''}</td></tr>")
         parts.append("</table>")
+        surf = [r for r in rows if surface_cost.is_row(r)]
+        if surf:
+            parts.append(f"<p>{html.escape(surface_cost.CAPTION)}.</p><table><tr>"
+                         + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in surface_cost.COLUMNS) + "</tr>")
+            parts += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in surface_cost.cells(r)) + "</tr>"
+                      for r in surf]
+            parts.append("</table>")
         acc = _split(rows)[1]
         if acc:
             parts.append(f"<p>{html.escape(ACCURACY_CAPTION)}.</p><table><tr>"
@@ -180,6 +212,9 @@ def markdown(result: dict) -> str:
             out.append(f"| {r['case']}{star} | {r['size']:g} | {err} | {r['time_s']:.2f} | {r['memory_mb']:.0f} | "
                        f"{'yes' if r['cached'] else 'no'} |")
         out.append("")
+        surf = [r for r in own if surface_cost.is_row(r)]
+        if surf:
+            out += [f"**{stage}: {surface_cost.CAPTION}**", "", *surface_cost.markdown(surf), ""]
         if acc:
             out += [f"**{stage}: {ACCURACY_CAPTION}**", "",
                     "| " + " | ".join(h for h, _, _ in ACCURACY_COLUMNS) + " |", "|" + "---|" * len(ACCURACY_COLUMNS),

@@ -23,12 +23,14 @@ error of each row is against an independent reference:
   then whole curves of
   the model classes (:mod:`.hb_classes`: single-DOF soft and stiff,
   3- and 5-mass friction chains, UPD-24, with pyHarm and NLvib when given), their
-  first-harmonic peak against a dense reference (:mod:`.hb_reference`).
+  first-harmonic peak against a dense reference (:mod:`.hb_reference`);
+* surface: UPD-24 with contact surfaces, the CPU time of one residual evaluation per
+  node count and per H (:mod:`.surface_cost`; no error: the cost side).
 
 ``time_s`` is the command's wall time, interpreter start and imports included
 (hb: the solver's own time, which the CLI reports; the cost rows: process time). Rows carry ``default: True``
-where the setting is the tool's default. The blade-damper stage joins STAGES
-when it lands: a function ``(quick, work, log) -> list[Row]``.
+where the setting is the tool's default. A stage is a function ``(quick, work, log) ->
+list[Row]`` in STAGES.
 """
 from __future__ import annotations
 
@@ -230,5 +232,14 @@ def _hb_settings(quick: bool, log) -> list[Row]:
     return rows
 
 
-#: Stage name -> function (quick, work, log) -> rows. The blade-damper stage joins here.
-STAGES = {"contact": contact, "tangential": tangential, "element": element, "fmu": fmu, "hb": hb}
+def surface(quick: bool, work: Path, log=print) -> list[Row]:
+    """UPD-24 with contact surfaces: the cost of one evaluation per node count and per H, the
+    condensed and the node-DOF models (:mod:`.surface_cost`)."""
+    from . import surface_cost
+
+    return surface_cost.run(quick, lambda s: log("  " + s))
+
+
+#: Stage name -> function (quick, work, log) -> rows.
+STAGES = {"contact": contact, "tangential": tangential, "element": element, "fmu": fmu, "hb": hb,
+          "surface": surface}

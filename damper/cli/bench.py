@@ -26,7 +26,7 @@ def register(sub) -> None:
     p.add_argument("--quick", action="store_true", help="small sizes only (about a minute)")
     p.add_argument("--out", default="out/bench", help="folder for bench.json and bench.html")
     p.add_argument("--stage", action="append", help="only these stages (repeatable): contact, tangential, "
-                   "element, fmu, hb, solvers")
+                   "element, fmu, hb, surface, solvers")
     p.add_argument("--solvers", action="store_true", help="also time every sparse back end (slow)")
     p.add_argument("--json", action="store_true", help="print one JSON object with `stages`")
     g = p.add_argument_group("hb stage: model classes and peers (damper.bench.hb_classes)")

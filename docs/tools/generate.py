@@ -270,6 +270,7 @@ def all_pages(docs: Path) -> None:
     data_page(docs, "validation", tables.validation)
     data_page(docs, "bench", tables.bench)
     data_page(docs, "bench_peers", tables.bench)
+    data_page(docs, "bench_surface", tables.bench)
     data_page(docs, "bench_peers_1pct", tables.peers_1pct)
     data_page(docs, "bench_peers_1pct_chain5", lambda d: tables.peers_1pct(d, "bench_peers_1pct_chain5"))
     data_page(docs, "stress", tables.stress)

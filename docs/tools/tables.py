@@ -15,6 +15,7 @@ MAKE = {
                                ".venv/bin/python -m damper.bench.peers_1pct --pyharm PYHARM "
                                "--case 'chain5 down' --json",
     "stress": "make docs-stress",
+    "bench_surface": "make docs-bench-surface",
     "accuracy": "make docs-accuracy",
     "accuracy_upd": "make docs-accuracy",
 }
@@ -103,6 +104,7 @@ def validation(data: dict) -> str:
 
 
 def bench(data: dict) -> str:
+    from damper.bench import surface_cost
     from damper.bench.report import ACCURACY_CAPTION, ACCURACY_COLUMNS, LEGEND
 
     res = data.get("result", {})
@@ -118,6 +120,10 @@ def bench(data: dict) -> str:
             out.append(f"| {_cell(case)} | {_g(r['size'])} | {_g(r['error'])} | {_g(r['time_s'])} | "
                        f"{_g(r['memory_mb'], 4)} | {_g(bool(r.get('cached')))} |")
         out.append("")
+        surf = [r for r in rows if surface_cost.is_row(r)]
+        if surf:
+            out += [surface_cost.CAPTION[0].upper() + surface_cost.CAPTION[1:] + ".", "",
+                    *surface_cost.markdown(surf), ""]
         acc = [r for r in rows if "estimate" in r and "tool" not in r]   # damper.bench.hb_accuracy
         if acc:
             out += [ACCURACY_CAPTION[0].upper() + ACCURACY_CAPTION[1:] + ".", "",

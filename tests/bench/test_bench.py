@@ -15,7 +15,7 @@ def test_bench_quick_report(tmp_path, capsys):
     out = json.loads(capsys.readouterr().out)
     assert code == 0
     stages = out["stages"]
-    assert set(stages) == {"contact", "tangential", "element", "fmu", "hb"}
+    assert set(stages) == {"contact", "tangential", "element", "fmu", "hb", "surface"}
     for name, rows in stages.items():
         assert rows, name
         for r in rows:
@@ -44,4 +44,4 @@ def test_bench_quick_report(tmp_path, capsys):
     assert acc and all(r["estimate"] is not None and r["error"] > 0 for r in acc)
     assert out["stamp"]["cores"] >= 1 and "numpy" in out["stamp"]["versions"]
     html = (tmp_path / "bench.html").read_text()
-    assert html.count("data:image/png;base64,") == 5 and "<th>true error</th>" in html
+    assert html.count("data:image/png;base64,") == 6 and "<th>true error</th>" in html
