@@ -53,7 +53,7 @@ import numpy as np
 
 from .forces import ForceElement, LocalForce, viscous_work
 from .fourier import FourierBasis
-from .massless import FactorCache, MasslessContacts
+from .massless import MAX_NEWTON, MAX_NEWTON_UNSPLIT, FactorCache, MasslessContacts
 from .surface_sensitivity import MarchSensitivity
 
 #: Periods marched; the last is the loop. A node that first slips in period 2 or later
@@ -69,8 +69,9 @@ FD_REL = 1e-4
 #: Load steps from the prestress to the first sample (the node solve's Newton settles a
 #: step within MAX_NEWTON iterations only for moderate changes of the contact set).
 RAMP = 8
-#: Halvings of a time step whose node solve does not settle (the load path is the
-#: same straight line, in shorter steps).
+#: Halvings of a time step whose node solve does not settle in massless.MAX_NEWTON
+#: iterations (the load path is the same straight line, in shorter steps); the shortest
+#: step may take massless.MAX_NEWTON_UNSPLIT.
 MAX_SPLIT = 4
 
 
@@ -172,10 +173,14 @@ class CondensedSurface(ForceElement):
         dq) pairs); halves the step where the node solve does not settle (it commits only a
         settled step) and carries ``sens`` over each committed step."""
         before = None if sens is None else [st.copy() for st in nodes.states]
+        # the shortest step gets the iterations of a step that cannot split: a node at a kink
+        # of its trial map at the solution leaves Newton converging linearly there, and
+        # halving the step does not move the kink
+        last = depth >= MAX_SPLIT
         try:
-            w1 = nodes.solve(A, end[0] @ self.AR.T, w)
+            w1 = nodes.solve(A, end[0] @ self.AR.T, w, MAX_NEWTON_UNSPLIT if last else MAX_NEWTON)
         except RuntimeError:
-            if depth >= MAX_SPLIT:
+            if last:
                 raise
         else:
             if sens is not None:

@@ -118,3 +118,26 @@ def test_condensed_jacobian_acts_as_the_directional_derivative(element):
     Fm = el.evaluate(U - eps * v, basis, 1.0, jac=False).F
     d = ((Fp - Fm) / (2 * eps)).ravel()
     assert res.dF @ v.ravel() == pytest.approx(d, rel=JACOBIAN_RTOL, abs=JACOBIAN_RTOL * np.abs(d).max())
+
+
+def test_a_step_whose_node_solve_needs_many_iterations_settles_at_the_shortest_split(element, monkeypatch):
+    """A node at a kink of its trial map leaves the node solve converging linearly, and
+    halving the step does not move the kink: the shortest split step takes the
+    iterations of a step that cannot split (massless.MAX_NEWTON_UNSPLIT) instead of
+    failing the march (which the harmonic balance saw as a non-finite residual and
+    stalled on). With one Newton iteration allowed before a split every step needs
+    that last resort here; the loop is the one of the default march to the node solve's
+    tolerance."""
+    from harmonic_balance import surface_condensed as sc
+
+    el, q_static, surface = element
+    j = surface.inputs.index("tangential_x")
+    amp = 2.0 * MU * N / el.stuck_stiffness()[j, j]     # gross slip: the nodes change state
+    _, _, ref = _loop(el, q_static, surface, amp)
+    monkeypatch.setattr(sc, "MAX_NEWTON", 1)
+    _, _, res = _loop(el, q_static, surface, amp)
+    assert np.all(np.isfinite(res.F))
+    assert res.F == pytest.approx(ref.F, rel=LINEAR_RTOL, abs=LINEAR_RTOL * np.abs(ref.F).max())
+    monkeypatch.setattr(sc, "MAX_NEWTON_UNSPLIT", 1)    # no last resort: the march fails
+    _, _, bad = _loop(el, q_static, surface, amp)
+    assert not np.all(np.isfinite(bad.F))
