@@ -52,9 +52,13 @@ def executor(scheduler, workers, serial, info: dict | None = None):
     if scheduler:
         try:
             client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, ValueError, TypeError) as err:
-            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
-                          "or give the right --scheduler address (tcp://host:8786)") from None
+        except Exception as err:  # noqa: BLE001 - any failure of the handshake is the address's
+            # Besides OSError (refused, timed out) and ValueError (a malformed address), a
+            # server that answers but is not a Dask scheduler makes Dask read its bytes as a
+            # frame length: a MemoryError for exabytes (seen), or a decoding error.
+            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(err).__name__}: "
+                          f"{str(err)[:200]}); start it or give the right --scheduler address "
+                          "(tcp://host:8786)") from None
         cluster = scratch = None
         info["workers"] = max(1, len(client.scheduler_info().get("workers", {})))
     else:

@@ -172,3 +172,32 @@ def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
     assert out == "" and "Traceback" not in err and "AllExit" not in err, err
     assert [ln for ln in err.splitlines() if ln.strip()] == [
         "damper upd: mistuning interrupted; the samples finished so far are in the cache, the same command resumes"]
+
+
+def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, capsys, monkeypatch):
+    """A --scheduler address where something else answers (here a web server's reply: Dask reads
+    its bytes as a frame length of exabytes, a MemoryError) is a bad address, exit 2, not a
+    traceback."""
+    import socket
+    import threading
+
+    monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 2)
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+
+    def answer():
+        try:
+            conn, _ = server.accept()
+            conn.sendall(b"HTTP/1.1 400 Bad Request\r\n\r\n")
+        except OSError:     # closed by the test when no connection came
+            pass
+
+    threading.Thread(target=answer, daemon=True).start()
+    try:
+        err = _run(SMALL + ["--scheduler", f"tcp://127.0.0.1:{server.getsockname()[1]}", "--json",
+                            "--cache-dir", str(tmp_path / "cache")], capsys, 2)
+    finally:
+        server.close()
+    assert "cannot reach the Dask scheduler" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "cache").exists()
