@@ -160,6 +160,7 @@ def run_frf(args) -> int:
             out["steady_state"] = {"note": f"--damper {args.damper} is linear: one steady state"}
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
+    out |= response_warnings(out)
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -167,7 +168,8 @@ def run_frf(args) -> int:
     else:
         at = ("" if "harmonics_peak" not in out else
               f" at H = {out['harmonics_peak']} (curve at H = {out['harmonics']})")
-        print(f"peak {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
+        what = "largest amplitude at the band's end" if out["band_end_warning"] else "peak"
+        print(f"{what} {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
               f"{out['peak_amplitude']:.6e} m{at} ({out['time_s']:.2f} s"
               + ("" if out.get("cpu_s") is None else f", {out['cpu_s']:.2f} s CPU") + ")")
         if "warning" in out:
@@ -176,10 +178,39 @@ def run_frf(args) -> int:
             print(out["zone_edge_warning"])
     from harmonic_balance.steady_state import summary_lines
 
-    for line in accuracy_lines(out) + summary_lines(out.get("steady_state")):
+    warnings = [out[k] for k in ("band_end_warning", "lift_off_warning") if out[k]]
+    for line in warnings + accuracy_lines(out) + summary_lines(out.get("steady_state")):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+#: Share of the period every contact (or face) is open at the peak above which the damper
+#: is said to rattle: it then carries its load in short impacts, which a few harmonics
+#: resolve poorly (UPD-24 at CF 120 N: 0.48-0.55 at F0 100 N, 0.94-0.95 at F0 1000 N, 0.98
+#: at 1e4 N, where the truncation check found no richer solution; CF 30 N, F0 30 N, the low
+#: end of the default load sweep: 0.57-0.68).
+RATTLE_LIFT_OFF = 0.9
+
+
+def response_warnings(out: dict) -> dict:
+    """``band_end_warning`` (the largest amplitude lies at an end of the band: no peak inside
+    it) and ``lift_off_warning`` (every contact open over more than :data:`RATTLE_LIFT_OFF`
+    of the period at the peak) of a ``upd frf`` result, each a line or None."""
+    amp, f = out["amplitude"], out["frequency_hz"]
+    i = int(np.argmax(amp))
+    band_end = None
+    if i in (0, len(amp) - 1):
+        band_end = (f"warning: the largest amplitude lies at the band's end {f[i]:g} Hz, not at a peak "
+                    f"inside the band {f[0]:g} ... {f[-1]:g} Hz: widen or move --band to find the resonance")
+    lift = out.get("lift_off")
+    rattle = None
+    if lift and min(lift) > RATTLE_LIFT_OFF:
+        rattle = (f"warning: every contact is open over at least {100 * min(lift):.0f} % of the period at the "
+                  f"peak (F0 {out['f0']:g} N against CF {out['cf']:g} N): the damper rattles, carrying its load "
+                  f"in short impacts that H = {out['harmonics']} harmonics resolve poorly; raise --cf or lower "
+                  "--f0" + ("" if "contact_surfaces" in out else ", or check the peak with --check-steady-state"))
+    return {"band_end_warning": band_end, "lift_off_warning": rattle}
 
 
 def _frf_linear(sector, args, omegas) -> dict:
