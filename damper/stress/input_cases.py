@@ -271,8 +271,8 @@ def _upd() -> list[InputCase]:
         ("frf surface with accuracy", "frf --contacts surface --accuracy 0.01"),
         ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
         ("frf surface H 50 (its dense Jacobian was killed for memory)", "frf --contacts surface --harmonics 50"),
-        ("frf surface nodes 41 (4006 nodes)", "frf --contacts surface --surface-nodes 41 --harmonics 1"),
-        ("frf surface H 19 (8307 unknowns)", "frf --contacts surface --harmonics 19 --json"),
+        ("frf surface nodes 41 (4048 nodes)", "frf --contacts surface --surface-nodes 41 --harmonics 1"),
+        ("frf surface H 19 (8775 unknowns)", "frf --contacts surface --harmonics 19 --json"),
         ("frf cf 1e-3 (a damper without load)", "frf --cf 1e-3 --points 5"),
         ("optimize cf-range 1e-3 10 (a damper without load)", "optimize --cf-range 1e-3 10 --points 3"),
         ("mistuning cf 1e-3 (a damper without load)", "mistuning --cf 1e-3 --samples 1"),
@@ -375,6 +375,10 @@ def _run() -> list[InputCase]:
              ("--no-cache with --cache-dir", "{fx}/s_ok.toml --no-cache --cache-dir c"),
              ("--cache-dir a file", "{fx}/s_ok.toml --cache-dir {fx}/a_file")]
     cases = _table("run", rows, "run")
+    cases.append(_case("run", "--out the folder of the scene's [upd] config", "run s.toml --out res",
+                       files={"s.toml": 'want = ["mistuning"]\n[upd]\nconfig = "res/upd.toml"\n'
+                                        '[mistuning]\nsamples = 1\ndamper = "free"\n',
+                              "res/upd.toml": "# the bundled UPD-24\n"}))
     cases.append(_case("run", "--cache-dir a folder of the user's (eviction)",
                        "run {fx}/s_kn_small.toml --cache-dir proj --cache-max-mb 1 --out out",
                        files={"proj/user_data.npz": "user data\n"}))
