@@ -109,6 +109,11 @@ class Study:
         changes = {}
         if self.blades is not None:
             changes["disk__blades"] = self.blades
+            if (self.engine_order is None and isinstance(self.blades, int) and self.blades >= 2
+                    and cfg.engine_order > self.blades // 2):
+                raise ValueError(f"blades {self.blades} with the model's engine order {cfg.engine_order} "
+                                 f"(above blades/2 = {self.blades // 2}): give the engine order too, "
+                                 f"0 .. {self.blades // 2}")
         if self.engine_order is not None:
             changes["disk__engine_order"] = self.engine_order
         return cfg.with_values(**changes) if changes else cfg

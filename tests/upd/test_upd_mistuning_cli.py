@@ -201,3 +201,11 @@ def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, cap
         server.close()
     assert "cannot reach the Dask scheduler" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "cache").exists()
+
+
+def test_fewer_blades_than_the_models_engine_order_allows_asks_for_an_engine_order(tmp_path, capsys):
+    """--blades 2 with UPD-24's engine order 6 (above N_b / 2): the message names the
+    option to add, not the config key the blades broke."""
+    err = _run(["upd", "mistuning", "--blades", "2", "--samples", "1", "--damper", "free", "--serial",
+                "--json", "--cache-dir", str(tmp_path / "c")], capsys, 2)
+    assert "give the engine order too, 0 .. 1" in err and len(err.strip().splitlines()) == 1
