@@ -226,7 +226,8 @@ def scenes() -> dict[str, str | bytes]:
 
 def upd_files() -> dict[str, str | bytes]:
     return {"upd_unknown.toml": "[load]\nwobble = 3\n", "upd_binary.toml": BINARY,
-            "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
+            "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n",
+            "upd_mu0.toml": "[damper]\nmu = 0.0\n"}
 
 
 def _forged_sizes(blob: bytes, size: int) -> bytes:
