@@ -75,3 +75,16 @@ def test_a_damper_open_over_most_of_the_period_is_said_to_rattle(capsys):
     assert "F0 30 N against CF 0.1 N" in light["lift_off_warning"]
     loaded = _run(["frf", "--harmonics", "3", "--points", "11", "--json"], capsys)
     assert max(loaded["lift_off"]) < 0.9 and loaded["lift_off_warning"] is None
+
+
+def test_the_rattle_warning_of_surfaces_names_no_time_integration():
+    """--check-steady-state integrates point contacts only: a surface result's warning does
+    not send the user there; the rule (every contact open over more than 90 %) is the same."""
+    from damper.cli.upd import RATTLE_LIFT_OFF, response_warnings
+
+    out = {"amplitude": [1.0, 2.0, 1.0], "frequency_hz": [400.0, 450.0, 500.0], "f0": 300.0, "cf": 20.0,
+           "harmonics": 3, "lift_off": [0.95, 0.97]}
+    points = response_warnings(out)["lift_off_warning"]
+    surfaces = response_warnings(out | {"contact_surfaces": {}})["lift_off_warning"]
+    assert "--check-steady-state" in points and "--check-steady-state" not in surfaces
+    assert response_warnings(out | {"lift_off": [0.95, RATTLE_LIFT_OFF]})["lift_off_warning"] is None
