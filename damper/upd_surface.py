@@ -87,7 +87,8 @@ def check_unknowns(sector, nodes_per_side: int, H: int, cf: float | None) -> Non
 
 
 def check_options(args) -> None:
-    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run."""
+    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run, no
+    time-integration check."""
     from harmonic_balance.surface import check_nodes
 
     if args.contacts != "surface":
@@ -98,6 +99,9 @@ def check_options(args) -> None:
                          "point model; drop --contacts surface or use --damper nonlinear")
     if args.accuracy is not None:
         raise ValueError("--contacts surface runs at the fixed --harmonics: drop --accuracy")
+    if getattr(args, "check_steady_state", False):   # refused now, not after the (slow) curve
+        raise ValueError("--check-steady-state integrates the ring with point contacts: drop it with "
+                         "--contacts surface")
 
 
 def sector_hb(sector, args):

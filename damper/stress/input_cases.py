@@ -269,6 +269,7 @@ def _upd() -> list[InputCase]:
         ("frf surface nodes 1e6", "frf --contacts surface --surface-nodes 1000000"),
         ("frf surface with stuck limits", "frf --contacts surface --damper stuck"),
         ("frf surface with accuracy", "frf --contacts surface --accuracy 0.01"),
+        ("frf surface with check-steady-state (point contacts only)", "frf --contacts surface --check-steady-state"),
         ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
         ("frf surface cf 1e6 (a cylinder contact beyond Hertz)", "frf --contacts surface --cf 1e6 --json"),
         ("frf surface with mu 0 (no virgin curve to condense)", "frf --contacts surface --config {fx}/upd_mu0.toml"),

@@ -98,6 +98,7 @@ def test_unknowns_counted_before_condensing_are_the_surface_sectors(surfaces):
     (["--surface-nodes", "99"], "surface nodes per side"),
     (["--damper", "stuck"], "--damper nonlinear"),
     (["--accuracy", "0.01"], "drop --accuracy"),
+    (["--check-steady-state"], "drop it with --contacts surface"),
 ])
 def test_bad_surface_options_are_one_line_refusals(tmp_path, capsys, monkeypatch, extra, words):
     monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
