@@ -522,7 +522,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
                                out | {"max_amplification": None, "mean_amplification": None,
                                       "std_amplification": None, "quantiles": None, "statistics": None})
     return out | {"max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
-                  "std_amplification": float(amp.std()),
+                  "std_amplification": float(amp.std()) if amp.size > 1 else None,   # one sample: unknown, not 0
                   "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
                   "statistics": mistuning_stats.summary(amp)}
 

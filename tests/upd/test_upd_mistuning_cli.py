@@ -209,3 +209,17 @@ def test_fewer_blades_than_the_models_engine_order_allows_asks_for_an_engine_ord
     err = _run(["upd", "mistuning", "--blades", "2", "--samples", "1", "--damper", "free", "--serial",
                 "--json", "--cache-dir", str(tmp_path / "c")], capsys, 2)
     assert "give the engine order too, 0 .. 1" in err and len(err.strip().splitlines()) == 1
+
+
+def test_one_sample_gives_no_spread_and_no_two_sided_interval(tmp_path, capsys):
+    """One sample: its value is every estimate, but its spread (null, not 0) and the
+    two-sided intervals of the mean and of the 0.95 quantile are unknown (null, '-' in the
+    table), and no distribution is fitted."""
+    out = _run(SMALL + ["--samples", "1", "--damper", "free", "--serial", "--json",
+                        "--cache-dir", str(tmp_path / "c")], capsys)
+    st = out["statistics"]
+    assert out["std_amplification"] is None and st["n"] == 1 and st["fit"] is None
+    assert st["mean"]["low"] is None and st["mean"]["high"] is None
+    q95 = next(q for q in st["quantiles"] if q["q"] == 0.95)
+    assert q95["low"] is None and q95["high"] is None and q95["half_width"] is None
+    assert q95["value"] == out["max_amplification"]
