@@ -107,8 +107,9 @@ def check_options(args) -> None:
 def sector_hb(sector, args):
     """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
     from damper.cache import Store
-    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB, face_inputs
 
+    face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
     check_unknowns(sector, args.surface_nodes, args.harmonics, args.cf)
     surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
     hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)

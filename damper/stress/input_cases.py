@@ -271,6 +271,7 @@ def _upd() -> list[InputCase]:
         ("frf surface with accuracy", "frf --contacts surface --accuracy 0.01"),
         ("frf surface with check-steady-state (point contacts only)", "frf --contacts surface --check-steady-state"),
         ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
+        ("frf surface with an axial platform DOF (not planar)", "frf --contacts surface --config {fx}/upd_axial.toml"),
         ("frf surface cf 1e6 (a cylinder contact beyond Hertz)", "frf --contacts surface --cf 1e6 --json"),
         ("frf surface with mu 0 (no virgin curve to condense)", "frf --contacts surface --config {fx}/upd_mu0.toml"),
         ("frf surface H 50 (its dense Jacobian was killed for memory)", "frf --contacts surface --harmonics 50"),

@@ -185,3 +185,18 @@ def test_node_dof_sector_with_input_dashpots_is_the_condensed_sector_when_stuck(
 def test_unknown_dashpot_placement_is_refused(surfaces):
     with pytest.raises(ValueError, match="dashpots must be one of"):
         SurfaceSectorHB(Sector(load_config(None)), surfaces, H=1, cf=600.0, dashpots="nodes")
+
+
+def test_a_sector_with_axial_platform_dofs_is_refused_before_condensing(tmp_path, capsys, monkeypatch):
+    """The surfaces are planar: a blade with an axial platform DOF is refused in one line
+    before contact_core condenses anything (nothing in the cache)."""
+    from damper.stress import input_fixtures as fx
+
+    for name in ("upd_axial.toml", "axial_blade.npz"):
+        (tmp_path / name).write_bytes(fx.upd_files()[name] if isinstance(fx.upd_files()[name], bytes)
+                                      else fx.upd_files()[name].encode())
+    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
+    code = main(["upd", "frf", "--contacts", "surface", "--config", str(tmp_path / "upd_axial.toml"), "--json"])
+    captured = capsys.readouterr()
+    assert code == 2 and "planar UPD sector" in captured.err and len(captured.err.strip().splitlines()) == 1
+    assert not (tmp_path / "cache").exists()
