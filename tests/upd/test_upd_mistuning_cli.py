@@ -223,3 +223,15 @@ def test_one_sample_gives_no_spread_and_no_two_sided_interval(tmp_path, capsys):
     q95 = next(q for q in st["quantiles"] if q["q"] == 0.95)
     assert q95["low"] is None and q95["high"] is None and q95["half_width"] is None
     assert q95["value"] == out["max_amplification"]
+
+
+@pytest.mark.parametrize("worst", [[], ["--worst"]])
+def test_a_band_that_cuts_off_the_tuned_peak_is_refused(tmp_path, capsys, worst):
+    """UPD-24 free: the tuned peak is at 426.13 Hz; on 380 ... 424 Hz the largest tuned value
+    is the band's end, which every amplification would divide by (they came out 2.6 to 3.1,
+    above Whitehead's bound): refused before any sample, nothing written."""
+    cache = tmp_path / "c"
+    err = _run(["upd", "mistuning", "--damper", "free", "--band", "380", "424", "--json", "--cache-dir", str(cache),
+                *(worst or ["--samples", "2", "--serial"])], capsys, 2)
+    assert "tuned peak lies at the end 424 Hz" in err and len(err.strip().splitlines()) == 1
+    assert not cache.exists()
