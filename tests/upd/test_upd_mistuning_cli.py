@@ -174,22 +174,28 @@ def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
         "damper upd: mistuning interrupted; the samples finished so far are in the cache, the same command resumes"]
 
 
-def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, capsys, monkeypatch):
-    """A --scheduler address where something else answers (here a web server's reply: Dask reads
-    its bytes as a frame length of exabytes, a MemoryError) is a bad address, exit 2, not a
-    traceback."""
+@pytest.mark.parametrize("reply", [b"HTTP/1.1 400 Bad Request\r\n\r\n", None])
+def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, capsys, monkeypatch, reply):
+    """A --scheduler address where something else answers is a bad address, exit 2, not a
+    traceback or a hang: a web server's reply (Dask reads its bytes as a frame length of
+    exabytes, a MemoryError), or none at all (Dask waits for the handshake without a bound:
+    ours is CONNECT_TIMEOUT + HANDSHAKE_GRACE)."""
     import socket
     import threading
 
-    monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 2)
+    monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 1)
+    monkeypatch.setattr("damper.tasks.HANDSHAKE_GRACE", 1)
     server = socket.socket()
     server.bind(("127.0.0.1", 0))
     server.listen()
+    held = []
 
     def answer():
         try:
             conn, _ = server.accept()
-            conn.sendall(b"HTTP/1.1 400 Bad Request\r\n\r\n")
+            held.append(conn)       # kept open: the silent server never closes it either
+            if reply is not None:
+                conn.sendall(reply)
         except OSError:     # closed by the test when no connection came
             pass
 
@@ -199,6 +205,8 @@ def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, cap
                             "--cache-dir", str(tmp_path / "cache")], capsys, 2)
     finally:
         server.close()
+        for conn in held:
+            conn.close()
     assert "cannot reach the Dask scheduler" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1 and not (tmp_path / "cache").exists()
 
