@@ -247,10 +247,10 @@ def check_tuned_inside(w: float, om: np.ndarray, given: bool) -> None:
     ``om`` [rad/s]: the band's end is not the tuned peak, and every amplification divides by
     it (``given``: the band is the user's, else the model's ``load.band_hz``)."""
     if _at_end(w, om):
-        where = "--band" if given else "the model's load.band_hz"
-        raise ValueError(f"the tuned peak lies at the end {w / 2 / np.pi:.6g} Hz of the band {om[0] / 2 / np.pi:g} "
-                         f"... {om[-1] / 2 / np.pi:g} Hz ({where}): the reference of every amplification "
-                         "must be a peak inside it; give a band around the tuned resonance")
+        where = "the given band" if given else "the model's load.band_hz"
+        raise ValueError(f"the tuned peak lies at the end {w / 2 / np.pi:.6g} Hz of {where} {om[0] / 2 / np.pi:g} "
+                         f"... {om[-1] / 2 / np.pi:g} Hz: the reference of every amplification must be a peak "
+                         "inside it; give a band around the tuned resonance")
 
 
 def _tuned_truncation(hb, curve) -> dict:

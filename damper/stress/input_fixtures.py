@@ -208,6 +208,8 @@ def scenes() -> dict[str, str | bytes]:
             "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',
             "s_mtcflow.toml": 'want = ["mistuning"]\n[mistuning]\ncf = 1e-3\nsamples = 1\n',
             "s_mtci.toml": 'want = ["mistuning"]\n[mistuning]\nuntil_ci = 1e300\n',
+            "s_mtband.toml": 'want = ["mistuning"]\n[mistuning]\ndamper = "free"\nband = [380.0, 424.0]\nsamples = 1\n',
+            "s_mtblades.toml": 'want = ["mistuning"]\n[mistuning]\ndamper = "free"\nblades = 2\nsamples = 1\n',
             "s_bbk.toml": _jenkins_backbone("contact_stiffness = 1e300\nslip_force = 60.0\n"
                                             "amplitude = [1e-7, 1e-4]\n"),
             "s_bbf.toml": _jenkins_backbone("contact_stiffness = 3.85e7\nslip_force = 1e300\n"
