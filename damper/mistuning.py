@@ -407,10 +407,15 @@ def _solve_sample(model: SampleModel, kappa) -> dict:
 END_RTOL, END_FREQ_RTOL = 1e-6, 1e-7
 
 
+def at_band_end(w: float, lo: float, hi: float) -> bool:
+    """Whether the frequency ``w`` lies at an end of the band [lo, hi] (any one unit;
+    :data:`END_RTOL`, :data:`END_FREQ_RTOL`)."""
+    return min(abs(w - lo), abs(w - hi)) <= END_RTOL * (hi - lo) + END_FREQ_RTOL * hi
+
+
 def _at_end(w: float, om: np.ndarray) -> bool:
-    """Whether ``w`` [rad/s] lies at an end of the band ``om`` (:data:`END_RTOL`)."""
-    tol = END_RTOL * (om[-1] - om[0]) + END_FREQ_RTOL * om[-1]
-    return min(abs(w - om[0]), abs(w - om[-1])) <= tol
+    """Whether ``w`` [rad/s] lies at an end of the band ``om``."""
+    return at_band_end(w, om[0], om[-1])
 
 
 def _inside(w: float, om: np.ndarray) -> None:

@@ -195,14 +195,15 @@ RATTLE_LIFT_OFF = 0.9
 
 
 def response_warnings(out: dict) -> dict:
-    """``band_end_warning`` (the largest amplitude lies at an end of the band: no peak inside
-    it) and ``lift_off_warning`` (every contact open over more than :data:`RATTLE_LIFT_OFF`
+    """``band_end_warning`` (the refined largest amplitude lies at an end of the band: no peak
+    inside it) and ``lift_off_warning`` (every contact open over more than :data:`RATTLE_LIFT_OFF`
     of the period at the peak) of a ``upd frf`` result, each a line or None."""
-    amp, f = out["amplitude"], out["frequency_hz"]
-    i = int(np.argmax(amp))
+    from damper.mistuning import at_band_end
+
+    f, w = out["frequency_hz"], out["peak_frequency_hz"]
     band_end = None
-    if i in (0, len(amp) - 1):
-        band_end = (f"warning: the largest amplitude lies at the band's end {f[i]:g} Hz, not at a peak "
+    if at_band_end(w, f[0], f[-1]):   # the refined maximum (a coarse grid's largest point may be an end)
+        band_end = (f"warning: the largest amplitude lies at the band's end {w:.6g} Hz, not at a peak "
                     f"inside the band {f[0]:g} ... {f[-1]:g} Hz: widen or move --band to find the resonance")
     lift = out.get("lift_off")
     rattle = None

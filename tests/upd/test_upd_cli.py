@@ -64,6 +64,9 @@ def test_a_maximum_at_the_band_end_is_not_called_a_peak(capsys):
     on = _run(["frf", "--damper", "free", "--points", "41", "--json"], capsys)
     assert on["band_end_warning"] is None
     assert on["frequency_hz"][0] < on["peak_frequency_hz"] < on["frequency_hz"][-1]
+    # three points: the grid's largest value is its first, the refined peak (426 Hz) inside
+    coarse = _run(["frf", "--damper", "free", "--band", "420", "520", "--points", "3", "--json"], capsys)
+    assert int(np.argmax(coarse["amplitude"])) == 0 and coarse["band_end_warning"] is None
 
 
 def test_a_damper_open_over_most_of_the_period_is_said_to_rattle(capsys):
@@ -82,7 +85,7 @@ def test_the_rattle_warning_of_surfaces_names_no_time_integration():
     not send the user there; the rule (every contact open over more than 90 %) is the same."""
     from damper.cli.upd import RATTLE_LIFT_OFF, response_warnings
 
-    out = {"amplitude": [1.0, 2.0, 1.0], "frequency_hz": [400.0, 450.0, 500.0], "f0": 300.0, "cf": 20.0,
+    out = {"frequency_hz": [400.0, 450.0, 500.0], "peak_frequency_hz": 450.0, "f0": 300.0, "cf": 20.0,
            "harmonics": 3, "lift_off": [0.95, 0.97]}
     points = response_warnings(out)["lift_off_warning"]
     surfaces = response_warnings(out | {"contact_surfaces": {}})["lift_off_warning"]
