@@ -230,6 +230,12 @@ def tuned_reference(study: Study, cfg) -> dict:
     else:
         w, a = tuned_linear_peak(sector, om, study.damper, study.f0)
     check_tuned_inside(w, om, study.band_hz is not None)
+    rattle = None
+    if study.damper == "nonlinear" and c.peak_x is not None:   # the reference's own damper rattling
+        from damper.upd_checks import rattle_warning
+
+        rattle = rattle_warning(hb.contact_summary(c.peak_x)["lift_off"], hb.f0, hb.cf, hb.H,
+                                " (the tuned sector's peak, every amplification's reference)")
     margin = BAND_MARGIN + BAND_SIGMAS * study.sigma_f()
     if study.band_hz is not None:
         band = list(study.band_hz)
@@ -239,7 +245,7 @@ def tuned_reference(study: Study, cfg) -> dict:
             f_t, tuned_linear_peak(sector, om, "stuck", study.f0)[0] / (2 * np.pi))
         band = default_band(f_t, hi, margin)
     return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band,
-            "harmonics": int(H), "truncation_error": rec}
+            "harmonics": int(H), "truncation_error": rec, "lift_off_warning": rattle}
 
 
 def check_tuned_inside(w: float, om: np.ndarray, given: bool) -> None:
@@ -400,21 +406,10 @@ def _solve_sample(model: SampleModel, kappa) -> dict:
             "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
 
 
-#: A peak within END_RTOL of the band's width plus END_FREQ_RTOL of its top frequency from
-#: one of its ends lies at that end: a bounded search of a maximum at the end stops short of
-#: it by ~sqrt(eps) |omega| (Brent's bounded method: a free tuned peak at the end of 380 ...
-#: 424 Hz came out 2.5e-8 of the frequency, 2.4e-7 of the width, inside; 1e-9 let it pass).
-END_RTOL, END_FREQ_RTOL = 1e-6, 1e-7
-
-
-def at_band_end(w: float, lo: float, hi: float) -> bool:
-    """Whether the frequency ``w`` lies at an end of the band [lo, hi] (any one unit;
-    :data:`END_RTOL`, :data:`END_FREQ_RTOL`)."""
-    return min(abs(w - lo), abs(w - hi)) <= END_RTOL * (hi - lo) + END_FREQ_RTOL * hi
-
-
 def _at_end(w: float, om: np.ndarray) -> bool:
-    """Whether ``w`` [rad/s] lies at an end of the band ``om``."""
+    """Whether ``w`` [rad/s] lies at an end of the band ``om`` (:func:`damper.upd_checks.at_band_end`)."""
+    from damper.upd_checks import at_band_end
+
     return at_band_end(w, om[0], om[-1])
 
 
@@ -544,6 +539,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "truncation_error": ref.get("truncation_error"),
             "truncation_warning": warning(ref.get("truncation_error")),
+            "lift_off_warning": ref.get("lift_off_warning"),
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),
             "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}

@@ -185,35 +185,22 @@ def run_frf(args) -> int:
     return 0
 
 
-#: Share of the period every contact (or face) is open at the peak above which the damper
-#: is said to rattle rather than rub: it then carries its load in short impacts (UPD-24 at
-#: CF 120 N: 0.48-0.55 at F0 100 N, 0.94-0.95 at F0 1000 N, 0.98 at 1e4 N; CF 30 N, F0 30 N,
-#: the low end of the default load sweep: 0.57-0.68). At F0 1000 N the ring's time
-#: integration (--check-steady-state) met the harmonic balance's peak within 0.33 %: the
-#: airfoil's amplitude holds, the impacts' contact forces are what a few harmonics miss.
-RATTLE_LIFT_OFF = 0.9
-
-
 def response_warnings(out: dict) -> dict:
     """``band_end_warning`` (the refined largest amplitude lies at an end of the band: no peak
-    inside it) and ``lift_off_warning`` (every contact open over more than :data:`RATTLE_LIFT_OFF`
-    of the period at the peak) of a ``upd frf`` result, each a line or None."""
-    from damper.mistuning import at_band_end
+    inside it) and ``lift_off_warning`` (:func:`damper.upd_checks.rattle_warning` at the peak)
+    of a ``upd frf`` result, each a line or None."""
+    from damper.upd_checks import at_band_end, rattle_warning
 
     f, w = out["frequency_hz"], out["peak_frequency_hz"]
     band_end = None
     if at_band_end(w, f[0], f[-1]):   # the refined maximum (a coarse grid's largest point may be an end)
         band_end = (f"warning: the largest amplitude lies at the band's end {w:.6g} Hz, not at a peak "
                     f"inside the band {f[0]:g} ... {f[-1]:g} Hz: widen or move --band to find the resonance")
-    lift = out.get("lift_off")
     rattle = None
-    if lift and min(lift) > RATTLE_LIFT_OFF:
-        rattle = (f"warning: every contact is open over at least {100 * min(lift):.0f} % of the period at the "
-                  f"peak (F0 {out['f0']:g} N against CF {out['cf']:g} N): the damper rattles rather than rubs, "
-                  f"its load carried in short impacts whose forces H = {out['harmonics']} harmonics resolve "
-                  "poorly" + ("" if "contact_surfaces" in out else
-                              " (--check-steady-state compares the peak with a time integration)")
-                  + "; raise --cf or lower --f0 for a damper that rubs")
+    if out.get("lift_off"):
+        hint = ("" if "contact_surfaces" in out else
+                " (--check-steady-state compares the peak with a time integration)")
+        rattle = rattle_warning(out["lift_off"], out["f0"], out["cf"], out["harmonics"], hint)
     return {"band_end_warning": band_end, "lift_off_warning": rattle}
 
 

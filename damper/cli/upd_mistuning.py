@@ -114,8 +114,9 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
-        if out.get("truncation_warning"):
-            print(out["truncation_warning"], file=sys.stderr)
+        for key in ("truncation_warning", "lift_off_warning"):
+            if out.get(key):
+                print(out[key], file=sys.stderr)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz"
@@ -127,6 +128,8 @@ def run_mistuning(args) -> int:
         print(line)
     for line in accuracy_lines(out):
         print(line)
+    if out.get("lift_off_warning"):
+        print(out["lift_off_warning"])
     return 0
 
 

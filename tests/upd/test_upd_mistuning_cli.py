@@ -243,3 +243,16 @@ def test_a_band_that_cuts_off_the_tuned_peak_is_refused(tmp_path, capsys, worst)
                 *(worst or ["--samples", "2", "--serial"])], capsys, 2)
     assert "tuned peak lies at the end 424 Hz" in err and len(err.strip().splitlines()) == 1
     assert not cache.exists()
+
+
+def test_a_rattling_tuned_reference_is_warned_about(tmp_path, capsys):
+    """F0 3000 N against CF 120 N: the tuned sector's contacts are open over ~97 % of the
+    period at its peak (the reference of every amplification): a warning in the JSON and on
+    stderr; at the default F0 30 N (contacts closed) none."""
+    loud = SMALL + ["--f0", "3000", "--samples", "1", "--serial", "--json", "--cache-dir", str(tmp_path / "c")]
+    assert main(loud) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert "rattles" in out["lift_off_warning"] and out["lift_off_warning"] in captured.err
+    quiet = _run(SMALL + ["--samples", "1", "--serial", "--json", "--cache-dir", str(tmp_path / "c")], capsys)
+    assert quiet["lift_off_warning"] is None
