@@ -138,7 +138,7 @@ def run_worst_friction(study, bound: float | None = None, linear_starts: int = L
            "worst_blade": r["blade"], "peak": r["peak"], "frequency_hz": r["omega"] / (2 * np.pi),
            "peak_per_blade": r["peak_per_blade"].tolist(),
            "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
-           "truncation_error": ref["truncation_error"],
+           "truncation_error": ref["truncation_error"], "lift_off_warning": ref["lift_off_warning"],
            "amplification": r["peak"] / a_t,
            "starts": [s | {"amplification": None if s["peak"] is None else s["peak"] / a_t}
                       for s in r["starts"]],

@@ -180,6 +180,7 @@ def _print_samples(out: dict) -> None:
 def _run_worst(args, study) -> int:
     """``--worst``: the worst pattern, printed (and written to --out)."""
     import json
+    import sys
     from pathlib import Path
 
     from damper.mistuning_worst import check_worst, run_worst
@@ -212,8 +213,10 @@ def _run_worst(args, study) -> int:
         atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
     if args.json:
         print_json(out)
+        if out.get("lift_off_warning"):
+            print(out["lift_off_warning"], file=sys.stderr)
         return 0
-    for line in worst_lines(out):
+    for line in worst_lines(out) + ([out["lift_off_warning"]] if out.get("lift_off_warning") else []):
         print(line)
     return 0
 
