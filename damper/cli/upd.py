@@ -228,14 +228,19 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
-    from harmonic_balance.bladed_disk.solve import energy_balance, frf
+    from harmonic_balance.bladed_disk.solve import SolverError, energy_balance, frf
     from harmonic_balance.bladed_disk.steady import annotate
 
     if args.contacts == "surface":
         from damper.upd_surface import sector_hb
 
         hb = sector_hb(sector, args)
-        c = frf(hb, omegas)
+        try:
+            c = frf(hb, omegas)
+        except SolverError as err:   # the generic advice (band, harmonics) misses the load
+            raise SolverError(f"{err}; with --contacts surface the node-DOF sector needs a well-loaded damper "
+                              "(UPD-24: CF 300 N solved a curve at H 1 and 440 Hz at H 3; the default 120 N "
+                              "failed at its start at H 3 and at 429 Hz at H 1): try a larger --cf") from None
         rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
     elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
