@@ -119,6 +119,14 @@ MAX_UNTIL_CI = 1.0
 #: the period and the sector's Newton solve finds no start (UPD-24, f0 = 30 N: CF = 1e-3 N
 #: failed at 400 Hz, 0.03 N solved); a damper that light is the free limit.
 MIN_CF_PER_F0 = 1e-3
+#: Unknowns of the sector's harmonic balance with contact surfaces (``upd frf --contacts
+#: surface``: (n_dof + node DOFs) (2H + 1)): its Jacobian is dense and a solve holds about
+#: eight matrices of that size (peak memory measured 0.71 GB at 3195 unknowns, 1.4 GB at
+#: 4899: 5 nodes per side, H 7 and 11), so 8000 unknowns is ~4 GB; H 50 at 5 nodes per side
+#: (21,513 unknowns) was killed for want of memory.
+MAX_SURFACE_UNKNOWNS = 8000
+SURFACE_UNKNOWNS_WHY = ("the sector's Jacobian is dense and a solve holds ~8 matrices of unknowns^2 "
+                        "numbers (4899 unknowns: 1.4 GB; 8000: ~4 GB)")
 #: Worker processes per core (``--workers``): each worker holds its own copy of the model.
 WORKERS_PER_CORE = 4
 

@@ -109,6 +109,11 @@ class Study:
         changes = {}
         if self.blades is not None:
             changes["disk__blades"] = self.blades
+            if (self.engine_order is None and isinstance(self.blades, int) and self.blades >= 2
+                    and cfg.engine_order > self.blades // 2):
+                raise ValueError(f"blades {self.blades} with the model's engine order {cfg.engine_order} "
+                                 f"(above blades/2 = {self.blades // 2}): give the engine order too, "
+                                 f"0 .. {self.blades // 2}")
         if self.engine_order is not None:
             changes["disk__engine_order"] = self.engine_order
         return cfg.with_values(**changes) if changes else cfg
@@ -224,6 +229,13 @@ def tuned_reference(study: Study, cfg) -> dict:
         rec = _tuned_truncation(hb, c)
     else:
         w, a = tuned_linear_peak(sector, om, study.damper, study.f0)
+    check_tuned_inside(w, om, study.band_hz is not None)
+    rattle = None
+    if study.damper == "nonlinear" and c.peak_x is not None:   # the reference's own damper rattling
+        from damper.upd_checks import rattle_warning
+
+        rattle = rattle_warning(hb.contact_summary(c.peak_x)["lift_off"], hb.f0, hb.cf, hb.H,
+                                " (the tuned sector's peak, every amplification's reference)")
     margin = BAND_MARGIN + BAND_SIGMAS * study.sigma_f()
     if study.band_hz is not None:
         band = list(study.band_hz)
@@ -233,7 +245,18 @@ def tuned_reference(study: Study, cfg) -> dict:
             f_t, tuned_linear_peak(sector, om, "stuck", study.f0)[0] / (2 * np.pi))
         band = default_band(f_t, hi, margin)
     return {"tuned_peak": float(a), "tuned_frequency_hz": float(w / (2 * np.pi)), "band_hz": band,
-            "harmonics": int(H), "truncation_error": rec}
+            "harmonics": int(H), "truncation_error": rec, "lift_off_warning": rattle}
+
+
+def check_tuned_inside(w: float, om: np.ndarray, given: bool) -> None:
+    """ValueError when the tuned peak (at ``w`` [rad/s]) lies at an end of its search grid
+    ``om`` [rad/s]: the band's end is not the tuned peak, and every amplification divides by
+    it (``given``: the band is the user's, else the model's ``load.band_hz``)."""
+    if _at_end(w, om):
+        where = "the given band" if given else "the model's load.band_hz"
+        raise ValueError(f"the tuned peak lies at the end {w / 2 / np.pi:.6g} Hz of {where} {om[0] / 2 / np.pi:g} "
+                         f"... {om[-1] / 2 / np.pi:g} Hz: the reference of every amplification must be a peak "
+                         "inside it; give a band around the tuned resonance")
 
 
 def _tuned_truncation(hb, curve) -> dict:
@@ -383,9 +406,16 @@ def _solve_sample(model: SampleModel, kappa) -> dict:
             "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
 
 
+def _at_end(w: float, om: np.ndarray) -> bool:
+    """Whether ``w`` [rad/s] lies at an end of the band ``om`` (:func:`damper.upd_checks.at_band_end`)."""
+    from damper.upd_checks import at_band_end
+
+    return at_band_end(w, om[0], om[-1])
+
+
 def _inside(w: float, om: np.ndarray) -> None:
     """RuntimeError when the largest peak (at w [rad/s]) lies at an end of the band ``om``."""
-    if min(abs(w - om[0]), abs(w - om[-1])) <= 1e-9 * om[-1]:
+    if _at_end(w, om):
         raise RuntimeError(f"the largest blade peak lies at the band's end {w / 2 / np.pi:.6g} Hz "
                            "(the peak is outside the band): give a wider --band")
 
@@ -509,6 +539,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
             "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
             "truncation_error": ref.get("truncation_error"),
             "truncation_warning": warning(ref.get("truncation_error")),
+            "lift_off_warning": ref.get("lift_off_warning"),
             "samples": samples, "failed": int(sum(s["error"] is not None for s in samples)),
             "cached": int(sum(s["cached"] for s in samples)),
             "whitehead_bound": whitehead_bound(cfg.blades), "time_s": time_s}
@@ -517,7 +548,7 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
                                out | {"max_amplification": None, "mean_amplification": None,
                                       "std_amplification": None, "quantiles": None, "statistics": None})
     return out | {"max_amplification": float(amp.max()), "mean_amplification": float(amp.mean()),
-                  "std_amplification": float(amp.std()),
+                  "std_amplification": float(amp.std()) if amp.size > 1 else None,   # one sample: unknown, not 0
                   "quantiles": {f"{q:g}": float(np.quantile(amp, q)) for q in QUANTILES},
                   "statistics": mistuning_stats.summary(amp)}
 

@@ -57,6 +57,7 @@ def run_worst(study, bound: float | None = None, starts: int = 32, **friction) -
 def _linear_search(study, b: float, starts: int):
     """(result of ``worst.worst_pattern``, its LinearPeak, tuned (omega, peak)) of the
     linear ring (damper free or stuck) in its band."""
+    from damper.mistuning import check_tuned_inside
     from harmonic_balance.bladed_disk.mistuning import tuned_linear_peak
     from harmonic_balance.bladed_disk.sector import Sector
     from harmonic_balance.bladed_disk.worst import LinearPeak, worst_pattern
@@ -66,6 +67,7 @@ def _linear_search(study, b: float, starts: int):
     search = study.band_hz or cfg["load.band_hz"]
     om = 2 * np.pi * np.linspace(search[0], search[1], GRID)
     w_t, a_t = tuned_linear_peak(sector, om, study.damper, study.f0)
+    check_tuned_inside(w_t, om, study.band_hz is not None)
     band = list(study.band_hz or [w_t * (1 - BAND_MARGIN - b) / (2 * np.pi),
                                   w_t * (1 + BAND_MARGIN + b) / (2 * np.pi)])
     peak = LinearPeak(sector, study.damper, 2 * np.pi * np.linspace(band[0], band[1], GRID), study.f0)
@@ -136,7 +138,7 @@ def run_worst_friction(study, bound: float | None = None, linear_starts: int = L
            "worst_blade": r["blade"], "peak": r["peak"], "frequency_hz": r["omega"] / (2 * np.pi),
            "peak_per_blade": r["peak_per_blade"].tolist(),
            "tuned_peak": a_t, "tuned_frequency_hz": ref["tuned_frequency_hz"],
-           "truncation_error": ref["truncation_error"],
+           "truncation_error": ref["truncation_error"], "lift_off_warning": ref["lift_off_warning"],
            "amplification": r["peak"] / a_t,
            "starts": [s | {"amplification": None if s["peak"] is None else s["peak"] / a_t}
                       for s in r["starts"]],

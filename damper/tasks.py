@@ -19,6 +19,37 @@ import tempfile
 
 #: Seconds to wait for a scheduler given by address before giving up.
 CONNECT_TIMEOUT = 10
+#: Seconds beyond CONNECT_TIMEOUT for the scheduler's handshake: Dask bounds the TCP
+#: connection but not its wait for the first reply, so a server that accepts and never
+#: answers held the client forever (seen: over 300 s with ``timeout=5``).
+HANDSHAKE_GRACE = 5
+
+
+def _connect(scheduler: str):
+    """A Dask client of the scheduler at ``scheduler``, made in a daemon thread whose wait is
+    bounded by CONNECT_TIMEOUT + HANDSHAKE_GRACE (TimeoutError after: the thread is left to
+    the process's end)."""
+    import threading
+
+    from dask.distributed import Client
+
+    box = {}
+
+    def connect():
+        try:
+            box["client"] = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except BaseException as err:  # noqa: BLE001 - handed to the caller's thread
+            box["error"] = err
+
+    thread = threading.Thread(target=connect, name="damper-dask-connect", daemon=True)
+    thread.start()
+    thread.join(CONNECT_TIMEOUT + HANDSHAKE_GRACE)
+    if thread.is_alive():
+        raise TimeoutError(f"no handshake within {CONNECT_TIMEOUT + HANDSHAKE_GRACE} s: something accepts "
+                           "connections there but does not answer as a Dask scheduler")
+    if "error" in box:
+        raise box["error"]
+    return box["client"]
 
 
 def _ignore_sigint_plugin():
@@ -40,7 +71,8 @@ def executor(scheduler, workers, serial, info: dict | None = None):
     (1 for ``serial``; the cluster's workers when connected).
 
     Raises OSError (a clear message, exit 2) when the scheduler at ``scheduler`` cannot
-    be reached within :data:`CONNECT_TIMEOUT` seconds.
+    be reached within :data:`CONNECT_TIMEOUT` seconds, or does not answer as one within
+    :data:`HANDSHAKE_GRACE` more.
     """
     info = {} if info is None else info
     if serial:
@@ -51,10 +83,14 @@ def executor(scheduler, workers, serial, info: dict | None = None):
 
     if scheduler:
         try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, ValueError, TypeError) as err:
-            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({err}); start it "
-                          "or give the right --scheduler address (tcp://host:8786)") from None
+            client = _connect(scheduler)
+        except Exception as err:  # noqa: BLE001 - any failure of the handshake is the address's
+            # Besides OSError (refused, timed out) and ValueError (a malformed address), a
+            # server that answers but is not a Dask scheduler makes Dask read its bytes as a
+            # frame length: a MemoryError for exabytes (seen), or a decoding error.
+            raise OSError(f"cannot reach the Dask scheduler at {scheduler!r} ({type(err).__name__}: "
+                          f"{str(err)[:200]}); start it or give the right --scheduler address "
+                          "(tcp://host:8786)") from None
         cluster = scratch = None
         info["workers"] = max(1, len(client.scheduler_info().get("workers", {})))
     else:

@@ -47,24 +47,48 @@ def build_surfaces(cfg, nodes_per_side: int, cf: float | None = None, store=None
         A node count outside its bound, or a geometry contact_core refuses.
     """
     from contact_core.condense import condense
-    from harmonic_balance.surface import build, check_nodes
+    from harmonic_balance.surface import build
+
+    mu, specs = _face_specs(cfg, nodes_per_side, cf)
+    out = {}
+    for face, spec in specs.items():
+        cc = condense(spec, directions=("z", "x"), cache=store if store is not None else False)
+        out[face] = build(cc, mu, penalty=DYNAMICS_PENALTY if penalty is None else penalty, tangents=("x",))
+    return out
+
+
+def _face_specs(cfg, nodes_per_side: int, cf: float | None) -> tuple:
+    """(mu, {face: ContactSpec}) of the two faces at ``nodes_per_side`` (bound checked)."""
+    from harmonic_balance.surface import check_nodes
 
     from .upd_geometry import contact_specs, geometry_params
 
     nodes = check_nodes(nodes_per_side)
     p = geometry_params(cfg, cf)
     specs = contact_specs(p)
-    out = {}
-    for face in ("left", "flat"):
-        spec, model, _ = specs[face]
-        cc = condense(replace(spec, grid=nodes, model=model), directions=("z", "x"),
-                      cache=store if store is not None else False)
-        out[face] = build(cc, p["mu"], penalty=DYNAMICS_PENALTY if penalty is None else penalty, tangents=("x",))
-    return out
+    return p["mu"], {face: replace(specs[face][0], grid=nodes, model=specs[face][1])
+                     for face in ("left", "flat")}
+
+
+def check_unknowns(sector, nodes_per_side: int, H: int, cf: float | None) -> None:
+    """ValueError, before any condensation, when the sector with surfaces has more than
+    :data:`damper.limits.MAX_SURFACE_UNKNOWNS` harmonic-balance unknowns, (n_dof + 2 n) (2H + 1)
+    with n the faces' contact-zone nodes (2 DOFs each, planar), counted on their meshes."""
+    from contact_core import mesh
+    from damper import limits
+
+    _, specs = _face_specs(sector.cfg, nodes_per_side, cf)
+    nodes = sum(mesh.build(spec)[1].contact.size for spec in specs.values())
+    n = (sector.n_dof + 2 * nodes) * (2 * H + 1)
+    if n > limits.MAX_SURFACE_UNKNOWNS:
+        raise ValueError(f"--contacts surface with --surface-nodes {nodes_per_side} and --harmonics {H}: "
+                         f"{nodes} contact nodes, {n} unknowns, above the limit {limits.MAX_SURFACE_UNKNOWNS} "
+                         f"({limits.SURFACE_UNKNOWNS_WHY}); lower --surface-nodes or --harmonics")
 
 
 def check_options(args) -> None:
-    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run."""
+    """The --contacts surface options: a node count in its bound, a nonlinear fixed-H run, no
+    time-integration check."""
     from harmonic_balance.surface import check_nodes
 
     if args.contacts != "surface":
@@ -75,13 +99,18 @@ def check_options(args) -> None:
                          "point model; drop --contacts surface or use --damper nonlinear")
     if args.accuracy is not None:
         raise ValueError("--contacts surface runs at the fixed --harmonics: drop --accuracy")
+    if getattr(args, "check_steady_state", False):   # refused now, not after the (slow) curve
+        raise ValueError("--check-steady-state integrates the ring with point contacts: drop it with "
+                         "--contacts surface")
 
 
 def sector_hb(sector, args):
     """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
     from damper.cache import Store
-    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB
+    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB, face_inputs
 
+    face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
+    check_unknowns(sector, args.surface_nodes, args.harmonics, args.cf)
     surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
     hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)
     args.surface_report = {face: {"nodes": s.n, "dofs": s.n_w, "nodes_per_side": args.surface_nodes}

@@ -10,7 +10,8 @@ links: compared by device and inode), is refused, as is an output that exists an
 not a regular file (``/dev/null``, a FIFO, a socket: writing through a temporary file
 and a rename would replace it). A result folder (``run --out``, ``sweep --out``) that
 holds one of the inputs is refused too: the command writes that folder's files as its
-own. Two outputs naming one path are refused. A figure folder (``--plot``) may hold
+own; so is one that holds a file the scene names (``Scene.files``: its matrices, its UPD
+model). Two outputs naming one path are refused. A figure folder (``--plot``) may hold
 inputs: its files have fixed ``.png`` names, and while the command runs no input it read is ever replaced
 (:func:`contact_core.fileio.guard_inputs`).
 """
@@ -226,6 +227,15 @@ def _distinct_outputs(args) -> None:
         seen[key] = f"{flag} {value}"
 
 
+def check_folder_holds_no_input(out, flag: str, inputs) -> None:
+    """Refuse a result folder ``out`` that holds one of ``inputs`` ((name, path) pairs; e.g. the
+    files a scene names): the command writes that folder's files as its own."""
+    for name, path in inputs:
+        if _inside(Path(out), Path(path)):
+            raise ValueError(f"{flag} {out} holds the input {name} {path}: the result folder is the "
+                             "command's own; give another folder")
+
+
 def check_outputs(args) -> None:
     """Refuse, before any work, an output that is one of the inputs or not a regular file, or two
     outputs that are one path (module docstring)."""
@@ -250,7 +260,4 @@ def check_outputs(args) -> None:
                     raise ValueError(f"{flag} {out} is the input {name} {path}: it would be overwritten; "
                                      "give another output name")
         elif kind == "folder":
-            for name, path in inputs:
-                if _inside(out, path):
-                    raise ValueError(f"{flag} {out} holds the input {name} {path}: the result folder is the "
-                                     "command's own; give another folder")
+            check_folder_holds_no_input(out, flag, inputs)

@@ -49,13 +49,14 @@ def run(args) -> int:
     from damper.run.runner import run_scene
     from damper.scene import load_scene
 
-    from .common import check_out_dir, print_json
+    from .common import check_folder_holds_no_input, check_out_dir, print_json
 
     if args.no_cache and args.cache_dir is not None:
         raise ValueError("--no-cache and --cache-dir exclude each other")
     scene = load_scene(args.scene)
     out = args.out if args.out is not None else Path("out") / Path(args.scene).stem
     if not args.dry_run:
+        check_folder_holds_no_input(out, "--out", scene.files())   # (before the write probe)
         check_out_dir(out, "--out")
     store = store_from_args(args).prepare()
     echo = (lambda text: print(text, file=sys.stderr)) if args.json else print

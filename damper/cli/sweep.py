@@ -102,14 +102,16 @@ def specs_from(items) -> list[tuple[str, list]]:
 
 def run(args) -> int:
     from damper import limits
+    from damper.scene import load_scene
     from damper.sweep import run_sweep
 
-    from .common import check_out_dir, print_json
+    from .common import check_folder_holds_no_input, check_out_dir, print_json
 
     if args.workers is not None:
         limits.check_workers("--workers", args.workers)
     specs = specs_from(args.specs)
     out = args.out if args.out is not None else Path("out") / f"sweep_{Path(args.scene).stem}"
+    check_folder_holds_no_input(out, "--out", load_scene(args.scene).files())   # (before the write probe)
     check_out_dir(out, "--out")
     store = store_from_args(args).prepare()
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print

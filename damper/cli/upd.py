@@ -160,6 +160,7 @@ def run_frf(args) -> int:
             out["steady_state"] = {"note": f"--damper {args.damper} is linear: one steady state"}
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
+    out |= response_warnings(out)
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -167,7 +168,8 @@ def run_frf(args) -> int:
     else:
         at = ("" if "harmonics_peak" not in out else
               f" at H = {out['harmonics_peak']} (curve at H = {out['harmonics']})")
-        print(f"peak {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
+        what = "largest amplitude at the band's end" if out["band_end_warning"] else "peak"
+        print(f"{what} {out['peak_frequency_hz']:.4f} Hz, first-harmonic amplitude "
               f"{out['peak_amplitude']:.6e} m{at} ({out['time_s']:.2f} s"
               + ("" if out.get("cpu_s") is None else f", {out['cpu_s']:.2f} s CPU") + ")")
         if "warning" in out:
@@ -176,10 +178,30 @@ def run_frf(args) -> int:
             print(out["zone_edge_warning"])
     from harmonic_balance.steady_state import summary_lines
 
-    for line in accuracy_lines(out) + summary_lines(out.get("steady_state")):
+    warnings = [out[k] for k in ("band_end_warning", "lift_off_warning") if out[k]]
+    for line in warnings + accuracy_lines(out) + summary_lines(out.get("steady_state")):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def response_warnings(out: dict) -> dict:
+    """``band_end_warning`` (the refined largest amplitude lies at an end of the band: no peak
+    inside it) and ``lift_off_warning`` (:func:`damper.upd_checks.rattle_warning` at the peak)
+    of a ``upd frf`` result, each a line or None."""
+    from damper.upd_checks import at_band_end, rattle_warning
+
+    f, w = out["frequency_hz"], out["peak_frequency_hz"]
+    band_end = None
+    if at_band_end(w, f[0], f[-1]):   # the refined maximum (a coarse grid's largest point may be an end)
+        band_end = (f"warning: the largest amplitude lies at the band's end {w:.6g} Hz, not at a peak "
+                    f"inside the band {f[0]:g} ... {f[-1]:g} Hz: widen or move --band to find the resonance")
+    rattle = None
+    if out.get("lift_off"):
+        hint = ("" if "contact_surfaces" in out else
+                " (--check-steady-state compares the peak with a time integration)")
+        rattle = rattle_warning(out["lift_off"], out["f0"], out["cf"], out["harmonics"], hint)
+    return {"band_end_warning": band_end, "lift_off_warning": rattle}
 
 
 def _frf_linear(sector, args, omegas) -> dict:
@@ -206,14 +228,19 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
-    from harmonic_balance.bladed_disk.solve import energy_balance, frf
+    from harmonic_balance.bladed_disk.solve import SolverError, energy_balance, frf
     from harmonic_balance.bladed_disk.steady import annotate
 
     if args.contacts == "surface":
         from damper.upd_surface import sector_hb
 
         hb = sector_hb(sector, args)
-        c = frf(hb, omegas)
+        try:
+            c = frf(hb, omegas)
+        except SolverError as err:   # the generic advice (band, harmonics) misses the load
+            raise SolverError(f"{err}; with --contacts surface the node-DOF sector needs a well-loaded damper "
+                              "(UPD-24: CF 300 N solved a curve at H 1 and 440 Hz at H 3; the default 120 N "
+                              "failed at its start at H 3 and at 429 Hz at H 1): try a larger --cf") from None
         rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
     elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)

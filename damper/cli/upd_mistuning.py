@@ -114,8 +114,9 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
-        if out.get("truncation_warning"):
-            print(out["truncation_warning"], file=sys.stderr)
+        for key in ("truncation_warning", "lift_off_warning"):
+            if out.get(key):
+                print(out[key], file=sys.stderr)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz"
@@ -127,6 +128,8 @@ def run_mistuning(args) -> int:
         print(line)
     for line in accuracy_lines(out):
         print(line)
+    if out.get("lift_off_warning"):
+        print(out["lift_off_warning"])
     return 0
 
 
@@ -177,6 +180,7 @@ def _print_samples(out: dict) -> None:
 def _run_worst(args, study) -> int:
     """``--worst``: the worst pattern, printed (and written to --out)."""
     import json
+    import sys
     from pathlib import Path
 
     from damper.mistuning_worst import check_worst, run_worst
@@ -209,8 +213,10 @@ def _run_worst(args, study) -> int:
         atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
     if args.json:
         print_json(out)
+        if out.get("lift_off_warning"):
+            print(out["lift_off_warning"], file=sys.stderr)
         return 0
-    for line in worst_lines(out):
+    for line in worst_lines(out) + ([out["lift_off_warning"]] if out.get("lift_off_warning") else []):
         print(line)
     return 0
 

@@ -47,7 +47,8 @@ class Mistuning(Kind):
         return [f"{len(o['samples'])} samples of {o['blades']} blades ({o['failed']} failed): amplification "
                 f"max {o['max_amplification']:.4f}, median {o['quantiles']['0.5']:.4f} over the tuned peak "
                 f"{o['tuned_peak']:.4e} m at {o['tuned_frequency_hz']:.2f} Hz, H = {o['harmonics']}"] + _ci_lines(o) + [
-                    f"   {line}" for line in truncation_lines(o)]
+                    f"   {line}" for line in truncation_lines(o)] + (
+                    [f"   {o['lift_off_warning']}"] if o.get("lift_off_warning") else [])
 
     def scalars(self, stage, result):
         o = result.data

@@ -54,6 +54,13 @@ class Scene:
     def want(self) -> list[str]:
         return list(self.data["want"])
 
+    def files(self) -> list[tuple[str, Path]]:
+        """(key, absolute path) of every file the scene reads besides itself (``structure.matrices``,
+        ``upd.config``): inputs of the run as much as the scene file."""
+        refs = (("structure", "matrices"), ("upd", "config"))
+        return [(f"{t}.{k}", Path(self.data[t][k])) for t, k in refs
+                if isinstance(self.data.get(t), dict) and self.data[t].get(k)]
+
     def hash(self) -> str:
         """SHA-256 (16 hex digits) of the validated content (comments and layout do not count)."""
         text = json.dumps(self.data, sort_keys=True, separators=(",", ":"))

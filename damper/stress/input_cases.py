@@ -269,7 +269,14 @@ def _upd() -> list[InputCase]:
         ("frf surface nodes 1e6", "frf --contacts surface --surface-nodes 1000000"),
         ("frf surface with stuck limits", "frf --contacts surface --damper stuck"),
         ("frf surface with accuracy", "frf --contacts surface --accuracy 0.01"),
+        ("frf surface with check-steady-state (point contacts only)", "frf --contacts surface --check-steady-state"),
         ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
+        ("frf surface with an axial platform DOF (not planar)", "frf --contacts surface --config {fx}/upd_axial.toml"),
+        ("frf surface cf 1e6 (a cylinder contact beyond Hertz)", "frf --contacts surface --cf 1e6 --json"),
+        ("frf surface with mu 0 (no virgin curve to condense)", "frf --contacts surface --config {fx}/upd_mu0.toml"),
+        ("frf surface H 50 (its dense Jacobian was killed for memory)", "frf --contacts surface --harmonics 50"),
+        ("frf surface nodes 41 (4048 nodes)", "frf --contacts surface --surface-nodes 41 --harmonics 1"),
+        ("frf surface H 19 (8775 unknowns)", "frf --contacts surface --harmonics 19 --json"),
         ("frf cf 1e-3 (a damper without load)", "frf --cf 1e-3 --points 5"),
         ("optimize cf-range 1e-3 10 (a damper without load)", "optimize --cf-range 1e-3 10 --points 3"),
         ("mistuning cf 1e-3 (a damper without load)", "mistuning --cf 1e-3 --samples 1"),
@@ -290,6 +297,7 @@ def _upd() -> list[InputCase]:
         ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
         ("mistuning samples 0", "mistuning --samples 0"), ("mistuning samples 1e5", "mistuning --samples 100000"),
         ("mistuning blades 1e5", "mistuning --blades 100000"),
+        ("mistuning blades 2 without an engine order (UPD-24's is 6)", "mistuning --blades 2 --serial"),
         ("mistuning factor -1", "mistuning --blades 4 --engine-order 1 --factors 1 -1 1 1"),
         ("mistuning factor nan", "mistuning --blades 4 --engine-order 1 --factors 1 nan 1 1"),
         ("mistuning 3 factors for 4 blades", "mistuning --blades 4 --engine-order 1 --factors 1 1 1"),
@@ -307,6 +315,9 @@ def _upd() -> list[InputCase]:
         ("mistuning until-ci -1", "mistuning --until-ci=-1"),
         ("mistuning until-ci with factors", "mistuning --blades 4 --engine-order 1 --factors 1 1 1 1 --until-ci 0.01"),
         ("mistuning solver bogus", "mistuning --solver bogus"),
+        ("mistuning band cutting off the tuned peak (426 Hz)",
+         "mistuning --damper free --band 380 424 --samples 2 --serial"),
+        ("mistuning worst band cutting off the tuned peak (426 Hz)", "mistuning --worst --damper free --band 380 424"),
         ("mistuning worst max-evaluations 0", "mistuning --worst --std 0.02 --max-evaluations 0"),
         ("mistuning worst max-evaluations 1e4", "mistuning --worst --std 0.02 --max-evaluations 10000"),
         ("mistuning max-evaluations with a linear worst", "mistuning --worst --damper free --max-evaluations 5"),
@@ -358,7 +369,8 @@ def _run() -> list[InputCase]:
         "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
         "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml",
         "s_step.toml", "s_bbk.toml", "s_bbf.toml", "s_bbamphuge.toml", "s_updcflow.toml", "s_mtcflow.toml",
-        "s_mtci.toml", "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml")]
+        "s_mtci.toml", "s_mtband.toml", "s_mtblades.toml",
+        "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),
@@ -372,6 +384,10 @@ def _run() -> list[InputCase]:
              ("--no-cache with --cache-dir", "{fx}/s_ok.toml --no-cache --cache-dir c"),
              ("--cache-dir a file", "{fx}/s_ok.toml --cache-dir {fx}/a_file")]
     cases = _table("run", rows, "run")
+    cases.append(_case("run", "--out the folder of the scene's [upd] config", "run s.toml --out res",
+                       files={"s.toml": 'want = ["mistuning"]\n[upd]\nconfig = "res/upd.toml"\n'
+                                        '[mistuning]\nsamples = 1\ndamper = "free"\n',
+                              "res/upd.toml": "# the bundled UPD-24\n"}))
     cases.append(_case("run", "--cache-dir a folder of the user's (eviction)",
                        "run {fx}/s_kn_small.toml --cache-dir proj --cache-max-mb 1 --out out",
                        files={"proj/user_data.npz": "user data\n"}))

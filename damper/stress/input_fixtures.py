@@ -208,6 +208,8 @@ def scenes() -> dict[str, str | bytes]:
             "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',
             "s_mtcflow.toml": 'want = ["mistuning"]\n[mistuning]\ncf = 1e-3\nsamples = 1\n',
             "s_mtci.toml": 'want = ["mistuning"]\n[mistuning]\nuntil_ci = 1e300\n',
+            "s_mtband.toml": 'want = ["mistuning"]\n[mistuning]\ndamper = "free"\nband = [380.0, 424.0]\nsamples = 1\n',
+            "s_mtblades.toml": 'want = ["mistuning"]\n[mistuning]\ndamper = "free"\nblades = 2\nsamples = 1\n',
             "s_bbk.toml": _jenkins_backbone("contact_stiffness = 1e300\nslip_force = 60.0\n"
                                             "amplitude = [1e-7, 1e-4]\n"),
             "s_bbf.toml": _jenkins_backbone("contact_stiffness = 3.85e7\nslip_force = 1e300\n"
@@ -226,7 +228,26 @@ def scenes() -> dict[str, str | bytes]:
 
 def upd_files() -> dict[str, str | bytes]:
     return {"upd_unknown.toml": "[load]\nwobble = 3\n", "upd_binary.toml": BINARY,
-            "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n"}
+            "upd_badtoml.toml": "[load\n", "upd_section.toml": "[nosuch]\nx = 1\n",
+            "upd_mu0.toml": "[damper]\nmu = 0.0\n", "upd_axial.toml": '[blade]\nfile = "axial_blade.npz"\n',
+            "axial_blade.npz": _axial_blade()}
+
+
+def _axial_blade() -> bytes:
+    """UPD-24's blade plus an axial platform DOF w_p (its own spring to ground): platform
+    points [u, v, w], a sector that is not planar."""
+    from harmonic_balance.bladed_disk.blade import blade_arrays
+    from harmonic_balance.bladed_disk.config import load_config
+
+    arr = blade_arrays(load_config().blade())
+    n = arr["M"].shape[0]
+    grow = lambda A, d: np.pad(A, ((0, 1), (0, 1))) + np.diag([0.0] * n + [d])  # noqa: E731
+    arr.update(M=grow(arr["M"], 0.1), K=grow(arr["K"], 8e5), K_next=grow(arr["K_next"], 0.0),
+               dofs=np.append(arr["dofs"], "w_p"), left=np.array(["u_p", "v_p", "w_p"]),
+               right=np.array(["u_p", "v_p", "w_p"]), forced=np.array("u_a"))
+    buf = io.BytesIO()
+    np.savez(buf, **arr)
+    return buf.getvalue()
 
 
 def _forged_sizes(blob: bytes, size: int) -> bytes:

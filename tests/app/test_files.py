@@ -99,6 +99,20 @@ def test_a_result_folder_holding_the_scene_is_refused(tmp_path, monkeypatch, cap
     _refused(["run", "s.toml", "--out", "."], tmp_path, capsys, "holds the input scene")
 
 
+@pytest.mark.parametrize("command", [["run"], ["sweep", "--param", "upd.points", "--values", "3", "--serial"]])
+def test_a_result_folder_holding_a_file_the_scene_names_is_refused(tmp_path, monkeypatch, capsys, command):
+    """The scene's own files (here its [upd] model) are inputs too: a result folder that holds
+    one is refused before any work, the file and the folder left as they were."""
+    monkeypatch.chdir(tmp_path)
+    Path("scenes").mkdir()
+    Path("res").mkdir()
+    Path("res/upd.toml").write_text("# the bundled UPD-24\n")
+    Path("scenes/s.toml").write_text('want = ["optimal_load"]\n[upd]\nconfig = "../res/upd.toml"\npoints = 3\n')
+    _refused([command[0], "scenes/s.toml", *command[1:], "--out", "res"], tmp_path, capsys,
+             "holds the input upd.config")
+    assert sorted(p.name for p in Path("res").iterdir()) == ["upd.toml"]
+
+
 def test_inputs_read_by_a_command_are_never_replaced_by_its_writes(tmp_path):
     """The guard behind every command (files named inside a scene included); a library user
     outside it may read, edit and write back a file."""

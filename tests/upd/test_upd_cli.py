@@ -53,3 +53,42 @@ def test_optimize_interior_minimum(capsys):
     assert out["interior"] and amp.argmin() not in (0, len(amp) - 1)
     assert out["optimum_peak_amplitude"] <= amp.min() * (1 + 1e-6)
     assert out["cf"][0] < out["optimum_cf"] < out["cf"][-1]
+
+
+def test_a_maximum_at_the_band_end_is_not_called_a_peak(capsys):
+    """Far below resonance the largest amplitude is the band's upper end: the result says so
+    (a warning on stderr with --json, its key in the JSON), and a band around the resonance
+    does not (linear limit: the same curve checks, faster)."""
+    off = _run(["frf", "--damper", "free", "--band", "10", "20", "--points", "5", "--json"], capsys)
+    assert off["peak_frequency_hz"] == pytest.approx(20.0) and "band's end 20 Hz" in off["band_end_warning"]
+    on = _run(["frf", "--damper", "free", "--points", "41", "--json"], capsys)
+    assert on["band_end_warning"] is None
+    assert on["frequency_hz"][0] < on["peak_frequency_hz"] < on["frequency_hz"][-1]
+    # three points: the grid's largest value is its first, the refined peak (426 Hz) inside
+    coarse = _run(["frf", "--damper", "free", "--band", "420", "520", "--points", "3", "--json"], capsys)
+    assert int(np.argmax(coarse["amplitude"])) == 0 and coarse["band_end_warning"] is None
+
+
+def test_a_damper_open_over_most_of_the_period_is_said_to_rattle(capsys):
+    """CF 0.1 N against F0 30 N: every contact open over ~98 % of the period at the peak (its
+    load in short impacts): a warning names F0 and CF; at the default CF 120 N (contacts closed
+    throughout) none."""
+    light = _run(["frf", "--cf", "0.1", "--harmonics", "3", "--points", "11", "--json"], capsys)
+    assert min(light["lift_off"]) > 0.9 and "rattles" in light["lift_off_warning"]
+    assert "F0 30 N against CF 0.1 N" in light["lift_off_warning"]
+    loaded = _run(["frf", "--harmonics", "3", "--points", "11", "--json"], capsys)
+    assert max(loaded["lift_off"]) < 0.9 and loaded["lift_off_warning"] is None
+
+
+def test_the_rattle_warning_of_surfaces_names_no_time_integration():
+    """--check-steady-state integrates point contacts only: a surface result's warning does
+    not send the user there; the rule (every contact open over more than 90 %) is the same."""
+    from damper.cli.upd import response_warnings
+    from damper.upd_checks import RATTLE_LIFT_OFF
+
+    out = {"frequency_hz": [400.0, 450.0, 500.0], "peak_frequency_hz": 450.0, "f0": 300.0, "cf": 20.0,
+           "harmonics": 3, "lift_off": [0.95, 0.97]}
+    points = response_warnings(out)["lift_off_warning"]
+    surfaces = response_warnings(out | {"contact_surfaces": {}})["lift_off_warning"]
+    assert "--check-steady-state" in points and "--check-steady-state" not in surfaces
+    assert response_warnings(out | {"lift_off": [0.95, RATTLE_LIFT_OFF]})["lift_off_warning"] is None

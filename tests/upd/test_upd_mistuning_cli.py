@@ -172,3 +172,87 @@ def test_ctrl_c_on_dask_is_one_line_and_exit_130(tmp_path):
     assert out == "" and "Traceback" not in err and "AllExit" not in err, err
     assert [ln for ln in err.splitlines() if ln.strip()] == [
         "damper upd: mistuning interrupted; the samples finished so far are in the cache, the same command resumes"]
+
+
+@pytest.mark.parametrize("reply", [b"HTTP/1.1 400 Bad Request\r\n\r\n", None])
+def test_a_server_that_is_no_dask_scheduler_is_refused_in_one_line(tmp_path, capsys, monkeypatch, reply):
+    """A --scheduler address where something else answers is a bad address, exit 2, not a
+    traceback or a hang: a web server's reply (Dask reads its bytes as a frame length of
+    exabytes, a MemoryError), or none at all (Dask waits for the handshake without a bound:
+    ours is CONNECT_TIMEOUT + HANDSHAKE_GRACE)."""
+    import socket
+    import threading
+
+    monkeypatch.setattr("damper.tasks.CONNECT_TIMEOUT", 1)
+    monkeypatch.setattr("damper.tasks.HANDSHAKE_GRACE", 1)
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def answer():
+        try:
+            conn, _ = server.accept()
+            held.append(conn)       # kept open: the silent server never closes it either
+            if reply is not None:
+                conn.sendall(reply)
+        except OSError:     # closed by the test when no connection came
+            pass
+
+    threading.Thread(target=answer, daemon=True).start()
+    try:
+        err = _run(SMALL + ["--scheduler", f"tcp://127.0.0.1:{server.getsockname()[1]}", "--json",
+                            "--cache-dir", str(tmp_path / "cache")], capsys, 2)
+    finally:
+        server.close()
+        for conn in held:
+            conn.close()
+    assert "cannot reach the Dask scheduler" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "cache").exists()
+
+
+def test_fewer_blades_than_the_models_engine_order_allows_asks_for_an_engine_order(tmp_path, capsys):
+    """--blades 2 with UPD-24's engine order 6 (above N_b / 2): the message names the
+    option to add, not the config key the blades broke."""
+    err = _run(["upd", "mistuning", "--blades", "2", "--samples", "1", "--damper", "free", "--serial",
+                "--json", "--cache-dir", str(tmp_path / "c")], capsys, 2)
+    assert "give the engine order too, 0 .. 1" in err and len(err.strip().splitlines()) == 1
+
+
+def test_one_sample_gives_no_spread_and_no_two_sided_interval(tmp_path, capsys):
+    """One sample: its value is every estimate, but its spread (null, not 0) and the
+    two-sided intervals of the mean and of the 0.95 quantile are unknown (null, '-' in the
+    table), and no distribution is fitted."""
+    out = _run(SMALL + ["--samples", "1", "--damper", "free", "--serial", "--json",
+                        "--cache-dir", str(tmp_path / "c")], capsys)
+    st = out["statistics"]
+    assert out["std_amplification"] is None and st["n"] == 1 and st["fit"] is None
+    assert st["mean"]["low"] is None and st["mean"]["high"] is None
+    q95 = next(q for q in st["quantiles"] if q["q"] == 0.95)
+    assert q95["low"] is None and q95["high"] is None and q95["half_width"] is None
+    assert q95["value"] == out["max_amplification"]
+
+
+@pytest.mark.parametrize("worst", [[], ["--worst"]])
+def test_a_band_that_cuts_off_the_tuned_peak_is_refused(tmp_path, capsys, worst):
+    """UPD-24 free: the tuned peak is at 426.13 Hz; on 380 ... 424 Hz the largest tuned value
+    is the band's end, which every amplification would divide by (they came out 2.6 to 3.1,
+    above Whitehead's bound): refused before any sample, nothing written."""
+    cache = tmp_path / "c"
+    err = _run(["upd", "mistuning", "--damper", "free", "--band", "380", "424", "--json", "--cache-dir", str(cache),
+                *(worst or ["--samples", "2", "--serial"])], capsys, 2)
+    assert "tuned peak lies at the end 424 Hz" in err and len(err.strip().splitlines()) == 1
+    assert not cache.exists()
+
+
+def test_a_rattling_tuned_reference_is_warned_about(tmp_path, capsys):
+    """F0 3000 N against CF 120 N: the tuned sector's contacts are open over ~97 % of the
+    period at its peak (the reference of every amplification): a warning in the JSON and on
+    stderr; at the default F0 30 N (contacts closed) none."""
+    loud = SMALL + ["--f0", "3000", "--samples", "1", "--serial", "--json", "--cache-dir", str(tmp_path / "c")]
+    assert main(loud) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert "rattles" in out["lift_off_warning"] and out["lift_off_warning"] in captured.err
+    quiet = _run(SMALL + ["--samples", "1", "--serial", "--json", "--cache-dir", str(tmp_path / "c")], capsys)
+    assert quiet["lift_off_warning"] is None

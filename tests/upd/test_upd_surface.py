@@ -76,11 +76,29 @@ def test_surface_sector_solves_one_frequency_with_its_energy_balanced(surfaces):
     assert hb.amplitude_h1(x) > 0.0
 
 
+def test_unknowns_counted_before_condensing_are_the_surface_sectors(surfaces):
+    """The size check counts the faces' nodes on their meshes, before any condensation: the
+    count must be the unknowns of the model it guards."""
+    from damper import limits
+    from damper.upd_surface import check_unknowns
+
+    sector, H = Sector(load_config(None)), 3
+    n = SurfaceSectorHB(sector, surfaces, H=H, cf=120.0).stuck_guess(2 * np.pi * 440.0).size
+    assert n == (sector.n_dof + sum(s.n_w for s in surfaces.values())) * (2 * H + 1)
+    H_max = (limits.MAX_SURFACE_UNKNOWNS // (n // (2 * H + 1)) - 1) // 2
+    check_unknowns(sector, NODES, H_max, None)
+    with pytest.raises(ValueError, match=f"{n // (2 * H + 1) * (2 * H_max + 3)} unknowns"):
+        check_unknowns(sector, NODES, H_max + 1, None)
+
+
 @pytest.mark.parametrize("extra, words", [
     (["--surface-nodes", "3"], "surface nodes per side"),
+    (["--surface-nodes", "41", "--harmonics", "1"], "lower --surface-nodes or --harmonics"),
+    (["--harmonics", "50"], "lower --surface-nodes or --harmonics"),
     (["--surface-nodes", "99"], "surface nodes per side"),
     (["--damper", "stuck"], "--damper nonlinear"),
     (["--accuracy", "0.01"], "drop --accuracy"),
+    (["--check-steady-state"], "drop it with --contacts surface"),
 ])
 def test_bad_surface_options_are_one_line_refusals(tmp_path, capsys, monkeypatch, extra, words):
     monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
@@ -89,6 +107,7 @@ def test_bad_surface_options_are_one_line_refusals(tmp_path, capsys, monkeypatch
     assert code == 2 and no_result(captured.out, captured.err, 2)
     assert words in captured.err and "Traceback" not in captured.err
     assert len(captured.err.strip().splitlines()) == 1
+    assert not (tmp_path / "cache").exists()   # refused before any condensation
 
 
 #: The node-DOF and the condensed sector at one frequency (5 nodes per side, penalty 100,
@@ -166,3 +185,18 @@ def test_node_dof_sector_with_input_dashpots_is_the_condensed_sector_when_stuck(
 def test_unknown_dashpot_placement_is_refused(surfaces):
     with pytest.raises(ValueError, match="dashpots must be one of"):
         SurfaceSectorHB(Sector(load_config(None)), surfaces, H=1, cf=600.0, dashpots="nodes")
+
+
+def test_a_sector_with_axial_platform_dofs_is_refused_before_condensing(tmp_path, capsys, monkeypatch):
+    """The surfaces are planar: a blade with an axial platform DOF is refused in one line
+    before contact_core condenses anything (nothing in the cache)."""
+    from damper.stress import input_fixtures as fx
+
+    for name in ("upd_axial.toml", "axial_blade.npz"):
+        (tmp_path / name).write_bytes(fx.upd_files()[name] if isinstance(fx.upd_files()[name], bytes)
+                                      else fx.upd_files()[name].encode())
+    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cache"))
+    code = main(["upd", "frf", "--contacts", "surface", "--config", str(tmp_path / "upd_axial.toml"), "--json"])
+    captured = capsys.readouterr()
+    assert code == 2 and "planar UPD sector" in captured.err and len(captured.err.strip().splitlines()) == 1
+    assert not (tmp_path / "cache").exists()
