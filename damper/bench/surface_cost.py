@@ -104,7 +104,7 @@ COLUMNS = (("case", "case", "s"), ("nodes per side", "size", "d"), ("H", "harmon
            ("memory [MB]", "memory_mb", ".0f"))
 CAPTION = ("contact surfaces: CPU time of one residual evaluation of the UPD-24 sector with its Jacobian "
            f"and without, at the stuck start (CF {CF:g} N, {FREQUENCY_HZ:g} Hz), per node of the two faces "
-           "and per harmonic coefficient (2 H + 1)")
+           "and per harmonic coefficient (2 H + 1); memory: the process's peak so far, rows in run order")
 
 
 def is_row(r: dict) -> bool:
