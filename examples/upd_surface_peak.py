@@ -104,13 +104,13 @@ def _bracket(neg, f0: float) -> tuple[float, float, float]:
     raise RuntimeError(f"no amplitude maximum within {abs(b - f0):.0f} Hz of {f0:.1f} Hz")
 
 
-def cf_path(make, omega: float, cf: float, start_cf: float):
+def cf_path(make, omega: float, cf: float, start_cf: float, steps: int = CF_STEPS):
     """A first solution at ``cf`` [N] reached from the stuck start at ``start_cf`` by
-    Newton at CF_STEPS loads between them (log-spaced), each warm-started from the last:
+    Newton at ``steps`` loads between them (log-spaced), each warm-started from the last:
     where the stuck start does not converge (low CF: much of the faces slips).
     ``make(cf)``: the model at that load."""
     x = None
-    for c in np.geomspace(start_cf, cf, CF_STEPS + 1):
+    for c in np.geomspace(start_cf, cf, steps + 1):
         hb = make(c)
         x = solve.start_point(hb, omega) if x is None else solve.solve_point(hb, omega, x, max_iter=80)
         if VERBOSE:
@@ -202,7 +202,7 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
         first = None
         if args.start_cf is not None:
             def first(w, model=model):
-                return cf_path(model, w, cf, args.start_cf)
+                return cf_path(model, w, cf, args.start_cf, args.cf_steps)
         if args.quick or args.at is not None:
             pk = surface_point(hb, f_guess if args.at is None else args.at, first)
         else:
@@ -300,6 +300,8 @@ def main(argv=None) -> int:
                     "frequency [Hz] instead of searching its peak (a comparison at a fixed frequency)")
     ap.add_argument("--start-cf", type=float, help="reach the first solution from the stuck start at this "
                     "CF [N] (cf_path) instead of at the CF itself")
+    ap.add_argument("--cf-steps", type=int, default=CF_STEPS, help="log-spaced loads of the path from "
+                    "--start-cf (each a Newton solve; ~24 from 300 to 40 N)")
     ap.add_argument("--ti", action="store_true", help="ring time integration at the finest surface peak")
     ap.add_argument("--ti-rest", action="store_true", help="also march the ring from rest (slow)")
     ap.add_argument("--ti-tol", type=float, default=1e-5, help="steady-state tolerance of the march")
@@ -315,6 +317,8 @@ def main(argv=None) -> int:
         args.dashpots = "inputs" if args.model == "condensed" else "bodies"
     if args.model == "condensed" and args.dashpots != "inputs":
         ap.error("the condensed model's dashpots act on the faces' rigid inputs: --dashpots inputs")
+    if not 1 <= args.cf_steps <= 1000:
+        ap.error(f"--cf-steps must be 1 ... 1000, not {args.cf_steps}")
     if args.at is not None and not args.at > 0:
         ap.error(f"--at must be a positive frequency [Hz], not {args.at:g}")
     if args.table:
