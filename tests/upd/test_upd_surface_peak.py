@@ -37,12 +37,14 @@ def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_pat
     assert len(rows) == 3 and rows[2].startswith("| 600 | nodes, 1 | 5 |") and "(fixed)" in rows[2]
 
 
-@pytest.mark.parametrize("extra", [["--model", "condensed", "--dashpots", "bodies"], ["--at", "-5"]])
+@pytest.mark.parametrize("extra", [["--model", "condensed", "--dashpots", "bodies"], ["--at", "-5"],
+                                   ["--cf-steps", "0"]])
 def test_contradictory_options_are_refused_before_any_solve(extra, capsys):
     with pytest.raises(SystemExit) as exc:
         _example().main(["--quick"] + extra)
     err = capsys.readouterr().err
-    assert exc.value.code == 2 and ("--dashpots inputs" in err or "--at must be" in err)
+    assert exc.value.code == 2 and ("--dashpots inputs" in err or "--at must be" in err
+                                    or "--cf-steps must be" in err)
 
 
 def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path):
