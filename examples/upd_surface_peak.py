@@ -185,6 +185,20 @@ def ring_check(shb: SurfaceSectorHB, x, basis, f: float, tol: float, periods: in
     return out
 
 
+def _factory(sector, surfaces, H: int, args):
+    """``model(cf)``, the surface model of ``args.model`` at that load, and the list of every
+    model it built (the CF path's too: their evaluations are the run's)."""
+    built = []
+
+    def model(c):
+        if args.model == "condensed":
+            built.append(CondensedSurfaceSectorHB(sector, surfaces, H, cf=c))
+        else:
+            built.append(SurfaceSectorHB(sector, surfaces, H, cf=c, dashpots=args.dashpots))
+        return built[-1]
+    return model, built
+
+
 def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     """One CF: the point peak, the surface peak per node count, the ring check."""
     rec = {"cf": cf, "model": args.model, "dashpots": args.dashpots,
@@ -194,10 +208,7 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     f_guess = rec["point"]["peak_hz"]
     for n in nodes:
         surfaces = build_surfaces(cfg, n, cf, Store().prepare())
-        def model(c, surfaces=surfaces):
-            if args.model == "condensed":
-                return CondensedSurfaceSectorHB(sector, surfaces, H, cf=c)
-            return SurfaceSectorHB(sector, surfaces, H, cf=c, dashpots=args.dashpots)
+        model, built = _factory(sector, surfaces, H, args)
         hb = model(cf)
         first = None
         if args.start_cf is not None:
@@ -207,6 +218,7 @@ def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
             pk = surface_point(hb, f_guess if args.at is None else args.at, first)
         else:
             pk = surface_peak(hb, f_guess, args.xtol, first)
+        pk["evaluations"] = sum(m.evaluations for m in built)
         f_guess = pk["peak_hz"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
             "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size,
