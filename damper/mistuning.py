@@ -612,7 +612,7 @@ def _plot_statistics(ax, st: dict, per_density: float, edges) -> None:
         ax.plot(x, per_density * pdf, color="C1", lw=1.5,
                 label=f"{f['family']} fit (KS D {f['ks_distance']:.3f})")
     q = next((q for q in st["quantiles"] if q["q"] == 0.95), None)
-    if q is not None:
+    if q is not None and q["value"] is not None:
         ax.axvline(q["value"], color="C2", lw=1, label="0.95 quantile")
         if q["low"] is not None and q["high"] is not None:
             ax.axvspan(q["low"], q["high"], color="C2", alpha=0.2, label="its 95 % interval")
