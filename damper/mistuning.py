@@ -144,8 +144,8 @@ class Study:
         if self.blades is not None:
             limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
         if self.damper == "nonlinear":
-            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or the free limit (damper free) "
-                                  "for a damper without load")
+            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or damper free for the blades "
+                                  "without a damper")
         if self.until_ci is not None:
             if self.factors is not None:
                 raise ValueError("--until-ci needs random samples (--std/--samples), not --factors")
