@@ -144,8 +144,8 @@ class Study:
         if self.blades is not None:
             limits.check_size("blades", self.blades, 2, limits.MAX_RING_BLADES, limits.RING_BLADES_WHY)
         if self.damper == "nonlinear":
-            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or the free limit (damper free) "
-                                  "for a damper without load")
+            limits.check_cf_floor("cf", self.cf, self.f0, self.config, "or damper free for the blades "
+                                  "without a damper")
         if self.until_ci is not None:
             if self.factors is not None:
                 raise ValueError("--until-ci needs random samples (--std/--samples), not --factors")
@@ -612,7 +612,7 @@ def _plot_statistics(ax, st: dict, per_density: float, edges) -> None:
         ax.plot(x, per_density * pdf, color="C1", lw=1.5,
                 label=f"{f['family']} fit (KS D {f['ks_distance']:.3f})")
     q = next((q for q in st["quantiles"] if q["q"] == 0.95), None)
-    if q is not None:
+    if q is not None and q["value"] is not None:
         ax.axvline(q["value"], color="C2", lw=1, label="0.95 quantile")
         if q["low"] is not None and q["high"] is not None:
             ax.axvspan(q["low"], q["high"], color="C2", alpha=0.2, label="its 95 % interval")

@@ -18,7 +18,16 @@ B(l - 1) <= alpha / 2 and u the smallest with B(u - 1) >= 1 - alpha / 2: each ta
 at most alpha / 2, the coverage (S1) is at least 1 - alpha (conservative: K is discrete).
 When B(0) > alpha / 2 no order statistic bounds xi_q from below (``low`` is None), when
 B(n - 1) < 1 - alpha / 2 none bounds it from above (``high`` is None): the two-sided
-95 % interval of the 0.95 quantile needs n >= 72, the 0.99 quantile's n >= 368.
+95 % interval of the 0.95 quantile needs n >= 72, the 0.99 quantile's n >= 368. With
+one end the interval is one-sided, at its exact coverage (S1) with the missing end at
+infinity (at least 1 - alpha / 2).
+
+The estimate is the sample quantile (numpy's linear interpolation, at the 1-based rank
+1 + (n - 1) q). A sample too small for a high quantile can bound it without estimating
+it: at n = 2 the 0.99 quantile is at least x_(2) (coverage 0.980), while the
+interpolation at rank 1.99 lies below x_(2). An estimate outside its own interval is
+not reported (``value`` None); for the reported quantiles this happens only at
+n = 2, q = 0.99 (checked for n < 3000).
 
 An interval checked against the q-quantile *estimate* of an independent sample of m
 (not the true xi_q) holds it less often than its coverage: the estimate scatters too.
@@ -95,18 +104,23 @@ def quantile_ci(x, q: float, level: float = LEVEL) -> dict:
     Returns
     -------
     dict
-        ``q``, ``value`` (numpy's default linear interpolation), ``low``, ``high`` (order
-        statistics, None where the sample is too small to bound that side), ``coverage``
-        (the interval's exact coverage, >= level when both ends exist), ``half_width``
-        ((high - low) / 2, None when a side is missing: JSON has no infinity).
+        ``q``, ``value`` (numpy's default linear interpolation; None where it lies outside
+        the interval: the sample bounds the quantile but cannot estimate it, module
+        docstring), ``low``, ``high`` (order statistics, None where the sample is too
+        small to bound that side: the interval is then one-sided), ``coverage`` (the
+        interval's exact coverage, >= level when both ends exist, >= (1 + level) / 2 with
+        one), ``half_width`` ((high - low) / 2, None when a side is missing: JSON has no
+        infinity).
     """
     xs = np.sort(_sample(x))
     lo, hi, cov = quantile_ci_ranks(xs.size, q, level)
     low = None if lo is None else float(xs[lo - 1])
     high = None if hi is None else float(xs[hi - 1])
     half = None if low is None or high is None else (high - low) / 2.0
-    return {"q": q, "value": float(np.quantile(xs, q)), "low": low, "high": high,
-            "coverage": cov, "half_width": half}
+    value = float(np.quantile(xs, q))
+    if (low is not None and value < low) or (high is not None and value > high):
+        value = None
+    return {"q": q, "value": value, "low": low, "high": high, "coverage": cov, "half_width": half}
 
 
 def containment_probability(n: int, m: int, q: float = 0.95, level: float = LEVEL) -> float:

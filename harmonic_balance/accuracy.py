@@ -8,10 +8,11 @@ Method (docs/method/accuracy.md). The curve's solutions near its refined peak ar
 with zeros to a richer harmonic set of the same kind (H' = the next admissible harmonic
 at or above RICHER_FACTOR H: odd sets stay odd), corrected at their frequencies by
 Newton, and the peak of that short branch is refined (:func:`continuation.refine_max`):
-a few dozen solves at H', no curve. A second check at H'' (the same rule from H') gives
-three levels. Where their differences give a convergence order p in ORDER_RANGE
-(|a_H - a_inf| ~ C H^-p), the peak is extrapolated (Richardson 1911; Roache 1998, ch. 5,
-for the observed order of grid-convergence studies),
+a few dozen solves at H', no curve (the UPD sector's checks also start from the refined
+peak itself, :func:`with_peak`: a coarse grid's points can miss a sharp peak). A second
+check at H'' (the same rule from H') gives three levels. Where their differences give a
+convergence order p in ORDER_RANGE (|a_H - a_inf| ~ C H^-p), the peak is extrapolated
+(Richardson 1911; Roache 1998, ch. 5, for the observed order of grid-convergence studies),
 
     a_inf = a_H'' + (a_H'' - a_H') / ((H'' / H')^p - 1),
 
@@ -117,6 +118,32 @@ def pad(x: np.ndarray, basis: FourierBasis, rich: FourierBasis) -> np.ndarray:
         if isn is not None:
             Y[jsn] = X[isn]
     return Y.ravel()
+
+
+def with_peak(xs, omegas, i: int, x_peak, omega_peak: float):
+    """The curve's points with its refined peak inserted in frequency order: (xs, omegas,
+    index of the peak), from which a richer set's peak is searched.
+
+    The check must start from the peak it checks: the curve's peak is refined on the
+    continuation's branch, while its points lie on the report grid, and on a coarse grid
+    a sharp peak falls between them. A search bracketed by grid points alone can then
+    stop at the grid's highest point (UPD-24 stuck at CF 1e6 N on a 10-point grid: the
+    H = 11 check at 477.78 Hz against the curve's 478.67 Hz, a 56 % "error" where the
+    true one is 1e-6). Unchanged when the peak coincides with a grid point or the grid is
+    not increasing (a folded branch reported at its own points).
+
+    Parameters
+    ----------
+    xs : list of (N,) arrays, the curve's solutions at ``omegas`` [rad/s]
+    i : int, index of the curve's highest point
+    x_peak : (N,) array, the refined peak's solution at ``omega_peak`` [rad/s]
+    """
+    om = np.asarray(omegas, dtype=float)
+    if x_peak is None or not np.isfinite(omega_peak) or not np.all(np.diff(om) > 0) \
+            or np.any(om == omega_peak):
+        return list(xs), om, i
+    k = int(np.searchsorted(om, omega_peak))
+    return list(xs[:k]) + [np.asarray(x_peak)] + list(xs[k:]), np.insert(om, k, omega_peak), k
 
 
 def observed_order(levels) -> float | None:

@@ -302,7 +302,7 @@ def _check_optimize(args) -> None:
     limits.check_workers("--workers", args.workers)
     check_accuracy_option(args.accuracy)
     check_out_dir(args.plot, "--plot")
-    limits.check_cf_floor("--cf-range", lo, None, args.config, "a damper without load is --damper free of upd frf")
+    limits.check_cf_floor("--cf-range", lo, None, args.config, "or start the range there")
 
 
 def run_optimize(args) -> int:

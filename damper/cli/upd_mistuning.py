@@ -144,13 +144,27 @@ def _ci(d: dict) -> str:
     return f"[{lo}, {hi}]"
 
 
+def _quantile_line(q: dict) -> str:
+    """One quantile with its interval; a one-sided interval says so, and a quantile the
+    sample bounds but cannot estimate (:func:`damper.mistuning_stats.quantile_ci`) has no
+    number printed as its estimate."""
+    est = "-     " if q["value"] is None else f"{q['value']:.4f}"
+    line = f"  quantile {q['q']:<4g} {est} {_ci(q)}"
+    if (q["low"] is None) != (q["high"] is None):
+        side, b = ("at least", q["low"]) if q["high"] is None else ("at most", q["high"])
+        line += f" one-sided: {side} {b:.4f} at {100 * q['coverage']:.1f} % confidence"
+        if q["value"] is None:
+            line += "; too few samples for an estimate"
+    return line
+
+
 def statistics_lines(out: dict) -> list:
     """The printed statistics: mean and quantiles with their 95 % intervals, the fit, the
     stopping rule, the parallel efficiency."""
     st = out["statistics"]
-    lines = [f"amplification over {st['n']} samples (95 % intervals): mean {st['mean']['value']:.4f} "
-             f"{_ci(st['mean'])}"]
-    lines += [f"  quantile {q['q']:<4g} {q['value']:.4f} {_ci(q)}" for q in st["quantiles"]]
+    lines = [f"amplification over {st['n']} samples (95 % intervals, '-' where the sample gives no "
+             f"bound): mean {st['mean']['value']:.4f} {_ci(st['mean'])}"]
+    lines += [_quantile_line(q) for q in st["quantiles"]]
     fit = st["fit"]
     if fit and fit["best"]:
         f = fit["fits"][fit["best"]]

@@ -67,7 +67,8 @@ def _q95(o: dict) -> dict:
 def _ci_lines(o: dict) -> list:
     """The 0.95 quantile's interval and the --until-ci outcome."""
     q = _q95(o)
-    line = (f"0.95 quantile {q['value']:.4f}, 95 % interval " + (
+    est = "not estimated" if q["value"] is None else f"{q['value']:.4f}"
+    line = (f"0.95 quantile {est}, 95 % interval " + (
         f"[{q['low']:.4f}, {q['high']:.4f}]" if q["half_width"] is not None else "not bounded by so few samples"))
     if "until_ci" in o:
         u = o["until_ci"]

@@ -324,7 +324,7 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
         except (OSError, ValueError):   # the model file's own check reports it
             return
         try:
-            limits.check_cf_floor("cf_range low", lo_hi[0], f0, None, "a damper without load is the free limit")
+            limits.check_cf_floor("cf_range low", lo_hi[0], f0, None, "or start the range there")
         except ValueError as err:
             problems.append((("upd", "cf_range"), str(err)))
 

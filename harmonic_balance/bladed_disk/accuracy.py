@@ -1,8 +1,9 @@
 """Truncation error of the UPD sector's peak, and sector curves to a requested accuracy.
 
 The sector's counterpart of :mod:`..frf_accuracy`, with the same method
-(:mod:`..accuracy`): the curve's solutions near the refined peak (first-harmonic
-amplitude of the response DOF) padded to a richer set 0..H' (H' = ceil(1.5 H)), corrected
+(:mod:`..accuracy`): the refined peak (first-harmonic amplitude of the response DOF) and
+the curve's solutions around it (:func:`..accuracy.with_peak`) padded to a richer set
+0..H' (H' = ceil(1.5 H)), corrected
 at their frequencies, and the peak of that short branch refined; the difference of the
 two peaks, scaled for the error left at H' with the assumed order, estimates the
 truncation error of the computed peak (CHECK_LEVELS).
@@ -53,17 +54,17 @@ def truncation_error(hb: SectorHB, curve, limit: int = MAX_HARMONIC, levels: int
         return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
                 "note": "the peak is at the band's end"}
     checks, hs = [], hb.basis.harmonics
+    pts, om, i = acc.with_peak(curve.x, curve.omega, i, curve.peak_x, curve.peak_omega)
     for k in range(levels):
         nxt = acc.richer(hs, limit=limit)
         if nxt == hs:
             break
         hs = nxt
         rich = check_sector(hb, hs[-1])
-        xs = [acc.pad(x, hb.basis, rich.basis) for x in curve.x]
+        xs = [acc.pad(x, hb.basis, rich.basis) for x in pts]
         try:
             _, wc, ac, _ = peak_search.peak_at(rich.__call__, lambda x, w, r=rich: r.amplitude_h1(x), xs,
-                                               np.asarray(curve.omega), i, 1e-10 * max(hb.f0, hb.cf),
-                                               1e-6 * curve.peak_omega)
+                                               om, i, 1e-10 * max(hb.f0, hb.cf), 1e-6 * curve.peak_omega)
         except RuntimeError as err:
             if k == 0:
                 return {**base, "peak_amplitude_rel": None, "peak_frequency_rel": None,
@@ -164,8 +165,8 @@ def peak_to_accuracy(sector, omegas, accuracy: float, H: int = 7, limit: int = P
             rich = check_sector(hb, hs[-1])
             return (rich, lambda x, w, r=rich: r.amplitude_h1(x),   # rich itself: its value() too
                     1e-10 * max(hb.f0, hb.cf), rich.basis)
-        run = acc.raise_at_peak(problem_at, hb.basis, curve.x, np.asarray(curve.omega), i, level0,
-                                tol, limit, 1e-6 * curve.peak_omega)
+        pts, om, i = acc.with_peak(curve.x, curve.omega, i, curve.peak_x, curve.peak_omega)
+        run = acc.raise_at_peak(problem_at, hb.basis, pts, om, i, level0, tol, limit, 1e-6 * curve.peak_omega)
     else:
         run = {"levels": [level0], "harmonics": hb.basis.harmonics, "x": None, "error": None,
                "met": False, "solves": 0, "message": "the peak is at the band's end (widen the band)"}

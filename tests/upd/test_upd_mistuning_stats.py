@@ -6,6 +6,7 @@ import pytest
 from scipy import stats
 
 from damper.mistuning_stats import (
+    QUANTILES,
     containment_probability,
     fit_distribution,
     fit_family,
@@ -156,3 +157,36 @@ def test_summary_orders_quantiles_and_refuses_nonfinite():
     assert v == sorted(v) and s["n"] == 500
     with pytest.raises(ValueError):
         summary([1.0, float("nan")])
+
+
+#: Sample sizes over which every reported quantile is checked against its own interval
+#: (the small sizes where intervals are one-sided, and beyond the 0.99 quantile's 368).
+SIZES = range(1, 401)
+
+
+def test_a_reported_quantile_estimate_lies_inside_its_own_interval():
+    rng = np.random.default_rng(20261128)
+    for n in SIZES:
+        x = stats.genextreme.rvs(*GEV, size=n, random_state=rng)
+        for r in (quantile_ci(x, q) for q in QUANTILES):
+            if r["value"] is not None:
+                assert r["low"] is None or r["low"] <= r["value"]
+                assert r["high"] is None or r["value"] <= r["high"]
+
+
+def test_two_samples_bound_the_99_percent_quantile_without_estimating_it():
+    # K ~ Bin(2, 0.99): P(K <= 1) = 1 - 0.99^2 <= 0.025, so xi_0.99 >= x_(2) with coverage
+    # 0.99^2, while the interpolated estimate at rank 1.99 lies below x_(2)
+    r = quantile_ci([1.2, 1.4], 0.99)
+    assert r["low"] == 1.4 and r["high"] is None and r["value"] is None
+    assert r["coverage"] == pytest.approx(0.99**2, abs=1e-14)
+    assert quantile_ci([1.2, 1.4], 0.95)["value"] == pytest.approx(1.2 + 0.95 * 0.2, abs=1e-14)
+
+
+def test_printed_quantiles_say_when_an_interval_is_one_sided_and_print_no_estimate_outside_it():
+    from damper.cli.upd_mistuning import statistics_lines
+
+    out = {"statistics": summary([1.2, 1.4]),
+           "efficiency": {"efficiency": 1.0, "cpu_s": 1.0, "chunks": 1, "chunk_size": 2, "workers": 1, "wall_s": 1.0}}
+    q99 = next(line for line in statistics_lines(out) if "quantile 0.99" in line)
+    assert "1.39" not in q99 and "[1.4000, -]" in q99 and "at least 1.4000" in q99 and "98.0 %" in q99
