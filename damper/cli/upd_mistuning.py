@@ -64,7 +64,8 @@ def register(s) -> None:
 def run_mistuning(args) -> int:
     import sys
 
-    from damper.mistuning import AllSamplesFailed, Study, plot_study, run_study
+    from damper.mistuning import AllSamplesFailed, Study, run_study
+    from damper.mistuning_plot import plot_study
 
     from .cache import store_from_args
     from .common import check_accuracy_option, check_out_dir, print_json

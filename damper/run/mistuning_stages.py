@@ -30,7 +30,8 @@ class Mistuning(Kind):
                       extra={"data": {"mistuning": data["mistuning"], "upd": upd}})]
 
     def compute(self, stage, inputs, ctx):
-        from damper.mistuning import plot_study, run_study, study_from_scene
+        from damper.mistuning import run_study, study_from_scene
+        from damper.mistuning_plot import plot_study
 
         out = run_study(study_from_scene(stage.extra["data"]), ctx.store, serial=True,
                         echo=lambda text: None)
