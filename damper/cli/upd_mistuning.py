@@ -64,35 +64,13 @@ def register(s) -> None:
 def run_mistuning(args) -> int:
     import sys
 
-    from damper.mistuning import AllSamplesFailed, Study, run_study
+    from damper.mistuning import AllSamplesFailed, run_study
     from damper.mistuning_plot import plot_study
 
     from .cache import store_from_args
-    from .common import check_accuracy_option, check_out_dir, print_json
+    from .common import print_json
 
-    given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
-                            ("--serial", args.serial)) if v]
-    if len(given) > 1:
-        raise ValueError(f"give one of --scheduler, --workers, --serial (got {', '.join(given)})")
-    from damper import limits
-
-    if args.workers is not None:
-        limits.check_workers("--workers", args.workers)
-    check_out_dir(args.plot, "--plot")
-    check_accuracy_option(args.accuracy)
-    if args.accuracy is not None and args.damper != "nonlinear":
-        raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
-                         "has no harmonic truncation (drop --accuracy)")
-    draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
-    if args.until_ci is not None and args.factors is None:
-        draw.setdefault("samples", UNTIL_CI_SAMPLES)
-    if args.factors is not None and draw:
-        raise ValueError("give --factors or --std/--samples/--seed, not both")
-    study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
-                  **draw, kind=args.kind,
-                  distribution=args.distribution, factors=args.factors, damper=args.damper,
-                  cf=args.cf, f0=args.f0, harmonics=args.harmonics, accuracy=args.accuracy,
-                  band_hz=args.band, points=args.points, until_ci=args.until_ci, solver=args.solver)
+    study = _study(args)
     if args.worst or args.bound is not None or args.out is not None or args.max_evaluations is not None:
         if args.until_ci is not None:
             raise ValueError("--until-ci goes with a random study, not with --worst")
@@ -132,6 +110,37 @@ def run_mistuning(args) -> int:
     if out.get("lift_off_warning"):
         print(out["lift_off_warning"])
     return 0
+
+
+def _study(args):
+    """The Study the options ask for, every option combination checked first (ValueError)."""
+    from damper import limits
+    from damper.mistuning import Study
+
+    from .common import check_accuracy_option, check_out_dir
+
+    given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
+                            ("--serial", args.serial)) if v]
+    if len(given) > 1:
+        raise ValueError(f"give one of --scheduler, --workers, --serial (got {', '.join(given)})")
+    if args.workers is not None:
+        limits.check_workers("--workers", args.workers)
+    check_out_dir(args.plot, "--plot")
+    check_accuracy_option(args.accuracy)
+    if args.accuracy is not None and args.damper != "nonlinear":
+        raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
+                         "has no harmonic truncation (drop --accuracy)")
+    draw = {k: getattr(args, k) for k in ("std", "samples", "seed") if getattr(args, k) is not None}
+    if args.until_ci is not None and args.factors is None:
+        draw.setdefault("samples", UNTIL_CI_SAMPLES)
+    if args.factors is not None and draw:
+        raise ValueError("give --factors or --std/--samples/--seed, not both")
+    study = Study(config=args.config, blades=args.blades, engine_order=args.engine_order,
+                  **draw, kind=args.kind,
+                  distribution=args.distribution, factors=args.factors, damper=args.damper,
+                  cf=args.cf, f0=args.f0, harmonics=args.harmonics, accuracy=args.accuracy,
+                  band_hz=args.band, points=args.points, until_ci=args.until_ci, solver=args.solver)
+    return study
 
 
 #: Most ring curves per start of a friction --worst search.
