@@ -152,6 +152,15 @@ def table_text(stage: str, rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+def _html_table(caption: str, columns, cell_rows) -> list[str]:
+    """HTML lines of a captioned table: headings from ``columns`` ((heading, key, format)
+    triples), one row of formatted cells per item of ``cell_rows``."""
+    return ([f"<p>{html.escape(caption)}.</p><table><tr>"
+             + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in columns) + "</tr>"]
+            + ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>" for cells in cell_rows]
+            + ["</table>"])
+
+
 def write(out: Path, result: dict) -> tuple[Path, Path]:
     """Write bench.json and bench.html into ``out``; return their paths."""
     from contact_core.fileio import atomic_write
@@ -178,17 +187,10 @@ def write(out: Path, result: dict) -> tuple[Path, Path]:
         parts.append("</table>")
         surf = [r for r in rows if surface_cost.is_row(r)]
         if surf:
-            parts.append(f"<p>{html.escape(surface_cost.CAPTION)}.</p><table><tr>"
-                         + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in surface_cost.COLUMNS) + "</tr>")
-            parts += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in surface_cost.cells(r)) + "</tr>"
-                      for r in surf]
-            parts.append("</table>")
+            parts += _html_table(surface_cost.CAPTION, surface_cost.COLUMNS, map(surface_cost.cells, surf))
         acc = _split(rows)[1]
         if acc:
-            parts.append(f"<p>{html.escape(ACCURACY_CAPTION)}.</p><table><tr>"
-                         + "".join(f"<th>{html.escape(h)}</th>" for h, _, _ in ACCURACY_COLUMNS) + "</tr>")
-            parts += ["<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in _cells(r)) + "</tr>" for r in acc]
-            parts.append("</table>")
+            parts += _html_table(ACCURACY_CAPTION, ACCURACY_COLUMNS, map(_cells, acc))
     parts.append("</body></html>")
     j = atomic_write(out / "bench.json", json.dumps(result, indent=1) + "\n")
     h = atomic_write(out / "bench.html", "\n".join(parts))
