@@ -11,7 +11,9 @@ Per centrifugal load CF:
   one harmonic count): the first-harmonic amplitude of u_a maximised over the frequency
   by Brent's search (:func:`harmonic_balance.brent.brent_min`), each frequency a Newton
   solve warm-started from the nearest one solved, the search started at the point
-  model's peak;
+  model's peak (or ``--guess``); with the condensed model, whose unknowns are the
+  sector's for every node count, each node count's first solve starts from the
+  previous one's peak solution (the CF path where that fails);
 * with ``--ti``, at the surface peak of the finest node count: the ring of the same
   sectors and surfaces marched in time
   (:func:`harmonic_balance.bladed_disk.ring_surface.march_ring_surface`) until its first
@@ -200,27 +202,46 @@ def _factory(sector, surfaces, H: int, args):
     return model, built
 
 
+def _first(model, hb, cf: float, args, x_prev):
+    """``first(omega)`` of the node count's search: Newton from the previous node count's peak
+    solution where the unknowns are the same (the condensed model's: the sector's DOFs, for
+    any node count), else, or where that fails, the CF path (``--start-cf``) or the stuck
+    start (None: the search's default)."""
+    def fallback(w):
+        if args.start_cf is None:
+            return solve.start_point(hb, w)
+        return cf_path(model, w, cf, args.start_cf, args.cf_steps)
+
+    if x_prev is None or x_prev.shape != (hb.size,):
+        return None if args.start_cf is None else fallback
+
+    def first(w):
+        try:
+            return solve.solve_point(hb, w, x_prev, max_iter=80)
+        except NewtonError:
+            return fallback(w)
+    return first
+
+
 def run_cf(cfg, sector, cf: float, nodes: list, H: int, args) -> dict:
     """One CF: the point peak, the surface peak per node count, the ring check."""
     rec = {"cf": cf, "model": args.model, "dashpots": args.dashpots,
            "point": point_peak(sector, H, cf, args.points), "surface": []}
     print(f"CF {cf:g} N: point model peak {rec['point']['peak_hz']:.3f} Hz, "
           f"|u_a,1| {rec['point']['peak_amplitude_h1']:.6e} m", flush=True)
-    f_guess = rec["point"]["peak_hz"]
+    f_guess = rec["point"]["peak_hz"] if args.guess is None else args.guess
+    x_prev = None
     for n in nodes:
         surfaces = build_surfaces(cfg, n, cf, Store().prepare())
         model, built = _factory(sector, surfaces, H, args)
         hb = model(cf)
-        first = None
-        if args.start_cf is not None:
-            def first(w, model=model):
-                return cf_path(model, w, cf, args.start_cf, args.cf_steps)
+        first = _first(model, hb, cf, args, x_prev)
         if args.quick or args.at is not None:
             pk = surface_point(hb, f_guess if args.at is None else args.at, first)
         else:
             pk = surface_peak(hb, f_guess, args.xtol, first)
         pk["evaluations"] = sum(m.evaluations for m in built)   # hb's and the CF path's models
-        f_guess = pk["peak_hz"]
+        f_guess, x_prev = pk["peak_hz"], pk["x"]
         row = {k: v for k, v in pk.items() if k != "x"} | {
             "nodes_per_side": n, "nodes": [s.n for s in surfaces.values()], "unknowns": hb.size,
             "searched": not (args.quick or args.at is not None)}
@@ -311,6 +332,8 @@ def main(argv=None) -> int:
                     "its only choice); the ring time integration takes the same")
     ap.add_argument("--at", type=float, metavar="HZ", help="solve the surface model at this one "
                     "frequency [Hz] instead of searching its peak (a comparison at a fixed frequency)")
+    ap.add_argument("--guess", type=float, metavar="HZ", help="start the first node count's peak search "
+                    "here [Hz] instead of at the point model's peak")
     ap.add_argument("--start-cf", type=float, help="reach the first solution from the stuck start at this "
                     "CF [N] (cf_path) instead of at the CF itself")
     ap.add_argument("--cf-steps", type=int, default=CF_STEPS, help="log-spaced loads of the path from "
@@ -332,6 +355,8 @@ def main(argv=None) -> int:
         ap.error("the condensed model's dashpots act on the faces' rigid inputs: --dashpots inputs")
     if not 1 <= args.cf_steps <= 1000:
         ap.error(f"--cf-steps must be 1 ... 1000, not {args.cf_steps}")
+    if args.guess is not None and not args.guess > 0:
+        ap.error(f"--guess must be a positive frequency [Hz], not {args.guess:g}")
     if args.at is not None and not args.at > 0:
         ap.error(f"--at must be a positive frequency [Hz], not {args.at:g}")
     if args.table:
