@@ -125,9 +125,14 @@ class CondensedSurface(ForceElement):
     def local_damping(self):
         return self.C
 
-    def march(self, q: np.ndarray, periods: int = PERIODS, dq=None):
+    #: Periods each evaluation marches (:data:`PERIODS`; an instance may set its own to
+    #: measure what the first period's transient leaves in the loop).
+    periods = PERIODS
+
+    def march(self, q: np.ndarray, periods: int | None = None, dq=None):
         """Resultants f_q (n_h, n_t, r) [N] and the last period's friction work (n_h,) [J] of
-        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring).
+        histories q (n_h, n_t, r) [m, rad], each one period of samples (module docstring),
+        over ``periods`` periods (default :attr:`periods`).
 
         With ``dq`` (n_t, r, n_d), the sensitivities of the samples along n_d directions
         (the same for every history), also their resultants' sensitivities df (n_h, n_t,
@@ -138,6 +143,7 @@ class CondensedSurface(ForceElement):
         RuntimeError
             The node solve found no equilibrium even in a step split MAX_SPLIT times.
         """
+        periods = self.periods if periods is None else int(periods)
         n_h, n_t, r = q.shape
         nodes = MasslessContacts(self.elements, range(self.surface.n_w), n_h, self.A != 0.0)
         A = nodes.split(self.A)
