@@ -75,15 +75,23 @@ MAX_BRACKET, MAX_SECTION, SECTION_RTOL = 20, 30, 0.1
 #: Passes of the Newton step that settle the side of the nodes at a kink.
 MAX_SIDES = 4
 #: Forward-difference step of the trial map's slope, relative to the slip plus a slip radius.
-FD_REL = 1e-7
+#: A node nearer its kink than the step gets a chord between the two sides' slopes: where
+#: it really sticks over Newton's (much shorter) step, each iteration then removes only the
+#: share of the residual that chord leaves, and Newton converges linearly. At 1e-7 that
+#: held steps of the UPD-24 condensed march (CF 120 N, 466.03 Hz, H 7, 256 samples, 5 nodes
+#: per side) at |r| ~ 1e-3 N for 30-150 iterations at 1-2 % each (63 of 1098 node solves
+#: over 50 evaluations, 30 failed and split; 9022 evaluations in one march); at 1e-9, 3 of
+#: 1038 and 3422 evaluations, the HB solution's amplitude equal to 2e-9
+#: (examples/surface_march_resolution.py measures the march's cost).
+FD_REL = 1e-9
 #: Relative tolerance of the homogeneity test that lets two node elements share a call.
 SAME_LAW_RTOL = 1e-12
 #: Significant digits of a node's Newton slope (relative to its stuck slope) kept in the
 #: key of a cached factorization: the slope comes from a difference of the trial map whose
-#: round-off is ~1e-9 of it (eps |F| / (k ds), ds = FD_REL of the slip), so the same
-#: stick/slip state gives the same key; the rounded slope is the one used, 5e-9 from the
-#: difference, far inside Newton's tolerance.
-SLOPE_DIGITS = 8
+#: round-off is ~2e-7 of it (eps |F| / (k ds), k ds >= FD_REL mu N), so the same
+#: stick/slip state gives the same key; the rounded slope is the one used, 5e-7 from the
+#: difference: Newton's contraction per iteration on a settled set, far inside its tolerance.
+SLOPE_DIGITS = 6
 #: Blocks of at least this many DOFs whose contacts add to the diagonal only are solved
 #: by diagonal updates of kept inverses (:meth:`FactorCache.solve_diagonal`). On UPD-24
 #: the blocks of 63 DOFs (5 nodes per side) cost the same either way within ~10 %, and
