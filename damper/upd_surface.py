@@ -81,9 +81,10 @@ def check_unknowns(sector, nodes_per_side: int, H: int, cf: float | None) -> Non
     nodes = sum(mesh.build(spec)[1].contact.size for spec in specs.values())
     n = (sector.n_dof + 2 * nodes) * (2 * H + 1)
     if n > limits.MAX_SURFACE_UNKNOWNS:
-        raise ValueError(f"--contacts surface with --surface-nodes {nodes_per_side} and --harmonics {H}: "
+        raise ValueError(f"--surface-model nodes with --surface-nodes {nodes_per_side} and --harmonics {H}: "
                          f"{nodes} contact nodes, {n} unknowns, above the limit {limits.MAX_SURFACE_UNKNOWNS} "
-                         f"({limits.SURFACE_UNKNOWNS_WHY}); lower --surface-nodes or --harmonics")
+                         f"({limits.SURFACE_UNKNOWNS_WHY}); lower --surface-nodes or --harmonics, or use "
+                         "--surface-model condensed (the sector's unknowns only)")
 
 
 def check_options(args) -> None:
