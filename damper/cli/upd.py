@@ -5,6 +5,7 @@ Examples::
     damper upd modes --json
     damper upd frf --cf 120 --f0 30 --harmonics 7 --band 400 500 --json --plot out/upd
     damper upd frf --damper stuck --json
+    damper upd frf --contacts surface --surface-nodes 5 --harmonics 3 --band 400 480 --points 9 --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
