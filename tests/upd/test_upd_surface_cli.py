@@ -51,6 +51,19 @@ def test_open_load_does_not_depend_on_the_cf_it_is_computed_at(surfaces):
     assert at_cf > CF   # UPD-24 at CF 120 N: the stuck start opens a face, so the path is needed
 
 
+#: The faces' prestress resultants carry the damper's force balance (N_L = N_R = CF / (2 cos g),
+#: as test_upd_surface.STATIC_RTOL for the node-DOF sector): round-off of the linear statics.
+STATIC_RTOL = 1e-8
+
+
+def test_condensed_faces_prestress_carries_the_damper_force_balance(surfaces):
+    from damper.upd_surface import static_loads
+
+    hb = _model(surfaces, CF)
+    N = CF / (2 * np.cos(np.radians(hb.sector.cfg["damper.angle_deg"])))
+    assert static_loads(hb) == pytest.approx([N, N], rel=STATIC_RTOL)
+
+
 @pytest.mark.parametrize("extra, words", [
     (["--surface-model", "nodes"], "--surface-model goes with --contacts surface"),
     (["--contacts", "geometry", "--surface-model", "condensed"], "add --contacts surface or drop --surface-model"),
