@@ -17,7 +17,7 @@ from damper.upd_surface import build_surfaces
 from harmonic_balance.bladed_disk import load_path
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.solve import solve_point
+from harmonic_balance.bladed_disk.solve import TOL_REL, solve_point
 from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
 
 NODES, H, CF = 5, 1, 120.0
@@ -25,13 +25,17 @@ BAND = (400.0, 405.0)
 #: (P1)'s two sides both scale with the CF: the open load computed at two CFs agrees to
 #: the round-off of the statics and the stuck solve.
 OPEN_LOAD_RTOL = 1e-9
-#: The CLI's first point is a Newton solution (|R| < solve.TOL_REL CF = 1.2e-8 N against
-#: forces of ~1e2 N on responses of ~2e-4 m): two solutions of the same equations from
-#: different paths agree in amplitude far below this.
-FIRST_POINT_RTOL = 1e-6
+#: The CLI's first point is a Newton solution (|R| < solve.TOL_REL CF = 1.2e-8 N against a
+#: stiffness of ~1e5 N/m or more on a response of ~2e-4 m: ~1e-9 relative): two solutions of
+#: the same equations from different paths agree to that. Measured 1.6e-15.
+FIRST_POINT_RTOL = 1e-8
 #: The other grid values are the continuation's cubic Hermite interpolation on its branch
-#: (solve.UPD_TOL: measured within 1.4e-4 of Newton solves on UPD-24's point model, H 7).
+#: (solve.UPD_TOL: measured within 1.4e-4 of Newton solves on UPD-24's point model, H 7;
+#: here 5e-9 at the middle point, the last is the branch's end, a Newton solution).
 GRID_RTOL = 1e-3
+#: Energy balance at the reported peak: exact at a Galerkin solution up to Newton's
+#: tolerance (as test_upd_cli.ENERGY_IMBALANCE). Measured 1.1e-16.
+ENERGY_IMBALANCE = TOL_REL
 
 
 @pytest.fixture(scope="module")
@@ -113,6 +117,10 @@ def test_cli_curve_is_the_library_path_and_newton_at_its_frequencies(cli_curve, 
     run = cli_curve["surface_model"]
     assert run["model"] == "condensed" and run["nodes_per_side"] == NODES and run["evaluations"] > 0
     assert run["start"]["loads"][-1] == CF and run["start"]["loads"][0] > CF   # the path ran
+    e = cli_curve["energy_per_cycle_at_peak"]
+    # the faces' input dashpots dissipate (beta_c times their stuck stiffness), their nodes' loops too
+    assert abs(e["imbalance"]) < ENERGY_IMBALANCE and e["W_dashpot"] > 0.0 and e["W_friction_loops"] >= 0.0
+    assert cli_curve["contact_points"] == ["left", "flat"] and all(0.0 <= v <= 1.0 for v in cli_curve["lift_off"])
     omegas = 2 * np.pi * np.asarray(cli_curve["frequency_hz"])
     x, loads = load_path.cf_path(lambda c: _model(surfaces, c), omegas[0], CF, 300.0, steps=3)
     hb = _model(surfaces, CF)
