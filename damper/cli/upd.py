@@ -210,8 +210,8 @@ def surface_line(run: dict) -> str:
     how = (f"first point by the path in CF {st['loads'][0]:.4g} -> {st['loads'][-1]:.4g} N "
            f"({len(st['loads'])} loads)" if len(st.get("loads", ())) > 1 else "first point from the stuck start")
     return (f"surface model {run['model']}, {run['nodes_per_side']} nodes per side ({run['nodes']} nodes): "
-            f"{run['evaluations']} evaluations, {run['cpu_s']:.1f} s CPU ({run['time_s']:.1f} s wall, the "
-            f"truncation check {run['truncation_check_s'] or 0.0:.1f} s of it); {how}")
+            f"{run['evaluations']} evaluations, {run['cpu_s']:.1f} s CPU ({run['time_s']:.1f} s wall), of which "
+            f"the truncation check (a peak search at more harmonics) {run['truncation_check_cpu_s']:.1f} s CPU; {how}")
 
 
 def response_warnings(out: dict) -> dict:
