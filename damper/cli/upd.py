@@ -5,7 +5,7 @@ Examples::
     damper upd modes --json
     damper upd frf --cf 120 --f0 30 --harmonics 7 --band 400 500 --json --plot out/upd
     damper upd frf --damper stuck --json
-    damper upd frf --contacts surface --surface-nodes 5 --harmonics 3 --band 400 480 --points 9 --json
+    damper upd frf --contacts surface --surface-nodes 5 --harmonics 1 --band 440 490 --points 5 --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
@@ -14,6 +14,8 @@ Examples::
 from __future__ import annotations
 
 import numpy as np
+
+from damper.upd_surface import SURFACE_MODELS
 
 from .common import accuracy_lines, upd_model_options, upd_response_options
 from .upd_mistuning import register as register_mistuning
@@ -76,7 +78,7 @@ def _contacts(p, surface: bool = False) -> None:
         p.add_argument("--surface-nodes", type=int, metavar="N",
                        help="with --contacts surface: contact-zone nodes per side of each face "
                        f"(5 .. 41; default {SURFACE_NODES})")
-        p.add_argument("--surface-model", choices=("condensed", "nodes"),
+        p.add_argument("--surface-model", choices=SURFACE_MODELS,
                        help="with --contacts surface: condensed (default): the faces condensed onto "
                        "their rigid inputs, the nodes marched in time in each evaluation, the first "
                        "point reached by a path in CF from the load where the stuck damper keeps its "
@@ -88,8 +90,9 @@ def _contacts(p, surface: bool = False) -> None:
 SURFACE_NODES = 5
 
 
-#: Surface model with ``--contacts surface`` when not given (damper.upd_surface.SURFACE_MODELS).
-SURFACE_MODEL = "condensed"
+#: Surface model with ``--contacts surface`` when not given: the condensed one, which reaches
+#: the default CF (damper.upd_surface.SURFACE_MODELS).
+SURFACE_MODEL = SURFACE_MODELS[0]
 
 
 def check_surface_nodes(args) -> None:
