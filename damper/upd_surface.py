@@ -81,9 +81,10 @@ def check_unknowns(sector, nodes_per_side: int, H: int, cf: float | None) -> Non
     nodes = sum(mesh.build(spec)[1].contact.size for spec in specs.values())
     n = (sector.n_dof + 2 * nodes) * (2 * H + 1)
     if n > limits.MAX_SURFACE_UNKNOWNS:
-        raise ValueError(f"--contacts surface with --surface-nodes {nodes_per_side} and --harmonics {H}: "
+        raise ValueError(f"--surface-model nodes with --surface-nodes {nodes_per_side} and --harmonics {H}: "
                          f"{nodes} contact nodes, {n} unknowns, above the limit {limits.MAX_SURFACE_UNKNOWNS} "
-                         f"({limits.SURFACE_UNKNOWNS_WHY}); lower --surface-nodes or --harmonics")
+                         f"({limits.SURFACE_UNKNOWNS_WHY}); lower --surface-nodes or --harmonics, or use "
+                         "--surface-model condensed (the sector's unknowns only)")
 
 
 def check_options(args) -> None:
@@ -104,28 +105,126 @@ def check_options(args) -> None:
                          "--contacts surface")
 
 
+#: ``--surface-model``: the faces condensed onto their rigid inputs, the nodes marched in
+#: time inside each evaluation (CondensedSurfaceSectorHB; the default: it reaches UPD-24's
+#: default CF 120 N by the path in CF), or every node's DOFs as harmonic-balance unknowns
+#: (SurfaceSectorHB; its Newton needs a well-loaded damper, CF ~300 N on UPD-24).
+SURFACE_MODELS = ("condensed", "nodes")
+
+
 def sector_hb(sector, args):
-    """The sector with the damper's faces as contact surfaces (damper.upd_surface)."""
+    """The sector with the damper's faces as contact surfaces of ``args.surface_model``
+    (:data:`SURFACE_MODELS`) at ``args.cf``, and ``make(cf)``: the same model at another
+    centrifugal load [N] (the CF path's), on the same condensed surfaces."""
     from damper.cache import Store
-    from harmonic_balance.bladed_disk.surface_hb import SurfaceSectorHB, face_inputs
+    from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB, face_inputs
 
     face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
-    check_unknowns(sector, args.surface_nodes, args.harmonics, args.cf)
+    if args.surface_model == "nodes":   # the condensed model's unknowns are the sector's alone
+        check_unknowns(sector, args.surface_nodes, args.harmonics, args.cf)
     surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
-    hb = SurfaceSectorHB(sector, surfaces, args.harmonics, cf=args.cf, f0=args.f0)
+    kind = CondensedSurfaceSectorHB if args.surface_model == "condensed" else SurfaceSectorHB
+
+    def make(cf):
+        return kind(sector, surfaces, args.harmonics, cf=cf, f0=args.f0)
     args.surface_report = {face: {"nodes": s.n, "dofs": s.n_w, "nodes_per_side": args.surface_nodes}
                            for face, s in surfaces.items()}
-    return hb
+    return make(args.cf), make
+
+
+def surface_curve(sector, args, omegas):
+    """(hb, curve, truncation record, run record) of ``upd frf --contacts surface``.
+
+    The condensed model's first point comes from
+    :func:`harmonic_balance.bladed_disk.load_path.first_point` (the path in CF from the
+    open load where the CF is below it), the curve then continues from it as any
+    ``frf``. The run record: the model, its nodes, every residual evaluation (the path's
+    models' and the curve's; the truncation check's model counts its own), CPU and wall time
+    [s] of the whole, the truncation check's CPU time (a peak search at ceil(1.5 H): on
+    UPD-24 at H 1 it took longer than the curve), and the start.
+
+    Raises
+    ------
+    SolverError
+        The path, the start or the continuation failed (message says what to change).
+    """
+    import time
+
+    from damper import limits
+    from harmonic_balance.bladed_disk.accuracy import truncation_error
+    from harmonic_balance.bladed_disk.load_path import first_point
+    from harmonic_balance.bladed_disk.solve import SolverError, frf
+
+    t0, p0 = time.perf_counter(), time.process_time()
+    hb, make = sector_hb(sector, args)
+    built = [hb]
+
+    def counted(cf):
+        built.append(make(cf))
+        return built[-1]
+    start = {"method": "Newton from the stuck start at the CF"}
+    if args.surface_model == "condensed":
+        x0, path = first_point(counted, omegas[0], hb.cf)
+        start = {"method": "path in CF" if len(path["loads"]) > 1 else start["method"], **path}
+        c = frf(hb, omegas, x0=x0)
+    else:
+        try:
+            c = frf(hb, omegas)
+        except SolverError as err:   # the generic advice (band, harmonics) misses the load and the model
+            raise SolverError(f"{err}; the node-DOF surface model needs a well-loaded damper (UPD-24: CF "
+                              "300 N solved a curve at H 1, the default 120 N failed): use --surface-model "
+                              "condensed or a larger --cf") from None
+    p1 = time.process_time()
+    rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+    nodes = sum(r["nodes"] for r in args.surface_report.values())
+    run = {"model": args.surface_model, "nodes_per_side": args.surface_nodes, "nodes": nodes,
+           "evaluations": sum(m.evaluations for m in built), "start": start,
+           "truncation_check_cpu_s": time.process_time() - p1,
+           "cpu_s": time.process_time() - p0, "time_s": time.perf_counter() - t0}
+    return hb, c, rec, run
+
+
+def _condensed_faces(hb) -> list:
+    """(index in the model's elements, CondensedSurface) of each face of a condensed sector."""
+    from harmonic_balance.surface_condensed import CondensedSurface
+
+    return [(i, el) for i, el in enumerate(hb.model.elements) if isinstance(el, CondensedSurface)]
 
 
 def static_loads(hb) -> list:
-    """Prestress normal load per contact point [N]; with surfaces, per face (sum over its nodes)."""
+    """Prestress normal load per contact point [N]; with surfaces, per face (sum over its nodes;
+    condensed: the face's normal resultant, the same sum)."""
+    faces = _condensed_faces(hb)
+    if faces:   # (Q2) of harmonic_balance.surface_condensed at the prestress, approach row
+        return [float((el.RtAR @ el.q_static - el.RtA @ el.w_static)[0]) for _, el in faces]
     N = hb.static["N"]
     if not hasattr(hb, "surfaces"):
         return N.tolist()
     names = [e.name for e in hb.points]
     return [float(sum(n for n, name in zip(N, names) if name.startswith(f"{face} node")))
             for face in hb.surfaces]
+
+
+def condensed_summary(hb, x, omega: float) -> dict:
+    """Per face of a condensed sector at the solution x (omega [rad/s]): mean and range of
+    its normal resultant [N] (the sum over its nodes), the share of the period the whole
+    face is open (resultant <= 0: the nodes' own states stay inside the march), friction
+    energy per cycle of the marched loop [J]; refuses a damper that left both faces.
+    The zone-edge check needs each node's load: the node-DOF model's (``face_summary``)."""
+    lfs = hb.residual.evaluate(x, omega, jac=False)
+    out = {"names": [], "normal_load_mean": [], "normal_load_range": [], "lift_off": [],
+           "friction_energy": []}
+    for i, el in _condensed_faces(hb):
+        N = lfs[i].f[:, 0]
+        out["names"].append(el.name)
+        out["normal_load_mean"].append(float(N.mean()))
+        out["normal_load_range"].append(float(np.ptp(N)))
+        out["lift_off"].append(float((N <= 0.0).mean()))
+        out["friction_energy"].append(float(lfs[i].W - lfs[i].W_viscous))
+    if max(out["normal_load_mean"]) <= 0.0:
+        raise RuntimeError("the damper lost contact on both faces at the peak (no face carries a "
+                           "load): raise --cf or lower --f0")
+    return out
 
 
 def face_summary(hb, summ: dict) -> dict:

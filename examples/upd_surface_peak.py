@@ -43,7 +43,7 @@ import numpy as np
 
 from damper.cache import Store
 from damper.upd_surface import build_surfaces
-from harmonic_balance.bladed_disk import solve
+from harmonic_balance.bladed_disk import load_path, solve
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
@@ -108,16 +108,14 @@ def _bracket(neg, f0: float) -> tuple[float, float, float]:
 
 def cf_path(make, omega: float, cf: float, start_cf: float, steps: int = CF_STEPS):
     """A first solution at ``cf`` [N] reached from the stuck start at ``start_cf`` by
-    Newton at ``steps`` loads between them (log-spaced), each warm-started from the last:
-    where the stuck start does not converge (low CF: much of the faces slips).
-    ``make(cf)``: the model at that load."""
-    x = None
-    for c in np.geomspace(start_cf, cf, steps + 1):
-        hb = make(c)
-        x = solve.start_point(hb, omega) if x is None else solve.solve_point(hb, omega, x, max_iter=80)
+    Newton at ``steps`` loads between them (log-spaced), each warm-started from the last
+    (:func:`harmonic_balance.bladed_disk.load_path.cf_path`, the CLI's path): where the
+    stuck start does not converge (low CF: much of the faces slips). ``make(cf)``: the
+    model at that load."""
+    def report(c, hb, x):
         if VERBOSE:
             print(f"    CF {c:.1f} N at {omega / 2 / np.pi:.3f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
-    return x
+    return load_path.cf_path(make, omega, cf, start_cf, steps, max_iter=80, report=report)[0]
 
 
 def surface_peak(hb, f_guess: float, xtol: float = PEAK_XTOL, first=None) -> dict:

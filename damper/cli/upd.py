@@ -5,6 +5,7 @@ Examples::
     damper upd modes --json
     damper upd frf --cf 120 --f0 30 --harmonics 7 --band 400 500 --json --plot out/upd
     damper upd frf --damper stuck --json
+    damper upd frf --contacts surface --surface-nodes 5 --harmonics 1 --band 440 490 --points 5 --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
@@ -13,6 +14,8 @@ Examples::
 from __future__ import annotations
 
 import numpy as np
+
+from damper.upd_surface import SURFACE_MODELS
 
 from .common import accuracy_lines, upd_model_options, upd_response_options
 from .upd_mistuning import register as register_mistuning
@@ -75,19 +78,35 @@ def _contacts(p, surface: bool = False) -> None:
         p.add_argument("--surface-nodes", type=int, metavar="N",
                        help="with --contacts surface: contact-zone nodes per side of each face "
                        f"(5 .. 41; default {SURFACE_NODES})")
+        p.add_argument("--surface-model", choices=SURFACE_MODELS,
+                       help="with --contacts surface: condensed (default): the faces condensed onto "
+                       "their rigid inputs, the nodes marched in time in each evaluation, the first "
+                       "point reached by a path in CF from the load where the stuck damper keeps its "
+                       "faces closed (~1 s per evaluation at 5 nodes per side, ~2.5 s at 10); nodes: "
+                       "every node's DOFs as unknowns (needs a well-loaded damper, UPD-24: CF ~300 N)")
 
 
 #: Contact-zone nodes per side of each face with ``--contacts surface`` when not given.
 SURFACE_NODES = 5
 
 
+#: Surface model with ``--contacts surface`` when not given: the condensed one, which reaches
+#: the default CF (damper.upd_surface.SURFACE_MODELS).
+SURFACE_MODEL = SURFACE_MODELS[0]
+
+
 def check_surface_nodes(args) -> None:
-    """``--surface-nodes`` only with ``--contacts surface`` (refused otherwise); its default there."""
+    """``--surface-nodes`` and ``--surface-model`` only with ``--contacts surface`` (refused
+    otherwise); their defaults there."""
+    model = getattr(args, "surface_model", None)
     if args.contacts == "surface":
         args.surface_nodes = SURFACE_NODES if args.surface_nodes is None else args.surface_nodes
-    elif args.surface_nodes is not None:
-        raise ValueError(f"--surface-nodes goes with --contacts surface (got --contacts {args.contacts}): "
-                         "add --contacts surface or drop --surface-nodes")
+        args.surface_model = SURFACE_MODEL if model is None else model
+        return
+    for opt, value in (("--surface-nodes", args.surface_nodes), ("--surface-model", model)):
+        if value is not None:
+            raise ValueError(f"{opt} goes with --contacts surface (got --contacts {args.contacts}): "
+                             f"add --contacts surface or drop {opt}")
 
 
 def _sector(args):
@@ -160,6 +179,7 @@ def run_frf(args) -> int:
             out["steady_state"] = {"note": f"--damper {args.damper} is linear: one steady state"}
     out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
     out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
+    out |= {"surface_model": args.surface_run} if "surface_run" in args else {}
     out |= response_warnings(out)
     if args.plot:
         _plot_frf(out, args.plot)
@@ -176,6 +196,8 @@ def run_frf(args) -> int:
             print(f"warning: {out['warning']}")
         if out.get("zone_edge_warning"):
             print(out["zone_edge_warning"])
+        if "surface_model" in out:
+            print(surface_line(out["surface_model"]))
     from harmonic_balance.steady_state import summary_lines
 
     warnings = [out[k] for k in ("band_end_warning", "lift_off_warning") if out[k]]
@@ -183,6 +205,16 @@ def run_frf(args) -> int:
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
+
+
+def surface_line(run: dict) -> str:
+    """The printed line of ``upd frf --contacts surface``'s run record (its JSON ``surface_model``)."""
+    st = run["start"]
+    how = (f"first point by the path in CF {st['loads'][0]:.4g} -> {st['loads'][-1]:.4g} N "
+           f"({len(st['loads'])} loads)" if len(st.get("loads", ())) > 1 else "first point from the stuck start")
+    return (f"surface model {run['model']}, {run['nodes_per_side']} nodes per side ({run['nodes']} nodes): "
+            f"{run['evaluations']} evaluations, {run['cpu_s']:.1f} s CPU ({run['time_s']:.1f} s wall), of which "
+            f"the truncation check (a peak search at more harmonics) {run['truncation_check_cpu_s']:.1f} s CPU; {how}")
 
 
 def response_warnings(out: dict) -> dict:
@@ -228,20 +260,13 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     from harmonic_balance.accuracy import warning
     from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy, truncation_error
     from harmonic_balance.bladed_disk.hb import SectorHB
-    from harmonic_balance.bladed_disk.solve import SolverError, energy_balance, frf
+    from harmonic_balance.bladed_disk.solve import energy_balance, frf
     from harmonic_balance.bladed_disk.steady import annotate
 
     if args.contacts == "surface":
-        from damper.upd_surface import sector_hb
+        from damper.upd_surface import surface_curve
 
-        hb = sector_hb(sector, args)
-        try:
-            c = frf(hb, omegas)
-        except SolverError as err:   # the generic advice (band, harmonics) misses the load
-            raise SolverError(f"{err}; with --contacts surface the node-DOF sector needs a well-loaded damper "
-                              "(UPD-24: CF 300 N solved a curve at H 1 and 440 Hz at H 3; the default 120 N "
-                              "failed at its start at H 3 and at 429 Hz at H 1): try a larger --cf") from None
-        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
+        hb, c, rec, args.surface_run = surface_curve(sector, args, omegas)
     elif args.accuracy is None:
         hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
         c = frf(hb, omegas)
@@ -254,11 +279,7 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
                                       cf=args.cf, f0=args.f0)
         c.time_s = time.perf_counter() - t0
         c.extra["cpu_s"] = time.process_time() - p0   # the machine may be shared: CPU too
-    summ = hb.contact_summary(c.peak_x)
-    if args.contacts == "surface":
-        from damper.upd_surface import face_summary
-
-        summ = face_summary(hb, summ)
+    summ = _summary(hb, c, args)
     out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
             "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
             "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
@@ -282,6 +303,17 @@ def _frf_nonlinear(sector, args, omegas) -> dict:
     out |= annotate(hb, c, args.check_steady_state)
     out["time_s"] += out.get("steady_state", {}).get("time_s", 0.0)
     return out
+
+
+def _summary(hb, c, args) -> dict:
+    """The contacts' summary at the curve's peak: per point, or per face with surfaces."""
+    from damper import upd_surface
+
+    if args.contacts != "surface":
+        return hb.contact_summary(c.peak_x)
+    if args.surface_model == "condensed":
+        return upd_surface.condensed_summary(hb, c.peak_x, c.peak_omega)
+    return upd_surface.face_summary(hb, hb.contact_summary(c.peak_x))
 
 
 def _check_optimize(args) -> None:

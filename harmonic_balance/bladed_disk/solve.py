@@ -299,18 +299,22 @@ def energy_balance(hb: SectorHB, x: np.ndarray, omega: float) -> dict:
     projection; ``forces.harmonic_work``): W_struct = beta K_struct (the linear C and the
     rim element's dashpot), W_dashpot the contact dashpots (exact in harmonics), and
     W_friction the contacts' remaining harmonic work (friction, plus the normal springs'
-    AFT sampling error). W_friction_loops is the C core's area of the sampled friction
-    loops: it differs from W_friction by the AFT quadrature, O(n_t^-2).
+    AFT sampling error; a condensed surface's nodes likewise, from its marched resultants).
+    W_friction_loops is the C core's area of the sampled friction loops (a condensed
+    surface's: of its nodes' marched loops): it differs from W_friction by the AFT
+    quadrature, O(n_t^-2).
     """
     b, res = hb.basis, hb.residual
     X = x.reshape(hb.nb, hb.ndof)
     e = energy_per_cycle(hb.model, b, X, omega)
     lfs = res.evaluate(x, omega, jac=False)
     w_struct, w_dash, w_fric, w_loops = e["W_visc"], 0.0, 0.0, 0.0
+    from ..surface_condensed import CondensedSurface
+
     for el, lf in zip(res.elements, lfs):
         U = (el.kinematics.operators(b, res.dofs)[0] @ x).reshape(b.nb, el.m)
         w = harmonic_work(U, lf.F, b)
-        if isinstance(el, ContactElement):
+        if isinstance(el, (ContactElement, CondensedSurface)):   # a condensed face: its nodes' friction
             w_dash += lf.W_viscous
             w_fric += w - lf.W_viscous
             w_loops += lf.W - lf.W_viscous

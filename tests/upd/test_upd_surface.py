@@ -93,8 +93,8 @@ def test_unknowns_counted_before_condensing_are_the_surface_sectors(surfaces):
 
 @pytest.mark.parametrize("extra, words", [
     (["--surface-nodes", "3"], "surface nodes per side"),
-    (["--surface-nodes", "41", "--harmonics", "1"], "lower --surface-nodes or --harmonics"),
-    (["--harmonics", "50"], "lower --surface-nodes or --harmonics"),
+    (["--surface-model", "nodes", "--surface-nodes", "41", "--harmonics", "1"], "lower --surface-nodes or --harmonics"),
+    (["--surface-model", "nodes", "--harmonics", "50"], "or use --surface-model condensed"),
     (["--surface-nodes", "99"], "surface nodes per side"),
     (["--damper", "stuck"], "--damper nonlinear"),
     (["--accuracy", "0.01"], "drop --accuracy"),

@@ -57,3 +57,33 @@ def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path):
     assert "point_error" not in case
     row = ex.table([out]).splitlines()[2]
     assert "470.00 (fixed)" in row and row.split(" | ")[6].endswith(", -")
+
+
+#: Two Newton solutions of the same equations (|R| < solve.TOL_REL CF) reached by different
+#: paths in CF agree in amplitude far below this.
+SAME_SOLUTION_RTOL = 1e-6
+
+
+def test_the_examples_cf_path_reaches_the_solution_of_the_librarys_first_point(tmp_path):
+    """--start-cf runs the library's path (load_path.cf_path, 300 N -> 120 N in 2 steps); the
+    library's own start (from the open load) reaches the same solution at 400 Hz."""
+    from damper.cache import Store
+    from damper.upd_surface import build_surfaces
+    from harmonic_balance.bladed_disk import load_path
+    from harmonic_balance.bladed_disk.config import load_config
+    from harmonic_balance.bladed_disk.sector import Sector
+    from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
+
+    out = tmp_path / "path.json"
+    assert _example().main(["--quick", "--model", "condensed", "--cf", "120", "--start-cf", "300",
+                            "--cf-steps", "2", "--at", "400", "--json", str(out)]) == 0
+    amp = json.loads(out.read_text())["cases"][0]["surface"][0]["peak_amplitude_h1"]
+    cfg = load_config(None)
+    surfaces = build_surfaces(cfg, 5, 120.0, Store().prepare())
+    sector = Sector(cfg)
+
+    def make(c):
+        return CondensedSurfaceSectorHB(sector, surfaces, 1, cf=c)
+    x, rec = load_path.first_point(make, 2 * np.pi * 400.0, 120.0)
+    assert rec["loads"][0] == pytest.approx(rec["open_load"]) and rec["open_load"] > 300.0
+    assert amp == pytest.approx(make(120.0).amplitude_h1(x), rel=SAME_SOLUTION_RTOL)
