@@ -104,6 +104,8 @@ def spec_from_args(args):
                              f"{', '.join(_GEOMETRY_FLAGS[n] for n in bodies.get(args.body).required)})")
     if getattr(args, "height", None) is not None and args.body != "flat":
         raise ValueError(f"--height applies to the flat face only, not to --body {args.body}")
+    if getattr(args, "height", None) is not None and not args.height > 0:  # 0 is not the default height
+        raise ValueError(f"--height must be positive, got {args.height:g} (leave it out for max(W, L/2))")
     if args.p_design is not None and not (0 < args.p_design < float("inf")):
         raise ValueError(f"--p-design must be a positive finite pressure [Pa], got {args.p_design:g}")
     if args.force is not None and not args.force > 0:

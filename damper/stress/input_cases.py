@@ -88,6 +88,8 @@ def _normal() -> list[InputCase]:
         ("flat force 1e12", "--body flat --width 1.2e-3 --length 5e-3 --force 1e12 --grid 5"),
         ("radius 1e-300 (divided by zero)", "--body sphere --radius 1e-300 --force 100 --grid 5"),
         ("cylinder length 1e-300", "--body cylinder --radius 2.5e-3 --length 1e-300 --force 100 --grid 5"),
+        ("flat height 0 (not the default height)",
+         "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 0 --json"),
         ("flat height 1e-300", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 1e-300"),
         ("E 1e-300 (an infinite contact radius)", f"{SPHERE} --force 100 --grid 5 --E 1e-300"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
@@ -122,6 +124,8 @@ def _tangential() -> list[InputCase]:
         ("loop amplitude -1", f"{base} --mu 0.5 --loop-amplitude=-1"),
         ("loop amplitude nan", f"{base} --mu 0.5 --loop-amplitude nan"),
         ("loop amplitude 1e300 (hung)", f"{base} --mu 0.5 --loop-amplitude 1e300"),
+        ("loop amplitude 1e-18 (below the solve's tolerance: T 0 N)",
+         f"{base} --mu 0.5 --loop-amplitude 1e-18 --json"),
         ("flat, approach, eccentricity", "tangential --body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 "
                                          "--mu 0.5 --eccentricity 1e-4"),
         ("eccentricity on a sphere", f"{base} --mu 0.5 --eccentricity 1e-4"),

@@ -82,6 +82,32 @@ def test_loop_amplitude_far_beyond_gross_slip_is_refused_with_the_bound(capsys):
     assert bound == pytest.approx(MAX_LOOP_SLIPS * u_gross, rel=PRINTED)
 
 
+TANGENTIAL_BEM = ["tangential", "--body", "sphere", "--radius", str(R), "--force", "200", "--mu", "0.5",
+                  "--model", "bem", "--grid", "11", "--no-cache"]
+#: A loop far below the first slip of any node is the stuck line T = k_t u: round-off only.
+STUCK_LINE = 1e-9
+
+
+def test_loop_amplitude_below_the_solve_tolerance_is_refused_with_the_bound(capsys):
+    """1e-18 m printed a force amplitude of exactly 0 N (the motion was below the solve's tolerance)."""
+    from damper.limits import MIN_LOOP_SLIPS
+
+    err = _refused([*TANGENTIAL_BEM, "--loop-amplitude", "1e-18"], capsys)
+    u_gross, bound = (float(v) for v in re.search(r"displacement ([0-9.e+-]+) m.*at least ([0-9.e+-]+) m",
+                                                   err).groups())
+    assert bound == pytest.approx(MIN_LOOP_SLIPS * u_gross, rel=PRINTED)
+
+
+def test_the_smallest_loop_amplitude_follows_the_stuck_line(capsys):
+    from damper.limits import MIN_LOOP_SLIPS
+
+    u_slip = bodies.Sphere().tangential_reference(_steel_sphere(), 200.0, 0.5)["mindlin"]["u_slip"]
+    a = 1.1 * MIN_LOOP_SLIPS * u_slip  # u_slip of the bem model is within MINDLIN_BEM11 of Mindlin's
+    assert damper([*TANGENTIAL_BEM, "--loop-amplitude", f"{a:.6g}", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["loop"]["T_amplitude"] == pytest.approx(out["k_t"] * float(f"{a:.6g}"), rel=STUCK_LINE)
+
+
 def _steel_sphere():
     from contact_core.spec import ContactSpec
 
