@@ -91,6 +91,8 @@ def _normal() -> list[InputCase]:
         ("flat height 0 (not the default height)",
          "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 0 --json"),
         ("flat height 1e-300", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 1e-300"),
+        ("E2 2e5 against a steel sphere (the default design zone 164 m wide)",
+         f"{SPHERE} --force 0.05 --grid 5 --E2 2e5 --json"),
         ("E 1e-300 (an infinite contact radius)", f"{SPHERE} --force 100 --grid 5 --E 1e-300"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
         ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),

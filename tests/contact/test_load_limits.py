@@ -110,3 +110,13 @@ def test_the_largest_fe_poisson_ratio_keeps_the_approach_near_hertz():
     sol = api.solve(condense.condense(spec, cache=False), force=100.0)
     ref = hertz.sphere(100.0, 0.01, hertz.contact_modulus(200e9, nu, 200e9, nu))
     assert sol.q[0] == pytest.approx(ref["approach"], rel=LOCKING_RTOL)
+
+
+def test_a_design_pressure_too_high_for_soft_materials_names_the_largest_accepted(capsys):
+    """A plane 1e6 times softer than the steel sphere: the default 2000 MPa zone is 164 m wide."""
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--E2", "2e5", "--force", "0.05",
+                   "--grid", "5", "--no-cache"]) == 2
+    err = capsys.readouterr().err
+    p_max = float(re.search(r"--p-design of at most ([0-9.e+-]+) Pa", err).group(1))
+    spec = ContactSpec(body="sphere", radius=0.01, E2=2e5, grid=5, p_design=p_max)
+    assert spec.zone()[0] / spec.zone_margin == pytest.approx(bodies.MAX_CONTACT_SHARE * 0.01, rel=1e-2)
