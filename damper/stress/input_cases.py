@@ -219,6 +219,7 @@ def _frf() -> list[InputCase]:
         ("slip force -1", SDOF.replace("--slip-force 0.05", "--slip-force=-1") + f" {o}"),
         ("force 1e200", SDOF.replace("--force 0.05", "--force 1e200") + f" {o}"),
         ("stiffness 1e300", SDOF.replace("--stiffness 1", "--stiffness 1e300") + f" {o}"),
+        ("mass 1e-160 (natural frequency 1e80 rad/s)", SDOF.replace("--mass 1", "--mass 1e-160") + f" {o}"),
         ("sdof with --elements", f"{SDOF} {o} --elements {{fx}}/el_good.toml"),
         ("sdof with --force-scale", f"{SDOF} {o} --force-scale 2"),
         ("sdof response DOF 3", f"{SDOF} {o} --response-dof 3"),
@@ -235,7 +236,7 @@ def _frf() -> list[InputCase]:
         ("accuracy -0.01", f"{SDOF} {o} --accuracy=-0.01"),
     ]
     for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc",
-              "complex"):
+              "complex", "negC", "negK", "0x0", "Mhuge", "Mtiny"):
         rows.append((f"npz {m}", f"--model {{fx}}/m_{m}.npz --elements {{fx}}/el_good.toml --omega 100 300"))
     for e in ("wobble", "scael", "top", "badtoml", "binary", "none", "dof9", "nok", "type", "path", "negk",
               "dofstr", "same", "contact"):
@@ -252,6 +253,7 @@ def _backbone() -> list[InputCase]:
         ("mode 5 of one DOF", f"{SDOF} {a} --mode 5"),
         ("accuracy 0.5", f"{SDOF} {a} --accuracy 0.5"), ("accuracy 1e-7", f"{SDOF} {a} --accuracy 1e-7"),
         ("npz M = -I", "--model {fx}/m_negM.npz --elements {fx}/el_good.toml " + a),
+        ("npz C negative definite", "--model {fx}/m_negC.npz --elements {fx}/el_good.toml " + a),
         ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
         ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),
         ("npz complex K", "--model {fx}/m_complex.npz --elements {fx}/el_good.toml " + a),

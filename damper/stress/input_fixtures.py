@@ -73,7 +73,10 @@ def matrices() -> dict[str, bytes]:
             "m_cnan.npz": _npz(M=M, K=K, C=np.full((2, 2), np.inf), force=f),
             "m_text.npz": b"M = [[1, 0], [0, 1]]\n", "m_empty.npz": b"",
             "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200],
-            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f)}
+            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f),
+            "m_negC.npz": _npz(M=M, K=K, C=-C, force=f), "m_negK.npz": _npz(M=M, K=-K, C=C, force=f),
+            "m_0x0.npz": _npz(M=np.zeros((0, 0)), K=np.zeros((0, 0)), force=np.zeros(0)),
+            "m_Mhuge.npz": _npz(M=1e300 * M, K=K, C=C, force=f), "m_Mtiny.npz": _npz(M=1e-300 * M, K=K, C=C, force=f)}
 
 
 def elements() -> dict[str, str | bytes]:

@@ -157,3 +157,33 @@ def test_stability_modes(capsys):
     assert every["stability_checks"] == every["points"] == auto["points"]
     assert 2 <= auto["stability_checks"] < auto["points"] and auto["stable"] == every["stable"]
     assert off["stable"] is None and off["stability_checks"] == 0
+
+
+def _two_dof_with(tmp_path, **changes):
+    write_two_dof(tmp_path)
+    with np.load(tmp_path / "m.npz") as z:
+        arrays = dict(z)
+    np.savez(tmp_path / "m.npz", **(arrays | {k: f(arrays) for k, f in changes.items()}))
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"C": lambda a: -a["C"]}, "C must be positive semi-definite"),   # accepted: an unstable "steady state"
+    ({"K": lambda a: -a["K"]}, "K must be positive semi-definite"),   # exit 3, "undamped resonance"
+    ({"M": lambda a: 1e-300 * a["M"]}, "K over M"),                   # NaN inside the element
+    ({"M": lambda a: 1e300 * a["M"]}, "M has an entry of magnitude"),  # overflow, exit 3
+])
+def test_a_matrix_that_is_no_structure_is_refused_with_what_is_wrong(tmp_path, capsys, change, words):
+    _two_dof_with(tmp_path, **change)
+    code = main(["frf", "--model", str(tmp_path / "m.npz"), "--elements", str(tmp_path / "e.toml"),
+                 "--omega", "0.6", "2.0", "--json"])
+    cap = capsys.readouterr()
+    assert code == 2 and no_result(cap.out, cap.err, 2)
+    assert words in cap.err and len(cap.err.splitlines()) == 1
+
+
+def test_a_positive_semi_definite_damping_passes_the_structure_check():
+    """C of rank one (a single dashpot) and K singular (a free body held by its elements): a structure."""
+    from harmonic_balance.model import check_scales
+
+    K = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    check_scales(np.eye(2), K, 0.01 * K)
