@@ -190,12 +190,15 @@ def run(args) -> int:
                              stability=args.stability, accuracy=args.accuracy,
                              max_harmonic=limits.MAX_HARMONICS,
                              steady_state_check=args.check_steady_state)
+        check_peak_not_at_a_gap(result, FRFError)
     except FRFError as err:
         _emit(args, err.result.summary(), print_json, atomic_write, dumps)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
-        if err.result.points >= args.max_points:   # stopped by the point limit
+        if getattr(err, "hint", None):
+            hint = err.hint
+        elif err.result.points >= args.max_points:   # stopped by the point limit
             hint = "raise --max-points, or a larger --tolerance takes fewer points"
         else:
             hint = "try fewer --harmonics, a narrower --omega range or a smaller --tolerance"
@@ -207,6 +210,23 @@ def run(args) -> int:
         plot_frf(result, args.plot)
     _emit(args, summary, print_json, atomic_write, dumps)
     return 0
+
+
+def check_peak_not_at_a_gap(result, error) -> None:
+    """Raise ``error`` (FRFError) when the highest peak lies at a stretch the continuation
+    jumped (its corrector stalled and a homotopy restarted past it): the peak there is not
+    resolved, and the response may grow without bound (a resonance without viscous damping
+    whose friction cannot bound it, as Den Hartog's: sdof, c = 0, slip force 0.01 against a
+    force 0.05 printed a peak of 1.4e5 m as a complete curve)."""
+    p = result.peak_omega
+    for a, b in result.extra.get("gaps") or ():
+        if p is not None and a - (b - a) <= p <= b + (b - a):  # within a gap's width of it
+            result.status = (f"the peak at omega {p:.6g} rad/s lies at a stretch the corrector could not "
+                             f"trace (no points in omega {a:.6g}-{b:.6g}): the response may grow without bound "
+                             "there (a resonance with too little damping)")
+            err = error(result.status, result)
+            err.hint = "add damping (C) or a larger slip force, or leave that frequency out of --omega"
+            raise err
 
 
 def check_samples(samples: int) -> None:

@@ -219,6 +219,12 @@ def _frf() -> list[InputCase]:
         ("slip force -1", SDOF.replace("--slip-force 0.05", "--slip-force=-1") + f" {o}"),
         ("force 1e200", SDOF.replace("--force 0.05", "--force 1e200") + f" {o}"),
         ("stiffness 1e300", SDOF.replace("--stiffness 1", "--stiffness 1e300") + f" {o}"),
+        ("damping 0, slip force 0 (an undamped linear resonance)",
+         SDOF.replace("--damping 0.01", "--damping 0").replace("--slip-force 0.05", "--slip-force 0")
+         + " --omega 0.9 1.6 --json"),
+        ("damping 0, slip force 0.01 (friction cannot bound the resonance)",
+         SDOF.replace("--damping 0.01", "--damping 0").replace("--slip-force 0.05", "--slip-force 0.01")
+         + " --omega 0.9 1.6"),
         ("mass 1e-160 (natural frequency 1e80 rad/s)", SDOF.replace("--mass 1", "--mass 1e-160") + f" {o}"),
         ("sdof with --elements", f"{SDOF} {o} --elements {{fx}}/el_good.toml"),
         ("sdof with --force-scale", f"{SDOF} {o} --force-scale 2"),

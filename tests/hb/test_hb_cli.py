@@ -187,3 +187,17 @@ def test_a_positive_semi_definite_damping_passes_the_structure_check():
 
     K = np.array([[1.0, -1.0], [-1.0, 1.0]])
     check_scales(np.eye(2), K, 0.01 * K)
+
+
+@pytest.mark.parametrize("slip_force, bounded", [(0.01, False), (0.05, True)])
+def test_an_undamped_resonance_that_friction_cannot_bound_is_a_failure_not_a_peak(capsys, slip_force, bounded):
+    """No viscous damping: a Jenkins link bounds the resonance at omega = 1 rad/s only when its
+    dissipation per cycle 4 fs a outgrows the excitation's work pi P a (Den Hartog), fs > pi P / 4
+    = 0.039 N here. The unbounded one printed a peak of 1.4e5 m as a complete curve."""
+    argv = [a for a in SDOF]
+    argv[argv.index("--damping") + 1] = "0"
+    argv[argv.index("--slip-force") + 1] = str(slip_force)
+    assert (slip_force > np.pi * 0.05 / 4) == bounded
+    code, out = run_json(capsys, argv + ["--harmonics", "3", "--omega", "0.9", "1.6", "--json"])
+    assert code == (0 if bounded else 3)
+    assert ("grow without bound" in out["status"]) != bounded
