@@ -144,7 +144,7 @@ def _tangential() -> list[InputCase]:
 def _loop() -> list[InputCase]:
     a = "--amplitude 2e-6"
     rows = [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json {a}") for kind in
-            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip")]
+            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip", "steep")]
     return _table("loop", rows + [
         ("curve missing", f"--curve {{fx}}/nowhere.json {a}"), ("curve is a folder", f"--curve {{fx}} {a}"),
         ("amplitude 1e10", "--curve {fx}/curve.json --amplitude 1e10"),
@@ -174,6 +174,8 @@ def _fmu() -> list[InputCase]:
     return _table("fmu", [
         ("curve binary", "--curve {fx}/curve_binary.json -o d.fmu"), ("curve missing", "--curve {fx}/no.json -o d.fmu"),
         ("curve convex", "--curve {fx}/curve_convex.json -o d.fmu"), ("no output", "--curve {fx}/curve.json"),
+        *[(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu --json")
+          for kind in ("empty", "one", "nan", "dip", "decreasing", "steep")],
         ("-o an existing folder", "--curve {fx}/curve.json -o {fx}"),
         ("-o below a file", "--curve {fx}/curve.json -o {fx}/a_file/d.fmu"),
         ("n-ref 0", "--curve {fx}/curve.json -o d.fmu --n-ref 0"),

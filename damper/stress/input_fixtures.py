@@ -40,6 +40,7 @@ def curves() -> dict[str, str | bytes]:
             "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
             "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
             "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")}),
+            "curve_steep.json": json.dumps(dict(good, u=[1e-300 * x for x in good["u"]], k_t=None)),
             "normal_120.json": json.dumps(_normal_curve(120.0))}
 
 
