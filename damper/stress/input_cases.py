@@ -485,7 +485,7 @@ def _typed() -> list[InputCase]:
     for kind in ("mutrue", "Tstr", "wobble", "plateau", "huge"):
         cases += _table("loop", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json --amplitude 2e-6")], "loop")
         cases += _table("fmu", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu")], "fmu")
-    for kind in ("wobble", "Nstr"):
+    for kind in ("wobble", "Nstr", "steep"):
         cases += _table("fmu", [(f"point: normal curve {kind}",
                                  f"--curve {{fx}}/curve.json -o d.fmu --normal {{fx}}/normal_{kind}.json")], "fmu")
     for kind in ("mutrue", "mdstr", "band3", "bandnan", "blades"):

@@ -297,6 +297,7 @@ def typed_files() -> dict[str, str | bytes]:
            "normal_good.json": json.dumps(normal),
            "normal_wobble.json": json.dumps(dict(normal, wobble=3)),
            "normal_Nstr.json": json.dumps(dict(normal, N=["0", "50", "140"])),
+           "normal_steep.json": json.dumps(dict(normal, approach=[0.0, 1e-306, 2e-306])),
            "upd_mutrue.toml": "[damper]\nmu = true\n", "upd_mdstr.toml": '[damper]\nm_d = "0.005"\n',
            "upd_band3.toml": "[load]\nband_hz = [400.0, 450.0, 500.0]\n",
            "upd_bandnan.toml": "[load]\nband_hz = [nan, 500.0]\n",

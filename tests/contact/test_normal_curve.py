@@ -64,3 +64,12 @@ def test_cli_without_a_curve_writes_nothing(tmp_path, capsys, monkeypatch):
                  "--normal-curve", str(out)])
     assert rc == 2 and "F-approach curve" in capsys.readouterr().err
     assert not out.exists() and not res.exists()
+
+
+def test_a_normal_curve_stiffer_than_any_contact_is_refused_as_a_unit_error():
+    from contact_core.curve import MAX_STIFFNESS
+    from contact_core.normal_curve import check_normal_table
+
+    with pytest.raises(ValueError, match="points 1-2: a stiffness of .* N/m, above"):
+        check_normal_table(np.array([0.0, 1e-6, 1e-6 * (1 + 1e-12)]), np.array([0.0, 50.0, 140.0]))
+    check_normal_table(np.array([0.0, 1e-6, 2e-6]), np.array([0.0, 50.0, 50.0 + 1e-6 * MAX_STIFFNESS]))
