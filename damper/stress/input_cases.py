@@ -369,6 +369,7 @@ def _system() -> list[InputCase]:
     ]) + [_case("system", name, f"cosim r.ssp {cmd}", pre=[shlex.split("system --cf 120 --f0 30 -o r.ssp")],
                 timeout=120.0) for name, cmd in (
         ("cosim frequency 1e-300", "--frequency-hz 1e-300"),
+        ("cosim tol 10 (settled after 5 periods, 15 % off)", "--frequency-hz 448 --tol 10 --json"),
         ("cosim periods 1e12", "--frequency-hz 448 --periods 1000000000000"),
         ("cosim 1.2e8 steps", "--frequency-hz 448 --periods 50000"),
         ("cosim a diverging coupling (--force, 13 x the step limit)",
