@@ -359,6 +359,7 @@ def _system() -> list[InputCase]:
         ("system frequency 1e300", "system --frequency-hz 1e300 -o r.ssp"),
         ("system geometry contacts at CF 1e-300 (hung)", "system --contacts geometry --cf 1e-300 -o r.ssp"),
         ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system cf 1e-3 (a damper without load)", "system --cf 1e-3 -o r.ssp --json"),
         ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
         ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
         ("system frequency -1", "system --frequency-hz=-1 -o r.ssp"),
