@@ -151,11 +151,15 @@ class NormalCurve:
         curve = result.get("curve")
         if not curve or not curve.get("force"):
             raise ValueError("the normal solution has no F-approach curve (pass --curve N > 0)")
+        load = float(result["force"])
+        if not abs(curve["force"][-1] - load) <= 1e-9 * load:  # one point was 5 % of the load only
+            raise ValueError(f"the F-approach curve ends at {curve['force'][-1]:.4g} N, not at the load {load:.4g} N: "
+                             "a normal law up to the load needs a curve to it (--curve 2 or more)")
         p = np.concatenate([[0.0], curve["approach"]])
         N = np.concatenate([[0.0], curve["force"]])
         k_n = np.concatenate([[curve["k_n"][0]], curve["k_n"]])
         meta = result.get("meta", {})
-        return cls(p, N, float(result["force"]), k_n, geometry=meta.get("spec", {}),
+        return cls(p, N, load, k_n, geometry=meta.get("spec", {}),
                    provenance={"command": "damper normal"})
 
 

@@ -283,6 +283,9 @@ def check_options(args) -> None:
                              "these options shape generated bodies only")
     if args.eccentricity is not None and args.force is None:
         raise ValueError("--eccentricity places the normal force: it needs --force, not --approach")
+    if args.curve == 1:  # one point is 5 % of the load: a curve (and --normal-curve) that stops short
+        raise ValueError("--curve 1: the F-approach curve runs from 5 % to 100 % of the load, so it needs at "
+                         "least 2 points (0: no curve)")
     if args.curve:
         limits.check_size("--curve", args.curve, 0, limits.MAX_APPROACH_POINTS,
                           "each point of the F-approach curve is a normal solve")

@@ -97,6 +97,8 @@ def _normal() -> list[InputCase]:
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
         ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),
         ("curve 1e6 points", f"{SPHERE} --force 100 --curve 1000000"), ("curve -1", f"{SPHERE} --force 100 --curve=-1"),
+        ("curve 1 (a normal curve to 5 % of the load)",
+         f"{SPHERE} --force 100 --grid 5 --curve 1 --normal-curve n.json"),
         ("length on a sphere", f"{SPHERE} --force 100 --length 1e-3"),
         ("cylinder without length", "--body cylinder --radius 2.5e-3 --force 100"),
         ("p-design 0", f"{SPHERE} --force 100 --p-design 0"), ("body cube", "--body cube --radius 0.01 --force 1"),
