@@ -147,10 +147,20 @@ def _check_approach_floor(spec, approach: float) -> None:
 
 def _check_flat_load(spec, force, approach) -> None:
     """A flat face's mean pressure (force) or mean strain (approach / the face's smaller
-    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*): linear elasticity."""
-    from damper.limits import MAX_CONTACT_STRAIN
+    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*: linear elasticity) and at
+    least ``MIN_CONTACT_STRAIN`` (double precision)."""
+    from damper.limits import MAX_CONTACT_STRAIN, MIN_CONTACT_STRAIN
 
     side = min(spec.width, spec.length)
+    f_min = MIN_CONTACT_STRAIN * spec.Estar * spec.width * spec.length
+    if approach is not None and approach < MIN_CONTACT_STRAIN * side:
+        raise ValueError(f"--approach {approach:g} m is below {MIN_CONTACT_STRAIN:g} of the face's smaller side "
+                         f"({side:.3g} m), where the contact forces leave double precision; give at least "
+                         f"{MIN_CONTACT_STRAIN * side:.3g} m")
+    if force is not None and force < f_min:
+        raise ValueError(f"--force {force:g} N gives a mean pressure below {MIN_CONTACT_STRAIN:g} E* on the "
+                         f"{spec.width:.3g} x {spec.length:.3g} m face, where the contact forces leave double "
+                         f"precision; give at least {f_min:.4g} N")
     if approach is not None and approach > MAX_CONTACT_STRAIN * side:
         raise ValueError(f"--approach {approach:g} m is above {MAX_CONTACT_STRAIN:g} of the face's smaller side "
                          f"({side:.3g} m): beyond the small strains of the linear-elastic model; give at most "

@@ -86,6 +86,7 @@ def _normal() -> list[InputCase]:
         ("cylinder approach 5e-324", "--body cylinder --radius 2.5e-3 --length 1.2e-3 --approach 5e-324 --grid 5"),
         ("flat approach 1", "--body flat --width 1.2e-3 --length 5e-3 --approach 1 --grid 5"),
         ("flat force 1e12", "--body flat --width 1.2e-3 --length 5e-3 --force 1e12 --grid 5"),
+        ("flat approach 5e-324 (a subnormal force)", "--body flat --width 1.2e-3 --length 5e-3 --approach 5e-324"),
         ("radius 1e-300 (divided by zero)", "--body sphere --radius 1e-300 --force 100 --grid 5"),
         ("cylinder length 1e-300", "--body cylinder --radius 2.5e-3 --length 1e-300 --force 100 --grid 5"),
         ("flat height 0 (not the default height)",

@@ -64,6 +64,15 @@ def test_flat_face_load_beyond_small_strain_is_refused_with_the_bound(load, caps
     assert f"{MAX_CONTACT_STRAIN:g}" in err and "give at most" in err
 
 
+@pytest.mark.parametrize("load", [["--approach", "5e-324"], ["--force", "1e-300"]])
+def test_flat_face_load_below_double_precision_is_refused_with_the_bound(load, capsys):
+    """5e-324 m gave a force 1.9 times k_n times the approach (subnormal numbers)."""
+    from damper.limits import MIN_CONTACT_STRAIN
+
+    err = _refused([*FLAT, *load], capsys)
+    assert f"{MIN_CONTACT_STRAIN:g}" in err and "give at least" in err
+
+
 #: Gross-slip displacement of the bem model on 11 nodes against Mindlin's closed form
 #: (3 mu N / (16 G* a)): measured 0.1 %.
 MINDLIN_BEM11 = 0.02
