@@ -192,7 +192,8 @@ def run(args) -> int:
                              steady_state_check=args.check_steady_state)
         check_peak_not_at_a_gap(result, FRFError)
     except FRFError as err:
-        _emit(args, err.result.summary(), print_json, atomic_write, dumps)
+        # the partial result on stdout; stderr keeps one line, the failure's (its warnings are in the JSON)
+        _emit(args, err.result.summary(), print_json, atomic_write, dumps, warn=False)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
@@ -295,7 +296,7 @@ def _report_curve_fits(model) -> None:
                   f"limit; largest force error of the fit {err:.3g} N", file=sys.stderr)
 
 
-def _emit(args, summary, print_json, atomic_write, dumps):
+def _emit(args, summary, print_json, atomic_write, dumps, warn: bool = True):
     from harmonic_balance.frf_accuracy import summary_lines as accuracy_lines
     from harmonic_balance.steady_state import summary_lines as state_lines
 
@@ -304,7 +305,7 @@ def _emit(args, summary, print_json, atomic_write, dumps):
     if args.json:
         print_json(summary)
         for line in accuracy_lines(summary)[1:] + state_lines(summary.get("steady_state"))[1:]:
-            if line.startswith("warning"):
+            if warn and line.startswith("warning"):
                 import sys
 
                 print(line, file=sys.stderr)
