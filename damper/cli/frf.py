@@ -123,6 +123,8 @@ def _dest(flag: str) -> str:
 
 def check_model_arguments(args) -> None:
     """Refuse, before any work, options that do not apply to the model (and fill the sdof defaults)."""
+    import os
+
     from damper import limits
 
     if args.model == "sdof":
@@ -141,6 +143,8 @@ def check_model_arguments(args) -> None:
                 raise ValueError(f"{flag} {v:g} is beyond the limit {limits.MAX_MAGNITUDE:g}: the harmonic "
                                  "balance squares forces and displacements, which overflows above ~1e154")
         return
+    if not os.path.exists(args.model):  # a misspelt 'sdof' is not "a .npz model without --elements"
+        raise ValueError(f"--model {args.model}: no such file; give 'sdof' or a .npz model file")
     given = [flag for flag in SDOF if getattr(args, _dest(flag)) is not None]
     if given:
         raise ValueError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to --model sdof only; "

@@ -237,6 +237,7 @@ def _frf() -> list[InputCase]:
         ("npz with --mass", f"{NPZ} --mass 5 --omega 100 300"),
         ("npz without --elements", "--model {fx}/m_good.npz --omega 100 300"),
         ("npz missing", "--model {fx}/nowhere.npz --elements {fx}/el_good.toml --omega 100 300"),
+        ("model SDOF (not sdof, no such file)", "--model SDOF --omega 1 2 --json"),
         ("npz response DOF 99", f"{NPZ} --response-dof 99 --omega 100 300"),
         ("npz force-scale inf", f"{NPZ} --force-scale inf --omega 100 300"),
         ("--out an existing folder", f"{SDOF} {o} --out {{fx}}"),
