@@ -244,6 +244,10 @@ def run(args) -> int:
         from contact_core import byo
         result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,
                                     args.approach, cache)
+        if result["zone_edge_in_contact"]:  # as for generated bodies (contact_core.api.run_normal)
+            raise ValueError("the contact reaches the edge of the imported bodies' contact nodes: they do not "
+                             "hold the contact at this load; give a smaller load, or bodies whose contact nodes "
+                             "cover a larger zone (or check the stiffness units)")
     else:
         points = args.curve or (NORMAL_CURVE_POINTS if args.normal_curve else (8 if args.plot else 0))
         result = api.run_normal(spec, force=args.force, approach=args.approach,

@@ -344,11 +344,32 @@ def archives() -> dict[str, bytes]:
     return {"ring_nofmu.ssp": _ring_archive(_ring_info(), ssd)}
 
 
+def imported_bodies() -> dict[str, bytes]:
+    """Bodies for ``damper normal --stiffness/--nodes``: the half-space model's flat blocks
+    (a sphere's curvature in its gap, none in the coordinates), a flat punch in contact
+    over every node."""
+    import tempfile
+
+    from contact_core import assembly, byo, mesh
+    from contact_core.spec import ContactSpec
+
+    spec = ContactSpec(body="sphere", model="halfspace", grid=3)
+    b1, b2, meta = mesh.build(spec)
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, body in ((1, b1), (2, b2)):
+            k, n = Path(tmp) / f"byo_K{i}.npz", Path(tmp) / f"byo_n{i}.npz"
+            byo.export_body(body, assembly.stiffness(body.p, body.t, spec.E1, spec.nu1), k, n,
+                            symmetry=meta["symmetry"])
+            out |= {k.name: k.read_bytes(), n.name: n.read_bytes()}
+    return out
+
+
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
     for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives(),
-                  forged_archives()):
+                  forged_archives(), imported_bodies()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):
