@@ -111,7 +111,7 @@ def _normal() -> list[InputCase]:
         ("stiffness without nodes", "--body sphere --force 100 --stiffness {fx}/m_good.npz {fx}/m_good.npz"),
         ("stiffness with radius", f"{SPHERE} --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz "
                                   "--nodes {fx}/m_good.npz {fx}/m_good.npz"),
-        ("imported flat blocks (a flat punch: contact over every node)", "--body sphere --force 100 --json "
+        ("imported flat blocks (a flat punch: contact over every node)", "--body sphere --force 100 --no-cache "
          "--stiffness {fx}/byo_K1.npz {fx}/byo_K2.npz --nodes {fx}/byo_n1.npz {fx}/byo_n2.npz"),
         ("stiffness files not matrices", "--body sphere --force 100 --stiffness {fx}/binary.bin {fx}/binary.bin "
                                          "--nodes {fx}/binary.bin {fx}/binary.bin"),
