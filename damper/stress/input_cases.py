@@ -430,6 +430,8 @@ def _sweep() -> list[InputCase]:
         ("range not numbers", f"{s} --param contact.damper.mu --range a b c --serial"),
         ("range nan", f"{s} --param contact.damper.mu --range nan 1 3 --serial"),
         ("values without param", f"{s} --values 1 2 --serial"), ("param without values", f"{s} {p} --serial"),
+        ("a value given twice", f"{s} {p} --values 30 30 --serial --json"),
+        ("range of one value three times", f"{s} {p} --range 30 30 3 --serial"),
         ("a second range for one param", f"{s} {p} --values 30 --range 10 20 3 --serial"),
         ("unknown param", f"{s} --param contact.damper.colour --values 1 --serial"),
         ("a value of the wrong type", f"{s} {p} --values high --serial"),
