@@ -322,5 +322,5 @@ def _print_text(r: dict) -> None:
         from contact_core.bodies import MIN_NODES_ACROSS
 
         print(f"warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid spacings "
-              "(radius or half-width), so its size and peak pressure are rough; lower --p-design "
-              "(the potential zone is sized for that peak pressure) or refine --grid")
+              "(radius or half-width), so its size, peak pressure, approach and k_n are rough (grid 3: k_n 54 % "
+              "below Hertz); lower --p-design (the potential zone is sized for that peak pressure) or refine --grid")
