@@ -114,6 +114,12 @@ def _positive(name: str, value: float) -> None:
                          "of a friction damper is millimetres to centimetres)")
 
 
+def _floor3(x: float) -> float:
+    """``x`` > 0 rounded down to three significant digits."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.floor(x / step) * step
+
+
 class Body:
     """Base class of a body kind; subclasses override what their geometry changes.
 
@@ -239,9 +245,13 @@ class Sphere(Body):
             self.check_load(spec, spec.load_hint)
         zx, _ = self.zone(spec)
         if zx >= MAX_CONTACT_SHARE * spec.zone_margin * spec.radius * 1.0000001:
+            # a = pi R p0 / (2 E*) at a = MAX_CONTACT_SHARE R
+            p_max = 2.0 * spec.Estar * MAX_CONTACT_SHARE / math.pi
+            p_max = _floor3(p_max)  # printed, then typed back: never rounded up past the limit
             raise ValueError(f"the potential contact zone (half-width {zx:.3g} m, sized for the design "
                              f"pressure {spec.p_design:.3g} Pa) is too large for a sphere of radius "
-                             f"{spec.radius:.3g} m: lower --p-design")
+                             f"{spec.radius:.3g} m: give a --p-design of at most {p_max:.3g} Pa (the Hertz peak "
+                             f"pressure of a contact radius of {MAX_CONTACT_SHARE:g} R for these materials)")
 
     def check_load(self, spec, force):
         """Refuse a force whose Hertz contact radius is outside [MIN_CONTACT_SHARE,

@@ -66,7 +66,8 @@ MAX_DISPLACEMENT = 1.0
 #: Largest |T| and N of a curve file [N]: far above any contact of a machine (1 GN), far
 #: below where the harmonic balance's squares of forces overflow (~1e154).
 MAX_FORCE = 1e9
-#: Largest stiffness k_t, k_n of a curve file [N/m] (a steel contact is ~1e8-1e9).
+#: Largest stiffness k_t, k_n of a curve file, and slope of its table [N/m] (a steel
+#: contact is ~1e8-1e9).
 MAX_STIFFNESS = 1e16
 #: Largest friction coefficient: dry contacts have mu below a few; beyond 100 it is a typo.
 MAX_MU = 100.0
@@ -118,6 +119,7 @@ class VirginCurve:
         u = np.array(self.u, dtype=float)
         T = np.array(self.T, dtype=float)
         check_table(u, T)
+        check_slopes(u, T)
         u.setflags(write=False)
         T.setflags(write=False)
         object.__setattr__(self, "u", u)
@@ -261,6 +263,17 @@ def check_table(u: np.ndarray, T: np.ndarray) -> None:
     bad = np.flatnonzero(T < 0.0)
     if bad.size:
         raise ValueError(f"curve: point {bad[0]}: T = {float(T[bad[0]])!r} is negative (T must be non-negative)")
+
+
+def check_slopes(u: np.ndarray, T: np.ndarray) -> None:
+    """Raise ValueError when a segment of a checked table (SI units) is steeper than
+    :data:`MAX_STIFFNESS`: a unit error (u scaled by 1e-300 gave slopes of 6e307 N/m and an
+    element whose input bound was 1e-297 m). The element itself takes any units."""
+    slope = np.abs(np.diff(T)) / np.diff(u)
+    i = int(np.argmax(slope))
+    if slope[i] > MAX_STIFFNESS:
+        raise ValueError(f"curve: points {i}-{i + 1}: a slope of {float(slope[i]):.3g} N/m, above {MAX_STIFFNESS:g} "
+                         "N/m (a steel contact's stiffness is ~1e8-1e9): u in metres, T in newtons?")
 
 
 def read_curve(path: str | Path) -> VirginCurve:

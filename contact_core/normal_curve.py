@@ -62,7 +62,8 @@ class NormalCurveFile(FileModel):
 
 
 def check_normal_table(p: np.ndarray, N: np.ndarray) -> None:
-    """Raise ValueError unless p, N start at (0, 0) and both strictly increase."""
+    """Raise ValueError unless p, N start at (0, 0) and both strictly increase, with no
+    segment stiffer than :data:`~contact_core.curve.MAX_STIFFNESS`."""
     if p.ndim != 1 or p.shape != N.shape or p.size < 2:
         raise ValueError(f"normal curve: approach and N must be 1-D of equal length >= 2, "
                          f"got {p.shape} and {N.shape}")
@@ -76,6 +77,11 @@ def check_normal_table(p: np.ndarray, N: np.ndarray) -> None:
             i = int(bad[0]) + 1
             raise ValueError(f"normal curve: {name} must increase strictly (a monotone curve, no "
                              f"negative approach); point {i} has {name} = {x[i]!r} after {x[i - 1]!r}")
+    slope = np.diff(N) / np.diff(p)
+    i = int(np.argmax(slope))
+    if slope[i] > MAX_STIFFNESS:  # a unit error: p scaled by 1e-300 gave 1e308 N/m
+        raise ValueError(f"normal curve: points {i}-{i + 1}: a stiffness of {float(slope[i]):.3g} N/m, above "
+                         f"{MAX_STIFFNESS:g} N/m (a steel contact's is ~1e8-1e10): approach in metres, N in newtons?")
 
 
 @dataclass(frozen=True)
@@ -145,11 +151,15 @@ class NormalCurve:
         curve = result.get("curve")
         if not curve or not curve.get("force"):
             raise ValueError("the normal solution has no F-approach curve (pass --curve N > 0)")
+        load = float(result["force"])
+        if not abs(curve["force"][-1] - load) <= 1e-9 * load:  # one point was 5 % of the load only
+            raise ValueError(f"the F-approach curve ends at {curve['force'][-1]:.4g} N, not at the load {load:.4g} N: "
+                             "a normal law up to the load needs a curve to it (--curve 2 or more)")
         p = np.concatenate([[0.0], curve["approach"]])
         N = np.concatenate([[0.0], curve["force"]])
         k_n = np.concatenate([[curve["k_n"][0]], curve["k_n"]])
         meta = result.get("meta", {})
-        return cls(p, N, float(result["force"]), k_n, geometry=meta.get("spec", {}),
+        return cls(p, N, load, k_n, geometry=meta.get("spec", {}),
                    provenance={"command": "damper normal"})
 
 

@@ -49,6 +49,10 @@ from damper.ring_info import RingInfo
 FIT_HARMONICS = 9
 #: Default settling tolerance (relative change of the first harmonic, extrapolated).
 SETTLE_TOL = 1e-4
+#: Largest settling tolerance (open bound): a relative change of half the amplitude per
+#: period is no settling (10 called a ring "settled" after 5 periods, 15 % below its
+#: steady amplitude, as the harmonic balance's --accuracy is bounded below 0.5).
+MAX_SETTLE_TOL = 0.5
 #: Fewest periods before settling is tested (the start transient of the contacts).
 MIN_PERIODS = 5
 #: Fewest steps a period (the fit of the first harmonic needs samples of the period).
@@ -374,8 +378,9 @@ def run(ssp, frequency_hz: float, periods: int, step: float | None = None, force
     _check_members(Path(ssp))
     limits.check_size("--periods", periods, 1, limits.MAX_COSIM_PERIODS,
                       "a ring settles in tens to hundreds of periods; a period costs ~0.7 s at the default step")
-    if not (np.isfinite(tol) and tol >= 0):
-        raise ValueError(f"--tol must be finite and >= 0, got {tol}")
+    if not (np.isfinite(tol) and 0 <= tol < MAX_SETTLE_TOL):
+        raise ValueError(f"--tol must be a relative change per period in [0, {MAX_SETTLE_TOL:g}), got {tol:g} "
+                         "(0 runs all --periods)")
     plan = plan_step(info, frequency_hz, step, force)
     if periods * plan["steps_per_period"] > limits.MAX_COSIM_STEPS:
         raise ValueError(f"--periods {periods} of {plan['steps_per_period']} steps is "

@@ -103,10 +103,19 @@ MIN_CURVE_TOL = 1e-6
 #: (contact radius <= 0.15 R) is a mean pressure of 0.064 E*; an approach of 1 m on a
 #: 1.2 mm face gave 9e13 Pa as a result.
 MAX_CONTACT_STRAIN = 0.1
+#: Smallest mean strain of a flat face's contact, by force or by approach (the sphere's
+#: floor, a contact radius of 3e-6 R, is an approach of 9e-12 R): far below, the forces
+#: leave double precision (an approach of 5e-324 m gave a force 1.9 times k_n times it).
+MIN_CONTACT_STRAIN = 1e-12
 #: Largest hysteresis-loop amplitude of ``damper tangential --loop-amplitude`` in gross-slip
 #: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
 #: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).
 MAX_LOOP_SLIPS = 100.0
+#: Smallest loop amplitude, in gross-slip displacements: the tangential solve converges to
+#: 1e-11 of its displacement scale (``contact_core.tangential.SOLVE_TOL``), so much smaller
+#: motions are below its tolerance (1e-18 m on the 10 mm sphere, 3e-13 gross slips, gave a
+#: force amplitude of exactly 0 N); 1e-6 keeps five orders of margin and is a linear loop.
+MIN_LOOP_SLIPS = 1e-6
 #: Largest cache size limit [MiB] (``--cache-max-mb``, ``$DAMPER_CACHE_MAX_MB``): 2^30 MiB
 #: is 1 PiB, more than any disk the cache lives on (1e300 MiB printed a 300-digit limit).
 MAX_CACHE_MB = 2.0**30

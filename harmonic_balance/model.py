@@ -67,6 +67,19 @@ from .fourier import FourierBasis
 from .kinematics import Kinematics
 from .linear import LinearModel
 
+#: Largest magnitude of an entry of M, K or C: the harmonic balance squares forces and
+#: displacements (residual norms, Omega^2 M), which overflows double precision above ~1e154
+#: (M scaled by 1e300 overflowed in the first corrector step).
+MAX_ENTRY = 1e100
+#: Largest bound on the squared natural frequencies, lambda_max(K) / lambda_min(M)
+#: [rad^2/s^2], and on the modal damping, lambda_max(C) / lambda_min(M) squared: the
+#: modal data are squared in norms (M scaled by 1e-300 gave NaN in the first harmonic
+#: balance step, a mass of 1e-160 kg an overflow warning).
+MAX_OMEGA_SQUARED = 1e100
+#: A symmetric K or C may have negative eigenvalues down to this fraction of its largest
+#: (round-off of an assembly, ~1e-13); below that it is not positive semi-definite.
+PSD_TOL = 1e-9
+
 
 @dataclass
 class Model:
@@ -207,6 +220,8 @@ def sdof_model(mass, stiffness, damping, contact_stiffness, slip_force, force) -
                     ("force", force)):
         if not np.isfinite(v) or v < 0 or (name == "mass" and v == 0):
             raise ValueError(f"{name} must be finite and {'> 0' if name == 'mass' else '>= 0'}, got {v}")
+    check_scales(np.array([[mass]]), np.array([[stiffness + contact_stiffness]]), np.array([[damping]]),
+                 ("mass", "stiffness + contact stiffness", "damping"))
     lin = LinearModel(M=[[mass]], C=[[damping]], K=[[stiffness]])
     links = [FrictionLink(jenkins_element(contact_stiffness, slip_force), 0, None, "jenkins")]
     return Model(lin, links, {1: np.array([force], dtype=complex)}, 0)
@@ -248,6 +263,43 @@ def load_matrices(path) -> tuple[LinearModel, dict, int]:
 REAL_ARRAYS = ("M", "K", "C", "phi", "omega_r", "zeta_r")
 
 
+def check_scales(M: np.ndarray, K: np.ndarray, C: np.ndarray, names=("M", "K", "C")) -> None:
+    """Refuse a structure that is not one: K or C not positive semi-definite (a negative
+    stiffness or damping feeds energy in: no steady state to continue), an entry above
+    :data:`MAX_ENTRY`, or natural frequencies beyond :data:`MAX_OMEGA_SQUARED`.
+
+    Parameters
+    ----------
+    M, K, C : (n, n) arrays
+        Symmetric mass [kg], stiffness [N/m] and damping [N s/m] matrices; M positive definite.
+    names : three str
+        What the messages call M, K and C.
+    """
+    eig = {}
+    for name, A in zip(names, (M, K, C)):
+        big = float(np.abs(A).max())
+        if big > MAX_ENTRY:
+            raise ValueError(f"{name} has an entry of magnitude {big:.3g}, above {MAX_ENTRY:g}: the harmonic balance "
+                             "squares forces and displacements, which overflows; check the units")
+        eig[name] = np.linalg.eigvalsh(A)
+    m, k, c = names
+    what = {k: "a stiffness: a negative one has no stable rest",
+            c: "a damping: a negative one feeds energy in, no steady state"}
+    for name, kind in what.items():
+        low, top = float(eig[name][0]), float(np.abs(eig[name]).max())
+        if low < -PSD_TOL * top:
+            raise ValueError(f"{name} must be positive semi-definite ({kind}), but its smallest eigenvalue is "
+                             f"{low:.3g}")
+    with np.errstate(over="ignore"):
+        for name, power in ((k, 1), (c, 2)):
+            ratio = (float(eig[name][-1]) / float(eig[m][0])) ** power if eig[name][-1] > 0 else 0.0
+            if not ratio <= MAX_OMEGA_SQUARED:
+                how = ("" if M.size == 1 else f" ({name}'s largest eigenvalue over {m}'s smallest)") \
+                    + (", squared," if power == 2 else "")
+                raise ValueError(f"{name} over {m}{how} is above {MAX_OMEGA_SQUARED:g} rad^2/s^2: "
+                                 "natural frequencies or damping rates far beyond any structure; check the units")
+
+
 def refuse_complex(data: dict, names, where: str) -> None:
     """ValueError when one of ``names`` in ``data`` is complex (e.g. K (1 + i eta), a loss
     factor): hysteretic damping is not modelled, and making it real would drop it silently."""
@@ -262,13 +314,17 @@ def _matrices_from(data: dict, path: Path) -> tuple[LinearModel, dict, int]:
     keys = set(data)
     refuse_complex(data, REAL_ARRAYS, str(path))
     if {"M", "K"} <= keys:
-        lin = LinearModel(M=data["M"], C=data["C"] if "C" in keys else None, K=data["K"])
+        if np.asarray(data["M"]).size == 0 or np.asarray(data["K"]).size == 0:
+            raise ValueError("M and K are 0 x 0: a model needs at least one DOF")
+        with np.errstate(all="ignore"):  # its modal norms overflow for scales check_scales refuses next
+            lin = LinearModel(M=data["M"], C=data["C"] if "C" in keys else None, K=data["K"])
         try:
             np.linalg.cholesky(lin.M)
         except np.linalg.LinAlgError:
             low = float(np.linalg.eigvalsh(lin.M).min())
             raise ValueError(f"M must be positive definite (a mass matrix), but its smallest eigenvalue "
                              f"is {low:.3g}; give every DOF a positive mass") from None
+        check_scales(lin.M, lin.K, lin.C)
     elif {"phi", "omega_r"} <= keys:
         w = np.asarray(data["omega_r"], dtype=float)
         z = np.asarray(data["zeta_r"], dtype=float) if "zeta_r" in keys else np.zeros_like(w)

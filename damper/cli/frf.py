@@ -123,6 +123,8 @@ def _dest(flag: str) -> str:
 
 def check_model_arguments(args) -> None:
     """Refuse, before any work, options that do not apply to the model (and fill the sdof defaults)."""
+    import os
+
     from damper import limits
 
     if args.model == "sdof":
@@ -141,6 +143,8 @@ def check_model_arguments(args) -> None:
                 raise ValueError(f"{flag} {v:g} is beyond the limit {limits.MAX_MAGNITUDE:g}: the harmonic "
                                  "balance squares forces and displacements, which overflows above ~1e154")
         return
+    if not os.path.exists(args.model):  # a misspelt 'sdof' is not "a .npz model without --elements"
+        raise ValueError(f"--model {args.model}: no such file; give 'sdof' or a .npz model file")
     given = [flag for flag in SDOF if getattr(args, _dest(flag)) is not None]
     if given:
         raise ValueError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} to --model sdof only; "
@@ -190,12 +194,16 @@ def run(args) -> int:
                              stability=args.stability, accuracy=args.accuracy,
                              max_harmonic=limits.MAX_HARMONICS,
                              steady_state_check=args.check_steady_state)
+        check_peak_not_at_a_gap(result, FRFError)
     except FRFError as err:
-        _emit(args, err.result.summary(), print_json, atomic_write, dumps)
+        # the partial result on stdout; stderr keeps one line, the failure's (its warnings are in the JSON)
+        _emit(args, err.result.summary(), print_json, atomic_write, dumps, warn=False)
         # What usually helps (measured: 1e12 k, H = 7 ended at |R| = 3e-10, the round-off of
         # the stiff link, where H = 3 completes): fewer harmonics, a shorter range, or
         # smaller steps past a sharp feature.
-        if err.result.points >= args.max_points:   # stopped by the point limit
+        if getattr(err, "hint", None):
+            hint = err.hint
+        elif err.result.points >= args.max_points:   # stopped by the point limit
             hint = "raise --max-points, or a larger --tolerance takes fewer points"
         else:
             hint = "try fewer --harmonics, a narrower --omega range or a smaller --tolerance"
@@ -207,6 +215,23 @@ def run(args) -> int:
         plot_frf(result, args.plot)
     _emit(args, summary, print_json, atomic_write, dumps)
     return 0
+
+
+def check_peak_not_at_a_gap(result, error) -> None:
+    """Raise ``error`` (FRFError) when the highest peak lies at a stretch the continuation
+    jumped (its corrector stalled and a homotopy restarted past it): the peak there is not
+    resolved, and the response may grow without bound (a resonance without viscous damping
+    whose friction cannot bound it, as Den Hartog's: sdof, c = 0, slip force 0.01 against a
+    force 0.05 printed a peak of 1.4e5 m as a complete curve)."""
+    p = result.peak_omega
+    for a, b in result.extra.get("gaps") or ():
+        if p is not None and a - (b - a) <= p <= b + (b - a):  # within a gap's width of it
+            result.status = (f"the peak at omega {p:.6g} rad/s lies at a stretch the corrector could not "
+                             f"trace (no points in omega {a:.6g}-{b:.6g}): the response may grow without bound "
+                             "there (a resonance with too little damping)")
+            err = error(result.status, result)
+            err.hint = "add damping (C) or a larger slip force, or leave that frequency out of --omega"
+            raise err
 
 
 def check_samples(samples: int) -> None:
@@ -275,7 +300,7 @@ def _report_curve_fits(model) -> None:
                   f"limit; largest force error of the fit {err:.3g} N", file=sys.stderr)
 
 
-def _emit(args, summary, print_json, atomic_write, dumps):
+def _emit(args, summary, print_json, atomic_write, dumps, warn: bool = True):
     from harmonic_balance.frf_accuracy import summary_lines as accuracy_lines
     from harmonic_balance.steady_state import summary_lines as state_lines
 
@@ -284,7 +309,7 @@ def _emit(args, summary, print_json, atomic_write, dumps):
     if args.json:
         print_json(summary)
         for line in accuracy_lines(summary)[1:] + state_lines(summary.get("steady_state"))[1:]:
-            if line.startswith("warning"):
+            if warn and line.startswith("warning"):
                 import sys
 
                 print(line, file=sys.stderr)

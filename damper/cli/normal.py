@@ -104,6 +104,8 @@ def spec_from_args(args):
                              f"{', '.join(_GEOMETRY_FLAGS[n] for n in bodies.get(args.body).required)})")
     if getattr(args, "height", None) is not None and args.body != "flat":
         raise ValueError(f"--height applies to the flat face only, not to --body {args.body}")
+    if getattr(args, "height", None) is not None and not args.height > 0:  # 0 is not the default height
+        raise ValueError(f"--height must be positive, got {args.height:g} (leave it out for max(W, L/2))")
     if args.p_design is not None and not (0 < args.p_design < float("inf")):
         raise ValueError(f"--p-design must be a positive finite pressure [Pa], got {args.p_design:g}")
     if args.force is not None and not args.force > 0:
@@ -145,10 +147,20 @@ def _check_approach_floor(spec, approach: float) -> None:
 
 def _check_flat_load(spec, force, approach) -> None:
     """A flat face's mean pressure (force) or mean strain (approach / the face's smaller
-    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*): linear elasticity."""
-    from damper.limits import MAX_CONTACT_STRAIN
+    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*: linear elasticity) and at
+    least ``MIN_CONTACT_STRAIN`` (double precision)."""
+    from damper.limits import MAX_CONTACT_STRAIN, MIN_CONTACT_STRAIN
 
     side = min(spec.width, spec.length)
+    f_min = MIN_CONTACT_STRAIN * spec.Estar * spec.width * spec.length
+    if approach is not None and approach < MIN_CONTACT_STRAIN * side:
+        raise ValueError(f"--approach {approach:g} m is below {MIN_CONTACT_STRAIN:g} of the face's smaller side "
+                         f"({side:.3g} m), where the contact forces leave double precision; give at least "
+                         f"{MIN_CONTACT_STRAIN * side:.3g} m")
+    if force is not None and force < f_min:
+        raise ValueError(f"--force {force:g} N gives a mean pressure below {MIN_CONTACT_STRAIN:g} E* on the "
+                         f"{spec.width:.3g} x {spec.length:.3g} m face, where the contact forces leave double "
+                         f"precision; give at least {f_min:.4g} N")
     if approach is not None and approach > MAX_CONTACT_STRAIN * side:
         raise ValueError(f"--approach {approach:g} m is above {MAX_CONTACT_STRAIN:g} of the face's smaller side "
                          f"({side:.3g} m): beyond the small strains of the linear-elastic model; give at most "
@@ -232,6 +244,10 @@ def run(args) -> int:
         from contact_core import byo
         result = byo.run_from_files(args.stiffness, args.nodes, args.body, args.force,
                                     args.approach, cache)
+        if result["zone_edge_in_contact"]:  # as for generated bodies (contact_core.api.run_normal)
+            raise ValueError("the contact reaches the edge of the imported bodies' contact nodes: they do not "
+                             "hold the contact at this load; give a smaller load, or bodies whose contact nodes "
+                             "cover a larger zone (or check the stiffness units)")
     else:
         points = args.curve or (NORMAL_CURVE_POINTS if args.normal_curve else (8 if args.plot else 0))
         result = api.run_normal(spec, force=args.force, approach=args.approach,
@@ -281,6 +297,9 @@ def check_options(args) -> None:
                              "these options shape generated bodies only")
     if args.eccentricity is not None and args.force is None:
         raise ValueError("--eccentricity places the normal force: it needs --force, not --approach")
+    if args.curve == 1:  # one point is 5 % of the load: a curve (and --normal-curve) that stops short
+        raise ValueError("--curve 1: the F-approach curve runs from 5 % to 100 % of the load, so it needs at "
+                         "least 2 points (0: no curve)")
     if args.curve:
         limits.check_size("--curve", args.curve, 0, limits.MAX_APPROACH_POINTS,
                           "each point of the F-approach curve is a normal solve")
@@ -303,5 +322,5 @@ def _print_text(r: dict) -> None:
         from contact_core.bodies import MIN_NODES_ACROSS
 
         print(f"warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid spacings "
-              "(radius or half-width), so its size and peak pressure are rough; lower --p-design "
-              "(the potential zone is sized for that peak pressure) or refine --grid")
+              "(radius or half-width), so its size, peak pressure, approach and k_n are rough (grid 3: k_n 54 % "
+              "below Hertz); lower --p-design (the potential zone is sized for that peak pressure) or refine --grid")

@@ -1,7 +1,7 @@
 """``damper study cylinders|compression|eccentric``: the thesis's studies, recomputed.
 
     damper study cylinders [--quick] [--plot DIR] [--json]
-    damper study compression [--quick] [--json]
+    damper study compression [--quick] [--plot DIR] [--json]
     damper study eccentric [--quick] [--plot DIR] [--json]
 
 ``cylinders``: delta = C F^a L^-b D^c fits of the normal and tangential approach

@@ -100,6 +100,23 @@ def specs_from(items) -> list[tuple[str, list]]:
     return out
 
 
+def check_distinct_variants(specs, zipped: bool) -> None:
+    """Refuse two variants that are the same run (a value given twice: ``--values 0.5 0.5``,
+    ``--range 0.5 0.5 3``; with ``--zip``, the same tuple twice), before any work."""
+    if zipped:
+        rows = list(zip(*(values for _, values in specs)))
+        twice = [r for i, r in enumerate(rows) if r in rows[:i]]
+        if twice:
+            raise ValueError(f"--zip: the values {', '.join(f'{n}={v}' for (n, _), v in zip(specs, twice[0]))} "
+                             "are given twice: the two variants would be the same run; give distinct ones")
+        return
+    for name, values in specs:
+        twice = [v for i, v in enumerate(values) if v in values[:i]]
+        if twice:
+            raise ValueError(f"--param {name}: {twice[0]} is given twice: the two variants would be the same "
+                             "run; give distinct values")
+
+
 def run(args) -> int:
     from damper import limits
     from damper.scene import load_scene
@@ -110,6 +127,7 @@ def run(args) -> int:
     if args.workers is not None:
         limits.check_workers("--workers", args.workers)
     specs = specs_from(args.specs)
+    check_distinct_variants(specs, args.zip)
     out = args.out if args.out is not None else Path("out") / f"sweep_{Path(args.scene).stem}"
     check_folder_holds_no_input(out, "--out", load_scene(args.scene).files())   # (before the write probe)
     check_out_dir(out, "--out")

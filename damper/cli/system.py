@@ -45,6 +45,8 @@ def run(args) -> int:
     for label, v in (("--cf", cf), ("--f0", f0)):
         if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
             raise ValueError(f"{label} must be finite, > 0 and at most {limits.MAX_MAGNITUDE:g} N, got {v}")
+    limits.check_cf_floor("--cf", cf, f0, args.config, "or damper upd frf --damper free for the blades without a "
+                          "damper")
     if args.frequency_hz is not None:
         limits.check_range("--frequency-hz", args.frequency_hz, limits.MIN_OMEGA / (2 * np.pi),
                            limits.MAX_OMEGA / (2 * np.pi), "Hz", "the band of a structural mode, "

@@ -163,10 +163,14 @@ def _reference_curve(result):
 
 
 def _check_loop_amplitude(amplitude: float, u_gross: float) -> None:
-    """A loop amplitude [m] at most :data:`damper.limits.MAX_LOOP_SLIPS` times the
-    gross-slip displacement ``u_gross`` [m] (refused before the loop is marched)."""
-    from damper.limits import MAX_LOOP_SLIPS
+    """A loop amplitude [m] between :data:`damper.limits.MIN_LOOP_SLIPS` and ``MAX_LOOP_SLIPS``
+    times the gross-slip displacement ``u_gross`` [m] (refused before the loop is marched)."""
+    from damper.limits import MAX_LOOP_SLIPS, MIN_LOOP_SLIPS
 
+    if amplitude < MIN_LOOP_SLIPS * u_gross:
+        raise ValueError(f"--loop-amplitude {amplitude:g} m is below {MIN_LOOP_SLIPS:g} times the gross-slip "
+                         f"displacement {u_gross:.4g} m, under the tangential solve's tolerance; give at least "
+                         f"{MIN_LOOP_SLIPS * u_gross:.4g} m (a loop that small is a straight line of slope k_t)")
     if amplitude > MAX_LOOP_SLIPS * u_gross:
         raise ValueError(f"--loop-amplitude {amplitude:g} m is above {MAX_LOOP_SLIPS:g} times the gross-slip "
                          f"displacement {u_gross:.4g} m: the loop is then sliding almost throughout (energy "

@@ -73,7 +73,9 @@ def _normal() -> list[InputCase]:
         ("sphere without radius", "--body sphere --force 100"),
         ("radius and diameter", "--body sphere --radius 0.01 --diameter 0.02 --force 100"),
         ("E negative", f"{SPHERE} --force 100 --E=-2e11"), ("nu 0.5", f"{SPHERE} --force 100 --nu 0.5"),
-        ("nu -1.5", f"{SPHERE} --force 100 --nu=-1.5"), ("grid 2", f"{SPHERE} --force 100 --grid 2"),
+        ("nu -1.5", f"{SPHERE} --force 100 --nu=-1.5"),
+        ("nu2 0.49 (the FE hexahedra lock)", f"{SPHERE} --force 100 --nu2 0.49 --grid 5 --json"),
+        ("grid 2", f"{SPHERE} --force 100 --grid 2"),
         ("grid 100000", f"{SPHERE} --force 100 --grid 100000"),
         ("grid 1e3 (not an integer)", f"{SPHERE} --force 1 --grid 1e3"),
         ("force 1e12 (Hertz radius > R)", f"{SPHERE} --force 1e12"),
@@ -84,13 +86,20 @@ def _normal() -> list[InputCase]:
         ("cylinder approach 5e-324", "--body cylinder --radius 2.5e-3 --length 1.2e-3 --approach 5e-324 --grid 5"),
         ("flat approach 1", "--body flat --width 1.2e-3 --length 5e-3 --approach 1 --grid 5"),
         ("flat force 1e12", "--body flat --width 1.2e-3 --length 5e-3 --force 1e12 --grid 5"),
+        ("flat approach 5e-324 (a subnormal force)", "--body flat --width 1.2e-3 --length 5e-3 --approach 5e-324"),
         ("radius 1e-300 (divided by zero)", "--body sphere --radius 1e-300 --force 100 --grid 5"),
         ("cylinder length 1e-300", "--body cylinder --radius 2.5e-3 --length 1e-300 --force 100 --grid 5"),
+        ("flat height 0 (not the default height)",
+         "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 0 --json"),
         ("flat height 1e-300", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --grid 5 --height 1e-300"),
+        ("E2 2e5 against a steel sphere (the default design zone 164 m wide)",
+         f"{SPHERE} --force 0.05 --grid 5 --E2 2e5 --json"),
         ("E 1e-300 (an infinite contact radius)", f"{SPHERE} --force 100 --grid 5 --E 1e-300"),
         ("eccentricity with approach", "--body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 --eccentricity 1e-4"),
         ("eccentricity off the face", "--body flat --width 1.2e-3 --length 5e-3 --force 100 --eccentricity 1e-3"),
         ("curve 1e6 points", f"{SPHERE} --force 100 --curve 1000000"), ("curve -1", f"{SPHERE} --force 100 --curve=-1"),
+        ("curve 1 (a normal curve to 5 % of the load)",
+         f"{SPHERE} --force 100 --grid 5 --curve 1 --normal-curve n.json"),
         ("length on a sphere", f"{SPHERE} --force 100 --length 1e-3"),
         ("cylinder without length", "--body cylinder --radius 2.5e-3 --force 100"),
         ("p-design 0", f"{SPHERE} --force 100 --p-design 0"), ("body cube", "--body cube --radius 0.01 --force 1"),
@@ -102,6 +111,8 @@ def _normal() -> list[InputCase]:
         ("stiffness without nodes", "--body sphere --force 100 --stiffness {fx}/m_good.npz {fx}/m_good.npz"),
         ("stiffness with radius", f"{SPHERE} --force 100 --stiffness {{fx}}/m_good.npz {{fx}}/m_good.npz "
                                   "--nodes {fx}/m_good.npz {fx}/m_good.npz"),
+        ("imported flat blocks (a flat punch: contact over every node)", "--body sphere --force 100 --no-cache "
+         "--stiffness {fx}/byo_K1.npz {fx}/byo_K2.npz --nodes {fx}/byo_n1.npz {fx}/byo_n2.npz"),
         ("stiffness files not matrices", "--body sphere --force 100 --stiffness {fx}/binary.bin {fx}/binary.bin "
                                          "--nodes {fx}/binary.bin {fx}/binary.bin"),
     ], "normal") + [_case("normal", "--cache-dir a folder of the user's",
@@ -120,6 +131,8 @@ def _tangential() -> list[InputCase]:
         ("loop amplitude -1", f"{base} --mu 0.5 --loop-amplitude=-1"),
         ("loop amplitude nan", f"{base} --mu 0.5 --loop-amplitude nan"),
         ("loop amplitude 1e300 (hung)", f"{base} --mu 0.5 --loop-amplitude 1e300"),
+        ("loop amplitude 1e-18 (below the solve's tolerance: T 0 N)",
+         f"{base} --mu 0.5 --loop-amplitude 1e-18 --json"),
         ("flat, approach, eccentricity", "tangential --body flat --width 1.2e-3 --length 5e-3 --approach 1e-6 "
                                          "--mu 0.5 --eccentricity 1e-4"),
         ("eccentricity on a sphere", f"{base} --mu 0.5 --eccentricity 1e-4"),
@@ -136,7 +149,7 @@ def _tangential() -> list[InputCase]:
 def _loop() -> list[InputCase]:
     a = "--amplitude 2e-6"
     rows = [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json {a}") for kind in
-            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip")]
+            ("binary", "trunc", "empty", "list", "nan", "decreasing", "convex", "one", "negT", "dip", "steep")]
     return _table("loop", rows + [
         ("curve missing", f"--curve {{fx}}/nowhere.json {a}"), ("curve is a folder", f"--curve {{fx}} {a}"),
         ("amplitude 1e10", "--curve {fx}/curve.json --amplitude 1e10"),
@@ -166,6 +179,8 @@ def _fmu() -> list[InputCase]:
     return _table("fmu", [
         ("curve binary", "--curve {fx}/curve_binary.json -o d.fmu"), ("curve missing", "--curve {fx}/no.json -o d.fmu"),
         ("curve convex", "--curve {fx}/curve_convex.json -o d.fmu"), ("no output", "--curve {fx}/curve.json"),
+        *[(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu --json")
+          for kind in ("empty", "one", "nan", "dip", "decreasing", "steep")],
         ("-o an existing folder", "--curve {fx}/curve.json -o {fx}"),
         ("-o below a file", "--curve {fx}/curve.json -o {fx}/a_file/d.fmu"),
         ("n-ref 0", "--curve {fx}/curve.json -o d.fmu --n-ref 0"),
@@ -211,12 +226,20 @@ def _frf() -> list[InputCase]:
         ("slip force -1", SDOF.replace("--slip-force 0.05", "--slip-force=-1") + f" {o}"),
         ("force 1e200", SDOF.replace("--force 0.05", "--force 1e200") + f" {o}"),
         ("stiffness 1e300", SDOF.replace("--stiffness 1", "--stiffness 1e300") + f" {o}"),
+        ("damping 0, slip force 0 (an undamped linear resonance)",
+         SDOF.replace("--damping 0.01", "--damping 0").replace("--slip-force 0.05", "--slip-force 0")
+         + " --omega 0.9 1.6 --json"),
+        ("damping 0, slip force 0.01 (friction cannot bound the resonance)",
+         SDOF.replace("--damping 0.01", "--damping 0").replace("--slip-force 0.05", "--slip-force 0.01")
+         + " --omega 0.9 1.6"),
+        ("mass 1e-160 (natural frequency 1e80 rad/s)", SDOF.replace("--mass 1", "--mass 1e-160") + f" {o}"),
         ("sdof with --elements", f"{SDOF} {o} --elements {{fx}}/el_good.toml"),
         ("sdof with --force-scale", f"{SDOF} {o} --force-scale 2"),
         ("sdof response DOF 3", f"{SDOF} {o} --response-dof 3"),
         ("npz with --mass", f"{NPZ} --mass 5 --omega 100 300"),
         ("npz without --elements", "--model {fx}/m_good.npz --omega 100 300"),
         ("npz missing", "--model {fx}/nowhere.npz --elements {fx}/el_good.toml --omega 100 300"),
+        ("model SDOF (not sdof, no such file)", "--model SDOF --omega 1 2 --json"),
         ("npz response DOF 99", f"{NPZ} --response-dof 99 --omega 100 300"),
         ("npz force-scale inf", f"{NPZ} --force-scale inf --omega 100 300"),
         ("--out an existing folder", f"{SDOF} {o} --out {{fx}}"),
@@ -227,7 +250,7 @@ def _frf() -> list[InputCase]:
         ("accuracy -0.01", f"{SDOF} {o} --accuracy=-0.01"),
     ]
     for m in ("nan", "negM", "asym", "shape", "noforce", "forcelen", "cnan", "text", "empty", "nokeys", "trunc",
-              "complex"):
+              "complex", "negC", "negK", "0x0", "Mhuge", "Mtiny"):
         rows.append((f"npz {m}", f"--model {{fx}}/m_{m}.npz --elements {{fx}}/el_good.toml --omega 100 300"))
     for e in ("wobble", "scael", "top", "badtoml", "binary", "none", "dof9", "nok", "type", "path", "negk",
               "dofstr", "same", "contact"):
@@ -244,6 +267,7 @@ def _backbone() -> list[InputCase]:
         ("mode 5 of one DOF", f"{SDOF} {a} --mode 5"),
         ("accuracy 0.5", f"{SDOF} {a} --accuracy 0.5"), ("accuracy 1e-7", f"{SDOF} {a} --accuracy 1e-7"),
         ("npz M = -I", "--model {fx}/m_negM.npz --elements {fx}/el_good.toml " + a),
+        ("npz C negative definite", "--model {fx}/m_negC.npz --elements {fx}/el_good.toml " + a),
         ("--out an existing folder", f"{SDOF} {a} --out {{fx}}"),
         ("sdof with --elements", f"{SDOF} {a} --elements {{fx}}/el_good.toml"),
         ("npz complex K", "--model {fx}/m_complex.npz --elements {fx}/el_good.toml " + a),
@@ -346,6 +370,7 @@ def _system() -> list[InputCase]:
         ("system frequency 1e300", "system --frequency-hz 1e300 -o r.ssp"),
         ("system geometry contacts at CF 1e-300 (hung)", "system --contacts geometry --cf 1e-300 -o r.ssp"),
         ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system cf 1e-3 (a damper without load)", "system --cf 1e-3 -o r.ssp --json"),
         ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
         ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
         ("system frequency -1", "system --frequency-hz=-1 -o r.ssp"),
@@ -356,6 +381,7 @@ def _system() -> list[InputCase]:
     ]) + [_case("system", name, f"cosim r.ssp {cmd}", pre=[shlex.split("system --cf 120 --f0 30 -o r.ssp")],
                 timeout=120.0) for name, cmd in (
         ("cosim frequency 1e-300", "--frequency-hz 1e-300"),
+        ("cosim tol 10 (settled after 5 periods, 15 % off)", "--frequency-hz 448 --tol 10 --json"),
         ("cosim periods 1e12", "--frequency-hz 448 --periods 1000000000000"),
         ("cosim 1.2e8 steps", "--frequency-hz 448 --periods 50000"),
         ("cosim a diverging coupling (--force, 13 x the step limit)",
@@ -409,6 +435,8 @@ def _sweep() -> list[InputCase]:
         ("range not numbers", f"{s} --param contact.damper.mu --range a b c --serial"),
         ("range nan", f"{s} --param contact.damper.mu --range nan 1 3 --serial"),
         ("values without param", f"{s} --values 1 2 --serial"), ("param without values", f"{s} {p} --serial"),
+        ("a value given twice", f"{s} {p} --values 30 30 --serial --json"),
+        ("range of one value three times", f"{s} {p} --range 30 30 3 --serial"),
         ("a second range for one param", f"{s} {p} --values 30 --range 10 20 3 --serial"),
         ("unknown param", f"{s} --param contact.damper.colour --values 1 --serial"),
         ("a value of the wrong type", f"{s} {p} --values high --serial"),
@@ -472,7 +500,7 @@ def _typed() -> list[InputCase]:
     for kind in ("mutrue", "Tstr", "wobble", "plateau", "huge"):
         cases += _table("loop", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json --amplitude 2e-6")], "loop")
         cases += _table("fmu", [(f"curve {kind}", f"--curve {{fx}}/curve_{kind}.json -o d.fmu")], "fmu")
-    for kind in ("wobble", "Nstr"):
+    for kind in ("wobble", "Nstr", "steep"):
         cases += _table("fmu", [(f"point: normal curve {kind}",
                                  f"--curve {{fx}}/curve.json -o d.fmu --normal {{fx}}/normal_{kind}.json")], "fmu")
     for kind in ("mutrue", "mdstr", "band3", "bandnan", "blades"):

@@ -40,6 +40,7 @@ def curves() -> dict[str, str | bytes]:
             "curve_one.json": json.dumps(dict(good, u=[0.0], T=[0.0])),
             "curve_negT.json": json.dumps(dict(good, T=[-t for t in good["T"]])),
             "curve_noN.json": json.dumps({k: v for k, v in good.items() if k not in ("N", "mu")}),
+            "curve_steep.json": json.dumps(dict(good, u=[1e-300 * x for x in good["u"]], k_t=None)),
             "normal_120.json": json.dumps(_normal_curve(120.0))}
 
 
@@ -73,7 +74,10 @@ def matrices() -> dict[str, bytes]:
             "m_cnan.npz": _npz(M=M, K=K, C=np.full((2, 2), np.inf), force=f),
             "m_text.npz": b"M = [[1, 0], [0, 1]]\n", "m_empty.npz": b"",
             "m_nokeys.npz": _npz(A=np.eye(2)), "m_trunc.npz": _npz(M=M, K=K, C=C, force=f)[:200],
-            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f)}
+            "m_complex.npz": _npz(M=M, K=K * (1 + 0.02j), force=f),
+            "m_negC.npz": _npz(M=M, K=K, C=-C, force=f), "m_negK.npz": _npz(M=M, K=-K, C=C, force=f),
+            "m_0x0.npz": _npz(M=np.zeros((0, 0)), K=np.zeros((0, 0)), force=np.zeros(0)),
+            "m_Mhuge.npz": _npz(M=1e300 * M, K=K, C=C, force=f), "m_Mtiny.npz": _npz(M=1e-300 * M, K=K, C=C, force=f)}
 
 
 def elements() -> dict[str, str | bytes]:
@@ -293,6 +297,7 @@ def typed_files() -> dict[str, str | bytes]:
            "normal_good.json": json.dumps(normal),
            "normal_wobble.json": json.dumps(dict(normal, wobble=3)),
            "normal_Nstr.json": json.dumps(dict(normal, N=["0", "50", "140"])),
+           "normal_steep.json": json.dumps(dict(normal, approach=[0.0, 1e-306, 2e-306])),
            "upd_mutrue.toml": "[damper]\nmu = true\n", "upd_mdstr.toml": '[damper]\nm_d = "0.005"\n',
            "upd_band3.toml": "[load]\nband_hz = [400.0, 450.0, 500.0]\n",
            "upd_bandnan.toml": "[load]\nband_hz = [nan, 500.0]\n",
@@ -339,11 +344,32 @@ def archives() -> dict[str, bytes]:
     return {"ring_nofmu.ssp": _ring_archive(_ring_info(), ssd)}
 
 
+def imported_bodies() -> dict[str, bytes]:
+    """Bodies for ``damper normal --stiffness/--nodes``: the half-space model's flat blocks
+    (a sphere's curvature in its gap, none in the coordinates), a flat punch in contact
+    over every node."""
+    import tempfile
+
+    from contact_core import assembly, byo, mesh
+    from contact_core.spec import ContactSpec
+
+    spec = ContactSpec(body="sphere", model="halfspace", grid=3)
+    b1, b2, meta = mesh.build(spec)
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for i, body in ((1, b1), (2, b2)):
+            k, n = Path(tmp) / f"byo_K{i}.npz", Path(tmp) / f"byo_n{i}.npz"
+            byo.export_body(body, assembly.stiffness(body.p, body.t, spec.E1, spec.nu1), k, n,
+                            symmetry=meta["symmetry"])
+            out |= {k.name: k.read_bytes(), n.name: n.read_bytes()}
+    return out
+
+
 def make(folder: Path) -> Path:
     """Write every fixture into ``folder``; return it."""
     folder.mkdir(parents=True, exist_ok=True)
     for group in (curves(), matrices(), elements(), scenes(), upd_files(), typed_files(), archives(),
-                  forged_archives()):
+                  forged_archives(), imported_bodies()):
         for name, content in group.items():
             path = folder / name
             if isinstance(content, bytes):

@@ -50,3 +50,17 @@ def test_dask_two_workers_equal_serial_and_shared_stages_run_once(tmp_path):
     assert (tmp_path / "s2" / "sweep.csv").read_text().count("\n") == 3 and (tmp_path / "s2" / "sweep.png").exists()
     again = run_sweep(SMALL, specs, Store(tmp_path / "c2"), None, serial=True, **QUIET)
     assert again.computations == {} and again.rows == serial.rows      # all from the cache
+
+
+@pytest.mark.parametrize("argv", [["--values", "0.5", "0.5"], ["--range", "0.5", "0.5", "3"]])
+def test_a_variant_given_twice_is_refused_before_any_run(argv, capsys):
+    assert damper(["sweep", "nowhere.toml", "--param", "contact.damper.mu", *argv, "--serial"]) == 2
+    assert "given twice" in capsys.readouterr().err
+
+
+def test_zipped_variants_may_repeat_one_parameter_but_not_a_whole_variant():
+    from damper.cli.sweep import check_distinct_variants
+
+    check_distinct_variants([("a", [1.0, 1.0]), ("b", [2.0, 3.0])], zipped=True)
+    with pytest.raises(ValueError, match="given twice"):
+        check_distinct_variants([("a", [1.0, 1.0]), ("b", [2.0, 2.0])], zipped=True)

@@ -64,6 +64,15 @@ def test_flat_face_load_beyond_small_strain_is_refused_with_the_bound(load, caps
     assert f"{MAX_CONTACT_STRAIN:g}" in err and "give at most" in err
 
 
+@pytest.mark.parametrize("load", [["--approach", "5e-324"], ["--force", "1e-300"]])
+def test_flat_face_load_below_double_precision_is_refused_with_the_bound(load, capsys):
+    """5e-324 m gave a force 1.9 times k_n times the approach (subnormal numbers)."""
+    from damper.limits import MIN_CONTACT_STRAIN
+
+    err = _refused([*FLAT, *load], capsys)
+    assert f"{MIN_CONTACT_STRAIN:g}" in err and "give at least" in err
+
+
 #: Gross-slip displacement of the bem model on 11 nodes against Mindlin's closed form
 #: (3 mu N / (16 G* a)): measured 0.1 %.
 MINDLIN_BEM11 = 0.02
@@ -80,6 +89,32 @@ def test_loop_amplitude_far_beyond_gross_slip_is_refused_with_the_bound(capsys):
     ref = bodies.Sphere().tangential_reference(_steel_sphere(), 200.0, 0.5)["mindlin"]["u_slip"]
     assert u_gross == pytest.approx(ref, rel=MINDLIN_BEM11)
     assert bound == pytest.approx(MAX_LOOP_SLIPS * u_gross, rel=PRINTED)
+
+
+TANGENTIAL_BEM = ["tangential", "--body", "sphere", "--radius", str(R), "--force", "200", "--mu", "0.5",
+                  "--model", "bem", "--grid", "11", "--no-cache"]
+#: A loop far below the first slip of any node is the stuck line T = k_t u: round-off only.
+STUCK_LINE = 1e-9
+
+
+def test_loop_amplitude_below_the_solve_tolerance_is_refused_with_the_bound(capsys):
+    """1e-18 m printed a force amplitude of exactly 0 N (the motion was below the solve's tolerance)."""
+    from damper.limits import MIN_LOOP_SLIPS
+
+    err = _refused([*TANGENTIAL_BEM, "--loop-amplitude", "1e-18"], capsys)
+    u_gross, bound = (float(v) for v in re.search(r"displacement ([0-9.e+-]+) m.*at least ([0-9.e+-]+) m",
+                                                   err).groups())
+    assert bound == pytest.approx(MIN_LOOP_SLIPS * u_gross, rel=PRINTED)
+
+
+def test_the_smallest_loop_amplitude_follows_the_stuck_line(capsys):
+    from damper.limits import MIN_LOOP_SLIPS
+
+    u_slip = bodies.Sphere().tangential_reference(_steel_sphere(), 200.0, 0.5)["mindlin"]["u_slip"]
+    a = 1.1 * MIN_LOOP_SLIPS * u_slip  # u_slip of the bem model is within MINDLIN_BEM11 of Mindlin's
+    assert damper([*TANGENTIAL_BEM, "--loop-amplitude", f"{a:.6g}", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["loop"]["T_amplitude"] == pytest.approx(out["k_t"] * float(f"{a:.6g}"), rel=STUCK_LINE)
 
 
 def _steel_sphere():

@@ -74,6 +74,8 @@ def test_upd_cf_below_the_floor_is_refused_before_any_work(capsys):
     assert "EO force" in _one_line(capsys.readouterr().err)
     assert damper(["upd", "optimize", "--cf-range", "1e-3", "10"]) == 2
     assert "--cf-range" in _one_line(capsys.readouterr().err)
+    assert damper(["system", "--cf", "1e-3", "-o", "never_written.ssp"]) == 2   # its ring would rattle too
+    assert "EO force" in _one_line(capsys.readouterr().err)
 
 
 @pytest.mark.parametrize("damper_kind", ["stuck", "nonlinear"])

@@ -124,3 +124,13 @@ def test_table_errors_name_the_point(tmp_path):
         path.write_text(json.dumps(data))
         with pytest.raises(ValueError, match=message):
             read_curve(path)
+
+
+def test_a_curve_steeper_than_any_contact_is_refused_as_a_unit_error():
+    """u in units 1e300 times too small: slopes of ~6e307 N/m (the element then bounded its
+    input at 1e-297 m); the same table at MAX_STIFFNESS is accepted."""
+    from contact_core.curve import MAX_STIFFNESS
+
+    with pytest.raises(ValueError, match="points 0-1: a slope of .* N/m, above"):
+        VirginCurve(u=[0.0, 1e-306, 2e-306], T=[0.0, 50.0, 60.0])
+    VirginCurve(u=[0.0, 1e-6, 2e-6], T=[0.0, MAX_STIFFNESS * 1e-6, MAX_STIFFNESS * 1e-6])

@@ -86,3 +86,37 @@ def test_default_zone_follows_a_tiny_load(capsys):
     out = json.loads(capsys.readouterr().out)
     assert not out["under_resolved"]
     assert abs(out["hertz"]["error_size"]) < TINY_LOAD_RTOL
+
+
+#: Sphere of 10 mm at 100 N, halfspace model, grid 9, nu = MAX_FE_NU on both bodies:
+#: approach -3.0 % against Hertz (measured; -1.3 % at nu 0.3, -64 % at nu 0.4999 where
+#: the hexahedra lock). The bound must keep the locking error at the mesh error's size.
+LOCKING_RTOL = 0.05
+
+
+def test_fe_bodies_refuse_a_poisson_ratio_where_hexahedra_lock():
+    from contact_core import condense
+
+    spec = ContactSpec(body="sphere", radius=0.01, model="halfspace", grid=5, nu2=condense.MAX_FE_NU + 0.01)
+    with pytest.raises(ValueError, match="hexahedra lock"):
+        condense.condense(spec, cache=False)
+
+
+def test_the_largest_fe_poisson_ratio_keeps_the_approach_near_hertz():
+    from contact_core import api, condense
+
+    nu = condense.MAX_FE_NU
+    spec = ContactSpec(body="sphere", radius=0.01, model="halfspace", grid=9, nu1=nu, nu2=nu, load_hint=100.0)
+    sol = api.solve(condense.condense(spec, cache=False), force=100.0)
+    ref = hertz.sphere(100.0, 0.01, hertz.contact_modulus(200e9, nu, 200e9, nu))
+    assert sol.q[0] == pytest.approx(ref["approach"], rel=LOCKING_RTOL)
+
+
+def test_a_design_pressure_too_high_for_soft_materials_names_the_largest_accepted(capsys):
+    """A plane 1e6 times softer than the steel sphere: the default 2000 MPa zone is 164 m wide."""
+    assert damper(["normal", "--body", "sphere", "--radius", "0.01", "--E2", "2e5", "--force", "0.05",
+                   "--grid", "5", "--no-cache"]) == 2
+    err = capsys.readouterr().err
+    p_max = float(re.search(r"--p-design of at most ([0-9.e+-]+) Pa", err).group(1))
+    spec = ContactSpec(body="sphere", radius=0.01, E2=2e5, grid=5, p_design=p_max)
+    assert spec.zone()[0] / spec.zone_margin == pytest.approx(bodies.MAX_CONTACT_SHARE * 0.01, rel=1e-2)

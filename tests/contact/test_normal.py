@@ -385,3 +385,14 @@ def test_lcp_matches_nnls_on_a_boussinesq_like_kernel():
     f_ref, _ = optimize.nnls(L.T, -sla.solve_triangular(L, b, lower=True), maxiter=10 * b.size)
     assert np.allclose(f, f_ref, atol=1e-8 * f_ref.max())
     assert 0 < active.sum() < b.size
+
+
+def test_imported_bodies_whose_contact_reaches_their_edge_are_refused(tmp_path, capsys):
+    """Flat blocks (the half-space model's bodies: its curvature lives in the gap, not in the
+    coordinates) make a flat punch in contact over every node: a result printed as the
+    sphere's; refused as for generated bodies."""
+    spec = ContactSpec(body="sphere", model="halfspace", grid=3)
+    (k1, n1), (k2, n2) = _export_pair(tmp_path, spec)
+    rc = damper(["normal", "--body", "sphere", "--force", "100", "--no-cache", "--json",
+                 "--stiffness", str(k1), str(k2), "--nodes", str(n1), str(n2)])
+    assert rc == 2 and "edge of the imported bodies' contact nodes" in capsys.readouterr().err

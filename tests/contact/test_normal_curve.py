@@ -64,3 +64,25 @@ def test_cli_without_a_curve_writes_nothing(tmp_path, capsys, monkeypatch):
                  "--normal-curve", str(out)])
     assert rc == 2 and "F-approach curve" in capsys.readouterr().err
     assert not out.exists() and not res.exists()
+
+
+def test_a_normal_curve_stiffer_than_any_contact_is_refused_as_a_unit_error():
+    from contact_core.curve import MAX_STIFFNESS
+    from contact_core.normal_curve import check_normal_table
+
+    with pytest.raises(ValueError, match="points 1-2: a stiffness of .* N/m, above"):
+        check_normal_table(np.array([0.0, 1e-6, 1e-6 * (1 + 1e-12)]), np.array([0.0, 50.0, 140.0]))
+    check_normal_table(np.array([0.0, 1e-6, 2e-6]), np.array([0.0, 50.0, 50.0 + 1e-6 * MAX_STIFFNESS]))
+
+
+def test_a_normal_curve_short_of_the_load_is_refused(tmp_path, capsys):
+    """One curve point is 5 % of the load: the normal law written ended at 5 N for a 100 N load."""
+    from contact_core.normal_curve import NormalCurve
+
+    out = tmp_path / "normal.json"
+    rc = damper(["normal", "--body", "sphere", "--radius", "0.01", "--force", "100", "--grid", "5",
+                 "--model", "halfspace", "--curve", "1", "--normal-curve", str(out)])
+    assert rc == 2 and "at least 2 points" in capsys.readouterr().err and not out.exists()
+    short = {"force": 100.0, "curve": {"force": [5.0], "approach": [4.8e-7], "k_n": [2e7]}}
+    with pytest.raises(ValueError, match="not at the load 100 N"):
+        NormalCurve.from_result(short)

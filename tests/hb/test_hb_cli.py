@@ -157,3 +157,47 @@ def test_stability_modes(capsys):
     assert every["stability_checks"] == every["points"] == auto["points"]
     assert 2 <= auto["stability_checks"] < auto["points"] and auto["stable"] == every["stable"]
     assert off["stable"] is None and off["stability_checks"] == 0
+
+
+def _two_dof_with(tmp_path, **changes):
+    write_two_dof(tmp_path)
+    with np.load(tmp_path / "m.npz") as z:
+        arrays = dict(z)
+    np.savez(tmp_path / "m.npz", **(arrays | {k: f(arrays) for k, f in changes.items()}))
+
+
+@pytest.mark.parametrize("change, words", [
+    ({"C": lambda a: -a["C"]}, "C must be positive semi-definite"),   # accepted: an unstable "steady state"
+    ({"K": lambda a: -a["K"]}, "K must be positive semi-definite"),   # exit 3, "undamped resonance"
+    ({"M": lambda a: 1e-300 * a["M"]}, "K over M"),                   # NaN inside the element
+    ({"M": lambda a: 1e300 * a["M"]}, "M has an entry of magnitude"),  # overflow, exit 3
+])
+def test_a_matrix_that_is_no_structure_is_refused_with_what_is_wrong(tmp_path, capsys, change, words):
+    _two_dof_with(tmp_path, **change)
+    code = main(["frf", "--model", str(tmp_path / "m.npz"), "--elements", str(tmp_path / "e.toml"),
+                 "--omega", "0.6", "2.0", "--json"])
+    cap = capsys.readouterr()
+    assert code == 2 and no_result(cap.out, cap.err, 2)
+    assert words in cap.err and len(cap.err.splitlines()) == 1
+
+
+def test_a_positive_semi_definite_damping_passes_the_structure_check():
+    """C of rank one (a single dashpot) and K singular (a free body held by its elements): a structure."""
+    from harmonic_balance.model import check_scales
+
+    K = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    check_scales(np.eye(2), K, 0.01 * K)
+
+
+@pytest.mark.parametrize("slip_force, bounded", [(0.01, False), (0.05, True)])
+def test_an_undamped_resonance_that_friction_cannot_bound_is_a_failure_not_a_peak(capsys, slip_force, bounded):
+    """No viscous damping: a Jenkins link bounds the resonance at omega = 1 rad/s only when its
+    dissipation per cycle 4 fs a outgrows the excitation's work pi P a (Den Hartog), fs > pi P / 4
+    = 0.039 N here. The unbounded one printed a peak of 1.4e5 m as a complete curve."""
+    argv = [a for a in SDOF]
+    argv[argv.index("--damping") + 1] = "0"
+    argv[argv.index("--slip-force") + 1] = str(slip_force)
+    assert (slip_force > np.pi * 0.05 / 4) == bounded
+    code, out = run_json(capsys, argv + ["--harmonics", "3", "--omega", "0.9", "1.6", "--json"])
+    assert code == (0 if bounded else 3)
+    assert ("grow without bound" in out["status"]) != bounded

@@ -24,6 +24,7 @@ def _cli(argv, capsys):
     (["--frequency-hz", "1e12"], "above the limit"),
     (["--frequency-hz", "448", "--periods", "1000000000000"], f"above the limit {limits.MAX_COSIM_PERIODS}"),
     (["--frequency-hz", "448", "--periods", "50000"], "steps, above the limit"),   # 50000 x ~2400 steps
+    (["--frequency-hz", "448", "--tol", "10"], "--tol must be a relative change"),   # "settled", 15 % off
 ])
 def test_unbounded_work_is_refused_before_libcosim_starts(ring_ssp, capsys, extra, words):
     code, out, err = _cli(["cosim", str(ring_ssp), *extra, "--json"], capsys)
