@@ -214,6 +214,24 @@ DS_MAX = 0.5
 STABILITY_AUTO_MAX = 200
 
 
+def check_peak_traced(result: FRFResult) -> None:
+    """Raise FRFError when the highest peak lies at a stretch the continuation jumped (its
+    corrector stalled and a homotopy restarted past it, ``result.extra["gaps"]``): the peak
+    there is not resolved, and the response may grow without bound (a resonance without
+    viscous damping whose friction cannot bound it, Den Hartog's: sdof, c = 0, slip force
+    0.01 N against a force 0.05 N gave a peak of 1.4e5 m as a complete curve). The error's
+    ``hint`` says what to change; ``result.status`` says what happened."""
+    p = result.peak_omega
+    for a, b in result.extra.get("gaps") or ():
+        if p is not None and a - (b - a) <= p <= b + (b - a):  # within a gap's width of it
+            result.status = (f"the peak at omega {p:.6g} rad/s lies at a stretch the corrector could not "
+                             f"trace (no points in omega {a:.6g}-{b:.6g}): the response may grow without bound "
+                             "there (a resonance with too little damping)")
+            err = FRFError(result.status, result)
+            err.hint = "add damping (C) or a larger slip force, or leave that frequency out of the range"
+            raise err
+
+
 def compute_frf(model: Model, harmonics, omega_range, n_t: int = 0, condensed=None,
                 ds_max: float = DS_MAX, max_points: int = 2000, refine: bool = True,
                 stability="auto", progress=None, aft: str = "exact",

@@ -179,7 +179,7 @@ def run(args) -> int:
 
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # small dense work: one thread is faster
     from damper import limits
-    from harmonic_balance.frf import FRFError, compute_frf
+    from harmonic_balance.frf import FRFError, check_peak_traced, compute_frf
 
     from .common import atomic_write, dumps, print_json
 
@@ -194,7 +194,7 @@ def run(args) -> int:
                              stability=args.stability, accuracy=args.accuracy,
                              max_harmonic=limits.MAX_HARMONICS,
                              steady_state_check=args.check_steady_state)
-        check_peak_not_at_a_gap(result, FRFError)
+        check_peak_traced(result)
     except FRFError as err:
         # the partial result on stdout; stderr keeps one line, the failure's (its warnings are in the JSON)
         _emit(args, err.result.summary(), print_json, atomic_write, dumps, warn=False)
@@ -215,23 +215,6 @@ def run(args) -> int:
         plot_frf(result, args.plot)
     _emit(args, summary, print_json, atomic_write, dumps)
     return 0
-
-
-def check_peak_not_at_a_gap(result, error) -> None:
-    """Raise ``error`` (FRFError) when the highest peak lies at a stretch the continuation
-    jumped (its corrector stalled and a homotopy restarted past it): the peak there is not
-    resolved, and the response may grow without bound (a resonance without viscous damping
-    whose friction cannot bound it, as Den Hartog's: sdof, c = 0, slip force 0.01 against a
-    force 0.05 printed a peak of 1.4e5 m as a complete curve)."""
-    p = result.peak_omega
-    for a, b in result.extra.get("gaps") or ():
-        if p is not None and a - (b - a) <= p <= b + (b - a):  # within a gap's width of it
-            result.status = (f"the peak at omega {p:.6g} rad/s lies at a stretch the corrector could not "
-                             f"trace (no points in omega {a:.6g}-{b:.6g}): the response may grow without bound "
-                             "there (a resonance with too little damping)")
-            err = error(result.status, result)
-            err.hint = "add damping (C) or a larger slip force, or leave that frequency out of --omega"
-            raise err
 
 
 def check_samples(samples: int) -> None:

@@ -74,7 +74,7 @@ class FRF(Kind):
     def compute(self, stage, inputs, ctx):
         from damper import limits
         from fmu_src.element import IwanElement
-        from harmonic_balance.frf import FRFError, compute_frf
+        from harmonic_balance.frf import FRFError, check_peak_traced, compute_frf
         from harmonic_balance.plots import plot_frf
 
         p = stage.params
@@ -89,8 +89,10 @@ class FRF(Kind):
             result = compute_frf(model, str(sw["harmonics"]), omega, ds_max=sw["max_step"], max_points=MAX_POINTS,
                                  progress=ctx.progress, accuracy=sw.get("accuracy"),
                                  max_harmonic=limits.MAX_HARMONICS)
+            check_peak_traced(result)
         except FRFError as err:
-            raise RuntimeError(f"{err} ({err.result.points} points kept)") from None
+            hint = f": {err.hint}" if getattr(err, "hint", None) else ""
+            raise RuntimeError(f"{err} ({err.result.points} points kept){hint}") from None
         with tempfile.TemporaryDirectory() as tmp:
             plot_frf(result, tmp)
             files = collect_files(Path(tmp))

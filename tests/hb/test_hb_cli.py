@@ -201,3 +201,23 @@ def test_an_undamped_resonance_that_friction_cannot_bound_is_a_failure_not_a_pea
     code, out = run_json(capsys, argv + ["--harmonics", "3", "--omega", "0.9", "1.6", "--json"])
     assert code == (0 if bounded else 3)
     assert ("grow without bound" in out["status"]) != bounded
+
+
+def test_a_peak_at_a_jumped_stretch_is_an_error_and_one_away_from_it_is_not():
+    """The rule the CLI and the scene's frf stage share (harmonic_balance.frf.check_peak_traced):
+    a peak within a gap's width of a stretch the continuation jumped is not a result."""
+    from types import SimpleNamespace
+
+    from harmonic_balance.frf import FRFError, check_peak_traced
+
+    gap = (1.0, 1.1)
+    for peak, raises in ((1.05, True), (1.19, True), (0.91, True), (1.25, False), (0.8, False)):
+        result = SimpleNamespace(peak_omega=peak, extra={"gaps": [gap]}, status="complete")
+        if raises:
+            with pytest.raises(FRFError, match="grow without bound") as e:
+                check_peak_traced(result)
+            assert e.value.hint and "grow without bound" in result.status
+        else:
+            check_peak_traced(result)
+            assert result.status == "complete"
+    check_peak_traced(SimpleNamespace(peak_omega=1.05, extra={}, status="complete"))   # no gaps
