@@ -25,13 +25,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from damper.bench.common import revision
 from damper.cache import Store
 from damper.upd_surface import build_surfaces
 from harmonic_balance.bladed_disk import solve
@@ -39,18 +39,6 @@ from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.sector import Sector
 from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
 from harmonic_balance.surface_condensed import CondensedSurface
-
-
-def revision() -> str:
-    """The git revision of this tree (with '+' when it has uncommitted changes)."""
-    try:
-        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                             text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "-uno"], capture_output=True,
-                               text=True, check=True).stdout.strip()
-        return rev + ("+" if dirty else "")
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def case(sector, surfaces, H: int, cf: float, f: float, n_t: int, periods: int, start) -> tuple:
@@ -104,7 +92,7 @@ def main(argv=None) -> int:
               f"{row['evaluations']:11d} {row['eval_jac_cpu_s']:10.2f}", flush=True)
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps({"revision": revision(), "command": " ".join(sys.argv),
+        Path(args.json).write_text(json.dumps({"revision": revision() or "unknown", "command": " ".join(sys.argv),
                                                "cf": args.cf, "nodes": args.nodes, "harmonics": args.harmonics,
                                                "frequency_hz": args.at, "rows": rows}, indent=1) + "\n")
     return 0

@@ -34,13 +34,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
+from damper.bench.common import revision
 from damper.cache import Store
 from damper.upd_surface import build_surfaces
 from harmonic_balance.bladed_disk import load_path, solve
@@ -64,18 +64,6 @@ VERBOSE = False
 #: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
 #: 1e-4 in frequency moves it by far less than the 0.5 % the node study resolves.
 PEAK_XTOL = 1e-4
-
-
-def revision() -> str:
-    """The git revision of this tree (with '+' when it has uncommitted changes)."""
-    try:
-        rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
-                             text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "-uno"], capture_output=True,
-                               text=True, check=True).stdout.strip()
-        return rev + ("+" if dirty else "")
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def point_peak(sector: Sector, H: int, cf: float, points: int) -> dict:
@@ -370,7 +358,7 @@ def main(argv=None) -> int:
     cfg = load_config(None)
     sector = Sector(cfg)
     t0 = time.perf_counter()
-    out = {"revision": revision(), "harmonics": args.harmonics, "command": " ".join(sys.argv),
+    out = {"revision": revision() or "unknown", "harmonics": args.harmonics, "command": " ".join(sys.argv),
            "cases": [run_cf(cfg, sector, cf, nodes, args.harmonics, args) for cf in cfs]}
     out["time_s"] = time.perf_counter() - t0
     if args.json:

@@ -1,13 +1,10 @@
 """examples/surface_march_resolution.py: the condensed surface's march at other samples and periods."""
-import importlib.util
 import json
-from pathlib import Path
 
 import pytest
 
 pytestmark = pytest.mark.slow
 
-SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "surface_march_resolution.py"
 #: The march's second period is its steady loop (surface_condensed.PERIODS = 2): a third
 #: repeats it, so the two solutions differ by Newton's tolerance only (its residual 1e-8 of
 #: the loads: far below 1e-7 of the amplitude), while one period leaves the first one's
@@ -18,16 +15,9 @@ SAME_LOOP_RTOL = 1e-7
 ONE_PERIOD_MIN = 1e-4
 
 
-def _example():
-    spec = importlib.util.spec_from_file_location("surface_march_resolution", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_a_third_period_repeats_the_second_one_period_does_not_and_the_rows_are_written(tmp_path):
+def test_a_third_period_repeats_the_second_one_period_does_not_and_the_rows_are_written(tmp_path, load_example):
     out = tmp_path / "res.json"
-    ex = _example()
+    ex = load_example("surface_march_resolution")
     assert ex.main(["--cf", "300", "--harmonics", "1", "--at", "440", "--samples", "32",
                     "--periods", "2,3,1", "--json", str(out)]) == 0
     rec = json.loads(out.read_text())
@@ -38,7 +28,7 @@ def test_a_third_period_repeats_the_second_one_period_does_not_and_the_rows_are_
     assert two["amplitude_h1"] > 0 and rec["revision"]
 
 
-def test_samples_at_or_below_twice_the_harmonics_are_refused():
+def test_samples_at_or_below_twice_the_harmonics_are_refused(load_example):
     with pytest.raises(SystemExit) as e:
-        _example().main(["--harmonics", "7", "--samples", "14"])
+        load_example("surface_march_resolution").main(["--harmonics", "7", "--samples", "14"])
     assert e.value.code == 2

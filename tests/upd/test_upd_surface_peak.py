@@ -1,26 +1,14 @@
 """examples/upd_surface_peak.py runs (smoke) and reports a maximum of what it solved."""
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 pytestmark = pytest.mark.slow
 
-SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "upd_surface_peak.py"
-
-
-def _example():
-    spec = importlib.util.spec_from_file_location("upd_surface_peak", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_path):
+def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_path, load_example):
     out = tmp_path / "peak.json"
-    ex = _example()
+    ex = load_example("upd_surface_peak")
     assert ex.main(["--quick", "--cf", "600", "--ti", "--json", str(out)]) == 0
     rec = json.loads(out.read_text())
     case = rec["cases"][0]
@@ -39,18 +27,18 @@ def test_quick_run_reports_the_largest_solved_amplitude_and_a_ring_march(tmp_pat
 
 @pytest.mark.parametrize("extra", [["--model", "condensed", "--dashpots", "bodies"], ["--at", "-5"],
                                    ["--cf-steps", "0"]])
-def test_contradictory_options_are_refused_before_any_solve(extra, capsys):
+def test_contradictory_options_are_refused_before_any_solve(extra, capsys, load_example):
     with pytest.raises(SystemExit) as exc:
-        _example().main(["--quick"] + extra)
+        load_example("upd_surface_peak").main(["--quick"] + extra)
     err = capsys.readouterr().err
     assert exc.value.code == 2 and ("--dashpots inputs" in err or "--at must be" in err
                                     or "--cf-steps must be" in err)
 
 
-def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path):
+def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path, load_example):
     """--at solves one frequency, not the surface's peak: no point-model error is reported."""
     out = tmp_path / "at.json"
-    ex = _example()
+    ex = load_example("upd_surface_peak")
     assert ex.main(["--quick", "--cf", "600", "--at", "470", "--json", str(out)]) == 0
     case = json.loads(out.read_text())["cases"][0]
     assert case["surface"][0]["peak_hz"] == 470.0 and not case["surface"][0]["searched"]
@@ -64,7 +52,7 @@ def test_a_fixed_frequency_is_not_held_against_the_point_peak(tmp_path):
 SAME_SOLUTION_RTOL = 1e-6
 
 
-def test_the_examples_cf_path_reaches_the_solution_of_the_librarys_first_point(tmp_path):
+def test_the_examples_cf_path_reaches_the_solution_of_the_librarys_first_point(tmp_path, load_example):
     """--start-cf runs the library's path (load_path.cf_path, 300 N -> 120 N in 2 steps); the
     library's own start (from the open load) reaches the same solution at 400 Hz."""
     from damper.cache import Store
@@ -75,7 +63,7 @@ def test_the_examples_cf_path_reaches_the_solution_of_the_librarys_first_point(t
     from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB
 
     out = tmp_path / "path.json"
-    assert _example().main(["--quick", "--model", "condensed", "--cf", "120", "--start-cf", "300",
+    assert load_example("upd_surface_peak").main(["--quick", "--model", "condensed", "--cf", "120", "--start-cf", "300",
                             "--cf-steps", "2", "--at", "400", "--json", str(out)]) == 0
     amp = json.loads(out.read_text())["cases"][0]["surface"][0]["peak_amplitude_h1"]
     cfg = load_config(None)
