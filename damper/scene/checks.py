@@ -110,3 +110,20 @@ def check_upd(data: dict, problems: list) -> None:
         load_config(u["config"])
     except ValueError as err:
         problems.append((("upd", "config"), str(err)))
+
+
+def check_upd_surface(data: dict, problems: list) -> None:
+    """The node-DOF surface model's harmonic-balance unknowns within their limit
+    (``damper.upd_surface.check_unknowns``, counted on the faces' meshes, before any stage)."""
+    u = data.get("upd")
+    if (u is None or "upd_frf" not in data["want"] or u["contacts"] != "surface"
+            or u["surface_model"] != "nodes"):
+        return
+    from damper.upd_frf import options, upd_sector
+    from damper.upd_surface import check_unknowns
+
+    try:
+        sector = upd_sector(options(config=u.get("config")))
+        check_unknowns(sector, u["surface_nodes"], u["harmonics"], u.get("cf"))
+    except ValueError as err:
+        problems.append((("upd", "surface_nodes"), str(err)))
