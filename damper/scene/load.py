@@ -158,7 +158,7 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         checks.check_element(data, problems)
         checks.check_response(data, problems)
         checks.check_upd(data, problems)
-        checks.check_upd_surface(data, problems)
+        checks.check_upd_contacts(data, problems)
     return data
 
 

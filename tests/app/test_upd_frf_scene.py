@@ -96,3 +96,24 @@ def test_run_of_a_refused_scene_exits_2_with_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "upd.surface_nodes" in err and err.count("\n") == 1, err
     assert not (tmp_path / "out").exists()
+
+
+def test_contacts_errors_of_the_model_are_refused_at_load(tmp_path):
+    (tmp_path / "mu0.toml").write_text("[damper]\nmu = 0.0\n")
+    text = UPD + 'config = "mu0.toml"\ncontacts = "surface"\n'
+    with pytest.raises(SceneError) as err:
+        parse_scene(text, "bad.toml", base=tmp_path)
+    assert "upd.contacts: " in str(err.value) and "mu > 0" in str(err.value), str(err.value)
+
+
+@pytest.mark.slow   # ~40 s CPU each run (the path in CF from the open load, 43 evaluations at 109 nodes)
+def test_surface_scene_result_is_the_record_of_upd_frf_contacts_surface(tmp_path, capsys):
+    band = 'band = [400.0, 405.0]\ngrid = 3\ncontacts = "surface"\nsurface_nodes = 5\n'
+    text = "\n".join(line for line in UPD.splitlines() if line.split(" =")[0] not in ("band", "grid", "cf"))
+    rec = run_scene(parse_scene(text + "\n" + band), Store(tmp_path / "cache"), tmp_path / "out", **QUIET)
+    stage = rec.results["upd_frf"].data
+    assert stage["surface_model"]["nodes_per_side"] == 5 and stage["contact_points"] == ["left", "flat"]
+    assert main(["upd", "frf", "--contacts", "surface", "--surface-nodes", "5", "--harmonics", "1",
+                 "--points", "3", "--band", "400", "405", "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    _assert_same(_without_timings(cli), _without_timings(stage))
