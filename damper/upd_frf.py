@@ -11,7 +11,8 @@ Options (an ``argparse.Namespace`` or any object with these attributes): ``confi
 None: the bundled UPD-24), ``contacts`` ("toml", "geometry", "surface"), ``cf``, ``f0`` [N]
 (None: the config's), ``damper`` ("nonlinear", "free", "stuck"), ``harmonics``, ``accuracy``
 (None: fixed H), ``band`` ([lo, hi] Hz or None: the config's), ``points``, ``surface_nodes``,
-``surface_model``, ``check_steady_state``, ``json`` (True: the geometry report is not printed).
+``surface_model``, ``check_steady_state``, ``json`` (True: the geometry report is not printed),
+``store`` (the cache of the condensed contacts; None or absent: the default).
 The run's reports are set on it as the CLI's hooks do (``contact_report``, ``surface_report``,
 ``surface_run``).
 """
@@ -37,18 +38,34 @@ def options(**kw) -> SimpleNamespace:
     (a scene's ``[upd]`` table passes its keys)."""
     base = {"config": None, "contacts": "toml", "cf": None, "f0": None, "damper": "nonlinear",
             "harmonics": 7, "accuracy": None, "band": None, "points": 200, "surface_nodes": None,
-            "surface_model": None, "check_steady_state": False, "json": True}
+            "surface_model": None, "check_steady_state": False, "json": True, "store": None}
     return SimpleNamespace(**(base | kw))
 
 
 def upd_sector(opts):
     """The sector of ``opts.config`` with the contacts ``opts.contacts`` names (geometry: computed
-    and cached, the report in ``opts.contact_report``)."""
-    from damper.upd_geometry import apply_to_args
+    and kept in :func:`store_of`, the report in ``opts.contact_report``, printed unless ``opts.json``)."""
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.sector import Sector
 
-    return Sector(apply_to_args(opts, load_config(opts.config)))
+    cfg = load_config(opts.config)
+    if getattr(opts, "contacts", "toml") == "geometry":
+        from damper.upd_geometry import report_lines, with_geometry_contacts
+
+        cfg, opts.contact_report = with_geometry_contacts(cfg, getattr(opts, "cf", None), store_of(opts))
+        if not getattr(opts, "json", False):
+            print("\n".join(report_lines(opts.contact_report)))
+    return Sector(cfg)
+
+
+def store_of(opts):
+    """The cache of the contacts' condensations: ``opts.store`` (a scene's), else the default."""
+    store = getattr(opts, "store", None)
+    if store is None:
+        from damper.cache import Store
+
+        store = Store().prepare()
+    return store
 
 
 def frf_record(opts) -> dict:

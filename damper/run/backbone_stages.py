@@ -141,7 +141,8 @@ class OptimalLoad(Kind):
         from harmonic_balance.bladed_disk.optimize import optimal_load
 
         p = stage.params
-        sector = upd_sector(options(config=stage.extra["config"], contacts=p.get("contacts", "toml")))
+        sector = upd_sector(options(config=stage.extra["config"], contacts=p.get("contacts", "toml"),
+                                    store=ctx.store))
         if p.get("accuracy") is None:
             out = optimal_load(sector, p["cf_range"], p["points"], p["harmonics"], grid=p["grid"])
             out["truncation_error"] = optimum_truncation(sector, out, p["grid"], limits.MAX_UPD_HARMONICS)

@@ -39,7 +39,7 @@ class UPDFRF(Kind):
         from damper.upd_frf import frf_record, options, plot_frf
 
         p = stage.params
-        opts = options(config=stage.extra["config"], points=p["grid"],
+        opts = options(config=stage.extra["config"], points=p["grid"], store=ctx.store,
                        **{k: p[k] for k in ("cf", "f0", "band", "harmonics", "accuracy", "contacts",
                                             "surface_nodes", "surface_model") if k in p})
         out = frf_record(opts)

@@ -107,7 +107,8 @@ def test_contacts_errors_of_the_model_are_refused_at_load(tmp_path):
 
 
 @pytest.mark.slow   # ~40 s CPU each run (the path in CF from the open load, 43 evaluations at 109 nodes)
-def test_surface_scene_result_is_the_record_of_upd_frf_contacts_surface(tmp_path, capsys):
+def test_surface_scene_result_is_the_record_of_upd_frf_contacts_surface(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cli_cache"))   # the command's condensations
     band = 'band = [400.0, 405.0]\ngrid = 3\ncontacts = "surface"\nsurface_nodes = 5\n'
     text = "\n".join(line for line in UPD.splitlines() if line.split(" =")[0] not in ("band", "grid", "cf"))
     rec = run_scene(parse_scene(text + "\n" + band), Store(tmp_path / "cache"), tmp_path / "out", **QUIET)
