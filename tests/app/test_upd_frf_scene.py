@@ -61,6 +61,17 @@ def test_scene_result_is_the_record_of_upd_frf_with_the_same_options(tmp_path, c
     assert run_scene(scene, store, tmp_path / "out", **QUIET).computed == []   # cached
 
 
+def test_scalars_and_lines_are_the_records_peak(tmp_path):
+    from damper.run.upd_frf_stages import UPDFRF
+
+    rec = run_scene(parse_scene(UPD), Store(tmp_path / "cache"), tmp_path / "out", **QUIET)
+    stage, result = rec.plan["upd_frf"], rec.results["upd_frf"]
+    o, sc = result.data, UPDFRF().scalars(stage, result)
+    assert (sc["peak_frequency_Hz"], sc["peak_amplitude_m"]) == (o["peak_frequency_hz"], o["peak_amplitude"])
+    assert sc["harmonics_H"] == 1 and sc["truncation_error_rel"] == o["truncation_error"]["peak_amplitude_rel"]
+    assert f"{o['peak_frequency_hz']:.4f} Hz" in UPDFRF().lines(stage, result)[0]
+
+
 @pytest.mark.parametrize("edit, key, words", [
     ("surface_nodes = 7\n", "upd.surface_nodes", 'goes with contacts = "surface"'),
     ('surface_model = "nodes"\n', "upd.surface_model", 'goes with contacts = "surface"'),
