@@ -116,13 +116,13 @@ def sector_hb(sector, args):
     """The sector with the damper's faces as contact surfaces of ``args.surface_model``
     (:data:`SURFACE_MODELS`) at ``args.cf``, and ``make(cf)``: the same model at another
     centrifugal load [N] (the CF path's), on the same condensed surfaces."""
-    from damper.cache import Store
+    from damper.upd_frf import store_of
     from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB, face_inputs
 
     face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
     if args.surface_model == "nodes":   # the condensed model's unknowns are the sector's alone
         check_unknowns(sector, args.surface_nodes, args.harmonics, args.cf)
-    surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, Store().prepare())
+    surfaces = build_surfaces(sector.cfg, args.surface_nodes, args.cf, store_of(args))
     kind = CondensedSurfaceSectorHB if args.surface_model == "condensed" else SurfaceSectorHB
 
     def make(cf):

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from damper.upd_frf import SURFACE_MODEL, SURFACE_NODES, surface_line
 from damper.upd_surface import SURFACE_MODELS
 
 from .common import accuracy_lines, upd_model_options, upd_response_options
@@ -86,15 +87,6 @@ def _contacts(p, surface: bool = False) -> None:
                        "every node's DOFs as unknowns (needs a well-loaded damper, UPD-24: CF ~300 N)")
 
 
-#: Contact-zone nodes per side of each face with ``--contacts surface`` when not given.
-SURFACE_NODES = 5
-
-
-#: Surface model with ``--contacts surface`` when not given: the condensed one, which reaches
-#: the default CF (damper.upd_surface.SURFACE_MODELS).
-SURFACE_MODEL = SURFACE_MODELS[0]
-
-
 def check_surface_nodes(args) -> None:
     """``--surface-nodes`` and ``--surface-model`` only with ``--contacts surface`` (refused
     otherwise); their defaults there."""
@@ -110,11 +102,9 @@ def check_surface_nodes(args) -> None:
 
 
 def _sector(args):
-    from damper.upd_geometry import apply_to_args
-    from harmonic_balance.bladed_disk.config import load_config
-    from harmonic_balance.bladed_disk.sector import Sector
+    from damper.upd_frf import upd_sector
 
-    return Sector(apply_to_args(args, load_config(args.config)))
+    return upd_sector(args)
 
 
 def run_modes(args) -> int:
@@ -164,23 +154,12 @@ def _check_frf(args) -> None:
 def run_frf(args) -> int:
     import sys
 
+    from damper.upd_frf import frf_record
+
     from .common import print_json
 
     _check_frf(args)
-    sector = _sector(args)
-    cfg = sector.cfg
-    band = args.band or cfg["load.band_hz"]
-    omegas = 2 * np.pi * np.linspace(band[0], band[1], args.points)
-    if args.damper == "nonlinear":
-        out = _frf_nonlinear(sector, args, omegas)
-    else:
-        out = _frf_linear(sector, args, omegas)
-        if args.check_steady_state:
-            out["steady_state"] = {"note": f"--damper {args.damper} is linear: one steady state"}
-    out |= {"contacts_from_geometry": args.contact_report} if "contact_report" in args else {}
-    out |= {"contact_surfaces": args.surface_report} if "surface_report" in args else {}
-    out |= {"surface_model": args.surface_run} if "surface_run" in args else {}
-    out |= response_warnings(out)
+    out = frf_record(args)
     if args.plot:
         _plot_frf(out, args.plot)
     if args.json:
@@ -205,115 +184,6 @@ def run_frf(args) -> int:
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0
-
-
-def surface_line(run: dict) -> str:
-    """The printed line of ``upd frf --contacts surface``'s run record (its JSON ``surface_model``)."""
-    st = run["start"]
-    how = (f"first point by the path in CF {st['loads'][0]:.4g} -> {st['loads'][-1]:.4g} N "
-           f"({len(st['loads'])} loads)" if len(st.get("loads", ())) > 1 else "first point from the stuck start")
-    return (f"surface model {run['model']}, {run['nodes_per_side']} nodes per side ({run['nodes']} nodes): "
-            f"{run['evaluations']} evaluations, {run['cpu_s']:.1f} s CPU ({run['time_s']:.1f} s wall), of which "
-            f"the truncation check (a peak search at more harmonics) {run['truncation_check_cpu_s']:.1f} s CPU; {how}")
-
-
-def response_warnings(out: dict) -> dict:
-    """``band_end_warning`` (the refined largest amplitude lies at an end of the band: no peak
-    inside it) and ``lift_off_warning`` (:func:`damper.upd_checks.rattle_warning` at the peak)
-    of a ``upd frf`` result, each a line or None."""
-    from damper.upd_checks import at_band_end, rattle_warning
-
-    f, w = out["frequency_hz"], out["peak_frequency_hz"]
-    band_end = None
-    if at_band_end(w, f[0], f[-1]):   # the refined maximum (a coarse grid's largest point may be an end)
-        band_end = (f"warning: the largest amplitude lies at the band's end {w:.6g} Hz, not at a peak "
-                    f"inside the band {f[0]:g} ... {f[-1]:g} Hz: widen or move --band to find the resonance")
-    rattle = None
-    if out.get("lift_off"):
-        hint = ("" if "contact_surfaces" in out else
-                " (--check-steady-state compares the peak with a time integration)")
-        rattle = rattle_warning(out["lift_off"], out["f0"], out["cf"], out["harmonics"], hint)
-    return {"band_end_warning": band_end, "lift_off_warning": rattle}
-
-
-def _frf_linear(sector, args, omegas) -> dict:
-    import time
-
-    from harmonic_balance.bladed_disk.sector import linear_response, peak_of
-
-    t0 = time.perf_counter()
-    f0 = args.f0 or sector.cfg.f0
-    r = sector.response  # the blade's response DOF (u_a of UPD-24)
-    U = linear_response(sector, omegas, args.damper, f0)[:, r]
-    w, a = peak_of(lambda om: abs(linear_response(sector, om, args.damper, f0)[0, r]),
-                   omegas[0], omegas[-1], len(omegas))
-    return {"damper": args.damper, "response_dof": sector.dof_names[r],
-            "frequency_hz": (omegas / (2 * np.pi)).tolist(),
-            "amplitude": np.abs(U).tolist(), "amplitude_max": np.abs(U).tolist(),
-            "peak_frequency_hz": w / (2 * np.pi), "peak_amplitude": a,
-            "time_s": time.perf_counter() - t0}
-
-
-def _frf_nonlinear(sector, args, omegas) -> dict:
-    from damper import limits
-    from damper.upd_surface import static_loads
-    from harmonic_balance.accuracy import warning
-    from harmonic_balance.bladed_disk.accuracy import peak_to_accuracy, truncation_error
-    from harmonic_balance.bladed_disk.hb import SectorHB
-    from harmonic_balance.bladed_disk.solve import energy_balance, frf
-    from harmonic_balance.bladed_disk.steady import annotate
-
-    if args.contacts == "surface":
-        from damper.upd_surface import surface_curve
-
-        hb, c, rec, args.surface_run = surface_curve(sector, args, omegas)
-    elif args.accuracy is None:
-        hb = SectorHB(sector, args.harmonics, cf=args.cf, f0=args.f0)
-        c = frf(hb, omegas)
-        rec = truncation_error(hb, c, limits.MAX_UPD_HARMONICS)
-    else:
-        import time
-
-        t0, p0 = time.perf_counter(), time.process_time()
-        hb, c, rec = peak_to_accuracy(sector, omegas, args.accuracy, args.harmonics,
-                                      cf=args.cf, f0=args.f0)
-        c.time_s = time.perf_counter() - t0
-        c.extra["cpu_s"] = time.process_time() - p0   # the machine may be shared: CPU too
-    summ = _summary(hb, c, args)
-    out = {"damper": "nonlinear", "response_dof": sector.dof_names[sector.response],
-            "cf": hb.cf, "f0": hb.f0, "harmonics": hb.H, "n_t": hb.basis.n_t,
-            "frequency_hz": (c.omega / (2 * np.pi)).tolist(), "amplitude": c.amplitude.tolist(),
-            "amplitude_max": c.amplitude_max.tolist(),
-            "peak_frequency_hz": c.peak_omega / (2 * np.pi), "peak_amplitude": c.peak_amplitude,
-            "contact_points": summ["names"], "normal_load_mean": summ["normal_load_mean"],
-            "zone_edge_warning": summ.get("warning_zone_edge"),
-            "normal_load_range": summ["normal_load_range"], "lift_off": summ["lift_off"],
-            "static_normal_load": static_loads(hb),
-            "energy_per_cycle_at_peak": energy_balance(hb, c.peak_x, c.peak_omega),
-            "method": c.extra.get("method", ""), "peak_refined": c.extra.get("peak_refined"),
-            "branch_points": c.extra.get("branch_points"), "evaluations": c.evaluations,
-            "time_s": c.time_s, "truncation_error": rec,
-            "truncation_warning": warning(rec)}
-    a = rec.get("accuracy")
-    if a and "H_peak" in a:   # the peak raised to the accuracy: its richest level is the result
-        out |= {"peak_frequency_hz": a["peak_omega"] / (2 * np.pi), "peak_amplitude": a["peak_amplitude"],
-                "harmonics_peak": a["H_peak"], "cpu_s": c.extra.get("cpu_s")}
-    if "warning" in c.extra:  # a complete curve whose peak refinement failed: still exit 0
-        out["warning"] = c.extra["warning"]
-    out |= annotate(hb, c, args.check_steady_state)
-    out["time_s"] += out.get("steady_state", {}).get("time_s", 0.0)
-    return out
-
-
-def _summary(hb, c, args) -> dict:
-    """The contacts' summary at the curve's peak: per point, or per face with surfaces."""
-    from damper import upd_surface
-
-    if args.contacts != "surface":
-        return hb.contact_summary(c.peak_x)
-    if args.surface_model == "condensed":
-        return upd_surface.condensed_summary(hb, c.peak_x, c.peak_omega)
-    return upd_surface.face_summary(hb, hb.contact_summary(c.peak_x))
 
 
 def _check_optimize(args) -> None:
@@ -390,31 +260,12 @@ def flat_band_line(band, cf_range) -> str | None:
     return f"peak within 1 % of the optimum for CF {lo} ... {hi} N"
 
 
-def _figure():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _plot_frf(out, out_dir) -> None:
     from pathlib import Path
 
-    from harmonic_balance.plots import _save
+    from damper.upd_frf import plot_frf
 
-    plt = _figure()
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(out["frequency_hz"], np.array(out["amplitude"]) * 1e3, label="first harmonic")
-    ax.plot(out["frequency_hz"], np.array(out["amplitude_max"]) * 1e3, "--", label="max |u_a(t)|")
-    ax.set_xlabel("frequency [Hz]")
-    ax.set_ylabel("airfoil amplitude [mm]")
-    ax.set_title(f"UPD sector, damper {out['damper']}")
-    ax.legend()
-    fig.tight_layout()
-    _save(fig, Path(out_dir) / "upd_frf.png")
-    plt.close(fig)
+    plot_frf(out, Path(out_dir) / "upd_frf.png")
 
 
 def _plot_optimize(out, out_dir) -> None:

@@ -120,13 +120,14 @@ class OptimalLoad(Kind):
     (``harmonic_balance.bladed_disk.optimize.optimal_load``); no contact or FE stage."""
 
     name = "optimal_load"
-    modules = ("harmonic_balance", "fmu_src")
+    modules = ("harmonic_balance", "fmu_src", "damper.upd_frf", "damper.upd_geometry")
 
     def instances(self, data):
         u = data.get("upd")
         if u is None:
             return []
-        params = {k: v for k, v in u.items() if k != "config"}        # the file enters by its hash
+        keys = ("cf_range", "points", "harmonics", "grid", "accuracy", "contacts", "config_sha256")
+        params = {k: u[k] for k in keys if k in u}    # its own keys; the file enters by its hash
         return [Stage("optimal_load", self, params, products=("optimal_load",),
                       extra={"config": u.get("config")})]
 
@@ -134,14 +135,14 @@ class OptimalLoad(Kind):
         import time
 
         from damper import limits
+        from damper.upd_frf import options, upd_sector
         from harmonic_balance.accuracy import warning
         from harmonic_balance.bladed_disk.accuracy import optimal_load_to_accuracy, optimum_truncation
-        from harmonic_balance.bladed_disk.config import load_config
         from harmonic_balance.bladed_disk.optimize import optimal_load
-        from harmonic_balance.bladed_disk.sector import Sector
 
         p = stage.params
-        sector = Sector(load_config(stage.extra["config"]))
+        sector = upd_sector(options(config=stage.extra["config"], contacts=p.get("contacts", "toml"),
+                                    store=ctx.store))
         if p.get("accuracy") is None:
             out = optimal_load(sector, p["cf_range"], p["points"], p["harmonics"], grid=p["grid"])
             out["truncation_error"] = optimum_truncation(sector, out, p["grid"], limits.MAX_UPD_HARMONICS)

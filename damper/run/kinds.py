@@ -10,6 +10,7 @@ from .contact_stages import Condense, Normal, Tangential
 from .element_stages import FMU, Loop
 from .mistuning_stages import Mistuning
 from .response_stages import FRF
+from .upd_frf_stages import UPDFRF
 
 KINDS = (Condense(), Normal(), Tangential(), Loop(), FMU(), FRF(), Backbone(), OptimalLoad(),
-         Mistuning())
+         UPDFRF(), Mistuning())

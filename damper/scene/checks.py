@@ -11,6 +11,8 @@ list for a forced response, and a UPD model file that does not load.
 """
 from __future__ import annotations
 
+import re
+
 from . import schema
 
 
@@ -110,3 +112,33 @@ def check_upd(data: dict, problems: list) -> None:
         load_config(u["config"])
     except ValueError as err:
         problems.append((("upd", "config"), str(err)))
+
+
+def check_upd_contacts(data: dict, problems: list) -> None:
+    """Contacts other than the TOML's, checked on the model before any stage: its geometry
+    (``damper.upd_geometry.geometry_params``: a [geometry] section, mu > 0), and for surfaces a
+    planar sector, the faces' specifications and the node-DOF model's harmonic-balance unknowns
+    within their limit (``damper.upd_surface.check_unknowns``, counted on the faces' meshes)."""
+    u = data.get("upd")
+    if u is None or u["contacts"] == "toml" or any(path[:1] == ("upd",) for path, _ in problems):
+        return
+    from damper.upd_frf import options, upd_sector
+    from damper.upd_geometry import geometry_params
+    from damper.upd_surface import _face_specs, check_unknowns
+    from harmonic_balance.bladed_disk.surface_hb import face_inputs
+
+    key = "contacts"
+    try:
+        sector = upd_sector(options(config=u.get("config")))
+        geometry_params(sector.cfg, u.get("cf"))
+        if u["contacts"] == "surface" and "upd_frf" in data["want"]:
+            face_inputs(sector, "left")
+            _face_specs(sector.cfg, u["surface_nodes"], u.get("cf"))
+            key = "surface_nodes"
+            if u["surface_model"] == "nodes":
+                check_unknowns(sector, u["surface_nodes"], u["harmonics"], u.get("cf"))
+    except ValueError as err:   # the command's message, its options named as the scene's keys
+        msg = re.sub(r"--([a-z-]+) (\d+|nodes|condensed|toml|geometry|surface)\b",
+                     lambda m: f"{m[1]} = {m[2]}", str(err))
+        msg = re.sub(r"--([a-z-]+)", lambda m: m[1], msg).replace("surface-", "surface_")
+        problems.append((("upd", key), msg))

@@ -158,6 +158,7 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         checks.check_element(data, problems)
         checks.check_response(data, problems)
         checks.check_upd(data, problems)
+        checks.check_upd_contacts(data, problems)
     return data
 
 
@@ -269,9 +270,12 @@ def _check_wants(data: dict, problems: list) -> None:
         _check_backbone(data, problems)
     if "mistuning" in wants:
         _check_mistuning(data, problems)
-    if "optimal_load" in wants and "upd" not in data:
-        problems.append((("upd",), "missing: needed for optimal_load (an empty [upd] table takes the "
-                         "bundled UPD-24 model and the default CF range)"))
+    for w in ("optimal_load", "upd_frf"):
+        if w in wants and "upd" not in data:
+            problems.append((("upd",), f"missing: needed for {w} (an empty [upd] table takes the "
+                             "bundled UPD-24 model and its defaults)"))
+    if "upd" in data:
+        _check_upd_contacts(data, problems)
     if "frf" in wants:
         for table in ("structure", "excitation", "sweep"):
             if table not in data:
@@ -308,6 +312,9 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
     lo_hi = u["cf_range"]
     if len(lo_hi) != 2 or not lo_hi[1] > lo_hi[0]:
         problems.append((("upd", "cf_range"), "must be [low, high] with high > low"))
+    band = u.get("band")
+    if band is not None and not (len(band) == 2 and band[1] > band[0]):
+        problems.append((("upd", "band"), "must be [low, high] with high > low [Hz]"))
     if "config" in u:
         path = (base / u["config"]).resolve()
         try:
@@ -327,6 +334,41 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
             limits.check_cf_floor("cf_range low", lo_hi[0], f0, None, "or start the range there")
         except ValueError as err:
             problems.append((("upd", "cf_range"), str(err)))
+
+
+def _check_upd_contacts(data: dict, problems: list) -> None:
+    """[upd] contacts against the wanted results, as ``damper upd frf|optimize`` refuse them:
+    the surface options only with surface contacts (their defaults filled in there, so the
+    stage key holds them), surfaces only for upd_frf, at a fixed H; the CF above its floor."""
+    from damper import limits
+    from damper.upd_frf import SURFACE_MODEL, SURFACE_NODES
+
+    u, wants = data["upd"], data["want"]
+    if u["contacts"] != "surface":
+        for key in ("surface_nodes", "surface_model"):
+            if key in u:
+                problems.append((("upd", key), f"goes with contacts = \"surface\" (got contacts = "
+                                 f"{u['contacts']!r}): set contacts = \"surface\" or drop {key}"))
+    else:
+        u.setdefault("surface_nodes", SURFACE_NODES)
+        u.setdefault("surface_model", SURFACE_MODEL)
+        if "optimal_load" in wants:
+            problems.append((("upd", "contacts"), "contacts = \"surface\" is for upd_frf only: the "
+                             "load sweep of optimal_load takes \"toml\" or \"geometry\""))
+        if "upd_frf" in wants and "accuracy" in u:
+            problems.append((("upd", "accuracy"), "contacts = \"surface\" runs at the fixed harmonics: "
+                             "drop accuracy"))
+    if "upd_frf" in wants and "cf" in u and not any(p[0] == ("upd", "config") for p in problems):
+        from harmonic_balance.bladed_disk.config import load_config
+
+        try:
+            f0 = u.get("f0") or load_config(u.get("config")).f0
+        except (OSError, ValueError):   # the model file's own check reports it
+            return
+        try:
+            limits.check_cf_floor("cf", u["cf"], f0, None, "or drop cf (the model's own)")
+        except ValueError as err:
+            problems.append((("upd", "cf"), str(err)))
 
 
 def _check_mistuning(data: dict, problems: list) -> None:

@@ -39,6 +39,8 @@ from dataclasses import dataclass, field
 
 from contact_core.spec import MAX_GRID
 from damper import limits
+from damper.upd_surface import SURFACE_MODELS
+from harmonic_balance.surface import MAX_NODES, MIN_NODES
 
 
 @dataclass(frozen=True)
@@ -74,6 +76,8 @@ RESULTS = {
                  "frequency and damping ratio vs modal amplitude"),
     "optimal_load": ("optimal_load", False, "UPD bladed-disk sector: peak response against the "
                      "damper's centrifugal load CF and the optimal CF"),
+    "upd_frf": ("upd_frf", False, "UPD bladed-disk sector: forced response of the EO excitation at one "
+                "CF (as `damper upd frf`), with point or surface contacts"),
     "mistuning": ("mistuning", False, "UPD bladed disk: Monte Carlo of mistuning patterns on the "
                   "full ring, every blade's peak and the amplification over the tuned peak"),
     "report": ("report", False, "one-page HTML report of the run"),
@@ -194,12 +198,29 @@ UPD = {
                     why="each CF value is a whole forced response (seconds)"),
     "harmonics": Field("int", "highest harmonic", default=7, ge=1, le=limits.MAX_UPD_HARMONICS,
                        why=limits.harmonics_why(limits.MAX_UPD_HARMONICS)),
-    "grid": Field("int", "frequency points per curve before the peak refinement", default=40, ge=3,
+    "grid": Field("int", "frequency points per curve before the peak refinement (optimal_load: each "
+                  "CF's curve; upd_frf: the curve over the band)", default=40, ge=3,
                   le=limits.MAX_UPD_GRID, why="each point is a harmonic-balance solve of the sector"),
-    "accuracy": Field("float", "relative accuracy of the optimum's peak amplitude: its curve is raised "
-                      "in H until the estimated truncation error is below it, and the load sweep run "
-                      "again at that H (unset: the fixed `harmonics`, the optimum's estimate "
-                      "reported)", gt=1e-6, lt=0.5),
+    "accuracy": Field("float", "relative accuracy of the peak amplitude (optimal_load: the optimum's; its "
+                      "curve is raised in H until the estimated truncation error is below it, and the "
+                      "load sweep run again at that H; upd_frf: the curve's peak re-solved with more "
+                      "harmonics; unset: the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
+    "cf": Field("float", "upd_frf: centrifugal load on the damper [N] (default: the UPD model's)", gt=0,
+                le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "f0": Field("float", "upd_frf: EO force amplitude on the airfoil [N] (default: the UPD model's)", gt=0,
+                le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "band": Field("list[float]", "upd_frf: [low, high] frequency band [Hz] (default: the UPD model's)",
+                  ge=_F_MIN, le=_F_MAX, why=_F_WHY),
+    "contacts": Field("str", "contact laws: toml (the model's Jenkins points), geometry (computed by "
+                      "contact_core from its [geometry] section), surface (upd_frf only: the damper's faces "
+                      "as contact surfaces of many 3D points on the condensed FE bodies; slower)",
+                      default="toml", choices=("toml", "geometry", "surface")),
+    "surface_nodes": Field("int", "contacts = surface: contact-zone nodes per side of each face "
+                           "(default 5)", ge=MIN_NODES, le=MAX_NODES,
+                           why="each node is a 3D contact point of the harmonic balance"),
+    "surface_model": Field("str", "contacts = surface: condensed (default; the faces condensed onto their "
+                           "rigid inputs, the nodes marched in time) or nodes (every node's DOFs as "
+                           "unknowns; needs a well-loaded damper)", choices=SURFACE_MODELS),
 }
 
 MISTUNING = {

@@ -209,6 +209,20 @@ def scenes() -> dict[str, str | bytes]:
             "s_fmiempty.toml": SMALL.replace('want = ["virgin_curve", "k_t", "loop", "frf"]', 'want = ["fmu"]')
                                     .replace("fmi_versions = [2]", "fmi_versions = []"),
             "s_updcflow.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [1e-3, 10.0]\npoints = 3\n',
+            # upd_frf: the refusals of `damper upd frf`'s options, as [upd] keys
+            "s_ufnodes.toml": 'want = ["upd_frf"]\n[upd]\nsurface_nodes = 7\n',
+            "s_ufmodel.toml": 'want = ["upd_frf"]\n[upd]\ncontacts = "geometry"\nsurface_model = "nodes"\n',
+            "s_ufnodes4.toml": 'want = ["upd_frf"]\n[upd]\ncontacts = "surface"\nsurface_nodes = 4\n',
+            "s_ufnodes42.toml": 'want = ["upd_frf"]\n[upd]\ncontacts = "surface"\nsurface_nodes = 42\n',
+            "s_ufunknowns.toml": ('want = ["upd_frf"]\n[upd]\ncontacts = "surface"\nsurface_model = "nodes"\n'
+                                  "surface_nodes = 41\nharmonics = 20\n"),
+            "s_ufacc.toml": 'want = ["upd_frf"]\n[upd]\ncontacts = "surface"\naccuracy = 0.01\n',
+            "s_ufband.toml": 'want = ["upd_frf"]\n[upd]\nband = [480.0, 440.0]\n',
+            "s_ufcflow.toml": 'want = ["upd_frf"]\n[upd]\ncf = 1e-3\n',
+            "s_ufolsurf.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\n',
+            "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
+            "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
+            "s_ufmu0.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_mu0.toml"\ncontacts = "surface"\n',
             "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',
             "s_mtcflow.toml": 'want = ["mistuning"]\n[mistuning]\ncf = 1e-3\nsamples = 1\n',
             "s_mtci.toml": 'want = ["mistuning"]\n[mistuning]\nuntil_ci = 1e300\n',

@@ -83,8 +83,8 @@ def test_a_damper_open_over_most_of_the_period_is_said_to_rattle(capsys):
 def test_the_rattle_warning_of_surfaces_names_no_time_integration():
     """--check-steady-state integrates point contacts only: a surface result's warning does
     not send the user there; the rule (every contact open over more than 90 %) is the same."""
-    from damper.cli.upd import response_warnings
     from damper.upd_checks import RATTLE_LIFT_OFF
+    from damper.upd_frf import response_warnings
 
     out = {"frequency_hz": [400.0, 450.0, 500.0], "peak_frequency_hz": 450.0, "f0": 300.0, "cf": 20.0,
            "harmonics": 3, "lift_off": [0.95, 0.97]}

@@ -1,0 +1,131 @@
+"""The upd_frf stage kind: the UPD sector's forced response at one CF, the record of ``damper upd frf``."""
+import json
+
+import numpy as np
+import pytest
+
+from damper.cache import Store
+from damper.cli import main
+from damper.run.runner import run_scene
+from damper.scene import SceneError, parse_scene
+from harmonic_balance.surface import MAX_NODES, MIN_NODES
+
+QUIET = {"echo": lambda text: None}
+
+#: The stage and the command solve the same model from the same start with the same code:
+#: every number of the record agrees to round-off (measured: bit-identical).
+ROUND_OFF = 1e-12
+
+#: Keys of the record that measure the run, not the result.
+TIMINGS = ("time_s", "cpu_s", "truncation_check_cpu_s")
+
+UPD = "want = [\"upd_frf\"]\n[upd]\nharmonics = 1\ngrid = 5\nband = [440.0, 480.0]\ncf = 150.0\n"
+
+
+def _without_timings(value):
+    if isinstance(value, dict):
+        return {k: _without_timings(v) for k, v in value.items() if k not in TIMINGS}
+    if isinstance(value, list):
+        return [_without_timings(v) for v in value]
+    return value
+
+
+def _assert_same(a, b, path=""):
+    """Equal structure, strings and None; numbers within ROUND_OFF."""
+    if isinstance(a, dict):
+        assert sorted(a) == sorted(b), path
+        for k in a:
+            _assert_same(a[k], b[k], f"{path}.{k}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b)):
+            _assert_same(x, y, f"{path}[{i}]")
+    elif isinstance(a, (int, float)) and not isinstance(a, bool):
+        assert np.isclose(a, b, rtol=ROUND_OFF, atol=0.0), (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+def test_scene_result_is_the_record_of_upd_frf_with_the_same_options(tmp_path, capsys):
+    scene, store = parse_scene(UPD), Store(tmp_path / "cache")
+    rec = run_scene(scene, store, tmp_path / "out", **QUIET)
+    assert rec.computed == ["upd_frf"]
+    stage = rec.results["upd_frf"].data
+    assert main(["upd", "frf", "--harmonics", "1", "--points", "5", "--band", "440", "480", "--cf", "150",
+                 "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    _assert_same(_without_timings(cli), _without_timings(stage))
+    written = json.loads((tmp_path / "out" / "upd_frf" / "result.json").read_text())["data"]
+    _assert_same(_without_timings(written), _without_timings(stage))
+    assert (tmp_path / "out" / "upd_frf" / "upd_frf.png").stat().st_size > 0
+    assert run_scene(scene, store, tmp_path / "out", **QUIET).computed == []   # cached
+
+
+def test_scalars_and_lines_are_the_records_peak(tmp_path):
+    from damper.run.upd_frf_stages import UPDFRF
+
+    rec = run_scene(parse_scene(UPD), Store(tmp_path / "cache"), tmp_path / "out", **QUIET)
+    stage, result = rec.plan["upd_frf"], rec.results["upd_frf"]
+    o, sc = result.data, UPDFRF().scalars(stage, result)
+    assert (sc["peak_frequency_Hz"], sc["peak_amplitude_m"]) == (o["peak_frequency_hz"], o["peak_amplitude"])
+    assert sc["harmonics_H"] == 1 and sc["truncation_error_rel"] == o["truncation_error"]["peak_amplitude_rel"]
+    assert f"{o['peak_frequency_hz']:.4f} Hz" in UPDFRF().lines(stage, result)[0]
+
+
+@pytest.mark.parametrize("edit, key, words", [
+    ("surface_nodes = 7\n", "upd.surface_nodes", 'goes with contacts = "surface"'),
+    ('surface_model = "nodes"\n', "upd.surface_model", 'goes with contacts = "surface"'),
+    (f'contacts = "surface"\nsurface_nodes = {MIN_NODES - 1}\n', "upd.surface_nodes", f"must be >= {MIN_NODES}"),
+    (f'contacts = "surface"\nsurface_nodes = {MAX_NODES + 1}\n', "upd.surface_nodes", f"must be <= {MAX_NODES}"),
+    ('contacts = "surface"\naccuracy = 0.01\n', "upd.accuracy", "fixed harmonics"),
+    ("band = [480.0, 440.0]\n", "upd.band", "high > low"),
+    ("cf = 0.001\n", "upd.cf", "is below"),
+])
+def test_upd_frf_refusals_name_the_key(edit, key, words):
+    given = {line.split(" =")[0] for line in edit.splitlines()}   # the edit replaces these keys
+    text = "\n".join(line for line in UPD.splitlines() if line.split(" =")[0] not in given) + "\n" + edit
+    with pytest.raises(SceneError) as err:
+        parse_scene(text, "bad.toml")
+    assert f"{key}: " in str(err.value) and words in str(err.value), str(err.value)
+
+
+def test_surface_contacts_in_optimal_load_are_refused():
+    with pytest.raises(SceneError) as err:
+        parse_scene(UPD.replace('["upd_frf"]', '["optimal_load"]') + 'contacts = "surface"\n', "bad.toml")
+    assert "upd.contacts: " in str(err.value) and "upd_frf only" in str(err.value)
+
+
+def test_surface_defaults_are_filled_in_for_the_stage_key():
+    u = parse_scene(UPD + 'contacts = "surface"\n').data["upd"]
+    assert (u["surface_nodes"], u["surface_model"]) == (5, "condensed")
+
+
+def test_run_of_a_refused_scene_exits_2_with_one_line(tmp_path, capsys):
+    path = tmp_path / "s.toml"
+    path.write_text(UPD + "surface_nodes = 7\n")
+    assert main(["run", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "upd.surface_nodes" in err and err.count("\n") == 1, err
+    assert not (tmp_path / "out").exists()
+
+
+def test_contacts_errors_of_the_model_are_refused_at_load(tmp_path):
+    (tmp_path / "mu0.toml").write_text("[damper]\nmu = 0.0\n")
+    text = UPD + 'config = "mu0.toml"\ncontacts = "surface"\n'
+    with pytest.raises(SceneError) as err:
+        parse_scene(text, "bad.toml", base=tmp_path)
+    assert "upd.contacts: " in str(err.value) and "mu > 0" in str(err.value), str(err.value)
+
+
+@pytest.mark.slow   # ~40 s CPU each run (the path in CF from the open load, 43 evaluations at 109 nodes)
+def test_surface_scene_result_is_the_record_of_upd_frf_contacts_surface(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("DAMPER_CACHE_DIR", str(tmp_path / "cli_cache"))   # the command's condensations
+    band = 'band = [400.0, 405.0]\ngrid = 3\ncontacts = "surface"\nsurface_nodes = 5\n'
+    text = "\n".join(line for line in UPD.splitlines() if line.split(" =")[0] not in ("band", "grid", "cf"))
+    rec = run_scene(parse_scene(text + "\n" + band), Store(tmp_path / "cache"), tmp_path / "out", **QUIET)
+    stage = rec.results["upd_frf"].data
+    assert stage["surface_model"]["nodes_per_side"] == 5 and stage["contact_points"] == ["left", "flat"]
+    assert main(["upd", "frf", "--contacts", "surface", "--surface-nodes", "5", "--harmonics", "1",
+                 "--points", "3", "--band", "400", "405", "--json"]) == 0
+    cli = json.loads(capsys.readouterr().out)
+    _assert_same(_without_timings(cli), _without_timings(stage))
