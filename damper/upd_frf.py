@@ -45,17 +45,11 @@ def options(**kw) -> SimpleNamespace:
 def upd_sector(opts):
     """The sector of ``opts.config`` with the contacts ``opts.contacts`` names (geometry: computed
     and kept in :func:`store_of`, the report in ``opts.contact_report``, printed unless ``opts.json``)."""
+    from damper.upd_geometry import apply_to_args
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.sector import Sector
 
-    cfg = load_config(opts.config)
-    if getattr(opts, "contacts", "toml") == "geometry":
-        from damper.upd_geometry import report_lines, with_geometry_contacts
-
-        cfg, opts.contact_report = with_geometry_contacts(cfg, getattr(opts, "cf", None), store_of(opts))
-        if not getattr(opts, "json", False):
-            print("\n".join(report_lines(opts.contact_report)))
-    return Sector(cfg)
+    return Sector(apply_to_args(opts, load_config(opts.config), store_of(opts)))
 
 
 def store_of(opts):

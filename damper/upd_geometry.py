@@ -258,19 +258,21 @@ def report_lines(report: dict) -> list[str]:
     return out
 
 
-def apply_to_args(args, cfg):
+def apply_to_args(args, cfg, store=None):
     """The CLI hook of ``damper upd``: ``cfg`` with the contacts that ``args.contacts`` names.
 
     ``--contacts toml`` (or no such option) returns ``cfg`` unchanged; ``geometry`` computes
-    them (the run's ``--cf`` sets the nominal loads), stores the report in
-    ``args.contact_report`` (the JSON's ``contacts_from_geometry``) and prints its lines
-    unless ``--json``.
+    them (the run's ``--cf`` sets the nominal loads; the condensations kept in ``store``,
+    default the application's cache), stores the report in ``args.contact_report`` (the
+    JSON's ``contacts_from_geometry``) and prints its lines unless ``--json``.
     """
     if getattr(args, "contacts", "toml") != "geometry":
         return cfg
-    from damper.cache import Store
+    if store is None:
+        from damper.cache import Store
 
-    cfg, report = with_geometry_contacts(cfg, getattr(args, "cf", None), Store().prepare())
+        store = Store().prepare()
+    cfg, report = with_geometry_contacts(cfg, getattr(args, "cf", None), store)
     args.contact_report = report
     if not getattr(args, "json", False):
         print("\n".join(report_lines(report)))

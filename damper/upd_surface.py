@@ -49,7 +49,7 @@ def build_surfaces(cfg, nodes_per_side: int, cf: float | None = None, store=None
     from contact_core.condense import condense
     from harmonic_balance.surface import build
 
-    mu, specs = _face_specs(cfg, nodes_per_side, cf)
+    mu, specs = face_specs(cfg, nodes_per_side, cf)
     out = {}
     for face, spec in specs.items():
         cc = condense(spec, directions=("z", "x"), cache=store if store is not None else False)
@@ -57,7 +57,7 @@ def build_surfaces(cfg, nodes_per_side: int, cf: float | None = None, store=None
     return out
 
 
-def _face_specs(cfg, nodes_per_side: int, cf: float | None) -> tuple:
+def face_specs(cfg, nodes_per_side: int, cf: float | None) -> tuple:
     """(mu, {face: ContactSpec}) of the two faces at ``nodes_per_side`` (bound checked)."""
     from harmonic_balance.surface import check_nodes
 
@@ -77,7 +77,7 @@ def check_unknowns(sector, nodes_per_side: int, H: int, cf: float | None) -> Non
     from contact_core import mesh
     from damper import limits
 
-    _, specs = _face_specs(sector.cfg, nodes_per_side, cf)
+    _, specs = face_specs(sector.cfg, nodes_per_side, cf)
     nodes = sum(mesh.build(spec)[1].contact.size for spec in specs.values())
     n = (sector.n_dof + 2 * nodes) * (2 * H + 1)
     if n > limits.MAX_SURFACE_UNKNOWNS:

@@ -124,7 +124,7 @@ def check_upd_contacts(data: dict, problems: list) -> None:
         return
     from damper.upd_frf import options, upd_sector
     from damper.upd_geometry import geometry_params
-    from damper.upd_surface import _face_specs, check_unknowns
+    from damper.upd_surface import check_unknowns, face_specs
     from harmonic_balance.bladed_disk.surface_hb import face_inputs
 
     key = "contacts"
@@ -133,7 +133,7 @@ def check_upd_contacts(data: dict, problems: list) -> None:
         geometry_params(sector.cfg, u.get("cf"))
         if u["contacts"] == "surface" and "upd_frf" in data["want"]:
             face_inputs(sector, "left")
-            _face_specs(sector.cfg, u["surface_nodes"], u.get("cf"))
+            face_specs(sector.cfg, u["surface_nodes"], u.get("cf"))
             key = "surface_nodes"
             if u["surface_model"] == "nodes":
                 check_unknowns(sector, u["surface_nodes"], u["harmonics"], u.get("cf"))
