@@ -426,3 +426,9 @@ class Store:
                 with contextlib.suppress(FileNotFoundError, PermissionError):
                     p.unlink()
                     total -= s.st_size
+
+
+def store_of(opts) -> Store:
+    """The cache of a run's condensations: ``opts.store`` (a scene's), else the default one."""
+    store = getattr(opts, "store", None)
+    return Store().prepare() if store is None else store

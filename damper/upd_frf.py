@@ -44,22 +44,13 @@ def options(**kw) -> SimpleNamespace:
 
 def upd_sector(opts):
     """The sector of ``opts.config`` with the contacts ``opts.contacts`` names (geometry: computed
-    and kept in :func:`store_of`, the report in ``opts.contact_report``, printed unless ``opts.json``)."""
+    and kept in :func:`damper.cache.store_of`, the report in ``opts.contact_report``, printed unless ``opts.json``)."""
+    from damper.cache import store_of
     from damper.upd_geometry import apply_to_args
     from harmonic_balance.bladed_disk.config import load_config
     from harmonic_balance.bladed_disk.sector import Sector
 
     return Sector(apply_to_args(opts, load_config(opts.config), store_of(opts)))
-
-
-def store_of(opts):
-    """The cache of the contacts' condensations: ``opts.store`` (a scene's), else the default."""
-    store = getattr(opts, "store", None)
-    if store is None:
-        from damper.cache import Store
-
-        store = Store().prepare()
-    return store
 
 
 def frf_record(opts) -> dict:

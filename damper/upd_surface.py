@@ -116,7 +116,7 @@ def sector_hb(sector, args):
     """The sector with the damper's faces as contact surfaces of ``args.surface_model``
     (:data:`SURFACE_MODELS`) at ``args.cf``, and ``make(cf)``: the same model at another
     centrifugal load [N] (the CF path's), on the same condensed surfaces."""
-    from damper.upd_frf import store_of
+    from damper.cache import store_of
     from harmonic_balance.bladed_disk.surface_hb import CondensedSurfaceSectorHB, SurfaceSectorHB, face_inputs
 
     face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
