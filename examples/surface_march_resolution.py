@@ -77,8 +77,11 @@ def main(argv=None) -> int:
     if min(periods) < 1 or min(samples) <= 2 * args.harmonics:
         ap.error("periods must be >= 1 and samples > 2 H")
     sector = Sector(load_config(None))
-    surfaces = build_surfaces(sector.cfg, args.nodes, args.cf, Store().prepare())
-    start = None if args.start is None else np.load(args.start)
+    try:   # a node count out of its bound, a start file that is missing or not an array
+        surfaces = build_surfaces(sector.cfg, args.nodes, args.cf, Store().prepare())
+        start = None if args.start is None else np.load(args.start)
+    except (ValueError, OSError) as err:
+        ap.error(str(err))
     cases = [(n, periods[0]) for n in samples] + [(samples[0], p) for p in periods[1:]]
     rows = []
     print(f"{'samples':>7s} {'periods':>7s} {'|u_a,1| [m]':>14s} {'difference':>11s} "

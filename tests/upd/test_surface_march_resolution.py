@@ -32,3 +32,10 @@ def test_samples_at_or_below_twice_the_harmonics_are_refused(load_example):
     with pytest.raises(SystemExit) as e:
         load_example("surface_march_resolution").main(["--harmonics", "7", "--samples", "14"])
     assert e.value.code == 2
+
+
+@pytest.mark.parametrize("argv", [["--nodes", "1"], ["--start", "no_such_solution.npy"]])
+def test_a_node_count_out_of_bound_or_a_missing_start_is_a_usage_error(argv, load_example, capsys):
+    with pytest.raises(SystemExit) as e:
+        load_example("surface_march_resolution").main(argv)
+    assert e.value.code == 2 and "error:" in capsys.readouterr().err
