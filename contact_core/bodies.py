@@ -40,6 +40,14 @@ MAX_CONTACT_SHARE = 0.15
 #: (a = 4.5e-6 R) solves, 2e-11 N (a = 1.2e-6 R) puts contact on the zone's edge, 1e-20 N
 #: asks for a mesh of 6e7 nodes and an approach of 5e-324 m divides by zero.
 MIN_CONTACT_SHARE = 3e-6
+#: Largest mean strain of a flat face's contact: mean pressure over E*, or approach over
+#: the face's smaller side. The sphere's bound (contact radius <= 0.15 R) is a mean
+#: pressure of 0.064 E*; an approach of 1 m on a 1.2 mm face gave 9e13 Pa as a result.
+MAX_CONTACT_STRAIN = 0.1
+#: Smallest mean strain of a flat face's contact, by force or by approach (the sphere's
+#: floor, a contact radius of 3e-6 R, is an approach of 9e-12 R): far below, the forces
+#: leave double precision (an approach of 5e-324 m gave a force 1.9 times k_n times it).
+MIN_CONTACT_STRAIN = 1e-12
 
 _KINDS: dict[str, Body] = {}
 
@@ -456,6 +464,38 @@ class FlatFace(Body):
     required = ("length", "width")
     symmetry = "half"
     curved = False
+
+    def validate(self, spec):
+        super().validate(spec)
+        if spec.load_hint > 0:
+            self.check_load(spec, spec.load_hint)
+
+    def check_load(self, spec, force):
+        """Refuse a force whose mean pressure lies outside [MIN_CONTACT_STRAIN,
+        MAX_CONTACT_STRAIN] E* (double precision; linear elasticity's small strains)."""
+        area = spec.width * spec.length
+        f_min, f_max = (s * spec.Estar * area for s in (MIN_CONTACT_STRAIN, MAX_CONTACT_STRAIN))
+        if force < f_min:
+            raise ValueError(f"a force of {force:.4g} N gives a mean pressure below {MIN_CONTACT_STRAIN:g} E* on "
+                             f"the {spec.width:.3g} x {spec.length:.3g} m face, where the contact forces leave "
+                             f"double precision; give at least {f_min:.4g} N")
+        if force > f_max:
+            raise ValueError(f"a force of {force:.4g} N gives a mean pressure above {MAX_CONTACT_STRAIN:g} E* on "
+                             f"the {spec.width:.3g} x {spec.length:.3g} m face: beyond the small strains of the "
+                             f"linear-elastic model; give at most {f_max:.4g} N")
+
+    def check_approach(self, spec, approach):
+        """Refuse an approach outside [MIN_CONTACT_STRAIN, MAX_CONTACT_STRAIN] of the face's
+        smaller side."""
+        side = min(spec.width, spec.length)
+        if approach < MIN_CONTACT_STRAIN * side:
+            raise ValueError(f"an approach of {approach:g} m is below {MIN_CONTACT_STRAIN:g} of the face's smaller "
+                             f"side ({side:.3g} m), where the contact forces leave double precision; give at "
+                             f"least {MIN_CONTACT_STRAIN * side:.3g} m")
+        if approach > MAX_CONTACT_STRAIN * side:
+            raise ValueError(f"an approach of {approach:g} m is above {MAX_CONTACT_STRAIN:g} of the face's smaller "
+                             f"side ({side:.3g} m): beyond the small strains of the linear-elastic model; give "
+                             f"at most {MAX_CONTACT_STRAIN * side:.3g} m")
 
     def check_eccentricity(self, spec, eccentricity):
         if eccentricity is not None and abs(eccentricity) >= spec.width / 2:

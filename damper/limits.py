@@ -98,15 +98,6 @@ MAX_COSIM_STEPS = 50_000_000
 #: Smallest curve step tolerance of ``damper tangential --tol`` (fraction of mu N): the
 #: number of curve points grows as tol^-1/2, ~30 times the default's (1e-3) at 1e-6.
 MIN_CURVE_TOL = 1e-6
-#: Largest mean strain of a flat face's contact (``damper normal``/``tangential --body flat``):
-#: mean pressure over E*, or approach over the face's smaller side. The sphere's bound
-#: (contact radius <= 0.15 R) is a mean pressure of 0.064 E*; an approach of 1 m on a
-#: 1.2 mm face gave 9e13 Pa as a result.
-MAX_CONTACT_STRAIN = 0.1
-#: Smallest mean strain of a flat face's contact, by force or by approach (the sphere's
-#: floor, a contact radius of 3e-6 R, is an approach of 9e-12 R): far below, the forces
-#: leave double precision (an approach of 5e-324 m gave a force 1.9 times k_n times it).
-MIN_CONTACT_STRAIN = 1e-12
 #: Largest hysteresis-loop amplitude of ``damper tangential --loop-amplitude`` in gross-slip
 #: displacements: the loop's points grow as the amplitude (sphere, bem 11: 882 points at
 #: 10, 78752 at 1000; 1e5 did not end in two minutes, 1e300 hung).

@@ -146,30 +146,20 @@ def _check_approach_floor(spec, approach: float) -> None:
 
 
 def _check_flat_load(spec, force, approach) -> None:
-    """A flat face's mean pressure (force) or mean strain (approach / the face's smaller
-    side) at most :data:`damper.limits.MAX_CONTACT_STRAIN` (of E*: linear elasticity) and at
-    least ``MIN_CONTACT_STRAIN`` (double precision)."""
-    from damper.limits import MAX_CONTACT_STRAIN, MIN_CONTACT_STRAIN
+    """A flat face's mean pressure (force) or mean strain (approach) inside the library's
+    bounds (:meth:`contact_core.bodies.FlatFace.check_load`, ``check_approach``)."""
+    if approach is not None:
+        _refuse_as("--approach", spec.kind.check_approach, spec, approach)
+    if force is not None:
+        _refuse_as("--force", spec.kind.check_load, spec, force)
 
-    side = min(spec.width, spec.length)
-    f_min = MIN_CONTACT_STRAIN * spec.Estar * spec.width * spec.length
-    if approach is not None and approach < MIN_CONTACT_STRAIN * side:
-        raise ValueError(f"--approach {approach:g} m is below {MIN_CONTACT_STRAIN:g} of the face's smaller side "
-                         f"({side:.3g} m), where the contact forces leave double precision; give at least "
-                         f"{MIN_CONTACT_STRAIN * side:.3g} m")
-    if force is not None and force < f_min:
-        raise ValueError(f"--force {force:g} N gives a mean pressure below {MIN_CONTACT_STRAIN:g} E* on the "
-                         f"{spec.width:.3g} x {spec.length:.3g} m face, where the contact forces leave double "
-                         f"precision; give at least {f_min:.4g} N")
-    if approach is not None and approach > MAX_CONTACT_STRAIN * side:
-        raise ValueError(f"--approach {approach:g} m is above {MAX_CONTACT_STRAIN:g} of the face's smaller side "
-                         f"({side:.3g} m): beyond the small strains of the linear-elastic model; give at most "
-                         f"{MAX_CONTACT_STRAIN * side:.3g} m")
-    f_max = MAX_CONTACT_STRAIN * spec.Estar * spec.width * spec.length
-    if force is not None and force > f_max:
-        raise ValueError(f"--force {force:g} N gives a mean pressure above {MAX_CONTACT_STRAIN:g} E* on the "
-                         f"{spec.width:.3g} x {spec.length:.3g} m face: beyond the small strains of the "
-                         f"linear-elastic model; give at most {f_max:.4g} N")
+
+def _refuse_as(option: str, check, *args) -> None:
+    """Run ``check``; its ValueError is prefixed with the option it concerns."""
+    try:
+        check(*args)
+    except ValueError as err:
+        raise ValueError(f"{option}: {err}") from None
 
 
 def sphere_approach_force(spec, approach: float) -> float:

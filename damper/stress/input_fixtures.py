@@ -206,6 +206,9 @@ def scenes() -> dict[str, str | bytes]:
                              "contact_stiffness = 3.85e7\nslip_force = 60.0\namplitude = [1e-7, 1e-4]\n"
                              "accuracy = 0.5\n"),
             "s_updcfg.toml": 'want = ["optimal_load"]\n[upd]\nconfig = "missing.toml"\n',
+            # a flat face's load past the small strains (an approach of 6 m printed before)
+            "s_flatbig.toml": ('want = ["k_n"]\n[contact.damper]\nbody = "flat"\nwidth = 1.2e-3\nlength = 1.2e-3\n'
+                               "force = 1e9\ngrid = 7\n"),
             "s_fmiempty.toml": SMALL.replace('want = ["virgin_curve", "k_t", "loop", "frf"]', 'want = ["fmu"]')
                                     .replace("fmi_versions = [2]", "fmi_versions = []"),
             "s_updcflow.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [1e-3, 10.0]\npoints = 3\n',

@@ -99,3 +99,20 @@ def test_overrides_are_checked_like_the_file():
         parse_scene(SMALL, overrides={"contact.damper.mu": "high"})
     with pytest.raises(SceneError, match="not a scene parameter"):
         parse_scene(SMALL, overrides={"contact.damper.colour": 1})
+
+
+def test_an_under_resolved_normal_contact_is_flagged_in_the_scene_lines(tmp_path):
+    """A cylinder's contact across fewer than MIN_NODES_ACROSS grid spacings (1e-12 N: the FE
+    half-width is the grid's, orders above 2D Hertz) prints the warning the CLI prints."""
+    from contact_core.bodies import MIN_NODES_ACROSS
+    from damper.cache import Store
+    from damper.run.runner import run_scene
+
+    text = ('want = ["k_n"]\n[contact.damper]\nbody = "cylinder"\ndiameter = 5.0e-3\nlength = 1.2e-3\n'
+            "force = 1e-12\ngrid = 7\n")
+    rec = run_scene(parse_scene(text), Store(tmp_path / "cache"), tmp_path / "out", echo=lambda text: None)
+    stage = rec.plan["normal:damper"]
+    result = rec.results["normal:damper"]
+    assert result.data["under_resolved"]
+    lines = stage.kind.lines(stage, result)
+    assert any(f"under-resolved: the contact spans fewer than {MIN_NODES_ACROSS}" in ln for ln in lines)

@@ -7,8 +7,8 @@ import re
 import pytest
 
 from contact_core import bodies, hertz
+from contact_core.bodies import MAX_CONTACT_STRAIN
 from damper.cli import main as damper
-from damper.limits import MAX_CONTACT_STRAIN
 
 R = 0.01
 ESTAR = hertz.contact_modulus(200e9, 0.3, 200e9, 0.3)
@@ -67,7 +67,7 @@ def test_flat_face_load_beyond_small_strain_is_refused_with_the_bound(load, caps
 @pytest.mark.parametrize("load", [["--approach", "5e-324"], ["--force", "1e-300"]])
 def test_flat_face_load_below_double_precision_is_refused_with_the_bound(load, capsys):
     """5e-324 m gave a force 1.9 times k_n times the approach (subnormal numbers)."""
-    from damper.limits import MIN_CONTACT_STRAIN
+    from contact_core.bodies import MIN_CONTACT_STRAIN
 
     err = _refused([*FLAT, *load], capsys)
     assert f"{MIN_CONTACT_STRAIN:g}" in err and "give at least" in err

@@ -120,3 +120,21 @@ def test_a_design_pressure_too_high_for_soft_materials_names_the_largest_accepte
     p_max = float(re.search(r"--p-design of at most ([0-9.e+-]+) Pa", err).group(1))
     spec = ContactSpec(body="sphere", radius=0.01, E2=2e5, grid=5, p_design=p_max)
     assert spec.zone()[0] / spec.zone_margin == pytest.approx(bodies.MAX_CONTACT_SHARE * 0.01, rel=1e-2)
+
+
+@pytest.mark.parametrize("force, words", [(1e9, "give at most"), (1e-300, "give at least")])
+def test_a_scene_flat_face_load_outside_the_strain_bounds_is_refused_at_its_key(force, words):
+    """The bound is the library's (FlatFace.check_load), so a scene meets it as the CLI does:
+    before, a scene's 1e9 N on a 1.2 mm face printed an approach of 6 m as a result."""
+    from damper.scene import SceneError, parse_scene
+
+    text = (f'want = ["k_n"]\n[contact.damper]\nbody = "flat"\nwidth = 1.2e-3\nlength = 1.2e-3\n'
+            f"force = {force!r}\ngrid = 7\n")
+    with pytest.raises(SceneError) as info:
+        parse_scene(text, "flat.toml")
+    msg = str(info.value)
+    assert "flat.toml:2: contact.damper: a force of" in msg and words in msg
+    spec = ContactSpec(body="flat", width=1.2e-3, length=1.2e-3)
+    bound = float(re.search(r"give at (?:most|least) ([0-9.e+-]+) N", msg).group(1))
+    strain = bodies.MAX_CONTACT_STRAIN if force > 1 else bodies.MIN_CONTACT_STRAIN
+    assert bound == pytest.approx(strain * spec.Estar * 1.2e-3 ** 2, rel=1e-3)  # 4 digits printed
