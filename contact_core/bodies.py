@@ -156,6 +156,8 @@ class Body:
             _positive(name, getattr(spec, name))
         if spec.height:
             _positive("height", spec.height)
+        if spec.load_hint > 0:
+            self.check_load(spec, spec.load_hint)
 
     def check_load(self, spec, force: float) -> None:
         """Refuse a normal force whose contact the model cannot represent (ValueError)."""
@@ -249,8 +251,6 @@ class Sphere(Body):
 
     def validate(self, spec):
         super().validate(spec)
-        if spec.load_hint > 0:
-            self.check_load(spec, spec.load_hint)
         zx, _ = self.zone(spec)
         if zx >= MAX_CONTACT_SHARE * spec.zone_margin * spec.radius * 1.0000001:
             # a = pi R p0 / (2 E*) at a = MAX_CONTACT_SHARE R
@@ -370,11 +370,6 @@ class Cylinder(Body):
     reference_label = "2D Hertz"
     profile_rows = (("y0", "FE, y = 0"), ("ymax", "FE, end y = L/2"))
 
-    def validate(self, spec):
-        super().validate(spec)
-        if spec.load_hint > 0:
-            self.check_load(spec, spec.load_hint)
-
     def check_load(self, spec, force):
         b = hertz.cylinder(force, spec.length, spec.radius, spec.Estar)["b"]
         if b > MAX_CONTACT_SHARE * spec.radius * (1.0 + 1e-9):
@@ -464,11 +459,6 @@ class FlatFace(Body):
     required = ("length", "width")
     symmetry = "half"
     curved = False
-
-    def validate(self, spec):
-        super().validate(spec)
-        if spec.load_hint > 0:
-            self.check_load(spec, spec.load_hint)
 
     def check_load(self, spec, force):
         """Refuse a force whose mean pressure lies outside [MIN_CONTACT_STRAIN,
