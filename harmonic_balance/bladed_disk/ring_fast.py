@@ -271,11 +271,9 @@ def sweep(solver: FastRingSolver, lo: float, hi: float, w0: float, x0, xp0):
     return w, xs, xps, a, da, errors
 
 
-def _flank(solver: FastRingSolver, br: Branch, end: float, band: float,
-           h0: float | None = None) -> str | None:
-    """Continue the branch from its last point to ``end`` (first step ``h0``, default
-    :data:`STEP_START` of the band [rad/s]); None or the failure's message."""
-    h = STEP_START * band if h0 is None else float(np.clip(h0, STEP_MIN * band, STEP_MAX * band))
+def _flank(solver: FastRingSolver, br: Branch, end: float, band: float) -> str | None:
+    """Continue the branch from its last point to ``end``; None or the failure's message."""
+    h = STEP_START * band
     sgn = np.sign(end - br.w[-1])
     while sgn * (end - br.w[-1]) > 1e-12 * abs(end):
         w, x, xp = br.w[-1], br.x[-1], br.xp[-1]
