@@ -125,6 +125,10 @@ class CondensedSurface(ForceElement):
     def local_damping(self):
         return self.C
 
+    #: Whether a march of one history solves its steps in C (massless_c; the numpy path,
+    #: its reference, where False or where the C step does not apply).
+    compiled = True
+
     #: Periods each evaluation marches (:data:`PERIODS`; an instance may set its own to
     #: measure what the first period's transient leaves in the loop).
     periods = PERIODS
@@ -149,6 +153,8 @@ class CondensedSurface(ForceElement):
         A = nodes.split(self.A)
         if n_h == 1:
             nodes.factors = self.factors
+            if self.compiled:
+                nodes.compile(A)
         sens = None if dq is None else MarchSensitivity(nodes, self.A, self.AR, dq.shape[2])
         dq = np.zeros((n_t, r, 0)) if dq is None else dq
         w = np.tile(self.w_static, (n_h, 1))
