@@ -48,6 +48,12 @@ class MsurfModel(ct.Structure):
                 + [(n, ct.c_int32) for n in ("max_sides", "max_bracket", "max_section", "n_slots")])
 
 
+class MsurfSens(ct.Structure):
+    """``msurf_sens`` of march_step.h."""
+    _fields_ = ([(n, ct.c_int32) for n in ("n_d", "ns_max", "r")] + [(n, _PD) for n in ("dw", "dz", "duc", "AR")]
+                + [("order", _P32)])
+
+
 class MsurfCache(ct.Structure):
     """``msurf_cache`` of march_step.h."""
     _fields_ = [("keys", _PD), ("lu", _PD), ("piv", _P32), ("used", ct.POINTER(ct.c_int64)),
@@ -68,6 +74,11 @@ def _load():
         getattr(_iwan, name).argtypes = [pm]
     _iwan.msurf_cache_sizes.restype = None
     _iwan.msurf_cache_sizes.argtypes = [pm] + [ct.POINTER(ct.c_size_t)] * 3
+    _iwan.msurf_sens_work_size.restype = ct.c_size_t
+    _iwan.msurf_sens_work_size.argtypes = [pm, ct.POINTER(MsurfSens)]
+    _iwan.msurf_advance.restype = ct.c_int
+    _iwan.msurf_advance.argtypes = [pm, ct.POINTER(MsurfCache), ct.POINTER(MsurfSens), StateArray,
+                                    StateArray, _PD, _PD, _PD]
     _iwan.msurf_solve.restype = ct.c_int
     _iwan.msurf_solve.argtypes = [pm, ct.POINTER(MsurfCache), StateArray, _PD, _PD, ct.c_int32,
                                   _PD, StateArray, _P32]
@@ -134,8 +145,9 @@ class CompiledStep:
         self.m = m
         self.work = np.zeros(lib.msurf_work_size(ct.byref(m)))
         self.swork = np.zeros(lib.msurf_state_work_size(ct.byref(m)), STATE_DTYPE)
-        self.cache = self._cache(cache)
+        self.cache = self._cache(cache, "compiled")
         self.sizes = [0] + [idx.size for _, idx, _ in nodes.groups]
+        self.groups = nodes.groups
         self.n_iter = ct.c_int32()
 
     @staticmethod
@@ -156,9 +168,10 @@ class CompiledStep:
         col = np.where(has, np.argmax(Q != 0, axis=1), -1)
         return col, np.where(has, Q[np.arange(Q.shape[0]), np.maximum(col, 0)], 0.0)
 
-    def _cache(self, owner):
-        """The kept factorizations, stored on the owner (a FactorCache: one per fixed A)."""
-        got = getattr(owner, "compiled", None)
+    def _cache(self, owner, name: str):
+        """The kept factorizations, stored on the owner (a FactorCache: one per fixed A) as
+        attribute ``name`` (the node solve's and the sensitivities' apart)."""
+        got = getattr(owner, name, None)
         key = self._keep["blk_ptr"].tobytes() + self._keep["blk_cptr"].tobytes()
         if got is None or got[0] != key:
             nk, nl, npv = ct.c_size_t(), ct.c_size_t(), ct.c_size_t()
@@ -169,7 +182,7 @@ class CompiledStep:
                            arrays[2].ctypes.data_as(_P32), arrays[3].ctypes.data_as(ct.POINTER(ct.c_int64)), 0)
             got = (key, c, arrays)
             if owner is not None:
-                owner.compiled = got
+                setattr(owner, name, got)
         return got[1]
 
     def solve(self, states: list, rhs: np.ndarray, guess: np.ndarray, max_iter: int):
@@ -190,3 +203,59 @@ class CompiledStep:
             raise IwanInputError(f"the massless node step: {_MESSAGES.get(st, st)}")
         off = np.cumsum(self.sizes)
         return w[None], [buf[a:e] for a, e in zip(off[:-1], off[1:])]
+
+
+class CompiledSensitivity:
+    """The forward sensitivities' advance (:meth:`.surface_sensitivity.MarchSensitivity.advance`
+    for one history, block-triangular, rows of one entry) in one C call per step, on the
+    blocks and laws of a :class:`CompiledStep`.
+
+    Parameters
+    ----------
+    step : CompiledStep
+    AR : ndarray (n_b, r)
+    n_d : int
+        Directions carried.
+    order : sequence of int
+        The blocks in the order they are solved (normal blocks first).
+    cache : FactorCache
+        Holds the kept factorizations across marches.
+
+    Attributes
+    ----------
+    dw : ndarray (1, n_b, n_d)
+        Sensitivity of the last committed displacements (updated in place).
+    """
+
+    def __init__(self, step: CompiledStep, AR, n_d: int, order, cache):
+        self.step = step
+        ns = max(int(ref.n_sliders) for ref in (g[0] for g in step_groups(step)))
+        n_f, n_b = step.m.n_f, step.m.n_b
+        self.dw = np.zeros((1, n_b, n_d))
+        self._dz, self._duc = np.zeros((n_f, ns, n_d)), np.zeros((n_f, n_d))
+        self._AR = np.ascontiguousarray(AR, dtype=np.float64)
+        self._order = np.ascontiguousarray(order, dtype=np.int32)
+        self.s = MsurfSens(int(n_d), ns, self._AR.shape[1], self.dw.ctypes.data_as(_PD),
+                           self._dz.ctypes.data_as(_PD), self._duc.ctypes.data_as(_PD),
+                           self._AR.ctypes.data_as(_PD), self._order.ctypes.data_as(_P32))
+        self.work = np.zeros(lib.msurf_sens_work_size(ct.byref(step.m), ct.byref(self.s)))
+        self.cache = step._cache(cache, "compiled_sensitivity")
+
+    def advance(self, before: list, after: list, w1: np.ndarray, dq1: np.ndarray) -> None:
+        """Carry the sensitivities over the step just committed (states per group before and
+        after it, w1 (1, n_b), dq1 (r, n_d))."""
+        b0 = np.concatenate(before)
+        b1 = np.concatenate(after)
+        w = np.ascontiguousarray(w1[0], dtype=np.float64)
+        dq = np.ascontiguousarray(dq1, dtype=np.float64)
+        st = lib.msurf_advance(ct.byref(self.step.m), ct.byref(self.cache), ct.byref(self.s),
+                               arr(b0, StateArray), arr(b1, StateArray), arr(w), arr(dq), arr(self.work))
+        if st == 3:
+            raise RuntimeError("the contact surface's sensitivity matrix is singular at a step")
+        if st != 0:
+            raise IwanInputError(f"the massless node sensitivities: {_MESSAGES.get(st, st)}")
+
+
+def step_groups(step: CompiledStep) -> list:
+    """The law groups of the nodes a :class:`CompiledStep` was made for."""
+    return step.groups

@@ -68,7 +68,7 @@ void msurf_cache_sizes(const msurf_model *m, size_t *n_keys, size_t *n_lu, size_
     size_t k = 0, l = 0, p = 0;
     for (int32_t b = 0; b < m->n_blocks; ++b) {
         const size_t mb = (size_t)block_size(m, b);
-        k += 2 * (size_t)(m->blk_cptr[b + 1] - m->blk_cptr[b]);
+        k += 3 * (size_t)(m->blk_cptr[b + 1] - m->blk_cptr[b]);
         l += mb * mb;
         p += mb;
     }
@@ -147,13 +147,14 @@ static void residual(const msurf_model *m, const double *rhs, iterate *it, doubl
     }
 }
 
-/* Offsets of block b's slots in the cache arrays. */
-static void slot_offsets(const msurf_model *m, int32_t b, size_t *key, size_t *lu, size_t *piv)
+/* Offsets of block b's slots in the cache arrays (kw key doubles per contact). */
+static void slot_offsets(const msurf_model *m, int32_t b, size_t kw, size_t *key, size_t *lu,
+                         size_t *piv)
 {
     size_t k = 0, l = 0, p = 0;
     for (int32_t a = 0; a < b; ++a) {
         const size_t ma = (size_t)block_size(m, a);
-        k += 2 * (size_t)(m->blk_cptr[a + 1] - m->blk_cptr[a]);
+        k += kw * (size_t)(m->blk_cptr[a + 1] - m->blk_cptr[a]);
         l += ma * ma;
         p += ma;
     }
@@ -189,6 +190,35 @@ static int factor_block(const msurf_model *m, int32_t b, const double *key, doub
     return info == 0 ? MSURF_OK : MSURF_SINGULAR;
 }
 
+/* The slot of block b holding the key (kw doubles per contact): a kept one, or the least
+ * recently used, emptied (*fresh = 1: the caller factorizes into it). */
+static int32_t find_slot(const msurf_model *m, msurf_cache *cache, int32_t b, size_t kw,
+                         const double *key, double **lu, int **piv, int *fresh)
+{
+    const int32_t mb = block_size(m, b), nc = m->blk_cptr[b + 1] - m->blk_cptr[b];
+    size_t ko, lo, po;
+    slot_offsets(m, b, kw, &ko, &lo, &po);
+    const size_t klen = kw * (size_t)nc, mm = (size_t)mb * (size_t)mb;
+    int64_t *used = cache->used + (size_t)b * m->n_slots;
+    int32_t slot = -1, oldest = 0;
+    for (int32_t s = 0; s < m->n_slots; ++s) {
+        if (used[s] && !memcmp(cache->keys + ko + s * klen, key, klen * sizeof(double))) {
+            slot = s;
+            break;
+        }
+        if (used[s] < used[oldest]) oldest = s;
+    }
+    *fresh = slot < 0;
+    if (slot < 0) {
+        slot = oldest;
+        memcpy(cache->keys + ko + slot * klen, key, klen * sizeof(double));
+    }
+    used[slot] = ++cache->clock;
+    *lu = cache->lu + lo + slot * mm;
+    *piv = (int *)cache->piv + po + (size_t)slot * mb;
+    return slot;
+}
+
 /* dx[dofs of b] = -J_b^{-1} r[dofs], J_b from the kept slot of its key or a new one. */
 static int solve_block(const msurf_model *m, msurf_cache *cache, int32_t b, const double *kte,
                        const double *kp, const double *r, double *dx, double *key, double *xb)
@@ -201,31 +231,13 @@ static int solve_block(const msurf_model *m, msurf_cache *cache, int32_t b, cons
         key[2 * k] = rint((kte[i] / m->kt_stuck[i]) * m->round_scale) / m->round_scale;
         key[2 * k + 1] = kp[i];
     }
-    size_t ko, lo, po;
-    slot_offsets(m, b, &ko, &lo, &po);
-    const size_t klen = 2 * (size_t)nc, mm = (size_t)mb * (size_t)mb;
-    int32_t slot = -1, oldest = 0;
-    for (int32_t s = 0; s < m->n_slots; ++s) {
-        const int64_t used = cache->used[(size_t)b * m->n_slots + s];
-        if (used && !memcmp(cache->keys + ko + s * klen, key, klen * sizeof(double))) {
-            slot = s;
-            break;
-        }
-        if (used < cache->used[(size_t)b * m->n_slots + oldest]) oldest = s;
-    }
     double *lu;
-    int *piv;
-    if (slot < 0) {
-        slot = oldest;
-        lu = cache->lu + lo + slot * mm;
-        piv = (int *)cache->piv + po + (size_t)slot * mb;
+    int *piv, fresh;
+    const int32_t slot = find_slot(m, cache, b, 2, key, &lu, &piv, &fresh);
+    if (fresh && factor_block(m, b, key, lu, piv) != MSURF_OK) {
         cache->used[(size_t)b * m->n_slots + slot] = 0;
-        if (factor_block(m, b, key, lu, piv) != MSURF_OK) return MSURF_SINGULAR;
-        memcpy(cache->keys + ko + slot * klen, key, klen * sizeof(double));
+        return MSURF_SINGULAR;
     }
-    lu = cache->lu + lo + slot * mm;
-    piv = (int *)cache->piv + po + (size_t)slot * mb;
-    cache->used[(size_t)b * m->n_slots + slot] = ++cache->clock;
     for (int32_t j = 0; j < mb; ++j)
         xb[j] = -r[dofs[j]];
     int n = mb, one = 1, info = 0;
@@ -401,4 +413,189 @@ int msurf_solve(const msurf_model *m, msurf_cache *cache, iwan_state *states, co
         if ((st = line_search(m, states, tmp, rhs, &cur, &cand, &s)) != MSURF_OK) return st;
     }
     return MSURF_NOT_SETTLED;
+}
+
+/* ------------------------------------------------------------ sensitivities */
+
+size_t msurf_sens_work_size(const msurf_model *m, const msurf_sens *s)
+{
+    int32_t cb;
+    const size_t mb = (size_t)largest_block(m, &cb), nd = (size_t)s->n_d;
+    const size_t nf = (size_t)m->n_f, ns = (size_t)s->ns_max;
+    return 3 * (size_t)m->n_c + (size_t)m->n_c * nd + 2 * nf * ns + 2 * nf + nf * ns * nd
+        + nf * nd + (size_t)m->n_b * nd + mb * nd + 3 * (size_t)cb + 2 * nd;
+}
+
+/* The end-state coefficients of one node (surface_sensitivity._end_state): a, b per
+ * slider, a_c, b_c; returns closed (1/0); *re, *tc, *dtc0, *dstep as there. */
+static double end_state(const iwan_model *law, const iwan_state *s0, const iwan_state *s1,
+                        double *a, double *b, double *ac, double *bc, int *stick, int *re,
+                        double *dtc0, double *tc, double *dstep)
+{
+    const int closed = s1->in_contact == 1;
+    *re = closed && s0->in_contact == 0;
+    const double n0 = s0->N, n1 = s1->N, den = *re ? n0 - n1 : 1.0;
+    const double t_c = *re ? n0 / den : 0.0, dtc1 = *re ? n0 / (den * den) : 0.0;
+    const double ds = s1->u - s0->u;
+    *dtc0 = *re ? -n1 / (den * den) : 0.0;
+    for (int32_t j = 0; j < law->n; ++j) {
+        const double z1 = s1->z[j], e = s1->u - z1;
+        const double sigma = (e > 0.0) - (e < 0.0);
+        const double r = (law->scale * law->fs[j]) / (law->n_ref * law->k[j]);
+        stick[j] = z1 == (*re ? s1->u_contact : s0->z[j]);
+        a[j] = stick[j] ? t_c : 1.0;
+        b[j] = stick[j] ? ds * dtc1 : -sigma * r;
+    }
+    *ac = t_c;
+    *bc = ds * dtc1;
+    *tc = t_c;
+    *dstep = ds;
+    return closed ? 1.0 : 0.0;
+}
+
+/* Block o's sensitivity matrix (surface_sensitivity._solve_cached's build: A_b plus the
+ * entries (q_a k) q_b of Q_s^T K_t Q_s, Q_s^T K_N Q_p, Q_p^T k_n Q_p) column-major into lu,
+ * factorized; key = (K_t, K_N k_n, k_n [P > 0]) per contact of the block. */
+static int factor_sens(const msurf_model *m, int32_t b, const double *key, double *lu, int *piv)
+{
+    const int32_t *ls = m->blk_ls, *lp = m->blk_lp;
+    const int32_t mb = block_size(m, b), c0 = m->blk_cptr[b], nc = m->blk_cptr[b + 1] - c0;
+    size_t off = 0;
+    for (int32_t a = 0; a < b; ++a)
+        off += (size_t)block_size(m, a) * (size_t)block_size(m, a);
+    const double *A = m->blk_A + off;
+    for (int32_t i = 0; i < mb; ++i)
+        for (int32_t j = 0; j < mb; ++j)
+            lu[i + (size_t)j * mb] = A[(size_t)i * mb + j];
+    for (int term = 0; term < 3; ++term)          /* numpy's order: ss, sp, pp */
+        for (int32_t k = 0; k < nc; ++k) {
+            const int32_t i = m->blk_c[c0 + k];
+            const int32_t row = term < 2 ? ls[c0 + k] : lp[c0 + k];
+            const int32_t col = term == 0 ? ls[c0 + k] : lp[c0 + k];
+            const double qa = term < 2 ? m->qs[i] : m->qp[i], qb = term == 0 ? m->qs[i] : m->qp[i];
+            if (row >= 0 && col >= 0) lu[row + (size_t)col * mb] += (qa * key[3 * k + term]) * qb;
+        }
+    int n = mb, info = 0;
+    dgetrf_p(&n, &n, lu, &n, piv, &info);
+    return info == 0 ? MSURF_OK : MSURF_SINGULAR;
+}
+
+/* dw of (M2), block by block in s->order (surface_sensitivity._solve_cached); rhs (n_b,
+ * n_d) row-major, K (3 n_c): K_t, K_N k_n, k_n [P > 0]; dw zero on entry. */
+static int solve_sens(const msurf_model *m, msurf_cache *cache, msurf_sens *s, const double *K,
+                      const double *rhs, double *xb, double *key)
+{
+    const int32_t nd = s->n_d;
+    for (int32_t o = 0; o < m->n_blocks; ++o) {
+        const int32_t b = s->order[o], mb = block_size(m, b);
+        const int32_t c0 = m->blk_cptr[b], nc = m->blk_cptr[b + 1] - c0;
+        const int32_t *dofs = m->blk_dofs + m->blk_ptr[b];
+        for (int32_t k = 0; k < nc; ++k)
+            for (int t = 0; t < 3; ++t)
+                key[3 * k + t] = K[t * m->n_c + m->blk_c[c0 + k]];
+        for (int32_t j = 0; j < mb; ++j)
+            for (int32_t d = 0; d < nd; ++d)
+                xb[j + (size_t)d * mb] = rhs[(size_t)dofs[j] * nd + d];
+        for (int32_t k = 0; k < nc; ++k) {        /* the solved normals' Coulomb coupling */
+            const int32_t i = m->blk_c[c0 + k], l = m->blk_ls[c0 + k];
+            if (l < 0 || m->cp[i] < 0) continue;
+            for (int32_t d = 0; d < nd; ++d)
+                xb[l + (size_t)d * mb] -= (K[m->n_c + i] * (s->dw[(size_t)m->cp[i] * nd + d] * m->qp[i]))
+                                          * m->qs[i];
+        }
+        double *lu;
+        int *piv, fresh;
+        const int32_t slot = find_slot(m, cache, b, 3, key, &lu, &piv, &fresh);
+        if (fresh && factor_sens(m, b, key, lu, piv) != MSURF_OK) {
+            cache->used[(size_t)b * m->n_slots + slot] = 0;
+            return MSURF_SINGULAR;
+        }
+        int n = mb, nrhs = nd, info = 0;
+        char trans = 'N';
+        dgetrs_p(&trans, &n, &nrhs, lu, &n, piv, xb, &n, &info);
+        for (int32_t j = 0; j < mb; ++j)
+            for (int32_t d = 0; d < nd; ++d)
+                s->dw[(size_t)dofs[j] * nd + d] = xb[j + (size_t)d * mb];
+    }
+    return MSURF_OK;
+}
+
+int msurf_advance(const msurf_model *m, msurf_cache *cache, msurf_sens *s,
+                  const iwan_state *before, const iwan_state *after, const double *w1,
+                  const double *dq1, double *work)
+{
+    if (!dgetrf_p || !dgetrs_p) return MSURF_NO_KERNELS;
+    const size_t nd = (size_t)s->n_d, ns = (size_t)s->ns_max, nf = (size_t)m->n_f;
+    const size_t nc = (size_t)m->n_c, nb = (size_t)m->n_b;
+    int32_t cb;
+    const size_t mb = (size_t)largest_block(m, &cb);
+    double *K = work, *G = K + 3 * nc, *a = G + nc * nd, *bco = a + nf * ns, *ac = bco + nf * ns;
+    double *bc = ac + nf, *gz = bc + nf, *gc = gz + nf * ns * nd, *rhs = gc + nf * nd;
+    double *xb = rhs + nb * nd, *key = xb + mb * nd, *ds0 = key + 3 * (size_t)cb, *dn0 = ds0 + nd;
+    int stick[IWAN_MAX_SLIDERS];
+    memset(K, 0, (3 * nc + nc * nd) * sizeof(double));
+    for (size_t f = 0; f < nf; ++f) {
+        const int32_t i = m->f_contact[f];
+        const iwan_model *law = m->laws[m->f_law[f]];
+        const double c = m->f_c[f], n_scale = m->kn[i] / c;
+        int re;
+        double dtc0, t_c, dstep;
+        const double closed = end_state(law, &before[f], &after[f], a + f * ns, bco + f * ns,
+                                        ac + f, bc + f, stick, &re, &dtc0, &t_c, &dstep);
+        for (size_t d = 0; d < nd; ++d) {
+            ds0[d] = m->cs[i] >= 0 ? s->dw[(size_t)m->cs[i] * nd + d] * m->qs[i] : 0.0;
+            dn0[d] = (m->cp[i] >= 0 ? s->dw[(size_t)m->cp[i] * nd + d] * m->qp[i] : 0.0) * n_scale;
+        }
+        double sum_a = 0.0, sum_b = 0.0;
+        for (int32_t j = 0; j < law->n; ++j) {
+            sum_a += (1.0 - a[f * ns + j]) * law->k[j];
+            sum_b += bco[f * ns + j] * law->k[j];
+        }
+        K[i] = (c * closed) * (sum_a + law->k_res * (1.0 - ac[f]));
+        K[nc + i] = (closed * (-sum_b - law->k_res * bc[f])) * m->kn[i];
+        for (size_t d = 0; d < nd; ++d) {
+            const double g_re = (1.0 - t_c) * ds0[d] + (dstep * dtc0) * dn0[d];
+            double gk = 0.0;
+            for (int32_t j = 0; j < law->n; ++j) {
+                double *g = gz + (f * ns + (size_t)j) * nd + d;
+                *g = (stick[j] && re ? g_re : 0.0) + (stick[j] && !re ? s->dz[(f * ns + (size_t)j) * nd + d] : 0.0);
+                gk += law->k[j] * *g;
+            }
+            gc[f * nd + d] = re ? g_re : s->duc[f * nd + d];
+            G[(size_t)i * nd + d] = -(c * closed) * (gk + law->k_res * gc[f * nd + d]);
+        }
+    }
+    for (size_t i = 0; i < nc; ++i) {
+        const double P = (m->cp[i] >= 0 ? w1[m->cp[i]] * m->qp[i] : 0.0) + m->p0[i];
+        K[2 * nc + i] = m->kn[i] * (P > 0.0 ? 1.0 : 0.0);
+    }
+    for (size_t j = 0; j < nb; ++j)               /* A R dq1 */
+        for (size_t d = 0; d < nd; ++d) {
+            double v = 0.0;
+            for (int32_t k = 0; k < s->r; ++k)
+                v += s->AR[j * (size_t)s->r + (size_t)k] * dq1[(size_t)k * nd + d];
+            rhs[j * nd + d] = v;
+        }
+    for (size_t i = 0; i < nc; ++i)               /* - Q_s^T G */
+        if (m->cs[i] >= 0)
+            for (size_t d = 0; d < nd; ++d)
+                rhs[(size_t)m->cs[i] * nd + d] -= G[i * nd + d] * m->qs[i];
+    memset(s->dw, 0, nb * nd * sizeof(double));
+    const int st = solve_sens(m, cache, s, K, rhs, xb, key);
+    if (st != MSURF_OK) return st;
+    for (size_t f = 0; f < nf; ++f) {
+        const int32_t i = m->f_contact[f];
+        const iwan_model *law = m->laws[m->f_law[f]];
+        const double n_scale = m->kn[i] / m->f_c[f];
+        for (size_t d = 0; d < nd; ++d) {
+            const double ds1 = m->cs[i] >= 0 ? s->dw[(size_t)m->cs[i] * nd + d] * m->qs[i] : 0.0;
+            const double dn1 = (m->cp[i] >= 0 ? s->dw[(size_t)m->cp[i] * nd + d] * m->qp[i] : 0.0) * n_scale;
+            for (int32_t j = 0; j < law->n; ++j) {
+                const size_t o = f * ns + (size_t)j;
+                s->dz[o * nd + d] = (a[o] * ds1 + bco[o] * dn1) + gz[o * nd + d];
+            }
+            s->duc[f * nd + d] = (ac[f] * ds1 + bc[f] * dn1) + gc[f * nd + d];
+        }
+    }
+    return MSURF_OK;
 }

@@ -94,6 +94,28 @@ void msurf_cache_sizes(const msurf_model *m, size_t *n_keys, size_t *n_lu, size_
 int msurf_solve(const msurf_model *m, msurf_cache *cache, iwan_state *states, const double *rhs,
                 double *w, int32_t max_iter, double *work, iwan_state *swork, int32_t *iterations);
 
+/* The march's forward sensitivities along n_d directions (harmonic_balance/
+ * surface_sensitivity.py, equations M1-M2 there): dw (n_b, n_d) of the last committed
+ * displacements, the sliders' dz (n_f, ns_max, n_d) and residual rest points' du_c (n_f,
+ * n_d), all row-major and carried in place; A R (n_b, r); the blocks in the order they are
+ * solved (normal blocks first: the system is block-triangular in it). */
+typedef struct {
+    int32_t n_d, ns_max, r;
+    double *dw, *dz, *duc;
+    const double *AR;
+    const int32_t *order;
+} msurf_sens;
+
+/* Doubles of the work space msurf_advance needs. */
+size_t msurf_sens_work_size(const msurf_model *m, const msurf_sens *s);
+
+/* Carry s over the step just committed: before / after the states of its start and end
+ * (n_f), w1 its displacements (n_b), dq1 (r, n_d) its inputs' sensitivity; the block
+ * factorizations kept in cache (a cache of its own: its keys are the consistent tangents). */
+int msurf_advance(const msurf_model *m, msurf_cache *cache, msurf_sens *s,
+                  const iwan_state *before, const iwan_state *after, const double *w1,
+                  const double *dq1, double *work);
+
 #ifdef __cplusplus
 }
 #endif

@@ -6,7 +6,7 @@ displacements and states to round-off: on a small flat face (15 nodes, x and z b
 along a path that sticks, slips grossly, reverses, repeats a sample (a zero step: every
 slipping node at the kink of its trial map), rocks (an edge opens) and lifts the whole
 face off and brings it back (re-contact). Then the condensed element's forces and exact
-Jacobian with the C step against the numpy one.
+Jacobian (the forward sensitivities advanced in C too) against the numpy path's.
 """
 from __future__ import annotations
 
@@ -92,20 +92,23 @@ def test_the_compiled_step_solves_each_step_as_the_numpy_path(element):
     assert c_nodes.dissipated()[0] > 0.0
 
 
-@pytest.mark.parametrize("slip", [0.3, 2.0], ids=["partial_slip", "gross_slip"])
-def test_the_condensed_element_gives_the_numpy_forces_and_jacobian(element, slip):
+@pytest.mark.parametrize("slip, breathing", [(0.3, 0.3), (2.0, 0.3), (1.0, 1.3)],
+                         ids=["partial_slip", "gross_slip", "lift_off_and_recontact"])
+def test_the_condensed_element_gives_the_numpy_forces_and_jacobian(element, slip, breathing):
     el, q_static, surface = element
     basis = FourierBasis((0, 1, 2), 64)
     U = np.zeros((basis.nb, el.m))
     U[0] = q_static
     j = surface.inputs.index("tangential_x")
     U[basis.index(1)[0], j] = slip * MU * N / el.stuck_stiffness()[j, j]
-    U[basis.index(1)[1], 0] = 0.3 * q_static[0]              # the load breathes
+    U[basis.index(1)[1], 0] = breathing * q_static[0]        # the load breathes (> 1: lifts off)
     out = []
     for compiled in (False, True):
         el.compiled = compiled
         el.factors = FactorCache()
         out.append(el.evaluate(U, basis, 1.0, jac=True))
+        if compiled:   # the march ran in C, its sensitivities too
+            assert el.factors.compiled is not None and el.factors.compiled_sensitivity is not None
     el.compiled = True
     (F0, J0), (F1, J1) = ((r.F, r.dF) for r in out)
     assert np.abs(F1 - F0).max() <= ELEMENT_RTOL * np.abs(F0).max()
