@@ -114,7 +114,9 @@ class FactorCache:
     has one operator; the second period repeats the first's sets), so a factorization is
     reused instead of recomputed; the key is the block and the bytes of the contact
     stiffnesses added to its fixed operator. The owner keeps one cache per fixed
-    operator A (a key does not name A).
+    operator A (a key does not name A). The compiled step (:mod:`.massless_c`) keeps its
+    factors and its large blocks' reference inverses here too (attributes ``compiled``,
+    ``compiled_sensitivity``, ``compiled_refs``; the inverses also under ``_inv["compiled"]``).
 
     Parameters
     ----------

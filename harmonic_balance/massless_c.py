@@ -45,7 +45,14 @@ class MsurfModel(ct.Structure):
                 + [(n, _P32) for n in ("blk_ptr", "blk_dofs", "blk_cptr", "blk_c", "blk_ls", "blk_lp")]
                 + [("blk_A", _PD)]
                 + [(n, ct.c_double) for n in ("fd_rel", "rtol", "section_rtol", "round_scale")]
-                + [(n, ct.c_int32) for n in ("max_sides", "max_bracket", "max_section", "n_slots")])
+                + [(n, ct.c_int32) for n in ("max_sides", "max_bracket", "max_section", "n_slots")]
+                + [(n, ct.c_int32) for n in ("diag_min", "n_refs")] + [("ref_share", ct.c_double)])
+
+
+class MsurfRefs(ct.Structure):
+    """``msurf_refs`` of march_step.h."""
+    _fields_ = [(n, _PD) for n in ("inv", "dref")] + [(n, ct.POINTER(ct.c_int64)) for n in ("id", "used")] \
+        + [(n, ct.c_int64) for n in ("clock", "count")]
 
 
 class MsurfSens(ct.Structure):
@@ -57,16 +64,16 @@ class MsurfSens(ct.Structure):
 class MsurfCache(ct.Structure):
     """``msurf_cache`` of march_step.h."""
     _fields_ = [("keys", _PD), ("lu", _PD), ("piv", _P32), ("used", ct.POINTER(ct.c_int64)),
-                ("clock", ct.c_int64)]
+                ("clock", ct.c_int64), ("refs", ct.POINTER(MsurfRefs))]
 
 
 def _load():
     if not hasattr(_iwan, "msurf_solve"):
         return None
     _iwan.msurf_set_kernels.restype = ct.c_int
-    _iwan.msurf_set_kernels.argtypes = [ct.c_void_p] * 3
+    _iwan.msurf_set_kernels.argtypes = [ct.c_void_p] * 4
     if _iwan.msurf_set_kernels(_capsule(cython_lapack, "dgetrf"), _capsule(cython_lapack, "dgetrs"),
-                               _capsule(cython_blas, "dgemv")) != 0:
+                               _capsule(cython_blas, "dgemv"), _capsule(cython_blas, "dgemm")) != 0:
         return None
     pm = ct.POINTER(MsurfModel)
     for name in ("msurf_work_size", "msurf_state_work_size"):
@@ -74,6 +81,8 @@ def _load():
         getattr(_iwan, name).argtypes = [pm]
     _iwan.msurf_cache_sizes.restype = None
     _iwan.msurf_cache_sizes.argtypes = [pm] + [ct.POINTER(ct.c_size_t)] * 3
+    _iwan.msurf_refs_sizes.restype = None
+    _iwan.msurf_refs_sizes.argtypes = [pm] + [ct.POINTER(ct.c_size_t)] * 2
     _iwan.msurf_sens_work_size.restype = ct.c_size_t
     _iwan.msurf_sens_work_size.argtypes = [pm, ct.POINTER(MsurfSens)]
     _iwan.msurf_advance.restype = ct.c_int
@@ -142,6 +151,7 @@ class CompiledStep:
         m.fd_rel, m.rtol, m.section_rtol = ms.FD_REL, ms.RESIDUAL_RTOL, ms.SECTION_RTOL
         m.round_scale = 10.0 ** ms.SLOPE_DIGITS
         m.max_sides, m.max_bracket, m.max_section, m.n_slots = ms.MAX_SIDES, ms.MAX_BRACKET, ms.MAX_SECTION, SLOTS
+        m.diag_min, m.n_refs, m.ref_share = ms.DIAGONAL_UPDATE_MIN, ms.MAX_REFERENCES, ms.REFERENCE_SHARE
         self.m = m
         self.work = np.zeros(lib.msurf_work_size(ct.byref(m)))
         self.swork = np.zeros(lib.msurf_state_work_size(ct.byref(m)), STATE_DTYPE)
@@ -152,13 +162,12 @@ class CompiledStep:
 
     @staticmethod
     def fits(nodes, A) -> bool:
-        """Whether the C step takes these nodes: one history, rows of one entry, the blocks
-        below DIAGONAL_UPDATE_MIN DOFs, every contact with a normal row."""
-        from . import massless as ms
+        """Whether the C step takes these nodes: one history, rows of one entry (so that a
+        block of DIAGONAL_UPDATE_MIN DOFs or more takes diagonal updates), every contact
+        with a normal row."""
         return (lib is not None and nodes.n_h == 1 and bool(nodes.groups)
                 and nodes.rows_s.gather and nodes.rows_p.gather
-                and np.all(np.count_nonzero(nodes.Qp, axis=1) == 1)
-                and all(dofs.size < ms.DIAGONAL_UPDATE_MIN for dofs, *_ in nodes.blocks))
+                and bool(np.all(np.count_nonzero(nodes.Qp, axis=1) == 1)))
 
     @staticmethod
     def _single(Q):
@@ -170,17 +179,34 @@ class CompiledStep:
 
     def _cache(self, owner, name: str):
         """The kept factorizations, stored on the owner (a FactorCache: one per fixed A) as
-        attribute ``name`` (the node solve's and the sensitivities' apart)."""
+        attribute ``name`` (the node solve's and the sensitivities' apart, sharing the large
+        blocks' reference inverses, attribute ``compiled_refs``)."""
         got = getattr(owner, name, None)
-        key = self._keep["blk_ptr"].tobytes() + self._keep["blk_cptr"].tobytes()
+        # the layout of the arrays: the blocks, and which of them take diagonal updates
+        key = (self._keep["blk_ptr"].tobytes() + self._keep["blk_cptr"].tobytes()
+               + np.array([self.m.diag_min, self.m.n_refs, self.m.n_slots, self.m.ref_share]).tobytes())
         if got is None or got[0] != key:
+            p64 = ct.POINTER(ct.c_int64)
+            refs = getattr(owner, "compiled_refs", None)
+            if refs is None or refs[0] != key:
+                ni, nd = ct.c_size_t(), ct.c_size_t()
+                lib.msurf_refs_sizes(ct.byref(self.m), ct.byref(ni), ct.byref(nd))
+                ra = (np.zeros(ni.value), np.zeros(nd.value), np.zeros(self.m.n_blocks * self.m.n_refs, np.int64),
+                      np.zeros(self.m.n_blocks * self.m.n_refs, np.int64))
+                refs = (key, MsurfRefs(ra[0].ctypes.data_as(_PD), ra[1].ctypes.data_as(_PD),
+                                       ra[2].ctypes.data_as(p64), ra[3].ctypes.data_as(p64), 0, 0), ra)
+                if owner is not None:
+                    owner.compiled_refs = refs
+                    if ra[0].size:   # the large blocks' reference inverses, beside the numpy path's
+                        owner._inv["compiled"] = refs
             nk, nl, npv = ct.c_size_t(), ct.c_size_t(), ct.c_size_t()
             lib.msurf_cache_sizes(ct.byref(self.m), ct.byref(nk), ct.byref(nl), ct.byref(npv))
             arrays = (np.zeros(nk.value), np.zeros(nl.value), np.zeros(npv.value, np.int32),
                       np.zeros(self.m.n_blocks * SLOTS, np.int64))
             c = MsurfCache(arrays[0].ctypes.data_as(_PD), arrays[1].ctypes.data_as(_PD),
-                           arrays[2].ctypes.data_as(_P32), arrays[3].ctypes.data_as(ct.POINTER(ct.c_int64)), 0)
-            got = (key, c, arrays)
+                           arrays[2].ctypes.data_as(_P32), arrays[3].ctypes.data_as(p64), 0,
+                           ct.pointer(refs[1]))
+            got = (key, c, arrays, refs)
             if owner is not None:
                 setattr(owner, name, got)
         return got[1]

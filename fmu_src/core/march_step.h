@@ -61,15 +61,30 @@ typedef struct {
     const double *blk_A;                    /* the blocks of A, row-major, one after another */
     double fd_rel, rtol, section_rtol, round_scale;  /* round_scale = 10^slope_digits */
     int32_t max_sides, max_bracket, max_section, n_slots;
+    int32_t diag_min, n_refs;   /* blocks of diag_min DOFs and more: diagonal updates of
+                                   n_refs kept inverses (rows of one entry: contacts on the
+                                   diagonal only) */
+    double ref_share;           /* share of changed entries beyond which a new reference */
 } msurf_model;
 
-/* Kept factorizations: per block n_slots slots of its key (2 n_cb doubles), column-major
- * LU (m^2) and pivots (m), each slot's last use (0: empty). Zero the arrays to start. */
+/* Kept reference inverses of the large blocks: per large block n_refs column-major
+ * inverses (m^2) and their diagonals (m); per block and reference its id (0: empty) and
+ * last use. Zero the arrays to start; one store serves both caches below. */
+typedef struct {
+    double *inv, *dref;
+    int64_t *id, *used;
+    int64_t clock, count;
+} msurf_refs;
+
+/* Kept factorizations: per block n_slots slots of its key (3 n_cb + 1 doubles), column-major
+ * LU (m^2; a large block's update matrix: floor(ref_share m)^2) and pivots, each slot's
+ * last use (0: empty). Zero the arrays to start. */
 typedef struct {
     double *keys, *lu;
     int32_t *piv;
     int64_t *used;
     int64_t clock;
+    msurf_refs *refs;
 } msurf_cache;
 
 /* Status codes. */
@@ -79,14 +94,16 @@ typedef struct {
 #define MSURF_SINGULAR 3        /* a block's Newton matrix is singular */
 #define MSURF_NO_KERNELS 4      /* msurf_set_kernels not called */
 
-/* The LAPACK / BLAS routines (Fortran dgetrf, dgetrs, dgemv); 0, or 1 if one is NULL. */
-int msurf_set_kernels(void *dgetrf, void *dgetrs, void *dgemv);
+/* The LAPACK / BLAS routines (Fortran dgetrf, dgetrs, dgemv, dgemm); 0, or 1 if one is NULL. */
+int msurf_set_kernels(void *dgetrf, void *dgetrs, void *dgemv, void *dgemm);
 
 /* Doubles and states of the work space msurf_solve needs. */
 size_t msurf_work_size(const msurf_model *m);
 size_t msurf_state_work_size(const msurf_model *m);
 /* Doubles of keys and LU, and ints of pivots, of a cache of m->n_slots slots per block. */
 void msurf_cache_sizes(const msurf_model *m, size_t *n_keys, size_t *n_lu, size_t *n_piv);
+/* Doubles of inverses and of diagonals of a reference store (msurf_refs). */
+void msurf_refs_sizes(const msurf_model *m, size_t *n_inv, size_t *n_d);
 
 /* Solve (E1) from the guess w (n_b, overwritten with the solution) and the committed
  * states (n_f, replaced by the solution's on MSURF_OK, untouched otherwise); rhs (n_b);

@@ -6,7 +6,8 @@ displacements and states to round-off: on a small flat face (15 nodes, x and z b
 along a path that sticks, slips grossly, reverses, repeats a sample (a zero step: every
 slipping node at the kink of its trial map), rocks (an edge opens) and lifts the whole
 face off and brings it back (re-contact). Then the condensed element's forces and exact
-Jacobian (the forward sensitivities advanced in C too) against the numpy path's.
+Jacobian (the forward sensitivities advanced in C too) against the numpy path's, with the
+blocks factorized and with the large blocks' diagonal updates of kept inverses.
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ import numpy as np
 import pytest
 from hbcases import condensed_flat_face
 
-from harmonic_balance import massless_c
+from harmonic_balance import massless, massless_c
 from harmonic_balance.fourier import FourierBasis
 from harmonic_balance.massless import MAX_NEWTON_UNSPLIT, FactorCache, MasslessContacts
 
@@ -92,9 +93,19 @@ def test_the_compiled_step_solves_each_step_as_the_numpy_path(element):
     assert c_nodes.dissipated()[0] > 0.0
 
 
+#: Block size from which both paths solve by diagonal updates of kept inverses in the
+#: large-block test (the face's blocks have 15 DOFs; UPD-24's from 10 nodes per side on
+#: are above massless.DIAGONAL_UPDATE_MIN).
+SMALL_UPDATE_MIN = 10
+
+
+@pytest.mark.parametrize("updates", [False, True], ids=["factorized", "diagonal_updates"])
 @pytest.mark.parametrize("slip, breathing", [(0.3, 0.3), (2.0, 0.3), (1.0, 1.3)],
                          ids=["partial_slip", "gross_slip", "lift_off_and_recontact"])
-def test_the_condensed_element_gives_the_numpy_forces_and_jacobian(element, slip, breathing):
+def test_the_condensed_element_gives_the_numpy_forces_and_jacobian(element, slip, breathing, updates,
+                                                                   monkeypatch):
+    if updates:
+        monkeypatch.setattr(massless, "DIAGONAL_UPDATE_MIN", SMALL_UPDATE_MIN)
     el, q_static, surface = element
     basis = FourierBasis((0, 1, 2), 64)
     U = np.zeros((basis.nb, el.m))
@@ -107,8 +118,9 @@ def test_the_condensed_element_gives_the_numpy_forces_and_jacobian(element, slip
         el.compiled = compiled
         el.factors = FactorCache()
         out.append(el.evaluate(U, basis, 1.0, jac=True))
-        if compiled:   # the march ran in C, its sensitivities too
+        if compiled:   # the march ran in C, its sensitivities too (and kept inverses if updated)
             assert el.factors.compiled is not None and el.factors.compiled_sensitivity is not None
+            assert np.any(el.factors.compiled_refs[2][2]) == updates
     el.compiled = True
     (F0, J0), (F1, J1) = ((r.F, r.dF) for r in out)
     assert np.abs(F1 - F0).max() <= ELEMENT_RTOL * np.abs(F0).max()
