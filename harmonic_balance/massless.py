@@ -44,6 +44,11 @@ With one history and a :class:`FactorCache` a block's factors are kept by contac
 state; a large block, whose contacts add to its diagonal only (a node coordinate per
 row), is solved by low-rank (Woodbury) updates of a few kept inverses instead of a new
 factorization per contact state (:meth:`FactorCache.solve_diagonal`).
+
+With one history and a FactorCache (the condensed surface's march) the whole step is one
+C call (:meth:`MasslessContacts.compile`, :mod:`.massless_c`: the same operations in
+``fmu_src/core/march_step.c``); the numpy code here serves batched histories (the time
+integration) and is the compiled step's reference.
 """
 from __future__ import annotations
 
