@@ -5,7 +5,8 @@
 calls on arrays of a few dozen entries; ``march_step.c`` makes the same step (the trial
 forces from the C core's Iwan step, Newton with the side passes, the factors kept by
 contact state, the line search) in one call, operation for operation, so the numpy path
-stays its reference (tests/hb/test_massless_c.py). LAPACK getrf/getrs and BLAS gemv are
+stays its reference (tests/hb/test_massless_c.py); :class:`CompiledSensitivity` advances
+the march's forward sensitivities likewise (``march_sens.c``). LAPACK getrf/getrs and BLAS gemv are
 scipy's, their addresses handed to the library once (as :mod:`.bladed_disk.ring_lu_c`
 does), so it links against nothing. :data:`lib` is None when the library lacks the step
 (an old build); :class:`CompiledStep` is then not used.

@@ -287,5 +287,5 @@ def _end_state(ref, st0, st1) -> _EndState:
     return _EndState(a, b, t_c, ds * dtc1, stick, re, closed.astype(float), t_c, dtc0, ds)
 
 
-#: The end states the compiled advance (fmu_src/core/march_step.c) mirrors.
+#: The end states the compiled advance (fmu_src/core/march_sens.c) mirrors.
 _END_STATE = _end_state

@@ -29,7 +29,8 @@
  * stiffnesses of its contacts), so a stick phase solves with factors already made; a kept
  * factorization is the same bits as a new one.
  *
- * Plain C99, no heap: the caller owns every buffer (sizes: msurf_work_size).
+ * Plain C99, no heap: the caller owns every buffer (sizes: msurf_work_size). The step:
+ * march_step.c; the sensitivities: march_sens.c; the kept factors: march_blocks.c.
  */
 #ifndef MARCH_STEP_H
 #define MARCH_STEP_H
