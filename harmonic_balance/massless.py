@@ -44,6 +44,11 @@ With one history and a :class:`FactorCache` a block's factors are kept by contac
 state; a large block, whose contacts add to its diagonal only (a node coordinate per
 row), is solved by low-rank (Woodbury) updates of a few kept inverses instead of a new
 factorization per contact state (:meth:`FactorCache.solve_diagonal`).
+
+With one history and a FactorCache (the condensed surface's march) the whole step is one
+C call (:meth:`MasslessContacts.compile`, :mod:`.massless_c`: the same operations in
+``fmu_src/core/march_step.c``); the numpy code here serves batched histories (the time
+integration) and is the compiled step's reference.
 """
 from __future__ import annotations
 
@@ -114,7 +119,9 @@ class FactorCache:
     has one operator; the second period repeats the first's sets), so a factorization is
     reused instead of recomputed; the key is the block and the bytes of the contact
     stiffnesses added to its fixed operator. The owner keeps one cache per fixed
-    operator A (a key does not name A).
+    operator A (a key does not name A). The compiled step (:mod:`.massless_c`) keeps its
+    factors and its large blocks' reference inverses here too (attributes ``compiled``,
+    ``compiled_sensitivity``, ``compiled_refs``; the inverses also under ``_inv["compiled"]``).
 
     Parameters
     ----------
@@ -299,6 +306,8 @@ class MasslessContacts:
             self.kt_stuck[idx] = c * (np.sum(ref.k) + ref.k_res)
         #: a FactorCache for one history (n_h = 1) with the same A in every solve, or None
         self.factors = None
+        #: the compiled step (:meth:`compile`), or None: the numpy path
+        self.compiled = None
         self._blocks(np.ones((n_b, n_b), bool) if pattern is None else np.asarray(pattern, bool))
         # the products on all DOFs (a contact touches a few DOFs)
         self.rows_s, self.rows_p = Rows(self.Qs), Rows(self.Qp)
@@ -361,6 +370,18 @@ class MasslessContacts:
         for ref, idx, c in self.groups:
             kt[idx] = c * (np.sum(ref.k) + ref.k_res)
         return self.Qp.T @ (self.kn * self.p0) - self.Qs.T @ (kt * self.s0)
+
+    def compile(self, A: list) -> bool:
+        """Solve each step of one history in one C call (:mod:`.massless_c`, the same
+        numbers as this module's numpy path) where it applies: n_h = 1, a
+        :attr:`factors` cache set, blocks below DIAGONAL_UPDATE_MIN DOFs; A the blocks
+        (:meth:`split`) every :meth:`solve` will get. Returns whether it applies."""
+        from .massless_c import CompiledStep
+
+        self.compiled = None
+        if self.factors is not None and CompiledStep.fits(self, A):
+            self.compiled = CompiledStep(self, A, self.factors)
+        return self.compiled is not None
 
     def evaluate(self, w: np.ndarray):
         """Trial forces from the committed states.
@@ -442,6 +463,9 @@ class MasslessContacts:
         RuntimeError
             Newton did not settle in ``max_iter`` iterations.
         """
+        if self.compiled is not None:             # the same step in one C call
+            w, self.states = self.compiled.solve(self.states, rhs, guess, max_iter)
+            return w
         w = guess.copy()
         fc, tan, trial = self.evaluate(w)
         r = self._residual(A, w, fc, rhs)

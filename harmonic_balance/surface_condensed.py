@@ -42,8 +42,11 @@ are kept by contact state (:class:`~.massless.FactorCache`, one per element, acr
 evaluations), so a stick phase and the repeated period solve with factors already
 made; blocks of 100 DOFs and more are solved by diagonal updates of a few kept inverses
 (the node solve's and the sensitivities' operators differ only in the nodes' contact
-stiffnesses), and a normal block's sensitivities for the r columns of A R only.
-Measured costs (UPD-24, 5 to 20 nodes per side): docs/method/contact_surface.md.
+stiffnesses), and a normal block's sensitivities for the r columns of A R only. A march of
+one history makes each step's node solve and sensitivity advance in one C call each
+(:mod:`.massless_c`, the same numbers as the numpy path, which :attr:`CondensedSurface.compiled`
+= False selects). Measured costs (UPD-24, 5 to 20 nodes per side):
+docs/method/contact_surface.md.
 
 Symbols as in :mod:`.surface`; q (r,) the rigid inputs, U (n_b, r) their harmonics.
 """
@@ -125,6 +128,10 @@ class CondensedSurface(ForceElement):
     def local_damping(self):
         return self.C
 
+    #: Whether a march of one history solves its steps in C (massless_c; the numpy path,
+    #: its reference, where False or where the C step does not apply).
+    compiled = True
+
     #: Periods each evaluation marches (:data:`PERIODS`; an instance may set its own to
     #: measure what the first period's transient leaves in the loop).
     periods = PERIODS
@@ -149,6 +156,8 @@ class CondensedSurface(ForceElement):
         A = nodes.split(self.A)
         if n_h == 1:
             nodes.factors = self.factors
+            if self.compiled:
+                nodes.compile(A)
         sens = None if dq is None else MarchSensitivity(nodes, self.A, self.AR, dq.shape[2])
         dq = np.zeros((n_t, r, 0)) if dq is None else dq
         w = np.tile(self.w_static, (n_h, 1))

@@ -93,6 +93,15 @@ class MarchSensitivity:
         self._diagonal = [self._entries is not None and self._entries[i][1][0].size == 0
                           and all(np.array_equal(t[1], t[2]) for t in self._entries[i])
                           for i in range(len(self._order))]
+        # the same advance in one C call per step where the node solve is compiled (and the
+        # end states are this module's: a replaced _end_state, e.g. a test's spy on the
+        # branches a march takes, keeps the numpy advance that calls it)
+        self.compiled = None
+        if (nodes.compiled is not None and self._triangular and self._entries is not None
+                and _end_state is _END_STATE):
+            from .massless_c import CompiledSensitivity
+            self.compiled = CompiledSensitivity(nodes.compiled, self.AR, n_d, self._index, nodes.factors)
+            self.dw = self.compiled.dw
 
     def _is_triangular(self) -> bool:
         """Whether (M2) is block-triangular in ``_order`` whatever the contact states: A and
@@ -127,6 +136,9 @@ class MarchSensitivity:
             Sensitivity of the step's inputs q_1.
         """
         nodes = self.nodes
+        if self.compiled is not None:
+            self.compiled.advance(before, nodes.states, w1, dq1)
+            return
         n_h, n_c = nodes.n_h, len(nodes.kn)
         ds0 = nodes.rows_s.rows(self.dw)
         dP0 = nodes.rows_p.rows(self.dw)
@@ -273,3 +285,7 @@ def _end_state(ref, st0, st1) -> _EndState:
     a = np.where(stick, t_c[..., None], 1.0)
     b = np.where(stick, (ds * dtc1)[..., None], -sigma * r)
     return _EndState(a, b, t_c, ds * dtc1, stick, re, closed.astype(float), t_c, dtc0, ds)
+
+
+#: The end states the compiled advance (fmu_src/core/march_sens.c) mirrors.
+_END_STATE = _end_state
