@@ -137,11 +137,8 @@ def _check_frf(args) -> None:
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
                       limits.harmonics_why(limits.MAX_UPD_HARMONICS))
     check_accuracy_option(args.accuracy)
-    for name in ("cf", "f0"):
-        v = getattr(args, name)
-        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
-            raise ValueError(f"--{name.replace('_', '-')} must be finite, > 0 and at most "
-                             f"{limits.MAX_MAGNITUDE:g} N, got {v:g}")
+    limits.check_load("--cf", args.cf)
+    limits.check_load("--f0", args.f0)
     check_out_dir(args.plot, "--plot")
     check_surface_nodes(args)
     from damper.upd_surface import check_options

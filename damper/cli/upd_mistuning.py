@@ -119,6 +119,9 @@ def _study(args):
 
     from .common import check_accuracy_option, check_out_dir
 
+    if args.scheduler is not None and not args.scheduler.strip():   # not a silent local cluster
+        raise ValueError("--scheduler '' names no scheduler: give its address (tcp://host:8786), or drop "
+                         "--scheduler for a local cluster")
     given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
                             ("--serial", args.serial)) if v]
     if len(given) > 1:
@@ -127,6 +130,8 @@ def _study(args):
         limits.check_workers("--workers", args.workers)
     check_out_dir(args.plot, "--plot")
     check_accuracy_option(args.accuracy)
+    limits.check_load("--cf", args.cf)
+    limits.check_load("--f0", args.f0)
     if args.accuracy is not None and args.damper != "nonlinear":
         raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
                          "has no harmonic truncation (drop --accuracy)")

@@ -222,6 +222,7 @@ def scenes() -> dict[str, str | bytes]:
             "s_ufolsurf.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\n',
             "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
             "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
+            "s_uff0tiny.toml": 'want = ["upd_frf"]\n[upd]\nf0 = 1e-300\npoints = 3\nharmonics = 1\n',
             "s_ufmu0.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_mu0.toml"\ncontacts = "surface"\n',
             "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',
             "s_mtcflow.toml": 'want = ["mistuning"]\n[mistuning]\ncf = 1e-3\nsamples = 1\n',
