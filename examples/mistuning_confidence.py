@@ -123,8 +123,10 @@ def row_lines(row: dict) -> list:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=Path("out/mt_confidence"))
+    p.add_argument("--out", type=out_folder, default=Path("out/mt_confidence"))
     p.add_argument("--samples", type=int, default=1000, help="samples of the first study (the second: 4x)")
     p.add_argument("--damper", choices=("free", "stuck", "nonlinear"), default="free")
     p.add_argument("--cache-dir", type=Path, help="sample cache (default: a temporary folder)")
@@ -146,4 +148,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))
