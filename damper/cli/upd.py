@@ -153,7 +153,7 @@ def run_frf(args) -> int:
 
     from damper.upd_frf import frf_record
 
-    from .common import print_json
+    from .common import print_json, print_warnings
 
     _check_frf(args)
     out = frf_record(args)
@@ -176,8 +176,8 @@ def run_frf(args) -> int:
             print(surface_line(out["surface_model"]))
     from harmonic_balance.steady_state import summary_lines
 
-    warnings = [out[k] for k in ("band_end_warning", "lift_off_warning") if out[k]]
-    for line in warnings + accuracy_lines(out) + summary_lines(out.get("steady_state")):
+    print_warnings(out, ("band_end_warning", "lift_off_warning"), args.json)
+    for line in accuracy_lines(out) + summary_lines(out.get("steady_state")):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0

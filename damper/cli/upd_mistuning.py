@@ -68,7 +68,7 @@ def run_mistuning(args) -> int:
     from damper.mistuning_plot import plot_study
 
     from .cache import store_from_args
-    from .common import print_json
+    from .common import print_json, print_warnings
 
     study = _study(args)
     if args.worst or args.bound is not None or args.out is not None or args.max_evaluations is not None:
@@ -93,9 +93,7 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
-        for key in ("truncation_warning", "lift_off_warning"):
-            if out.get(key):
-                print(out[key], file=sys.stderr)
+        print_warnings(out, ("truncation_warning", "lift_off_warning"), True)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz"
@@ -107,8 +105,7 @@ def run_mistuning(args) -> int:
         print(line)
     for line in accuracy_lines(out):
         print(line)
-    if out.get("lift_off_warning"):
-        print(out["lift_off_warning"])
+    print_warnings(out, ("lift_off_warning",), False)
     return 0
 
 
@@ -209,12 +206,11 @@ def _print_samples(out: dict) -> None:
 def _run_worst(args, study) -> int:
     """``--worst``: the worst pattern, printed (and written to --out)."""
     import json
-    import sys
     from pathlib import Path
 
     from damper.mistuning_worst import check_worst, run_worst
 
-    from .common import atomic_write, print_json
+    from .common import atomic_write, print_json, print_warnings
 
     if not args.worst:
         raise ValueError("--bound, --out and --max-evaluations go with --worst")
@@ -242,11 +238,10 @@ def _run_worst(args, study) -> int:
         atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
     if args.json:
         print_json(out)
-        if out.get("lift_off_warning"):
-            print(out["lift_off_warning"], file=sys.stderr)
-        return 0
-    for line in worst_lines(out) + ([out["lift_off_warning"]] if out.get("lift_off_warning") else []):
-        print(line)
+    else:
+        for line in worst_lines(out):
+            print(line)
+    print_warnings(out, ("lift_off_warning",), args.json)
     return 0
 
 
