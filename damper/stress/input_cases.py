@@ -405,7 +405,7 @@ def _run() -> list[InputCase]:
         "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
         "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml",
         "s_step.toml", "s_bbk.toml", "s_bbf.toml", "s_bbamphuge.toml", "s_updcflow.toml", "s_mtcflow.toml",
-        "s_mtci.toml", "s_mtband.toml", "s_mtblades.toml",
+        "s_mtci.toml", "s_mtband.toml", "s_mtblades.toml", "s_contactpath.toml",
         "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml",
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",

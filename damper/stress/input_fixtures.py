@@ -169,6 +169,7 @@ SCENE_EDITS = {
     "s_type.toml": ("force = 120.0", 'force = "heavy"'),
     "s_step.toml": ("harmonics = 3", "harmonics = 3\nmax_step = 1e-300"),
     "s_dupkey.toml": ("grid = 7", "grid = 7\ngrid = 9"),
+    "s_contactpath.toml": ("[contact.damper]", '[contact."../../../escaped"]'),
     "s_wantempty.toml": ('want = ["virgin_curve", "k_t", "loop", "frf"]', "want = []"),
     "s_fmiempty.toml": None,
     "s_duptable.toml": ("[element]", '[contact.damper]\nbody = "sphere"\n\n[element]'),
