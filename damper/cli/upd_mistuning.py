@@ -77,7 +77,8 @@ def run_mistuning(args) -> int:
         return _run_worst(args, study)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     try:
-        out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
+        # the cache folder checked before any sample (a file there was found only after the work)
+        out = run_study(study, store_from_args(args).prepare(), args.scheduler, args.workers, args.serial, echo)
     except KeyboardInterrupt:
         from damper.run.runner import Interrupted
 

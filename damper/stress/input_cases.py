@@ -345,6 +345,8 @@ def _upd() -> list[InputCase]:
         ("mistuning scheduler '' (a silent local cluster)", "mistuning --scheduler '' --samples 2 --damper free"),
         ("mistuning workers and serial", "mistuning --workers 2 --serial"),
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
+        ("mistuning --cache-dir a file (refused only after the samples)",
+         "mistuning --damper free --samples 1 --serial --cache-dir {fx}/a_file"),
         ("mistuning until-ci 0", "mistuning --until-ci 0"), ("mistuning until-ci nan", "mistuning --until-ci nan"),
         ("mistuning until-ci inf", "mistuning --until-ci inf"),
         ("mistuning until-ci 1e300", "mistuning --until-ci 1e300"),
