@@ -55,7 +55,8 @@ def test_run_returns_main_s_code_and_zero_for_a_result():
 @pytest.mark.parametrize("argv", [["bench_element.py", "--samples", "0"],
                                   ["bench_fmu.py", "--sliders", "abc"],
                                   ["cylinder_approach.py", "--grid", "1"],
-                                  ["masing_loops.py", "--smoke", "--out", "{file}"]])
+                                  ["masing_loops.py", "--smoke", "--out", "{file}"],
+                                  ["mistuning_confidence.py", "--quick", "--samples", "0"]])
 def test_an_example_given_a_bad_argument_exits_2_with_one_line(argv, tmp_path):
     (tmp_path / "a_file").write_text("x")
     argv = [a.replace("{file}", str(tmp_path / "a_file")) for a in argv]
