@@ -254,7 +254,8 @@ def cache_bytes(name: str, mb) -> int:
 #: evaluations each, and a failed step is halved up to 4 times. Measured on UPD-24 (F0 30 N,
 #: 5 nodes per side, H 1, 400 Hz, revision a0d7384; ~1 s CPU per evaluation): 815 -> 435 ->
 #: 232 -> 124 -> 66 N (2.2 F0) in 67 evaluations; the next load, 35 N (1.2 F0), failed after
-#: 363 evaluations (433 s CPU), so a CF of 10 N ran on for more than 10 min of CPU unanswered.
+#: 363 evaluations (433 s CPU), its halved step 48 N (1.6 F0) after 384 (421 s), while 56 N
+#: (1.9 F0) took 6: a CF of 10 N ran on for more than 15 min of CPU unanswered.
 MIN_SURFACE_CF_PER_F0 = 2.0
 
 
