@@ -130,6 +130,8 @@ def _study(args):
     check_accuracy_option(args.accuracy)
     limits.check_load("--cf", args.cf)
     limits.check_load("--f0", args.f0)
+    if args.engine_order is not None and args.engine_order < 0:   # (the model's check names its config key)
+        raise ValueError(f"--engine-order must be >= 0 (0 ... blades / 2), got {args.engine_order}")
     if args.accuracy is not None and args.damper != "nonlinear":
         raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
                          "has no harmonic truncation (drop --accuracy)")

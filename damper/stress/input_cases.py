@@ -332,6 +332,7 @@ def _upd() -> list[InputCase]:
         ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
         ("mistuning samples 0", "mistuning --samples 0"), ("mistuning samples 1e5", "mistuning --samples 100000"),
         ("mistuning blades 1e5", "mistuning --blades 100000"),
+        ("mistuning engine order -1 (named as a config key)", "mistuning --engine-order=-1 --damper free --serial"),
         ("mistuning blades 2 without an engine order (UPD-24's is 6)", "mistuning --blades 2 --serial"),
         ("mistuning factor -1", "mistuning --blades 4 --engine-order 1 --factors 1 -1 1 1"),
         ("mistuning factor nan", "mistuning --blades 4 --engine-order 1 --factors 1 nan 1 1"),
