@@ -248,33 +248,6 @@ def cache_bytes(name: str, mb) -> int:
     return size
 
 
-#: Least centrifugal load per newton of EO force of the condensed contact surfaces (``upd frf
-#: --contacts surface``): their first point is reached by a path in CF down from the open load
-#: (harmonic_balance.bladed_disk.load_path), whose failing Newton solves cost hundreds of
-#: evaluations each, and a failed step is halved up to 4 times. Measured on UPD-24 (F0 30 N,
-#: 5 nodes per side, H 1, 400 Hz, revision a0d7384; ~1 s CPU per evaluation): 815 -> 435 ->
-#: 232 -> 124 -> 66 N (2.2 F0) in 67 evaluations; the next load, 35 N (1.2 F0), failed after
-#: 363 evaluations (433 s CPU), its halved step 48 N (1.6 F0) after 384 (421 s), while 56 N
-#: (1.9 F0) took 6: a CF of 10 N ran on for more than 15 min of CPU unanswered.
-MIN_SURFACE_CF_PER_F0 = 2.0
-
-
-def check_surface_cf_floor(name: str, cf, f0, config, hint: str) -> None:
-    """A centrifugal load ``cf`` [N] (None: the UPD model ``config``'s) at least
-    :data:`MIN_SURFACE_CF_PER_F0` times the EO force (``f0``, None: the model's), else
-    ValueError naming ``name``."""
-    if cf is None or f0 is None:
-        from harmonic_balance.bladed_disk.config import load_config
-
-        cfg = load_config(config)
-        cf, f0 = cfg.cf if cf is None else cf, cfg.f0 if f0 is None else f0
-    if math.isfinite(cf) and 0 < cf < MIN_SURFACE_CF_PER_F0 * f0:
-        raise ValueError(f"{name} {cf:g} N is below {MIN_SURFACE_CF_PER_F0:g} x the EO force ({f0:g} N) with "
-                         "condensed contact surfaces: the path in CF from the open load down to it fails or takes "
-                         "tens of minutes of CPU (UPD-24: one load of 1.2 x F0 failed after 7 min); give a CF of "
-                         f"at least {MIN_SURFACE_CF_PER_F0 * f0:g} N, {hint}")
-
-
 def check_cf_floor(name: str, cf, f0, config, hint: str = "or --damper free for the blades without a damper") -> None:
     """A centrifugal load ``cf`` [N] at least :data:`MIN_CF_PER_F0` times the EO force
     (``f0``, default the UPD model ``config``'s), else ValueError naming ``name``."""

@@ -146,9 +146,6 @@ def _check_frf(args) -> None:
     check_options(args)
     if args.damper == "nonlinear":
         limits.check_cf_floor("--cf", args.cf, args.f0, args.config)
-    if args.contacts == "surface" and args.surface_model == "condensed":
-        limits.check_surface_cf_floor("--cf", args.cf, args.f0, args.config,
-                                      "or point contacts (--contacts toml or geometry)")
 
 
 def run_frf(args) -> int:

@@ -369,8 +369,6 @@ def _check_upd_contacts(data: dict, problems: list) -> None:
         if "upd_frf" in wants and "accuracy" in u:
             problems.append((("upd", "accuracy"), "contacts = \"surface\" runs at the fixed harmonics: "
                              "drop accuracy"))
-        if "upd_frf" in wants and u["surface_model"] == "condensed":
-            _check_surface_cf(u, problems)
     if "upd_frf" in wants and "cf" in u and not any(p[0] == ("upd", "config") for p in problems):
         from harmonic_balance.bladed_disk.config import load_config
 
@@ -382,23 +380,6 @@ def _check_upd_contacts(data: dict, problems: list) -> None:
             limits.check_cf_floor("cf", u["cf"], f0, None, "or drop cf (the model's own)")
         except ValueError as err:
             problems.append((("upd", "cf"), str(err)))
-
-
-def _check_surface_cf(u: dict, problems: list) -> None:
-    """[upd] cf (or the model's) of condensed contact surfaces above their floor
-    (:func:`damper.limits.check_surface_cf_floor`)."""
-    from damper import limits
-    from harmonic_balance.bladed_disk.config import load_config
-
-    try:
-        cfg = load_config(u.get("config"))
-    except (OSError, ValueError):   # the model file's own check reports it
-        return
-    try:
-        limits.check_surface_cf_floor("cf", u.get("cf", cfg.cf), u.get("f0", cfg.f0), None,
-                                      "or contacts = \"toml\" or \"geometry\"")
-    except ValueError as err:
-        problems.append((("upd", "cf"), str(err)))
 
 
 def _check_mistuning(data: dict, problems: list) -> None:

@@ -299,9 +299,6 @@ def _upd() -> list[InputCase]:
         ("frf surface with check-steady-state (point contacts only)", "frf --contacts surface --check-steady-state"),
         ("frf surface nodes without surface contacts", "frf --surface-nodes 7"),
         ("frf surface with an axial platform DOF (not planar)", "frf --contacts surface --config {fx}/upd_axial.toml"),
-        ("frf surface cf 10 (its path in CF ran for more than 10 min of CPU)",
-         "frf --contacts surface --cf 10 --harmonics 1 --points 3 --band 400 405 --json"),
-        ("frf surface cf 120 f0 100 (the config's CF below 2 F0)", "frf --contacts surface --f0 100"),
         ("frf surface cf 1e6 (a cylinder contact beyond Hertz)", "frf --contacts surface --cf 1e6 --json"),
         ("frf surface with mu 0 (no virgin curve to condense)", "frf --contacts surface --config {fx}/upd_mu0.toml"),
         ("frf surface nodes H 50 (its dense Jacobian was killed for memory)",
@@ -415,7 +412,7 @@ def _run() -> list[InputCase]:
         "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml",
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",
-        "s_ufaxial.toml", "s_ufmu0.toml", "s_uff0tiny.toml", "s_ufsurfcf.toml")]
+        "s_ufaxial.toml", "s_ufmu0.toml", "s_uff0tiny.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),

@@ -223,7 +223,6 @@ def scenes() -> dict[str, str | bytes]:
             "s_ufolsurf.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\n',
             "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
             "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
-            "s_ufsurfcf.toml": 'want = ["upd_frf"]\n[upd]\ncontacts = "surface"\ncf = 10.0\n',
             "s_uff0tiny.toml": 'want = ["upd_frf"]\n[upd]\nf0 = 1e-300\npoints = 3\nharmonics = 1\n',
             "s_ufmu0.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_mu0.toml"\ncontacts = "surface"\n',
             "s_cfrone.toml": 'want = ["optimal_load"]\n[upd]\ncf_range = [100.0]\npoints = 3\n',

@@ -80,8 +80,6 @@ def test_scalars_and_lines_are_the_records_peak(tmp_path):
     ('contacts = "surface"\naccuracy = 0.01\n', "upd.accuracy", "fixed harmonics"),
     ("band = [480.0, 440.0]\n", "upd.band", "high > low"),
     ("cf = 0.001\n", "upd.cf", "is below"),
-    # the condensed surfaces' path in CF ran for more than 10 min of CPU at 10 N (F0 30 N)
-    ('contacts = "surface"\ncf = 10.0\n', "upd.cf", "below 2 x the EO force (30 N) with condensed contact"),
 ])
 def test_upd_frf_refusals_name_the_key(edit, key, words):
     given = {line.split(" =")[0] for line in edit.splitlines()}   # the edit replaces these keys
