@@ -2,13 +2,12 @@
 contact area against Hertz, F-approach curve. Files are written atomically."""
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
 from . import bodies
-from .fileio import atomic_write
+from .fileio import save_png
 
 
 def _mirror(x, y, v, symmetry):
@@ -23,12 +22,6 @@ def _mirror(x, y, v, symmetry):
         ys += [y, -y]
         vs += [v, v]
     return np.concatenate(xs), np.concatenate(ys), np.concatenate(vs)
-
-
-def _save(fig, path: Path) -> Path:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120)
-    return atomic_write(path, buf.getvalue())
 
 
 def plot_all(result: dict, body, out_dir: str | Path) -> list[Path]:
@@ -54,7 +47,7 @@ def plot_all(result: dict, body, out_dir: str | Path) -> list[Path]:
     ax.set(xlabel="x [mm]", ylabel="y [mm]", title=f"{kind.name}: pressure, F = {result['force']:.4g} N")
     if np.ptp(y) <= 3 * np.ptp(x):
         ax.set_aspect("equal")
-    files.append(_save(fig, out_dir / "pressure_map.png"))
+    files.append(save_png(fig, out_dir / "pressure_map.png"))
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6, 5))
@@ -67,7 +60,7 @@ def plot_all(result: dict, body, out_dir: str | Path) -> list[Path]:
     if np.ptp(y) <= 3 * np.ptp(x):
         ax.set_aspect("equal")
     ax.legend(loc="upper right")
-    files.append(_save(fig, out_dir / "contact_area.png"))
+    files.append(save_png(fig, out_dir / "contact_area.png"))
     plt.close(fig)
 
     if h:
@@ -82,7 +75,7 @@ def plot_all(result: dict, body, out_dir: str | Path) -> list[Path]:
             ax.plot(ref * 1e6, F, "k--", label=kind.reference_label)
         ax.set(xlabel="approach [um]", ylabel="force [N]", title="force vs approach")
         ax.legend()
-        files.append(_save(fig, out_dir / "f_approach.png"))
+        files.append(save_png(fig, out_dir / "f_approach.png"))
         plt.close(fig)
     return files
 
@@ -103,6 +96,6 @@ def _profiles(result: dict, kind: bodies.Body, out_dir: Path, plt) -> Path:
             label=kind.reference_label)
     ax.set(xlabel="x [mm]", ylabel="pressure [MPa]", title=f"{kind.name}: pressure profiles")
     ax.legend()
-    path = _save(fig, out_dir / "pressure_profiles.png")
+    path = save_png(fig, out_dir / "pressure_profiles.png")
     plt.close(fig)
     return path

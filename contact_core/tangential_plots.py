@@ -97,9 +97,12 @@ def plot_all(path, problem, out, reference=None) -> list:
 
 
 def _save(fig, path: Path) -> Path:
+    """Lay out, write atomically (:func:`~contact_core.fileio.save_png`) and close ``fig``."""
     import matplotlib.pyplot as plt
 
+    from .fileio import save_png
+
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    save_png(fig, path)
     plt.close(fig)
     return path

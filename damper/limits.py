@@ -62,6 +62,11 @@ MAX_MU = 100.0
 #: force, ...): the harmonic balance squares forces and displacements (residual norms,
 #: omega^2 M), which overflows double precision above ~1e154.
 MAX_MAGNITUDE = 1e100
+#: Smallest load [N] of the UPD models (``upd frf|mistuning --cf/--f0``, ``system``, a scene's
+#: ``[upd]``): the energy per cycle is a force times a displacement of that size, which
+#: underflows to zero below ~1e-154 (``upd frf --f0 1e-160`` divided by zero in the energy
+#: balance): the mirror of :data:`MAX_MAGNITUDE`.
+MIN_LOAD = 1e-100
 #: Largest damping ratio of a structure's mode (a scene's ``structure.zeta``): 1 is critical
 #: damping, a blade's structural damping is below 1 %; 1e300 overflowed the Rayleigh
 #: matrix beta K into NaN.
@@ -141,6 +146,16 @@ WORKERS_PER_CORE = 4
 def max_workers() -> int:
     """Largest ``--workers``: :data:`WORKERS_PER_CORE` per core of this machine."""
     return WORKERS_PER_CORE * (os.cpu_count() or 1)
+
+
+def check_load(name: str, value) -> None:
+    """A load option [N] (``--cf``, ``--f0``) unset or finite in [:data:`MIN_LOAD`,
+    :data:`MAX_MAGNITUDE`], else ValueError naming ``name``."""
+    if value is None:
+        return
+    if not (math.isfinite(value) and MIN_LOAD <= value <= MAX_MAGNITUDE):
+        raise ValueError(f"{name} must be finite and in [{MIN_LOAD:g}, {MAX_MAGNITUDE:g}] N, got {value:g} "
+                         "(the energies per cycle underflow or the residual overflows beyond)")
 
 
 def check_size(name: str, value, low: int, high: int, why: str) -> int:

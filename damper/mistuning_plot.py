@@ -17,7 +17,7 @@ def plot_study(out: dict, folder) -> dict:
     import matplotlib.pyplot as plt
     import matplotlib.ticker
 
-    from harmonic_balance.plots import _save
+    from contact_core.fileio import save_png
 
     ok = [s for s in out["samples"] if s["error"] is None]
     amp = np.array([s["amplification"] for s in ok])
@@ -32,7 +32,7 @@ def plot_study(out: dict, folder) -> dict:
     ax.set_title(f"{len(ok)} samples, N_b = {out['blades']}, damper {out['damper']}")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    paths = {"histogram": str(_save(fig, folder / "mistuning_histogram.png"))}
+    paths = {"histogram": str(save_png(fig, folder / "mistuning_histogram.png"))}
     plt.close(fig)
     fig, ax = plt.subplots(figsize=(7, 4))
     blades = np.arange(out["blades"])
@@ -47,7 +47,7 @@ def plot_study(out: dict, folder) -> dict:
     ax.set_ylabel("peak / tuned peak")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    paths["blades"] = str(_save(fig, folder / "mistuning_blades.png"))
+    paths["blades"] = str(save_png(fig, folder / "mistuning_blades.png"))
     plt.close(fig)
     return paths
 

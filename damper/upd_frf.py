@@ -202,7 +202,7 @@ def plot_frf(out: dict, path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from harmonic_balance.plots import _save
+    from contact_core.fileio import save_png
 
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(out["frequency_hz"], np.array(out["amplitude"]) * 1e3, label="first harmonic")
@@ -212,5 +212,5 @@ def plot_frf(out: dict, path) -> None:
     ax.set_title(f"UPD sector, damper {out['damper']}")
     ax.legend()
     fig.tight_layout()
-    _save(fig, Path(path))
+    save_png(fig, Path(path))
     plt.close(fig)

@@ -133,14 +133,16 @@ def print_tables(rows, frows) -> None:
 
 
 def main(argv=None) -> int:
+    from damper.script import count
+
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 16, 64])
-    p.add_argument("--samples-per-cycle", type=int, default=1000)
-    p.add_argument("--cycles", type=int, default=10)
-    p.add_argument("--repeats", type=int, default=5)
+    p.add_argument("--sizes", type=count(1), nargs="+", default=[1, 4, 16, 64])
+    p.add_argument("--samples-per-cycle", type=count(1), default=1000)
+    p.add_argument("--cycles", type=count(1), default=10)
+    p.add_argument("--repeats", type=count(1), default=5)
     p.add_argument("--instructions", action="store_true", help="callgrind instruction counts")
-    p.add_argument("--fmu-sliders", type=int, default=16)
-    p.add_argument("--fmu-steps", type=int, default=100_000)
+    p.add_argument("--fmu-sliders", type=count(1), default=16)
+    p.add_argument("--fmu-steps", type=count(1), default=100_000)
     args = p.parse_args(argv)
     rows = element_rows(args.sizes, args.samples_per_cycle, args.cycles, args.repeats,
                         args.instructions)
@@ -149,4 +151,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -114,14 +114,18 @@ def print_table(rows) -> None:
 
 
 def main(argv=None) -> int:
+    from damper.script import count
+
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--sizes", type=int, nargs="+", default=[1, 4, 16, 64, 128, 256])
-    p.add_argument("--samples", type=int, default=10_000)
-    p.add_argument("--repeats", type=int, default=30)
+    p.add_argument("--sizes", type=count(1), nargs="+", default=[1, 4, 16, 64, 128, 256])
+    p.add_argument("--samples", type=count(1), default=10_000)
+    p.add_argument("--repeats", type=count(1), default=30)
     args = p.parse_args(argv)
     print_table(run(args.sizes, args.samples, args.repeats))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

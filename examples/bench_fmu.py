@@ -143,17 +143,20 @@ def print_table(rows: list[dict]) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from damper.script import count, numbers
+
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sliders", default="1,10,50,200",
+    parser.add_argument("--sliders", type=numbers(int, 0), default="1,10,50,200",
                         help="comma-separated slider counts of the element")
-    parser.add_argument("--steps", type=int, default=1_000_000, help="C master steps")
-    parser.add_argument("--py-steps", type=int, default=20_000, help="fmpy steps")
-    parser.add_argument("--repeats", type=int, default=5, help="C runs; the best counts")
+    parser.add_argument("--steps", type=count(1), default=1_000_000, help="C master steps")
+    parser.add_argument("--py-steps", type=count(1), default=20_000, help="fmpy steps")
+    parser.add_argument("--repeats", type=count(1), default=5, help="C runs; the best counts")
     args = parser.parse_args(argv)
-    sliders = [int(x) for x in args.sliders.split(",")]
-    print_table(measure(sliders, args.steps, args.py_steps, args.repeats))
+    print_table(measure(args.sliders, args.steps, args.py_steps, args.repeats))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

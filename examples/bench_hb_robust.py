@@ -211,11 +211,14 @@ def hb_vs_den_hartog(kts=(1e5, 1e6), Hs=(21, 51), omegas=(0.5, 0.75, 1.0, 1.5, 2
 
 
 def main(argv=None):
+    from damper.script import numbers
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--smoke", action="store_true", help="tiny grid (the test)")
     ap.add_argument("--full", action="store_true", help="the whole grid (hours)")
-    ap.add_argument("--harmonics", help="comma-separated subset of the grid's H (e.g. 1,3)")
-    ap.add_argument("--stiffness", help="comma-separated subset of the grid's kt/k (e.g. 1e5,1e6): "
+    ap.add_argument("--harmonics", type=numbers(int, 1), help="comma-separated subset of the grid's H (e.g. 1,3)")
+    ap.add_argument("--stiffness", type=numbers(float),
+                    help="comma-separated subset of the grid's kt/k (e.g. 1e5,1e6): "
                     "split a long map over processes or finish a partial one")
     ap.add_argument("--log", help="CSV file: one line per curve as it finishes")
     ap.add_argument("--no-cost", action="store_true", help="skip table 2")
@@ -235,9 +238,9 @@ def main(argv=None):
         return {"rerun": rerun_failed(args.rerun_failed, args.log)}
     grid = dict(SMOKE if args.smoke else FULL if args.full else GRID)
     if args.harmonics:
-        grid["H"] = tuple(int(h) for h in args.harmonics.split(","))
+        grid["H"] = tuple(args.harmonics)
     if args.stiffness:
-        grid["kt"] = tuple(float(v) for v in args.stiffness.split(","))
+        grid["kt"] = tuple(args.stiffness)
     log = open(args.log, "w") if args.log else None
     if log is not None:
         log.write("H,kt,fs,c,start,ok,points,iterations,seconds,evaluations,n_t,gaps,message\n")
@@ -250,4 +253,8 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -398,8 +398,10 @@ def _fmt(row: dict) -> str:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=Path("out/bench_mistuning"))
+    p.add_argument("--out", type=out_folder, default=Path("out/bench_mistuning"))
     p.add_argument("--rows", nargs="+", default=["scaling", "precond", "throughput"],
                    choices=("scaling", "band", "factor", "precond", "throughput", "worst", "worst_friction",
                             "confidence"))
@@ -458,4 +460,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

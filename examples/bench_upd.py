@@ -258,4 +258,8 @@ def _plot(rows, out):
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

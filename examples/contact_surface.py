@@ -93,8 +93,10 @@ def save_plot(out: Path, rows) -> None:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", type=Path, default=Path("out/contact_surface"))
+    p.add_argument("--out", type=out_folder, default=Path("out/contact_surface"))
     p.add_argument("--quick", action="store_true", help="the tests' grids (15 and 9)")
     p.add_argument("--cache-dir", default=None, help="condensation cache (default: the damper cache's "
                    "folder, $DAMPER_CACHE_DIR or .damper_cache)")
@@ -118,4 +120,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -173,11 +173,13 @@ def run(out: Path, modes: int = 6, harmonics: int = 3, points: int = 100, count:
 
 
 def main(argv=None) -> int:
+    from damper.script import count
+
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default="out/cb_blade", help="directory of blade.npz and upd.toml")
     ap.add_argument("--modes", type=int, default=6, help="fixed-interface modes kept")
     ap.add_argument("--harmonics", type=int, default=3, help="highest harmonic (module docstring)")
-    ap.add_argument("--points", type=int, default=100)
+    ap.add_argument("--points", type=count(3), default=100, help="frequency points")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
     res = run(Path(args.out), args.modes, args.harmonics, args.points)
@@ -197,4 +199,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -129,5 +129,6 @@ if __name__ == "__main__":
     ap.add_argument("--table", action="store_true", help="also the four cylinders of Table I")
     ap.add_argument("--grid", type=int, default=21)
     args = ap.parse_args()
-    main(args.out, args.table, args.grid)
-    sys.exit(0)
+    from damper.script import run as run_script
+
+    sys.exit(run_script(lambda: main(args.out, args.table, args.grid)))

@@ -195,4 +195,8 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -54,4 +54,8 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    import sys
+
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -108,8 +108,10 @@ def _save(fig, path: Path) -> None:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--out", type=Path, default=Path("out/masing_loops"))
+    p.add_argument("--out", type=out_folder, default=Path("out/masing_loops"))
     p.add_argument("--smoke", action="store_true", help="tiny study (for the tests)")
     args = p.parse_args(argv)
     ms = (8, 32) if args.smoke else (16, 64, 255)      # 255 segments: 256 sliders at most
@@ -125,4 +127,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -123,15 +123,19 @@ def row_lines(row: dict) -> list:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--out", type=Path, default=Path("out/mt_confidence"))
-    p.add_argument("--samples", type=int, default=1000, help="samples of the first study (the second: 4x)")
+    p.add_argument("--out", type=out_folder, default=Path("out/mt_confidence"))
+    p.add_argument("--samples", type=int, help="samples of the first study (the second: 4x; default 1000)")
     p.add_argument("--damper", choices=("free", "stuck", "nonlinear"), default="free")
     p.add_argument("--cache-dir", type=Path, help="sample cache (default: a temporary folder)")
     p.add_argument("--blades", type=int, help="N_b (default: the UPD model's 24; EO = N_b / 4)")
     p.add_argument("--quick", action="store_true", help="80 against 320 samples of 8 blades")
     a = p.parse_args(argv)
-    n, blades = (80, 8) if a.quick else (a.samples, a.blades)
+    if a.quick and (a.samples is not None or a.blades is not None):   # not silently replaced
+        p.error("--quick runs 80 samples of 8 blades: drop --samples and --blades, or --quick")
+    n, blades = (80, 8) if a.quick else (1000 if a.samples is None else a.samples, a.blades)
     if n < 72:
         p.error("--samples must be >= 72 (the 0.95 quantile's two-sided interval needs them)")
     with tempfile.TemporaryDirectory() as tmp:
@@ -146,4 +150,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

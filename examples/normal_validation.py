@@ -69,5 +69,7 @@ def main(out_dir: str | Path = "out/normal", cache=None) -> dict:
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--out", default="out/normal")
-    main(parser.parse_args().out)
-    sys.exit(0)
+    out = parser.parse_args().out
+    from damper.script import run as run_script
+
+    sys.exit(run_script(lambda: main(out)))

@@ -62,18 +62,19 @@ def case(sector, surfaces, H: int, cf: float, f: float, n_t: int, periods: int, 
 
 
 def main(argv=None) -> int:
+    from damper.script import numbers
+
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cf", type=float, default=120.0, help="centrifugal load [N]")
     ap.add_argument("--nodes", type=int, default=5, help="surface nodes per side")
     ap.add_argument("--harmonics", type=int, default=7, help="harmonic count H")
     ap.add_argument("--at", type=float, default=466.03, help="frequency [Hz]")
     ap.add_argument("--start", help="a solution (.npy, the sector's unknowns) to start Newton from")
-    ap.add_argument("--samples", default="256,128,512", help="samples per period, comma-separated")
-    ap.add_argument("--periods", default="2,1", help="periods marched, comma-separated")
+    ap.add_argument("--samples", type=numbers(int), default="256,128,512", help="samples per period, comma-separated")
+    ap.add_argument("--periods", type=numbers(int), default="2,1", help="periods marched, comma-separated")
     ap.add_argument("--json", metavar="FILE", help="write the rows here")
     args = ap.parse_args(argv)
-    samples = [int(v) for v in args.samples.split(",")]
-    periods = [int(v) for v in args.periods.split(",")]
+    samples, periods = args.samples, args.periods
     if min(periods) < 1 or min(samples) <= 2 * args.harmonics:
         ap.error("periods must be >= 1 and samples > 2 H")
     sector = Sector(load_config(None))
@@ -102,4 +103,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

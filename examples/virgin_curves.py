@@ -127,10 +127,12 @@ def plot(runs: dict, loop: dict, out: Path) -> list:
 
 
 def main(argv=None) -> int:
+    from damper.script import out_folder
+
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--model", choices=tangential_run.MODELS, default="bem")
     parser.add_argument("--grid", type=int, default=31)
-    parser.add_argument("--out", type=Path, default=Path("out/virgin_curves"))
+    parser.add_argument("--out", type=out_folder, default=Path("out/virgin_curves"))
     parser.add_argument("--smoke", action="store_true", help="tiny grid, quick check")
     args = parser.parse_args(argv)
     runs = run_cases(args.model, 9 if args.smoke else args.grid)
@@ -144,4 +146,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from damper.script import run as run_script
+
+    sys.exit(run_script(main))

@@ -5,18 +5,11 @@ failure leaves no half-written image.
 """
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-
-def _save(fig, path: Path) -> Path:
-    from contact_core.fileio import atomic_write
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=120)
-    return atomic_write(path, buf.getvalue())
+from contact_core.fileio import save_png
 
 
 def plot_frf(result, out_dir) -> list[Path]:
@@ -39,7 +32,7 @@ def plot_frf(result, out_dir) -> list[Path]:
            title=f"FRF, harmonics {list(b.harmonics)}")
     ax.legend()
     fig.tight_layout()
-    paths.append(_save(fig, out / "frf.png"))
+    paths.append(save_png(fig, out / "frf.png"))
     plt.close(fig)
 
     x, w = result.peak_solution, result.peak_omega
@@ -55,7 +48,7 @@ def plot_frf(result, out_dir) -> list[Path]:
            title=f"hysteresis loops at the peak, omega = {w:.6g} rad/s")
     ax.legend()
     fig.tight_layout()
-    paths.append(_save(fig, out / "loops.png"))
+    paths.append(save_png(fig, out / "loops.png"))
     plt.close(fig)
 
     r = prob.response(x, w)
@@ -65,7 +58,7 @@ def plot_frf(result, out_dir) -> list[Path]:
     ax.set_yscale("log")
     ax.set(xlabel="harmonic", ylabel="|X_h| [m]", title="response harmonics at the peak")
     fig.tight_layout()
-    paths.append(_save(fig, out / "harmonics.png"))
+    paths.append(save_png(fig, out / "harmonics.png"))
     plt.close(fig)
     return paths
 

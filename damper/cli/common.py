@@ -86,6 +86,15 @@ def print_json(obj) -> None:
     STATE["printed"] = True
 
 
+def print_warnings(out: dict, keys, as_json: bool) -> None:
+    """The warning lines ``out[key]`` of a result (None or absent: no warning), each printed
+    once: on stderr with ``--json`` (stdout holds the one JSON object, which has them too),
+    else on stdout after the text output."""
+    for key in keys:
+        if out.get(key):
+            print(out[key], file=sys.stderr if as_json else sys.stdout)
+
+
 def print_json_error(message: str, exit_code: int) -> None:
     """With ``--json``, a failure's one JSON object on stdout (``error``, ``exit_code``), unless
     the command printed its own (a partial result with its error)."""

@@ -56,7 +56,10 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     out = args.out if args.out is not None else Path("out") / Path(args.scene).stem
     if not args.dry_run:
-        check_folder_holds_no_input(out, "--out", scene.files())   # (before the write probe)
+        # the default folder too: a scene kept in out/<its name>/ would have its run's files
+        # (run.json, the stages' folders) written over or beside it, then fail after the work
+        flag = "--out" if args.out is not None else "the default output folder (no --out)"
+        check_folder_holds_no_input(out, flag, [("scene", Path(args.scene))] + scene.files())
         check_out_dir(out, "--out")
     store = store_from_args(args).prepare()
     echo = (lambda text: print(text, file=sys.stderr)) if args.json else print

@@ -126,10 +126,14 @@ def run(args) -> int:
 
     if args.workers is not None:
         limits.check_workers("--workers", args.workers)
+    if args.scheduler is not None and not args.scheduler.strip():   # not a silent local cluster
+        raise ValueError("--scheduler '' names no scheduler: give its address (tcp://host:8786), or drop "
+                         "--scheduler for a local cluster")
     specs = specs_from(args.specs)
     check_distinct_variants(specs, args.zip)
     out = args.out if args.out is not None else Path("out") / f"sweep_{Path(args.scene).stem}"
-    check_folder_holds_no_input(out, "--out", load_scene(args.scene).files())   # (before the write probe)
+    flag = "--out" if args.out is not None else "the default output folder (no --out)"   # (as damper run)
+    check_folder_holds_no_input(out, flag, [("scene", Path(args.scene))] + load_scene(args.scene).files())
     check_out_dir(out, "--out")
     store = store_from_args(args).prepare()
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print

@@ -42,9 +42,8 @@ def run(args) -> int:
     cfg = load_config(args.config)
     cf = cfg.cf if args.cf is None else args.cf
     f0 = cfg.f0 if args.f0 is None else args.f0
-    for label, v in (("--cf", cf), ("--f0", f0)):
-        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
-            raise ValueError(f"{label} must be finite, > 0 and at most {limits.MAX_MAGNITUDE:g} N, got {v}")
+    limits.check_load("--cf", cf)
+    limits.check_load("--f0", f0)
     limits.check_cf_floor("--cf", cf, f0, args.config, "or damper upd frf --damper free for the blades without a "
                           "damper")
     if args.frequency_hz is not None:

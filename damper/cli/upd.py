@@ -137,11 +137,8 @@ def _check_frf(args) -> None:
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
                       limits.harmonics_why(limits.MAX_UPD_HARMONICS))
     check_accuracy_option(args.accuracy)
-    for name in ("cf", "f0"):
-        v = getattr(args, name)
-        if v is not None and not (np.isfinite(v) and 0 < v <= limits.MAX_MAGNITUDE):
-            raise ValueError(f"--{name.replace('_', '-')} must be finite, > 0 and at most "
-                             f"{limits.MAX_MAGNITUDE:g} N, got {v:g}")
+    limits.check_load("--cf", args.cf)
+    limits.check_load("--f0", args.f0)
     check_out_dir(args.plot, "--plot")
     check_surface_nodes(args)
     from damper.upd_surface import check_options
@@ -156,7 +153,7 @@ def run_frf(args) -> int:
 
     from damper.upd_frf import frf_record
 
-    from .common import print_json
+    from .common import print_json, print_warnings
 
     _check_frf(args)
     out = frf_record(args)
@@ -179,8 +176,8 @@ def run_frf(args) -> int:
             print(surface_line(out["surface_model"]))
     from harmonic_balance.steady_state import summary_lines
 
-    warnings = [out[k] for k in ("band_end_warning", "lift_off_warning") if out[k]]
-    for line in warnings + accuracy_lines(out) + summary_lines(out.get("steady_state")):
+    print_warnings(out, ("band_end_warning", "lift_off_warning"), args.json)
+    for line in accuracy_lines(out) + summary_lines(out.get("steady_state")):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)
     return 0

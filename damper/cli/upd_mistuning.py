@@ -68,7 +68,7 @@ def run_mistuning(args) -> int:
     from damper.mistuning_plot import plot_study
 
     from .cache import store_from_args
-    from .common import print_json
+    from .common import print_json, print_warnings
 
     study = _study(args)
     if args.worst or args.bound is not None or args.out is not None or args.max_evaluations is not None:
@@ -77,7 +77,8 @@ def run_mistuning(args) -> int:
         return _run_worst(args, study)
     echo = (lambda t: print(t, file=sys.stderr)) if args.json else print
     try:
-        out = run_study(study, store_from_args(args), args.scheduler, args.workers, args.serial, echo)
+        # the cache folder checked before any sample (a file there was found only after the work)
+        out = run_study(study, store_from_args(args).prepare(), args.scheduler, args.workers, args.serial, echo)
     except KeyboardInterrupt:
         from damper.run.runner import Interrupted
 
@@ -93,9 +94,7 @@ def run_mistuning(args) -> int:
         out["plots"] = plot_study(out, args.plot)
     if args.json:
         print_json(out)
-        for key in ("truncation_warning", "lift_off_warning"):
-            if out.get(key):
-                print(out[key], file=sys.stderr)
+        print_warnings(out, ("truncation_warning", "lift_off_warning"), True)
         return 0
     _print_samples(out)
     print(f"tuned peak {out['tuned_peak']:.5e} m at {out['tuned_frequency_hz']:.2f} Hz"
@@ -107,8 +106,7 @@ def run_mistuning(args) -> int:
         print(line)
     for line in accuracy_lines(out):
         print(line)
-    if out.get("lift_off_warning"):
-        print(out["lift_off_warning"])
+    print_warnings(out, ("lift_off_warning",), False)
     return 0
 
 
@@ -119,6 +117,9 @@ def _study(args):
 
     from .common import check_accuracy_option, check_out_dir
 
+    if args.scheduler is not None and not args.scheduler.strip():   # not a silent local cluster
+        raise ValueError("--scheduler '' names no scheduler: give its address (tcp://host:8786), or drop "
+                         "--scheduler for a local cluster")
     given = [o for o, v in (("--scheduler", args.scheduler), ("--workers", args.workers),
                             ("--serial", args.serial)) if v]
     if len(given) > 1:
@@ -127,6 +128,10 @@ def _study(args):
         limits.check_workers("--workers", args.workers)
     check_out_dir(args.plot, "--plot")
     check_accuracy_option(args.accuracy)
+    limits.check_load("--cf", args.cf)
+    limits.check_load("--f0", args.f0)
+    if args.engine_order is not None and args.engine_order < 0:   # (the model's check names its config key)
+        raise ValueError(f"--engine-order must be >= 0 (0 ... blades / 2), got {args.engine_order}")
     if args.accuracy is not None and args.damper != "nonlinear":
         raise ValueError(f"--accuracy goes with --damper nonlinear: the linear limit {args.damper!r} "
                          "has no harmonic truncation (drop --accuracy)")
@@ -204,12 +209,11 @@ def _print_samples(out: dict) -> None:
 def _run_worst(args, study) -> int:
     """``--worst``: the worst pattern, printed (and written to --out)."""
     import json
-    import sys
     from pathlib import Path
 
     from damper.mistuning_worst import check_worst, run_worst
 
-    from .common import atomic_write, print_json
+    from .common import atomic_write, print_json, print_warnings
 
     if not args.worst:
         raise ValueError("--bound, --out and --max-evaluations go with --worst")
@@ -237,11 +241,10 @@ def _run_worst(args, study) -> int:
         atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
     if args.json:
         print_json(out)
-        if out.get("lift_off_warning"):
-            print(out["lift_off_warning"], file=sys.stderr)
-        return 0
-    for line in worst_lines(out) + ([out["lift_off_warning"]] if out.get("lift_off_warning") else []):
-        print(line)
+    else:
+        for line in worst_lines(out):
+            print(line)
+    print_warnings(out, ("lift_off_warning",), args.json)
     return 0
 
 

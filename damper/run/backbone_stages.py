@@ -193,7 +193,7 @@ def plot_optimal_load(o: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from harmonic_balance.plots import _save
+    from contact_core.fileio import save_png
 
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.loglog(o["cf"], np.array(o["peak_amplitude"]) * 1e3, "o-")
@@ -202,5 +202,5 @@ def plot_optimal_load(o: dict, path: Path) -> None:
     ax.set_ylabel("peak amplitude [mm]")
     ax.set_title("optimal-load curve (UPD sector)")
     fig.tight_layout()
-    _save(fig, Path(path))
+    save_png(fig, Path(path))
     plt.close(fig)

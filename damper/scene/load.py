@@ -9,6 +9,7 @@ from __future__ import annotations
 import copy
 import hashlib
 import json
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,6 +66,12 @@ class Scene:
         """SHA-256 (16 hex digits) of the validated content (comments and layout do not count)."""
         text = json.dumps(self.data, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+#: A named table's name ([contact.NAME]): it becomes a folder of the results (``normal_NAME``)
+#: and a part of a sweep's parameter path (``contact.NAME.mu``): a name holding ``/``, ``..``
+#: or ``.`` wrote a stage's files outside the output folder.
+ITEM_NAME = re.compile(r"[A-Za-z0-9_-]{1,64}")
 
 
 def load_scene(path: str | Path, overrides: dict | None = None) -> Scene:
@@ -142,6 +149,10 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         if named:
             data[name] = {}
             for item, sub in table.items():
+                if not ITEM_NAME.fullmatch(item):
+                    problems.append(((name, item), f"name {item!r}: use 1 to 64 letters, digits, '_' or '-' "
+                                     "(it names the result's folder and the sweep's parameter path)"))
+                    continue
                 if not isinstance(sub, dict):
                     problems.append(((name, item), f"must be a table [{name}.{item}] of contact options"))
                     continue

@@ -205,10 +205,10 @@ UPD = {
                       "curve is raised in H until the estimated truncation error is below it, and the "
                       "load sweep run again at that H; upd_frf: the curve's peak re-solved with more "
                       "harmonics; unset: the fixed `harmonics`, the estimate reported)", gt=1e-6, lt=0.5),
-    "cf": Field("float", "upd_frf: centrifugal load on the damper [N] (default: the UPD model's)", gt=0,
-                le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
-    "f0": Field("float", "upd_frf: EO force amplitude on the airfoil [N] (default: the UPD model's)", gt=0,
-                le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "cf": Field("float", "upd_frf: centrifugal load on the damper [N] (default: the UPD model's)",
+                ge=limits.MIN_LOAD, le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
+    "f0": Field("float", "upd_frf: EO force amplitude on the airfoil [N] (default: the UPD model's)",
+                ge=limits.MIN_LOAD, le=limits.MAX_MAGNITUDE, why=_MAG_WHY),
     "band": Field("list[float]", "upd_frf: [low, high] frequency band [Hz] (default: the UPD model's)",
                   ge=_F_MIN, le=_F_MAX, why=_F_WHY),
     "contacts": Field("str", "contact laws: toml (the model's Jenkins points), geometry (computed by "
@@ -237,8 +237,8 @@ MISTUNING = {
                      "samples, seed)", gt=0),
     "damper": Field("str", "nonlinear (harmonic balance), or the linear limits free (removed) and "
                     "stuck", default="nonlinear", choices=("nonlinear", "free", "stuck")),
-    "cf": Field("float", "centrifugal load on the damper [N] (default: the UPD model's)", gt=0),
-    "f0": Field("float", "EO force amplitude [N] (default: the UPD model's)", gt=0),
+    "cf": Field("float", "centrifugal load on the damper [N] (default: the UPD model's)", ge=limits.MIN_LOAD),
+    "f0": Field("float", "EO force amplitude [N] (default: the UPD model's)", ge=limits.MIN_LOAD),
     "harmonics": Field("int", "highest harmonic", default=7, ge=1),
     "band": Field("list[float]", "[low, high] band [Hz] (default: around the tuned peak)", gt=0),
     "points": Field("int", "frequency points per ring curve (solver full)", default=41, ge=3),

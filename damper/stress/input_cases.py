@@ -287,6 +287,9 @@ def _upd() -> list[InputCase]:
         ("frf cf 1e300 (overflowed: exit 3)", "frf --cf 1e300 --points 5"),
         ("frf geometry contacts at CF 1e-300", "frf --contacts geometry --cf 1e-300 --points 5"),
         ("frf f0 1e300 (overflowed: exit 3)", "frf --f0 1e300 --points 5"),
+        ("frf f0 1e-160 (the energy per cycle underflowed: divided by zero)",
+         "frf --f0 1e-160 --points 3 --harmonics 1 --json"),
+        ("mistuning cf 1e-160 f0 1e-160 (underflowed)", "mistuning --cf 1e-160 --f0 1e-160 --samples 1"),
         ("frf --plot a file", "frf --plot {fx}/a_file"),
         ("frf accuracy 0.6", "frf --accuracy 0.6"), ("frf accuracy nan", "frf --accuracy nan"),
         ("frf surface nodes 3", "frf --contacts surface --surface-nodes 3"),
@@ -326,6 +329,7 @@ def _upd() -> list[InputCase]:
         ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
         ("mistuning samples 0", "mistuning --samples 0"), ("mistuning samples 1e5", "mistuning --samples 100000"),
         ("mistuning blades 1e5", "mistuning --blades 100000"),
+        ("mistuning engine order -1 (named as a config key)", "mistuning --engine-order=-1 --damper free --serial"),
         ("mistuning blades 2 without an engine order (UPD-24's is 6)", "mistuning --blades 2 --serial"),
         ("mistuning factor -1", "mistuning --blades 4 --engine-order 1 --factors 1 -1 1 1"),
         ("mistuning factor nan", "mistuning --blades 4 --engine-order 1 --factors 1 nan 1 1"),
@@ -336,8 +340,11 @@ def _upd() -> list[InputCase]:
         ("mistuning uniform frequency std 0.5",
          "mistuning --kind frequency --distribution uniform --std 0.5 --samples 2"),
         ("mistuning unreachable scheduler", "mistuning --scheduler tcp://127.0.0.1:9 --samples 2"),
+        ("mistuning scheduler '' (a silent local cluster)", "mistuning --scheduler '' --samples 2 --damper free"),
         ("mistuning workers and serial", "mistuning --workers 2 --serial"),
         ("mistuning --plot a file", "mistuning --plot {fx}/a_file"),
+        ("mistuning --cache-dir a file (refused only after the samples)",
+         "mistuning --damper free --samples 1 --serial --cache-dir {fx}/a_file"),
         ("mistuning until-ci 0", "mistuning --until-ci 0"), ("mistuning until-ci nan", "mistuning --until-ci nan"),
         ("mistuning until-ci inf", "mistuning --until-ci inf"),
         ("mistuning until-ci 1e300", "mistuning --until-ci 1e300"),
@@ -370,6 +377,7 @@ def _system() -> list[InputCase]:
         ("system frequency 1e300", "system --frequency-hz 1e300 -o r.ssp"),
         ("system geometry contacts at CF 1e-300 (hung)", "system --contacts geometry --cf 1e-300 -o r.ssp"),
         ("system f0 nan", "system --f0 nan -o r.ssp"),
+        ("system f0 1e-160 (underflowed)", "system --f0 1e-160 -o r.ssp"),
         ("system cf 1e-3 (a damper without load)", "system --cf 1e-3 -o r.ssp --json"),
         ("system -o an existing folder", "system -o {fx}"), ("system -o below a file", "system -o {fx}/a_file/r.ssp"),
         ("system config missing", "system --config {fx}/nowhere.toml -o r.ssp"),
@@ -400,11 +408,11 @@ def _run() -> list[InputCase]:
         "s_updcfg.toml", "s_updbad.toml", "s_nocontact.toml", "s_bbacc.toml", "s_updacc.toml",
         "s_mtacc.toml", "s_mtacclin.toml", "s_kbhuge.toml", "s_zetahuge.toml", "s_fbig.toml", "s_fmintiny.toml",
         "s_step.toml", "s_bbk.toml", "s_bbf.toml", "s_bbamphuge.toml", "s_updcflow.toml", "s_mtcflow.toml",
-        "s_mtci.toml", "s_mtband.toml", "s_mtblades.toml",
+        "s_mtci.toml", "s_mtband.toml", "s_mtblades.toml", "s_contactpath.toml",
         "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml",
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",
-        "s_ufaxial.toml", "s_ufmu0.toml", "s_flatbig.toml")]
+        "s_ufaxial.toml", "s_ufmu0.toml", "s_flatbig.toml", "s_uff0tiny.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),
@@ -422,6 +430,8 @@ def _run() -> list[InputCase]:
                        files={"s.toml": 'want = ["mistuning"]\n[upd]\nconfig = "res/upd.toml"\n'
                                         '[mistuning]\nsamples = 1\ndamper = "free"\n',
                               "res/upd.toml": "# the bundled UPD-24\n"}))
+    cases.append(_case("run", "the default output folder holds the scene (out/<its name>/)", "run out/s/s.toml",
+                       files={"out/s/s.toml": 'want = ["upd_frf"]\n[upd]\npoints = 3\nharmonics = 1\n'}))
     cases.append(_case("run", "--cache-dir a folder of the user's (eviction)",
                        "run {fx}/s_kn_small.toml --cache-dir proj --cache-max-mb 1 --out out",
                        files={"proj/user_data.npz": "user data\n"}))

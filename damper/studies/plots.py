@@ -1,18 +1,11 @@
 """Figures of the studies (matplotlib, Agg; files written atomically)."""
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-from contact_core.fileio import atomic_write
-
-
-def _save(fig, path: Path) -> None:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    atomic_write(path, buf.getvalue())
+from contact_core.fileio import save_png
 
 
 def plot(name: str, result: dict, out_dir) -> None:
@@ -41,7 +34,7 @@ def plot(name: str, result: dict, out_dir) -> None:
             axes[1].set(xlabel="F [N]", ylabel="body-1 compression outside contact [%]")
         for ax in axes:
             ax.legend(fontsize=7)
-        _save(fig, out / f"{name}.png")
+        save_png(fig, out / f"{name}.png", dpi=110)
         plt.close(fig)
         return
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
@@ -56,5 +49,5 @@ def plot(name: str, result: dict, out_dir) -> None:
     axes[1].set(xlabel="x [mm]", ylabel="pressure at y = 0 [MPa]", title="pressure (Figs. 45-46)")
     for ax in axes:
         ax.legend(fontsize=7)
-    _save(fig, out / "eccentric.png")
+    save_png(fig, out / "eccentric.png", dpi=110)
     plt.close(fig)

@@ -99,6 +99,37 @@ def test_a_result_folder_holding_the_scene_is_refused(tmp_path, monkeypatch, cap
     _refused(["run", "s.toml", "--out", "."], tmp_path, capsys, "holds the input scene")
 
 
+@pytest.mark.parametrize(("command", "folder"), [(["run"], "out/s"),
+                                               (["sweep", "--param", "upd.points", "--values", "3", "--serial"],
+                                                "out/sweep_s")])
+def test_the_default_result_folder_holding_the_scene_is_refused_before_any_work(tmp_path, monkeypatch, capsys,
+                                                                                 command, folder):
+    """No --out: the default folder out/<scene name> (sweep: out/sweep_<scene name>) that holds
+    the scene is refused as --out is, nothing written beside it (it was, and the run failed
+    on run.json afterwards when the scene was named so)."""
+    monkeypatch.chdir(tmp_path)
+    Path(folder).mkdir(parents=True)
+    Path(folder, "s.toml").write_text('want = ["upd_frf"]\n[upd]\npoints = 3\nharmonics = 1\n')
+    _refused([command[0], f"{folder}/s.toml", *command[1:]], tmp_path, capsys, "holds the input scene")
+    assert [p.name for p in Path(folder).iterdir()] == ["s.toml"]
+
+
+def test_save_png_writes_a_png_and_leaves_nothing_when_drawing_fails(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [1, 0])
+    assert fileio.save_png(fig, tmp_path / "a" / "f.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    ax.text(0, 0, "$\\undefinedmacro$")   # mathtext fails while the figure is drawn
+    with pytest.raises(ValueError):
+        fileio.save_png(fig, tmp_path / "b.png")
+    plt.close(fig)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a"]
+
+
 @pytest.mark.parametrize("command", [["run"], ["sweep", "--param", "upd.points", "--values", "3", "--serial"]])
 def test_a_result_folder_holding_a_file_the_scene_names_is_refused(tmp_path, monkeypatch, capsys, command):
     """The scene's own files (here its [upd] model) are inputs too: a result folder that holds

@@ -47,6 +47,10 @@ def _line(text: str, needle: str) -> int:
     (("f_max = 1300.0", "f_max = 800.0"), "sweep.f_max", "f_max = 800.0", "must be > f_min"),
     (("forces = [30.0]", "forces = [30.0, -1]"), "excitation.forces", "forces =", "item 1: must be > 0"),
     (("f_max = 1300.0", "f_max = 1300.0\naccuracy = 0.6"), "sweep.accuracy", "accuracy = 0.6", "must be < 0.5"),
+    # a contact's name is a folder of the results: "../" in it wrote outside the output folder
+    (("[contact.damper]", '[contact."../../../x"]'), "contact.../../../x", '[contact."../../../x"]',
+     "use 1 to 64 letters, digits"),
+    (("[contact.damper]", '[contact."a.b"]'), "contact.a.b", '[contact."a.b"]', "use 1 to 64 letters, digits"),
 ])
 def test_malformed_scene_names_key_and_line(edit, key, line_of, words):
     text = SMALL.replace(*edit)

@@ -73,12 +73,14 @@ def test_frequency_below_the_static_limit_is_refused_with_the_limit(capsys):
 
 
 @pytest.mark.parametrize("option", ["--cf", "--f0"])
-def test_upd_load_beyond_the_magnitude_limit_is_refused_not_failed(option, capsys):
-    """1e300 N overflowed in the harmonic balance: exit 3 with advice about harmonics."""
-    from damper.limits import MAX_MAGNITUDE
+@pytest.mark.parametrize("value", ["1e300", "1e-160"])
+def test_upd_load_beyond_the_magnitude_limits_is_refused_not_failed(option, value, capsys):
+    """1e300 N overflowed in the harmonic balance (exit 3 with advice about harmonics); 1e-160 N
+    underflowed the energy per cycle to zero (a traceback dividing by it)."""
+    from damper.limits import MAX_MAGNITUDE, MIN_LOAD
 
-    assert damper(["upd", "frf", option, "1e300", "--points", "5"]) == 2
-    assert f"at most {MAX_MAGNITUDE:g} N" in _stderr_line(capsys.readouterr().err)
+    assert damper(["upd", "frf", option, value, "--points", "5"]) == 2
+    assert f"in [{MIN_LOAD:g}, {MAX_MAGNITUDE:g}] N" in _stderr_line(capsys.readouterr().err)
 
 
 def test_config_bound_is_printed_as_a_number_not_its_digits(tmp_path, capsys):

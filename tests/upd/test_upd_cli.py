@@ -92,3 +92,15 @@ def test_the_rattle_warning_of_surfaces_names_no_time_integration():
     surfaces = response_warnings(out | {"contact_surfaces": {}})["lift_off_warning"]
     assert "--check-steady-state" in points and "--check-steady-state" not in surfaces
     assert response_warnings(out | {"lift_off": [0.95, RATTLE_LIFT_OFF]})["lift_off_warning"] is None
+
+
+def test_a_result_s_warnings_go_once_to_stderr_with_json_and_to_stdout_without(capsys):
+    from damper.cli.common import print_warnings
+
+    out = {"band_end_warning": None, "lift_off_warning": "warning: rattles", "truncation_warning": "warning: H"}
+    print_warnings(out, ("band_end_warning", "lift_off_warning", "missing"), True)
+    c = capsys.readouterr()
+    assert (c.out, c.err) == ("", "warning: rattles\n")
+    print_warnings(out, ("lift_off_warning", "truncation_warning"), False)
+    c = capsys.readouterr()
+    assert (c.out, c.err) == ("warning: rattles\nwarning: H\n", "")
