@@ -110,6 +110,9 @@ MAX_REFERENCES, REFERENCE_SHARE = 4, 0.25
 #: Bytes of LU factors kept by a :class:`FactorCache` (least recently used dropped first):
 #: 2 x 20 nodes per side gives blocks of ~700 DOFs, 4 MB a factor.
 FACTOR_CACHE_BYTES = 256 * 2 ** 20
+#: The constants the compiled step (:mod:`.massless_c`) reads, handed to it by name.
+_STEP_PARAMS = ("FD_REL", "RESIDUAL_RTOL", "SECTION_RTOL", "SLOPE_DIGITS", "MAX_SIDES", "MAX_BRACKET",
+                "MAX_SECTION", "DIAGONAL_UPDATE_MIN", "MAX_REFERENCES", "REFERENCE_SHARE")
 
 
 class FactorCache:
@@ -380,7 +383,8 @@ class MasslessContacts:
 
         self.compiled = None
         if self.factors is not None and CompiledStep.fits(self, A):
-            self.compiled = CompiledStep(self, A, self.factors)
+            params = {name: globals()[name] for name in _STEP_PARAMS}   # as monkeypatched, if so
+            self.compiled = CompiledStep(self, A, self.factors, params)
         return self.compiled is not None
 
     def evaluate(self, w: np.ndarray):

@@ -18,6 +18,7 @@ path's diagonal updates.
 from __future__ import annotations
 
 import ctypes as ct
+from types import SimpleNamespace
 
 import numpy as np
 from scipy.linalg import cython_blas, cython_lapack
@@ -112,10 +113,14 @@ class CompiledStep:
         The blocks of A (:meth:`.MasslessContacts.split`), fixed for the march.
     cache : FactorCache
         Holds the kept factorizations across marches (one per fixed A).
+    params : dict
+        The numpy path's tolerances and limits, by their names in :mod:`.massless`
+        (FD_REL, RESIDUAL_RTOL, ...; :meth:`.MasslessContacts.compile` passes them), so
+        that both paths read one set and this module does not import that one.
     """
 
-    def __init__(self, nodes, A, cache):
-        from . import massless as ms
+    def __init__(self, nodes, A, cache, params: dict):
+        ms = SimpleNamespace(**params)
         n_c = len(nodes.kn)
         cs, qs = self._single(nodes.Qs)
         cp, qp = self._single(nodes.Qp)
