@@ -35,6 +35,14 @@ STEP_RATIO = 2.0
 #: Halvings (in log CF) of a load step whose Newton fails, before the path gives up
 #: (a step of ratio 2 is then 2^(1/16) = 1.04).
 MAX_HALVINGS = 4
+#: Failed Newton solves one step of the path may take (its halvings' included) before the
+#: path gives up: with MAX_HALVINGS alone a step that meets a wall (a load below which no
+#: warm start converges) could fail 2^(MAX_HALVINGS + 1) - 1 times, each failure a Newton's
+#: worth of line searches (UPD-24, condensed, 5 nodes per side, H 7, 400 Hz: the path from
+#: 815 N reached 66 N, then failed at 35 N and at 48 N after ~370 evaluations each, ~75 s
+#: with the compiled march, and went on halving for more than half an hour). The path
+#: 300 -> 40 N at the resonance (449.16 Hz) failed once in 26 loads.
+MAX_STEP_FAILURES = 4
 #: Newton iterations per load (a converging step took 3-9 on UPD-24; a failing one spends
 #: its iterations' line searches, ~8 evaluations each).
 MAX_ITER = 40
@@ -115,38 +123,42 @@ def cf_path(make, omega: float, cf: float, start_cf: float, steps: int | None = 
     try:
         x = solve_point(hb, omega, hb.stuck_guess(omega), max_iter)
     except NewtonError as err:
-        raise SolverError(_failed(start_cf, start_cf, cf, omega, err)) from None
+        raise SolverError(_failed(start_cf, [start_cf], cf, omega, err)) from None
     loads = [start_cf]
     if report:
         report(start_cf, hb, x)
     if start_cf == cf:
         return x, loads
     for c in np.geomspace(start_cf, cf, steps + 1)[1:]:
-        x = _step(make, omega, loads, x, float(c), 0, max_iter, report, cf)
+        x = _step(make, omega, loads, x, float(c), 0, max_iter, report, cf, [0])
     return x, loads
 
 
-def _step(make, omega, loads, x, c, depth, max_iter, report, cf):
-    """Newton at load c warm-started from the last load's x; halves the step on failure."""
+def _step(make, omega, loads, x, c, depth, max_iter, report, cf, failed):
+    """Newton at load c warm-started from the last load's x; halves the step on failure
+    (``failed``: the failures of this step of the path so far, a one-item list)."""
     hb = make(c)
     try:
         x1 = solve_point(hb, omega, x, max_iter)
     except NewtonError as err:
-        if depth >= MAX_HALVINGS:
-            raise SolverError(_failed(c, loads[0], cf, omega, err)) from None
+        failed[0] += 1
+        if depth >= MAX_HALVINGS or failed[0] >= MAX_STEP_FAILURES:
+            raise SolverError(_failed(c, loads, cf, omega, err)) from None
         mid = math.sqrt(loads[-1] * c)
-        x = _step(make, omega, loads, x, mid, depth + 1, max_iter, report, cf)
-        return _step(make, omega, loads, x, c, depth + 1, max_iter, report, cf)
+        x = _step(make, omega, loads, x, mid, depth + 1, max_iter, report, cf, failed)
+        return _step(make, omega, loads, x, c, depth + 1, max_iter, report, cf, failed)
     loads.append(c)
     if report:
         report(c, hb, x1)
     return x1
 
 
-def _failed(c: float, start: float, cf: float, omega: float, err) -> str:
-    where = "its stuck start" if c == start else f"{c:.4g} N"
+def _failed(c: float, loads, cf: float, omega: float, err) -> str:
+    start = loads[0]
+    where = "its stuck start" if c == start else f"{c:.4g} N (the last load solved: {loads[-1]:.4g} N)"
     return (f"the path in CF from {start:.4g} N to {cf:.4g} N at {omega / 2 / np.pi:.6g} Hz failed at "
-            f"{where} ({err}): start the band further from the resonance, or raise the CF")
+            f"{where} ({err}): start the band at another frequency (UPD-24 at CF 40 N: the path failed at "
+            "400 Hz, not at 449 Hz), or raise the CF")
 
 
 def first_point(make, omega: float, cf: float, report=None) -> tuple:

@@ -57,3 +57,20 @@ def test_a_step_beyond_its_halvings_is_a_solver_error_naming_the_load(stand_in, 
     monkeypatch.setattr(load_path, "MAX_HALVINGS", 0)
     with pytest.raises(SolverError, match=r"from 815 N to 120 N at .* failed at 4\d\d\.?\d* N .*raise the CF"):
         load_path.cf_path(_Model, 2 * np.pi * 400.0, 120.0, 815.0)
+
+
+def test_a_step_that_meets_a_wall_gives_up_after_its_failure_budget(stand_in, monkeypatch):
+    """Below a wall no warm start converges: without a budget the step's halvings would try
+    2^(MAX_HALVINGS + 1) - 1 Newton solves, each a few hundred evaluations on a real model."""
+    wall, calls = 70.0, []
+
+    def newton(hb, omega, x0, max_iter):
+        calls.append(hb.cf)
+        if hb.cf < wall:
+            raise NewtonError("no equilibrium", x0, max_iter, 1.0)
+        return _newton(hb, omega, x0, max_iter)
+    monkeypatch.setattr(load_path, "solve_point", newton)
+    with pytest.raises(SolverError, match=r"the last load solved: 7\d\.?\d* N"):
+        load_path.cf_path(_Model, 2 * np.pi * 400.0, 40.0, 815.0)
+    failures = sum(c < wall for c in calls)
+    assert failures == load_path.MAX_STEP_FAILURES
