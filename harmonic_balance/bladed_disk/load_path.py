@@ -38,10 +38,9 @@ MAX_HALVINGS = 4
 #: Failed Newton solves one step of the path may take (its halvings' included) before the
 #: path gives up: with MAX_HALVINGS alone a step that meets a wall (a load below which no
 #: warm start converges) could fail 2^(MAX_HALVINGS + 1) - 1 times, each failure a Newton's
-#: worth of line searches (UPD-24, condensed, 5 nodes per side, H 7, 400 Hz: the path from
-#: 815 N reached 66 N, then failed at 35 N and at 48 N after ~370 evaluations each, ~75 s
-#: with the compiled march, and went on halving for more than half an hour). The path
-#: 300 -> 40 N at the resonance (449.16 Hz) failed once in 26 loads.
+#: worth of line searches: ~350 evaluations on UPD-24 (condensed, 5 nodes per side, H 7),
+#: ~70 s with the march's node solve in C, several minutes before. Paths that arrive fail
+#: less: 815 -> 10 N at 400 Hz twice in 10 loads, 300 -> 40 N at 449.16 Hz once in 26.
 MAX_STEP_FAILURES = 4
 #: Newton iterations per load (a converging step took 3-9 on UPD-24; a failing one spends
 #: its iterations' line searches, ~8 evaluations each).
@@ -157,8 +156,7 @@ def _failed(c: float, loads, cf: float, omega: float, err) -> str:
     start = loads[0]
     where = "its stuck start" if c == start else f"{c:.4g} N (the last load solved: {loads[-1]:.4g} N)"
     return (f"the path in CF from {start:.4g} N to {cf:.4g} N at {omega / 2 / np.pi:.6g} Hz failed at "
-            f"{where} ({err}): start the band at another frequency (UPD-24 at CF 40 N: the path failed at "
-            "400 Hz, not at 449 Hz), or raise the CF")
+            f"{where} ({err}): start the band at another frequency, or raise the CF")
 
 
 def first_point(make, omega: float, cf: float, report=None) -> tuple:
