@@ -229,7 +229,9 @@ def condensed_summary(hb, x, omega: float) -> dict:
 
 def face_summary(hb, summ: dict) -> dict:
     """Per face (sums over its nodes): mean and range of N [N], the share of the period
-    lifted off (mean over its nodes of the share of the period), friction energy per cycle [J];
+    lifted off (mean over the nodes that touch at some time of the share of the period each
+    is open: the potential zone's nodes that never touch are not the contact, and counted a
+    stuck face a third open; 1 where none touches), friction energy per cycle [J];
     refuses a damper that left both faces; warns when a face loads its zone edge."""
     out = {"names": [], "normal_load_mean": [], "normal_load_range": [], "lift_off": [],
            "friction_energy": []}
@@ -238,7 +240,8 @@ def face_summary(hb, summ: dict) -> dict:
         out["names"].append(face)
         out["normal_load_mean"].append(sum(summ["normal_load_mean"][i] for i in idx))
         out["normal_load_range"].append(sum(summ["normal_load_range"][i] for i in idx))
-        out["lift_off"].append(float(np.mean([summ["lift_off"][i] for i in idx])))
+        shares = [summ["lift_off"][i] for i in idx if summ["lift_off"][i] < 1.0]
+        out["lift_off"].append(float(np.mean(shares)) if shares else 1.0)
         out["friction_energy"].append(sum(summ["friction_energy"][i] for i in idx))
     if max(out["normal_load_mean"]) <= 0.0:
         raise RuntimeError("the damper lost contact on both faces at the peak (no node carries a "

@@ -200,3 +200,21 @@ def test_a_sector_with_axial_platform_dofs_is_refused_before_condensing(tmp_path
     captured = capsys.readouterr()
     assert code == 2 and "planar UPD sector" in captured.err and len(captured.err.strip().splitlines()) == 1
     assert not (tmp_path / "cache").exists()
+
+
+def test_a_face_lift_off_share_counts_only_the_nodes_that_touch():
+    """The potential zone holds nodes outside the contact (never touching: open all period);
+    a stuck face (touching nodes never open) is 0 open, not their share of the zone."""
+    from types import SimpleNamespace
+
+    from damper.upd_surface import face_summary
+
+    names = [f"left node {i}" for i in range(6)]
+    summ = {"names": names, "normal_load_mean": [0.0, 10.0, 20.0, 20.0, 10.0, 0.0],
+            "normal_load_range": [0.0, 1.0, 1.0, 1.0, 1.0, 0.0], "lift_off": [1.0, 0.0, 0.0, 0.0, 0.5, 1.0],
+            "friction_energy": [0.0] * 6}
+    hb = SimpleNamespace(surfaces={"left": SimpleNamespace(zone_edge=np.zeros(6, bool))})
+    out = face_summary(hb, summ)
+    assert out["lift_off"] == [0.5 / 4]          # the four touching nodes: 0, 0, 0, 0.5
+    summ["lift_off"] = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    assert face_summary(hb, summ)["lift_off"] == [0.0]
