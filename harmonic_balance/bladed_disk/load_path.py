@@ -143,6 +143,23 @@ def _step(make, omega, loads, x, c, depth, max_iter, report, cf):
     return x1
 
 
+def warm_path(make, omega: float, x, c_from: float, c_to: float, max_iter: int | None = None) -> np.ndarray:
+    """The solution at ``c_to`` [N] from a solution ``x`` at ``c_from`` [N] whose direct warm
+    start failed: the step halved in log CF (Newton at sqrt(c_from c_to), then at c_to, each
+    halved again where it fails, MAX_HALVINGS in all). ``make`` and ``omega`` as
+    :func:`cf_path`'s; the unknowns of ``make(c_from)`` and ``make(c_to)`` must be the same.
+
+    Raises
+    ------
+    SolverError
+        A step still failed after MAX_HALVINGS halvings.
+    """
+    max_iter = MAX_ITER if max_iter is None else max_iter
+    loads = [float(c_from)]
+    x = _step(make, omega, loads, x, math.sqrt(c_from * c_to), 1, max_iter, None, c_to)
+    return _step(make, omega, loads, x, float(c_to), 1, max_iter, None, c_to)
+
+
 def _failed(c: float, start: float, cf: float, omega: float, err) -> str:
     where = "its stuck start" if c == start else f"{c:.4g} N"
     return (f"the path in CF from {start:.4g} N to {cf:.4g} N at {omega / 2 / np.pi:.6g} Hz failed at "
