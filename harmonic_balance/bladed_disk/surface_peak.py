@@ -264,7 +264,8 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
         Tolerance of the optimum in log CF.
     estimate : callable, optional
         ``estimate(evaluations, seconds)`` before the walk: the evaluations expected and
-        the measured CPU time [s] of one (the first model's stuck start, with its Jacobian).
+        the measured CPU time [s] of one (with its Jacobian, at the first load's stuck start
+        after its linear step: the first evaluation of a Newton solve).
     report : callable, optional
         As :class:`SurfaceWalk`'s.
 
@@ -281,13 +282,14 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
     t0, p0 = time.perf_counter(), time.process_time()
     cfs = np.geomspace(lo, hi, points)
     band = sector.cfg["load.band_hz"]
+    walk = SurfaceWalk(sector, surfaces_at, H, f0, report=report)
+    hb = walk.factory(hi)[0](hi)   # the largest load's faces first: a geometry refused before any solve
     # the first search's guess: the point model's peak at the largest load (seconds)
     w_guess, _ = peak_at(sector, hi, H, 2 * np.pi * np.linspace(band[0], band[1], 40), f0)
-    walk = SurfaceWalk(sector, surfaces_at, H, f0, report=report)
     if estimate is not None:
-        make, _ = walk.factory(hi)
+        x = hb.stuck_guess(w_guess)   # one evaluation at the prestress: every node stuck (cheap)
         c = time.process_time()
-        make(hi).stuck_guess(w_guess)
+        hb(x, w_guess)                # Newton's first from the stuck start: nodes slip (typical)
         estimate(expected_evaluations(points), time.process_time() - c)
     peaks = [walk.peak(c, w_guess / (2 * np.pi)) for c in cfs[::-1]][::-1]
     t_grid, c_search = time.perf_counter() - t0, time.process_time()
