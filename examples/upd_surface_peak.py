@@ -10,8 +10,8 @@ Per centrifugal load CF:
   (:class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`, ``--nodes`` per side,
   one harmonic count): the first-harmonic amplitude of u_a maximised over the frequency
   by the library's search (:func:`harmonic_balance.bladed_disk.surface_peak.surface_peak`:
-  an interval uphill, then Brent's search), each frequency a Newton solve warm-started
-  from the nearest one solved, the search started at the point
+  an interval uphill, then Brent's search), each frequency a Newton solve started on
+  the tangent of the nearest one solved, the search started at the point
   model's peak (or ``--guess``); with the condensed model, whose unknowns are the
   sector's for every node count, each node count's first solve starts from the
   previous one's peak solution (the CF path where that fails);
