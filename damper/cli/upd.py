@@ -7,6 +7,7 @@ Examples::
     damper upd frf --damper stuck --json
     damper upd frf --contacts surface --surface-nodes 5 --harmonics 1 --band 440 490 --points 5 --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
+    damper upd optimize --contacts surface --harmonics 3 --json   # slow: minutes per load
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
     damper upd mistuning --accuracy 0.01 --samples 20 --json   # H chosen on the tuned sector

@@ -360,6 +360,11 @@ def _check_upd_contacts(data: dict, problems: list) -> None:
         if "accuracy" in u:
             problems.append((("upd", "accuracy"), "contacts = \"surface\" runs at the fixed harmonics: "
                              "drop accuracy"))
+        from damper.upd_surface import MAX_OPTIMIZE_POINTS
+
+        if "optimal_load" in wants and u["points"] > MAX_OPTIMIZE_POINTS:
+            problems.append((("upd", "points"), f"at most {MAX_OPTIMIZE_POINTS} with contacts = \"surface\" "
+                             "(each load a peak search of minutes): lower points"))
     if "upd_frf" in wants and "cf" in u and not any(p[0] == ("upd", "config") for p in problems):
         from harmonic_balance.bladed_disk.config import load_config
 

@@ -415,7 +415,7 @@ def _run() -> list[InputCase]:
         "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml",
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",
-        "s_ufaxial.toml", "s_ufmu0.toml", "s_ufolsurfnodes.toml")]
+        "s_ufaxial.toml", "s_ufmu0.toml", "s_ufolsurfnodes.toml", "s_ufolsurfpts.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),

@@ -220,6 +220,7 @@ def scenes() -> dict[str, str | bytes]:
             "s_ufband.toml": 'want = ["upd_frf"]\n[upd]\nband = [480.0, 440.0]\n',
             "s_ufcflow.toml": 'want = ["upd_frf"]\n[upd]\ncf = 1e-3\n',
             "s_ufolsurf.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\naccuracy = 0.01\n',
+            "s_ufolsurfpts.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\npoints = 41\n',
             "s_ufolsurfnodes.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\nsurface_model = "nodes"\n',
             "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
             "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
