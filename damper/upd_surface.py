@@ -293,7 +293,7 @@ def optimize_record(sector, args, note=None) -> dict:
     peak search at more harmonics per load would double a run of minutes per load).
 
     ``note(line)`` receives the cost estimate before the walk (evaluations expected x the
-    measured CPU time of the first one).
+    measured CPU time of the first one) and a line per load solved.
 
     Raises
     ------
@@ -320,9 +320,14 @@ def optimize_record(sector, args, note=None) -> dict:
             note(f"upd optimize --contacts surface: about {evaluations} residual evaluations at "
                  f"{seconds:.2g} s CPU each (the first one measured): ~{evaluations * seconds / 60:.0f} min CPU")
 
+    def on_load(r):
+        if note is not None:
+            note(f"  CF {r['cf']:.4g} N: peak {r['peak_hz']:.3f} Hz, |u_a,1| {r['peak_amplitude_h1']:.5e} m "
+                 f"({r['evaluations']} evaluations, {r['cpu_s']:.0f} s CPU; {r['start']})")
+
     try:
         out = optimal_load_surface(sector, surfaces_at, args.cf_range, args.points, args.harmonics,
-                                   estimate=estimate)
+                                   estimate=estimate, on_load=on_load)
     except SolverError as err:
         raise SolverError(f"{err} (upd optimize --contacts surface: narrow --cf-range, or raise its low end)") \
             from None

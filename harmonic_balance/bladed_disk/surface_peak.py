@@ -176,11 +176,14 @@ class SurfaceWalk:
         Relative frequency tolerance of each peak.
     report : callable, optional
         ``report(cf, f, amplitude)`` after each frequency solved.
+    on_load : callable, optional
+        ``on_load(record)`` after each load's peak (the record :meth:`peak` returns).
     """
 
-    def __init__(self, sector, surfaces_at, H: int, f0=None, xtol: float = PEAK_XTOL, report=None):
+    def __init__(self, sector, surfaces_at, H: int, f0=None, xtol: float = PEAK_XTOL, report=None,
+                 on_load=None):
         self.sector, self.surfaces_at, self.H, self.f0 = sector, surfaces_at, int(H), f0
-        self.xtol, self.report = xtol, report
+        self.xtol, self.report, self.on_load = xtol, report, on_load
         self.built = []      # every model built (their evaluations are the walk's)
         self.solved = {}     # cf -> (omega, x) of its peak
         self.loads = []      # one record per load, in the order solved
@@ -229,6 +232,8 @@ class SurfaceWalk:
                "nodes": nodes, "evaluations": self.evaluations - e0, "cpu_s": time.process_time() - p0,
                "start": start["how"], "points": pk["points"]}
         self.loads.append(rec)
+        if self.on_load:
+            self.on_load(rec)
         return rec
 
     def _nearest(self, cf: float) -> float:
@@ -270,7 +275,8 @@ def expected_evaluations(points: int) -> int:
 
 
 def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=None,
-                         cf_xtol: float = SURFACE_CF_XTOL, estimate=None, report=None) -> dict:
+                         cf_xtol: float = SURFACE_CF_XTOL, estimate=None, report=None,
+                         on_load=None) -> dict:
     """Peak amplitude against CF and the optimum CF with contact surfaces (module docstring).
 
     Parameters
@@ -288,7 +294,7 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
         ``estimate(evaluations, seconds)`` before the walk: the evaluations expected and
         the measured CPU time [s] of one (with its Jacobian, at the first load's stuck start
         after its linear step: the first evaluation of a Newton solve).
-    report : callable, optional
+    report, on_load : callable, optional
         As :class:`SurfaceWalk`'s.
 
     Returns
@@ -304,7 +310,7 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
     t0, p0 = time.perf_counter(), time.process_time()
     cfs = np.geomspace(lo, hi, points)
     band = sector.cfg["load.band_hz"]
-    walk = SurfaceWalk(sector, surfaces_at, H, f0, report=report)
+    walk = SurfaceWalk(sector, surfaces_at, H, f0, report=report, on_load=on_load)
     hb = walk.factory(hi)[0](hi)   # the largest load's faces first: a geometry refused before any solve
     # the first search's guess: the point model's peak at the largest load (seconds)
     w_guess, _ = peak_at(sector, hi, H, 2 * np.pi * np.linspace(band[0], band[1], 40), f0)
