@@ -257,8 +257,8 @@ def face_summary(hb, summ: dict) -> dict:
 #: ``upd optimize --contacts surface`` walks the loads with the condensed model only: its unknowns
 #: are the sector's at every load, so each load's search starts from the last one's peak.
 OPTIMIZE_MODEL = "condensed"
-#: Most loads of ``upd optimize --contacts surface``: each is a peak search of ~1 min CPU at 5
-#: nodes per side (~60 evaluations of ~1 s), so 40 loads are about an hour.
+#: Most loads of ``upd optimize --contacts surface``: each is a peak search of 2-3 min CPU at 5
+#: nodes per side and H 7 (~120 evaluations of ~1.3 s), so 40 loads are about two hours.
 MAX_OPTIMIZE_POINTS = 40
 
 

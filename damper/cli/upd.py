@@ -87,7 +87,7 @@ def _contacts(p, surface: bool = False, slow: bool = False) -> None:
     if slow:
         what = ("; surface: the damper's faces as contact surfaces (damper.upd_surface, the condensed "
                 "model): SLOW, a peak search of minutes per load (~1 s CPU per residual evaluation at 5 "
-                "nodes per side, ~60 evaluations per load); the loads walked from the largest down, each "
+                "nodes per side, ~120 evaluations per load at H 7); the loads walked from the largest down, each "
                 "warm-started from the last; the estimate is printed before the walk")
     p.add_argument("--contacts", choices=("toml", "geometry") + (("surface",) if surface else ()),
                    default="toml",

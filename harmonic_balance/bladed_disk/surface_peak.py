@@ -52,14 +52,16 @@ MAX_ITER = 80
 #: moves the optimum's peak by far less than the truncation in H does.
 SURFACE_CF_XTOL = 0.02
 #: Residual evaluations expected per load (the cost estimate's, :func:`expected_evaluations`):
-#: ~12 frequencies per peak search (bracket and Brent), ~5 Newton evaluations each from the
-#: tangent predictor and one for the tangent (UPD-24, 5 nodes per side, H 1).
-EVALUATIONS_PER_LOAD = 60
+#: a load warm-started from the last took 112-130 (UPD-24, 5 nodes per side, H 7, CF 1554 ...
+#: 417 N: ~12 frequencies of bracket and Brent, ~9 Newton evaluations each from the tangent
+#: predictor and one for the tangent).
+EVALUATIONS_PER_LOAD = 120
 #: Loads of the refinement expected: Brent's bounded search to SURFACE_CF_XTOL between the
 #: neighbours of the smallest walked peak.
 REFINE_LOADS = 6
-#: Evaluations of the first load's path from its open load (a few Newton solves).
-PATH_EVALUATIONS = 30
+#: Evaluations of the first load's path from its open load, beyond a warm load's (UPD-24,
+#: H 7, CF 3000 N: 211 in all).
+PATH_EVALUATIONS = 90
 
 
 def bracket(neg, f0: float, step: float = BRACKET_STEP) -> tuple[float, float, float]:
