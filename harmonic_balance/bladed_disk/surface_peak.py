@@ -44,8 +44,12 @@ BRACKET_STEP, MAX_BRACKET = 0.005, 6
 #: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
 #: 1e-4 in frequency moves it by far less than the 0.5 % the node study resolves.
 PEAK_XTOL = 1e-4
-#: Newton iterations of a warm start (a converging one took 3-9 on UPD-24).
+#: Newton iterations of a warm start in frequency (a converging one took 3-9 on UPD-24).
 MAX_ITER = 80
+#: Newton iterations of a load's first solve from the nearest load's peak solution before the
+#: step is halved: a converging one took a few, a failing one spends ~8 evaluations per
+#: iteration in its line search (UPD-24, H 7, 57.9 -> 30 N: more than 7 min CPU in 80).
+LOAD_STEP_ITER = 15
 #: Tolerance of the optimum in log CF (2 % in CF). The point model's 1e-3
 #: (:data:`.optimize.CF_XTOL`) would double the refinement's loads, each a peak search of
 #: minutes; the minimum is flat (the peak within 1 % over a wide CF band), so 2 % in CF
@@ -256,7 +260,7 @@ class SurfaceWalk:
             c0 = self._nearest(cf)
             x0 = self.solved[c0][1]
             try:
-                x = solve_point(hb, w, x0, MAX_ITER)
+                x = solve_point(hb, w, x0, LOAD_STEP_ITER)
                 start["how"] = start["how"] or f"warm from {c0:.4g} N"
                 return x
             except NewtonError:
