@@ -255,3 +255,95 @@ def face_summary(hb, summ: dict) -> dict:
                                     "potential zone at the peak: the surface cuts it there (raise "
                                     "geometry.normal_load_left, which sizes the zone)")
     return out
+
+
+#: ``upd optimize --contacts surface`` walks the loads with the condensed model only: its unknowns
+#: are the sector's at every load, so each load's search starts from the last one's peak.
+OPTIMIZE_MODEL = "condensed"
+#: Most loads of ``upd optimize --contacts surface``: each is a peak search of 2-3 min CPU at 5
+#: nodes per side and H 7 (~120 evaluations of ~1.3 s), so 40 loads are about two hours.
+MAX_OPTIMIZE_POINTS = 40
+
+
+def check_optimize_options(args) -> None:
+    """``upd optimize --contacts surface``: the options of the point-contact sweep that do not
+    apply refused (ValueError naming what to drop); the surface options checked."""
+    from harmonic_balance.surface import check_nodes
+
+    if args.contacts != "surface":
+        return
+    check_nodes(args.surface_nodes)
+    if args.points > MAX_OPTIMIZE_POINTS:
+        raise ValueError(f"--points {args.points} with --contacts surface: at most {MAX_OPTIMIZE_POINTS} loads "
+                         "(each a peak search of minutes); lower --points")
+    if args.surface_model != OPTIMIZE_MODEL:
+        raise ValueError(f"upd optimize --contacts surface walks the loads with --surface-model {OPTIMIZE_MODEL} "
+                         f"(its unknowns are the same at every load): drop --surface-model {args.surface_model}")
+    refused = [("--accuracy", args.accuracy is not None, "runs at the fixed --harmonics"),
+               ("--grid", args.grid is not None, "searches each peak by Brent's method, not on a grid"),
+               ("--workers", args.workers is not None, "walks the loads in one process, each load "
+                "warm-started from the last")]
+    for opt, given, why in refused:
+        if given:
+            raise ValueError(f"upd optimize --contacts surface {why}: drop {opt}")
+
+
+def optimize_record(sector, args, note=None) -> dict:
+    """The ``upd optimize --contacts surface`` record
+    (:func:`harmonic_balance.bladed_disk.surface_peak.optimal_load_surface`): the faces condensed
+    at each load with ``args.surface_nodes`` per side (kept in the store), the same keys as the
+    point-contact sweep, ``surface_model`` with the node count, and no truncation estimate (a
+    peak search at more harmonics per load would double a run of minutes per load).
+
+    ``note(line)`` receives the cost estimate before the walk (evaluations expected x the
+    measured CPU time of the first one) and a line per load solved.
+
+    Raises
+    ------
+    ValueError
+        A geometry contact_core refuses at a load of the range.
+    SolverError
+        A load's peak search failed (the message names the load).
+    """
+    from damper.cache import store_of
+    from harmonic_balance.bladed_disk.solve import SolverError
+    from harmonic_balance.bladed_disk.surface_hb import face_inputs
+    from harmonic_balance.bladed_disk.surface_peak import optimal_load_surface
+
+    face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
+    for cf in args.cf_range:      # the faces' inputs (mu, nominal loads) at both ends, before any solve
+        face_specs(sector.cfg, args.surface_nodes, cf)
+    store = store_of(args)
+
+    def surfaces_at(cf):   # called once per load: the walk keeps each load's model
+        return build_surfaces(sector.cfg, args.surface_nodes, cf, store)
+
+    def estimate(evaluations, seconds):
+        if note is not None:
+            note(f"upd optimize --contacts surface: about {evaluations} residual evaluations at "
+                 f"{seconds:.2g} s CPU each (the first one measured): ~{evaluations * seconds / 60:.0f} min CPU")
+
+    def on_load(r):
+        if note is not None:
+            note(f"  CF {r['cf']:.4g} N: peak {r['peak_hz']:.3f} Hz, |u_a,1| {r['peak_amplitude_h1']:.5e} m "
+                 f"({r['evaluations']} evaluations, {r['cpu_s']:.0f} s CPU; {r['start']})")
+
+    try:
+        out = optimal_load_surface(sector, surfaces_at, args.cf_range, args.points, args.harmonics,
+                                   estimate=estimate, on_load=on_load)
+    except SolverError as err:
+        raise SolverError(f"{err} (upd optimize --contacts surface: narrow --cf-range, or raise its low end)") \
+            from None
+    out["surface_model"] |= {"nodes_per_side": args.surface_nodes}
+    out["truncation_error"] = None
+    return out
+
+
+def optimize_line(run: dict) -> str:
+    """The printed line of ``upd optimize --contacts surface``'s ``surface_model`` record."""
+    loads = run["loads"]
+    nodes = sorted({r["nodes"] for r in loads})
+    span = f"{nodes[0]}" if len(nodes) == 1 else f"{nodes[0]} ... {nodes[-1]}"
+    return (f"surface model {run['model']}, {run['nodes_per_side']} nodes per side ({span} nodes): "
+            f"{len(loads)} loads searched, {run['evaluations']} evaluations, {run['cpu_s']:.0f} s CPU "
+            f"({run['time_s']:.0f} s wall)")

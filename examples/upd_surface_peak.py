@@ -9,8 +9,9 @@ Per centrifugal load CF:
 * the peak of the sector with the damper's faces as contact surfaces
   (:class:`harmonic_balance.bladed_disk.surface_hb.SurfaceSectorHB`, ``--nodes`` per side,
   one harmonic count): the first-harmonic amplitude of u_a maximised over the frequency
-  by Brent's search (:func:`harmonic_balance.brent.brent_min`), each frequency a Newton
-  solve warm-started from the nearest one solved, the search started at the point
+  by the library's search (:func:`harmonic_balance.bladed_disk.surface_peak.surface_peak`:
+  an interval uphill, then Brent's search), each frequency a Newton solve started on
+  the tangent of the nearest one solved, the search started at the point
   model's peak (or ``--guess``); with the condensed model, whose unknowns are the
   sector's for every node count, each node count's first solve starts from the
   previous one's peak solution (the CF path where that fails);
@@ -49,21 +50,15 @@ from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.ring_surface import march_ring_surface
 from harmonic_balance.bladed_disk.sector import Sector
 from harmonic_balance.bladed_disk.surface_hb import DASHPOTS, CondensedSurfaceSectorHB, SurfaceSectorHB
-from harmonic_balance.brent import brent_min
+from harmonic_balance.bladed_disk.surface_peak import PEAK_XTOL
+from harmonic_balance.bladed_disk.surface_peak import surface_peak as library_peak
 from harmonic_balance.newton import NewtonError
 
-#: First step of the search for an interval around the surface peak, relative to the
-#: point model's peak frequency (the surfaces' stiffness differs from the points' by a few
-#: per cent), and the most doublings of it.
-BRACKET_STEP, MAX_BRACKET = 0.005, 6
 #: Loads of the path from ``--start-cf`` to the CF (:func:`cf_path`): steps of ~10 % at
 #: 300 -> 120 N, where the condensed model's Newton takes 5-15 evaluations a step.
 CF_STEPS = 8
 #: Print every frequency solved (``--verbose``).
 VERBOSE = False
-#: Frequency tolerance of the peak search, relative: the amplitude is flat at the peak, so
-#: 1e-4 in frequency moves it by far less than the 0.5 % the node study resolves.
-PEAK_XTOL = 1e-4
 
 
 def point_peak(sector: Sector, H: int, cf: float, points: int) -> dict:
@@ -74,24 +69,6 @@ def point_peak(sector: Sector, H: int, cf: float, points: int) -> dict:
     c = solve.frf(hb, 2 * np.pi * np.linspace(band[0], band[1], points))
     return {"peak_hz": c.peak_omega / (2 * np.pi), "peak_amplitude_h1": c.peak_amplitude,
             "cpu_s": time.process_time() - p0}
-
-
-def _bracket(neg, f0: float) -> tuple[float, float, float]:
-    """An interval (lo, hi) [Hz] and its best point around a maximum of -neg: uphill from f0 in steps of
-    BRACKET_STEP f0, doubled, until the amplitude falls (Press et al., Numerical Recipes,
-    sec. 10.1); every value is kept by neg's own cache."""
-    h = BRACKET_STEP * f0
-    a, b = f0, f0 + h
-    fa, fb = neg(a), neg(b)
-    if fb > fa:
-        a, b, fa, fb, h = b, a, fb, fa, -h
-    for _ in range(MAX_BRACKET):
-        c = b + 2 * h
-        fc = neg(c)
-        if fc > fb:
-            return min(a, c), max(a, c), b
-        a, b, fa, fb, h = b, c, fb, fc, 2 * h
-    raise RuntimeError(f"no amplitude maximum within {abs(b - f0):.0f} Hz of {f0:.1f} Hz")
 
 
 def cf_path(make, omega: float, cf: float, start_cf: float, steps: int = CF_STEPS):
@@ -107,40 +84,12 @@ def cf_path(make, omega: float, cf: float, start_cf: float, steps: int = CF_STEP
 
 
 def surface_peak(hb, f_guess: float, xtol: float = PEAK_XTOL, first=None) -> dict:
-    """Maximum over the frequency of the first harmonic of u_a (module docstring).
-
-    ``first(omega)``: the first solution (default :func:`solve.start_point`, the stuck start).
-
-    Returns
-    -------
-    dict: peak_hz, peak_amplitude_h1 [m], x (the solution there), points (Hz, amplitude of
-    every frequency solved), cpu_s. (The residual evaluations are counted by the caller,
-    over every model ``first`` builds too.)
-    """
-    p0 = time.process_time()
-    solved = {}   # omega -> x
-    first = first or (lambda w: solve.start_point(hb, w))
-
-    def neg_amp(f):
-        w = 2 * np.pi * f
-        if w in solved:
-            return -hb.amplitude_h1(solved[w])
-        x = None
-        if solved:   # warm start; the stuck start (and its homotopy) when that fails
-            try:
-                x = solve.solve_point(hb, w, solved[min(solved, key=lambda v: abs(v - w))], max_iter=80)
-            except NewtonError:
-                pass
-        solved[w] = x = first(w) if x is None else x
+    """The library's peak search (:func:`harmonic_balance.bladed_disk.surface_peak.surface_peak`),
+    every frequency printed with ``--verbose``."""
+    def report(f, a):
         if VERBOSE:
-            print(f"    {f:.4f} Hz: {hb.amplitude_h1(x):.6e} m", flush=True)
-        return -hb.amplitude_h1(x)
-
-    lo, hi, best = _bracket(neg_amp, f_guess)
-    f, a, _ = brent_min(neg_amp, lo, hi, xtol * f_guess, start=best)
-    pts = sorted((w / (2 * np.pi), hb.amplitude_h1(x)) for w, x in solved.items())
-    return {"peak_hz": float(f), "peak_amplitude_h1": float(-a), "x": solved[2 * np.pi * f],
-            "points": pts, "cpu_s": time.process_time() - p0}
+            print(f"    {f:.4f} Hz: {a:.6e} m", flush=True)
+    return library_peak(hb, f_guess, xtol, first, report)
 
 
 def surface_point(hb, f: float, first=None) -> dict:

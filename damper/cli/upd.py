@@ -7,6 +7,7 @@ Examples::
     damper upd frf --damper stuck --json
     damper upd frf --contacts surface --surface-nodes 5 --harmonics 1 --band 440 490 --points 5 --json
     damper upd optimize --cf-range 30 3000 --points 20 --json --plot out/upd
+    damper upd optimize --contacts surface --harmonics 3 --json   # slow: minutes per load
     damper upd mistuning --std 0.02 --samples 200 --seed 1 --workers 2 --json --plot out/mt
     damper upd mistuning --blades 4 --engine-order 1 --factors 1.04 0.97 1 0.99 --json
     damper upd mistuning --accuracy 0.01 --samples 20 --json   # H chosen on the tuned sector
@@ -52,29 +53,46 @@ def register(sub) -> None:
     o = s.add_parser("optimize", help="peak response against CF and the optimal load")
     upd_model_options(o)
     o.add_argument("--cf-range", type=float, nargs=2, default=(30.0, 3000.0), metavar=("LO", "HI"))
-    o.add_argument("--points", type=int, default=20, help="number of CF values (log-spaced)")
+    o.add_argument("--points", type=int, help=f"number of CF values (log-spaced; default {LOAD_POINTS}, "
+                   f"with --contacts surface {SURFACE_LOAD_POINTS})")
     o.add_argument("--harmonics", type=int, default=7, help="highest harmonic H of the load sweep "
                    "(with --accuracy the first one tried)")
     o.add_argument("--accuracy", type=float, metavar="TOL",
                    help="relative accuracy of the optimum's peak amplitude, in (1e-6, 0.5): its curve is "
                    "raised in H until the estimate is below TOL, and the sweep re-run at that H "
                    "(default: the fixed --harmonics, the optimum's estimate reported)")
-    o.add_argument("--grid", type=int, default=40, help="frequency points per curve")
-    o.add_argument("--workers", type=int, default=2,
-                   help="processes for the load grid (results do not depend on it)")
+    o.add_argument("--grid", type=int, help=f"frequency points per curve (default {GRID}; not with "
+                   "--contacts surface, whose peaks are searched by Brent's method)")
+    o.add_argument("--workers", type=int, help=f"processes for the load grid (default {WORKERS}; results "
+                   "do not depend on it; not with --contacts surface, which walks the loads in one process)")
     o.add_argument("--plot", metavar="DIR", help="write upd_optimize.png here")
-    _contacts(o)
+    _contacts(o, surface=True, slow=True)
     o.set_defaults(func=run_optimize)
     register_mistuning(s)
 
 
-def _contacts(p, surface: bool = False) -> None:
+#: ``upd optimize``'s --grid and --workers with point contacts when not given.
+GRID, WORKERS = 40, 2
+#: ``upd optimize``'s --points when not given: with point contacts, and with surfaces, whose
+#: every load is a peak search of minutes (the refinement between the neighbours of the
+#: smallest walked peak then finds the optimum, as with points).
+LOAD_POINTS, SURFACE_LOAD_POINTS = 20, 8
+
+
+def _contacts(p, surface: bool = False, slow: bool = False) -> None:
+    """--contacts and, with ``surface``, the surface options; ``slow``: ``upd optimize``'s
+    help, which says what a sweep with surfaces costs."""
+    what = ("; surface: the damper's faces as contact surfaces of many 3D points on the "
+            "condensed FE bodies (damper.upd_surface; slower)")
+    if slow:
+        what = ("; surface: the damper's faces as contact surfaces (damper.upd_surface, the condensed "
+                "model): SLOW, a peak search of minutes per load (~1 s CPU per residual evaluation at 5 "
+                "nodes per side, ~120 evaluations per load at H 7); the loads walked from the largest down, each "
+                "warm-started from the last; the estimate is printed before the walk")
     p.add_argument("--contacts", choices=("toml", "geometry") + (("surface",) if surface else ()),
                    default="toml",
                    help="contact laws: the TOML's Jenkins points, or computed by contact_core "
-                   "from the [geometry] section (damper.upd_geometry; cached)"
-                   + ("; surface: the damper's faces as contact surfaces of many 3D points on the "
-                      "condensed FE bodies (damper.upd_surface; slower)" if surface else ""))
+                   "from the [geometry] section (damper.upd_geometry; cached)" + (what if surface else ""))
     if surface:
         p.add_argument("--surface-nodes", type=int, metavar="N",
                        help="with --contacts surface: contact-zone nodes per side of each face "
@@ -192,13 +210,22 @@ def _check_optimize(args) -> None:
     lo, hi = args.cf_range
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= limits.MAX_MAGNITUDE):
         raise ValueError(f"--cf-range {lo:g} {hi:g}: give 0 < LO < HI <= {limits.MAX_MAGNITUDE:g} [N]")
+    if args.points is None:
+        args.points = SURFACE_LOAD_POINTS if args.contacts == "surface" else LOAD_POINTS
     limits.check_size("--points", args.points, 3, limits.MAX_LOAD_POINTS,
                       "each CF value is a whole forced response (seconds)")
     limits.check_size("--harmonics", args.harmonics, 1, limits.MAX_UPD_HARMONICS,
                       limits.harmonics_why(limits.MAX_UPD_HARMONICS))
-    limits.check_size("--grid", args.grid, 3, limits.MAX_UPD_GRID,
-                      "each frequency point is a harmonic-balance solve of the sector")
-    limits.check_workers("--workers", args.workers)
+    check_surface_nodes(args)
+    from damper.upd_surface import check_optimize_options
+
+    check_optimize_options(args)
+    if args.contacts != "surface":
+        args.grid = GRID if args.grid is None else args.grid
+        args.workers = WORKERS if args.workers is None else args.workers
+        limits.check_size("--grid", args.grid, 3, limits.MAX_UPD_GRID,
+                          "each frequency point is a harmonic-balance solve of the sector")
+        limits.check_workers("--workers", args.workers)
     check_accuracy_option(args.accuracy)
     check_out_dir(args.plot, "--plot")
     limits.check_cf_floor("--cf-range", lo, None, args.config, "or start the range there")
@@ -217,7 +244,11 @@ def run_optimize(args) -> int:
 
     _check_optimize(args)
     sector = _sector(args)
-    if args.accuracy is None:
+    if args.contacts == "surface":
+        from damper.upd_surface import optimize_record
+
+        out = optimize_record(sector, args, note=lambda line: print(line, file=sys.stderr, flush=True))
+    elif args.accuracy is None:
         out = optimal_load(sector, args.cf_range, args.points, args.harmonics, grid=args.grid,
                            workers=args.workers)
         out["truncation_error"] = optimum_truncation(sector, out, args.grid, limits.MAX_UPD_HARMONICS)
@@ -238,6 +269,10 @@ def run_optimize(args) -> int:
         line = flat_band_line(out.get("optimum_band_cf"), args.cf_range)
         if line:  # the minimum is flat: the CF range a design can use
             print(line)
+        if "surface_model" in out:
+            from damper.upd_surface import optimize_line
+
+            print(optimize_line(out["surface_model"]))
     for line in accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)

@@ -117,16 +117,18 @@ def plot_backbone(s: dict, path: Path) -> None:
 
 class OptimalLoad(Kind):
     """UPD bladed-disk sector: peak response against CF and the optimal load
-    (``harmonic_balance.bladed_disk.optimize.optimal_load``); no contact or FE stage."""
+    (``harmonic_balance.bladed_disk.optimize.optimal_load``; with contacts = "surface"
+    ``damper.upd_surface.optimize_record``); no contact or FE stage."""
 
     name = "optimal_load"
-    modules = ("harmonic_balance", "fmu_src", "damper.upd_frf", "damper.upd_geometry")
+    modules = ("harmonic_balance", "fmu_src", "damper.upd_frf", "damper.upd_geometry", "damper.upd_surface")
 
     def instances(self, data):
         u = data.get("upd")
         if u is None:
             return []
-        keys = ("cf_range", "points", "harmonics", "grid", "accuracy", "contacts", "config_sha256")
+        keys = ("cf_range", "points", "harmonics", "grid", "accuracy", "contacts", "config_sha256",
+                "surface_nodes", "surface_model")
         params = {k: u[k] for k in keys if k in u}    # its own keys; the file enters by its hash
         return [Stage("optimal_load", self, params, products=("optimal_load",),
                       extra={"config": u.get("config")})]
@@ -141,9 +143,15 @@ class OptimalLoad(Kind):
         from harmonic_balance.bladed_disk.optimize import optimal_load
 
         p = stage.params
-        sector = upd_sector(options(config=stage.extra["config"], contacts=p.get("contacts", "toml"),
-                                    store=ctx.store))
-        if p.get("accuracy") is None:
+        opts = options(config=stage.extra["config"], contacts=p.get("contacts", "toml"), store=ctx.store,
+                       cf_range=p["cf_range"], points=p["points"], harmonics=p["harmonics"],
+                       surface_nodes=p.get("surface_nodes"))
+        sector = upd_sector(opts)
+        if opts.contacts == "surface":   # the walk of the condensed surface model (damper upd optimize's)
+            from damper.upd_surface import optimize_record
+
+            out = optimize_record(sector, opts)
+        elif p.get("accuracy") is None:
             out = optimal_load(sector, p["cf_range"], p["points"], p["harmonics"], grid=p["grid"])
             out["truncation_error"] = optimum_truncation(sector, out, p["grid"], limits.MAX_UPD_HARMONICS)
         else:

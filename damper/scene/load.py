@@ -350,7 +350,8 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
 def _check_upd_contacts(data: dict, problems: list) -> None:
     """[upd] contacts against the wanted results, as ``damper upd frf|optimize`` refuse them:
     the surface options only with surface contacts (their defaults filled in there, so the
-    stage key holds them), surfaces only for upd_frf, at a fixed H; the CF above its floor."""
+    stage key holds them), surfaces at a fixed H, optimal_load's with the condensed model; the CF
+    above its floor."""
     from damper import limits
     from damper.upd_frf import SURFACE_MODEL, SURFACE_NODES
 
@@ -363,12 +364,18 @@ def _check_upd_contacts(data: dict, problems: list) -> None:
     else:
         u.setdefault("surface_nodes", SURFACE_NODES)
         u.setdefault("surface_model", SURFACE_MODEL)
-        if "optimal_load" in wants:
-            problems.append((("upd", "contacts"), "contacts = \"surface\" is for upd_frf only: the "
-                             "load sweep of optimal_load takes \"toml\" or \"geometry\""))
-        if "upd_frf" in wants and "accuracy" in u:
+        if "optimal_load" in wants and u["surface_model"] != "condensed":
+            problems.append((("upd", "surface_model"), "optimal_load with contacts = \"surface\" walks the "
+                             "loads with surface_model = \"condensed\" (its unknowns are the same at every "
+                             "load): drop surface_model"))
+        if "accuracy" in u:
             problems.append((("upd", "accuracy"), "contacts = \"surface\" runs at the fixed harmonics: "
                              "drop accuracy"))
+        from damper.upd_surface import MAX_OPTIMIZE_POINTS
+
+        if "optimal_load" in wants and u["points"] > MAX_OPTIMIZE_POINTS:
+            problems.append((("upd", "points"), f"at most {MAX_OPTIMIZE_POINTS} with contacts = \"surface\" "
+                             "(each load a peak search of minutes): lower points"))
     if "upd_frf" in wants and "cf" in u and not any(p[0] == ("upd", "config") for p in problems):
         from harmonic_balance.bladed_disk.config import load_config
 

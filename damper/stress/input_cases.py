@@ -367,6 +367,17 @@ def _upd() -> list[InputCase]:
         ("mistuning worst with factors", "mistuning --worst --damper free --blades 4 --engine-order 1 "
          "--factors 1 1 1 1"),
         ("mistuning worst --out a folder", "mistuning --worst --damper free --out {fx}"),
+        ("optimize surface with accuracy (fixed H)", "optimize --contacts surface --accuracy 0.01"),
+        ("optimize surface with grid (Brent's peak search)", "optimize --contacts surface --grid 20 --json"),
+        ("optimize surface with workers (one walk)", "optimize --contacts surface --workers 2"),
+        ("optimize surface model nodes", "optimize --contacts surface --surface-model nodes"),
+        ("optimize surface nodes 3", "optimize --contacts surface --surface-nodes 3"),
+        ("optimize surface points 41 (a peak search of minutes each)", "optimize --contacts surface --points 41"),
+        ("optimize surface nodes without surface contacts", "optimize --surface-nodes 7"),
+        ("optimize surface with an axial platform DOF (not planar)",
+         "optimize --contacts surface --config {fx}/upd_axial.toml"),
+        ("optimize surface with mu 0 (no virgin curve to condense)",
+         "optimize --contacts surface --config {fx}/upd_mu0.toml --json"),
     ], "upd")
 
 
@@ -412,7 +423,8 @@ def _run() -> list[InputCase]:
         "s_dupkey.toml", "s_duptable.toml", "s_cfrone.toml", "s_wantempty.toml", "s_fmiempty.toml",
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",
-        "s_ufaxial.toml", "s_ufmu0.toml", "s_flatbig.toml", "s_uff0tiny.toml")]
+        "s_ufaxial.toml", "s_ufmu0.toml", "s_flatbig.toml", "s_uff0tiny.toml", "s_ufolsurfnodes.toml",
+        "s_ufolsurfpts.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),

@@ -152,6 +152,24 @@ def _step(make, omega, loads, x, c, depth, max_iter, report, cf, failed):
     return x1
 
 
+def warm_path(make, omega: float, x, c_from: float, c_to: float, max_iter: int | None = None) -> np.ndarray:
+    """The solution at ``c_to`` [N] from a solution ``x`` at ``c_from`` [N] whose direct warm
+    start failed: the step halved in log CF (Newton at sqrt(c_from c_to), then at c_to, each
+    halved again where it fails, MAX_HALVINGS in all, at most MAX_STEP_FAILURES failures
+    counting the direct start's). ``make`` and ``omega`` as :func:`cf_path`'s; the unknowns
+    of ``make(c_from)`` and ``make(c_to)`` must be the same.
+
+    Raises
+    ------
+    SolverError
+        A step still failed after MAX_HALVINGS halvings or MAX_STEP_FAILURES failures.
+    """
+    max_iter = MAX_ITER if max_iter is None else max_iter
+    loads, failed = [float(c_from)], [1]
+    x = _step(make, omega, loads, x, math.sqrt(c_from * c_to), 1, max_iter, None, c_to, failed)
+    return _step(make, omega, loads, x, float(c_to), 1, max_iter, None, c_to, failed)
+
+
 def _failed(c: float, loads, cf: float, omega: float, err) -> str:
     start = loads[0]
     where = "its stuck start" if c == start else f"{c:.4g} N (the last load solved: {loads[-1]:.4g} N)"

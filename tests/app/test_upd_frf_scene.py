@@ -89,10 +89,21 @@ def test_upd_frf_refusals_name_the_key(edit, key, words):
     assert f"{key}: " in str(err.value) and words in str(err.value), str(err.value)
 
 
-def test_surface_contacts_in_optimal_load_are_refused():
+def test_node_dof_surfaces_in_optimal_load_are_refused():
+    """optimal_load walks the loads with the condensed model (its unknowns the same at every load)."""
     with pytest.raises(SceneError) as err:
-        parse_scene(UPD.replace('["upd_frf"]', '["optimal_load"]') + 'contacts = "surface"\n', "bad.toml")
-    assert "upd.contacts: " in str(err.value) and "upd_frf only" in str(err.value)
+        parse_scene(UPD.replace('["upd_frf"]', '["optimal_load"]') + 'contacts = "surface"\nsurface_model = "nodes"\n',
+                    "bad.toml")
+    assert "upd.surface_model: " in str(err.value) and 'surface_model = "condensed"' in str(err.value)
+
+
+def test_surface_optimal_load_stage_key_holds_the_node_count():
+    from damper.run.backbone_stages import OptimalLoad
+
+    data = parse_scene(UPD.replace('["upd_frf"]', '["optimal_load"]') + 'contacts = "surface"\n').data
+    (stage,) = OptimalLoad().instances(data)
+    assert (stage.params["contacts"], stage.params["surface_nodes"], stage.params["surface_model"]) == \
+        ("surface", 5, "condensed")
 
 
 def test_surface_defaults_are_filled_in_for_the_stage_key():
