@@ -60,6 +60,18 @@ static inline const double *block_A(const msurf_model *m, int32_t b)
     return m->blk_A + off;
 }
 
+/* Block b of A copied column-major into lu (LAPACK's layout), the start of a Newton or a
+ * sensitivity matrix; returns the block's size. */
+static inline int32_t block_A_colmajor(const msurf_model *m, int32_t b, double *lu)
+{
+    const int32_t mb = block_size(m, b);
+    const double *A = block_A(m, b);
+    for (int32_t i = 0; i < mb; ++i)
+        for (int32_t j = 0; j < mb; ++j)
+            lu[i + (size_t)j * mb] = A[(size_t)i * mb + j];
+    return mb;
+}
+
 /* The cache slot of block b holding key (klen doubles), or the least recently used one
  * emptied for it (*fresh = 1: the caller factorizes into *lu, *piv); returns the slot. */
 int32_t msurfp_find_slot(const msurf_model *m, msurf_cache *cache, int32_t b, size_t klen,

@@ -51,11 +51,7 @@ static double end_state(const iwan_model *law, const iwan_state *s0, const iwan_
 static int factor_sens(const msurf_model *m, int32_t b, const double *key, double *lu, int *piv)
 {
     const int32_t *ls = m->blk_ls, *lp = m->blk_lp;
-    const int32_t mb = block_size(m, b), c0 = m->blk_cptr[b], nc = m->blk_cptr[b + 1] - c0;
-    const double *A = block_A(m, b);
-    for (int32_t i = 0; i < mb; ++i)
-        for (int32_t j = 0; j < mb; ++j)
-            lu[i + (size_t)j * mb] = A[(size_t)i * mb + j];
+    const int32_t mb = block_A_colmajor(m, b, lu), c0 = m->blk_cptr[b], nc = m->blk_cptr[b + 1] - c0;
     for (int term = 0; term < 3; ++term)          /* numpy's order: ss, sp, pp */
         for (int32_t k = 0; k < nc; ++k) {
             const int32_t i = m->blk_c[c0 + k];
