@@ -64,14 +64,16 @@ def _frf_peak(cf: float, f_hz: float):
 
 
 @pytest.mark.slow
-def test_each_walked_peak_is_the_frf_peak_at_that_load(cli_run):
+def test_the_last_walked_peak_is_the_frf_peak_at_that_load(cli_run):
+    """The smallest load, reached by the walk's warm starts from every larger one, against
+    ``upd frf``'s own path from the open load (one curve: each costs ~40 s on a shared core)."""
     out, _ = cli_run
     loads = out["surface_model"]["loads"]
     assert [r["cf"] for r in loads] == pytest.approx(out["cf"][::-1])   # largest first, no refinement
-    for r in loads:
-        f, a = _frf_peak(r["cf"], r["peak_hz"])
-        assert r["peak_amplitude_h1"] == pytest.approx(a, rel=PEAK_AMPLITUDE_RTOL)
-        assert r["peak_hz"] == pytest.approx(f, rel=PEAK_FREQUENCY_RTOL)
+    r = loads[-1]
+    f, a = _frf_peak(r["cf"], r["peak_hz"])
+    assert r["peak_amplitude_h1"] == pytest.approx(a, rel=PEAK_AMPLITUDE_RTOL)
+    assert r["peak_hz"] == pytest.approx(f, rel=PEAK_FREQUENCY_RTOL)
 
 
 @pytest.mark.slow
