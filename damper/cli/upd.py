@@ -273,6 +273,8 @@ def run_optimize(args) -> int:
             from damper.upd_surface import optimize_line
 
             print(optimize_line(out["surface_model"]))
+    if "warning" in out:   # a surface walk that stopped above the range's low end
+        print(f"warning: {out['warning']}", file=sys.stderr if args.json else sys.stdout)
     for line in accuracy_lines(out):
         if not args.json or line.startswith("warning"):
             print(line, file=sys.stderr if args.json else sys.stdout)

@@ -8,7 +8,7 @@ from harmonic_balance.bladed_disk import load_path
 from harmonic_balance.bladed_disk.config import load_config
 from harmonic_balance.bladed_disk.hb import SectorHB
 from harmonic_balance.bladed_disk.sector import Sector
-from harmonic_balance.bladed_disk.solve import frf, solve_point, start_point
+from harmonic_balance.bladed_disk.solve import SolverError, frf, solve_point, start_point
 from harmonic_balance.bladed_disk.surface_peak import PEAK_XTOL, surface_peak
 
 H = 1
@@ -52,3 +52,29 @@ def test_halved_load_steps_reach_the_direct_solution(sector):
     direct = solve_point(make(150.0), omega, start_point(make(150.0), omega))
     hb = make(150.0)
     assert hb.amplitude_h1(x) == pytest.approx(hb.amplitude_h1(direct), rel=SAME_SOLUTION_RTOL)
+
+
+class _Walk:
+    """A stand-in walk whose peak search fails below ``floor`` [N]."""
+
+    def __init__(self, floor):
+        self.floor = floor
+
+    def peak(self, cf, f_guess=None):
+        if cf < self.floor:
+            raise SolverError(f"no peak at {cf:g} N")
+        return {"peak_amplitude_h1": 1.0 / cf, "peak_hz": 450.0}
+
+
+def test_a_walk_stops_at_the_first_load_that_fails_after_enough_loads():
+    """The lowest loads fail first (the damper near its floor): the walk keeps what it solved
+    and says where it stopped; a failure before MIN_WALKED loads is the command's error."""
+    from harmonic_balance.bladed_disk.surface_peak import MIN_WALKED, _walk_down
+
+    cfs = np.geomspace(30.0, 3000.0, 8)
+    peaks, stopped = _walk_down(_Walk(50.0), cfs, 450.0)
+    assert len(peaks) == 7 and stopped[0] == pytest.approx(30.0) and "no peak at 30 N" in stopped[1]
+    assert [p["peak_amplitude_h1"] for p in peaks] == pytest.approx(1.0 / cfs[1:])   # ascending CF
+    assert _walk_down(_Walk(0.0), cfs, 450.0)[1] is None
+    with pytest.raises(SolverError):
+        _walk_down(_Walk(cfs[-MIN_WALKED] * 1.01), cfs, 450.0)
