@@ -277,7 +277,7 @@ def frf(hb: SectorHB, omegas, refine: bool = True, x0: np.ndarray | None = None)
     lam_step = max(LAM_STEP, 1.0 / max(len(omegas) - 1, 1))
     branch = _trace(hb, x_start, omegas[0], omegas[-1], lam_step)
     xs = on_grid(branch, omegas)
-    n = len(branch.lam)
+    n, missed = len(branch.lam), []
     if xs is None:
         om, xs = np.asarray(branch.lam), branch.x
         method = f"continuation, {n} points (the branch folds: its own points)"
@@ -289,7 +289,7 @@ def frf(hb: SectorHB, omegas, refine: bool = True, x0: np.ndarray | None = None)
     c = Curve(om, xs, np.array([hb.amplitude_h1(x) for x in xs]),
               np.array([hb.amplitude_max(x) for x in xs]))
     c.extra.update(method=method, branch_points=n)
-    if om is omegas and missed:
+    if missed:
         _warn(c, f"{len(missed)} grid point(s) kept their interpolated value (Newton from it failed), "
                  f"first at {missed[0] / 2 / np.pi:.6g} Hz: refine the grid (--points)")
     if refine:

@@ -1,6 +1,6 @@
 """``damper upd optimize --contacts surface``: the condensed surface model's peaks walked over CF
-(harmonic_balance.bladed_disk.surface_peak) against independent ``upd frf --contacts surface``
-curves at the same loads, and the options that do not apply to surfaces refused.
+(harmonic_balance.bladed_disk.surface_peak) against an independent ``upd frf --contacts surface``
+curve at the lowest load, and the options that do not apply to surfaces refused.
 
 Tiny settings keep it to minutes: H 1, 5 nodes per side (the smallest count a surface
 takes), three loads 300 ... 1200 N of UPD-24 (F0 30 N).
