@@ -309,8 +309,6 @@ def _print_text(r: dict) -> None:
         errs = {k: v for k, v in r["hertz"].items() if k.startswith("error")}
         print("vs Hertz: " + ", ".join(f"{k[6:]} {100 * v:+.2f} %" for k, v in errs.items()))
     if r.get("under_resolved"):
-        from contact_core.bodies import MIN_NODES_ACROSS
+        from contact_core.bodies import under_resolved_warning
 
-        print(f"warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid spacings "
-              "(radius or half-width), so its size, peak pressure, approach and k_n are rough (grid 3: k_n 54 % "
-              "below Hertz); lower --p-design (the potential zone is sized for that peak pressure) or refine --grid")
+        print(under_resolved_warning("--p-design", "--grid"))

@@ -153,11 +153,9 @@ class Normal(Kind):
             out.append(f"{'':9s} approach fit d = A F^(2/3) + B F: A {100 * fit['error_A']:+.2f} % vs Hertz, "
                        f"B = {fit['B']:.3g} m/N (finite bodies)")
         if r.get("under_resolved"):
-            from contact_core.bodies import MIN_NODES_ACROSS
+            from contact_core.bodies import under_resolved_warning
 
-            out.append(f"{'':9s} warning: under-resolved: the contact spans fewer than {MIN_NODES_ACROSS} grid "
-                       "spacings, so its size, peak pressure, approach and k_n are rough; lower p_design (the "
-                       "potential zone is sized for that peak pressure) or refine grid")
+            out.append(f"{'':9s} " + under_resolved_warning("p_design", "grid"))
         return out
 
 
