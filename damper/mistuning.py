@@ -403,7 +403,7 @@ def _solve_sample(model: SampleModel, kappa) -> dict:
     _inside(c.peak_omega, om)
     return {"peak_per_blade": c.peak_per_blade.tolist(),
             "peak_frequency_per_blade_hz": (c.peak_omega_per_blade / 2 / np.pi).tolist(),
-            "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
+            "worst_blade": int(c.worst), "evaluations": c.evaluations, "truncated": c.extra["truncated"]}
 
 
 def _at_end(w: float, om: np.ndarray) -> bool:
@@ -521,7 +521,8 @@ def summarize(study: Study, cfg, ref: dict, kappas, results, time_s: float) -> d
              "cached": r.get("cached", False), "time_s": r.get("time_s")}
         if s["error"] is None:
             pk = np.asarray(r["peak_per_blade"])
-            j = int(pk.argmax())
+            j = r.get("worst_blade")   # the solver's refined blade among equal peaks
+            j = int(pk.argmax()) if j is None or pk[j] < pk.max() else int(j)
             s |= {"peak_per_blade": pk.tolist(), "amplification": float(pk[j] / a_t),
                   "worst_blade": j, "frequency_hz": r["peak_frequency_per_blade_hz"][j],
                   "peak_frequency_per_blade_hz": r["peak_frequency_per_blade_hz"],

@@ -390,9 +390,11 @@ def _polish_largest(solver: FastRingSolver, c: RingCurve, dA: np.ndarray) -> Non
         val, wk, xk = _polish(solver, c, dA)
         done.add(c.worst)
         if val > best:
-            best, w_best, x_best = val, wk, xk
+            best, w_best, x_best, j_best = val, wk, xk, c.worst
     c.peak_per_blade = np.minimum(c.peak_per_blade, best)
-    c.worst = int(c.peak_per_blade.argmax())
+    # the polished blade, not the first of those capped to its value: their frequencies
+    # are the Hermite interpolants', known less well than the values on a flat top
+    c.worst = j_best
     c.peak, c.peak_omega, c.peak_x = float(best), w_best, x_best
 
 

@@ -10,9 +10,6 @@ from damper.cli import main
 #: the ring's and the sector's searches stop at different points of a flat top: 1e-3 is
 #: the accuracy the amplification needs (ring_fast's module docstring).
 AMPLIFICATION_RTOL = 1e-3
-#: The frequency of a polished peak: the secant stops at a bracket of 1e-6 relative
-#: (ring_fast.PEAK_XTOL); the sector's refinement as tightly. 1e-4 is 0.045 Hz at 448 Hz.
-FREQUENCY_RTOL = 1e-4
 
 ARGS = ["upd", "mistuning", "--blades", "4", "--engine-order", "1", "--std", "0", "--samples", "1",
         "--serial", "--harmonics", "1", "--json"]
@@ -36,10 +33,28 @@ def test_zero_scatter_gives_the_tuned_peak_on_every_blade(zero_scatter):
     assert max(s["peak_per_blade"]) == pytest.approx(min(s["peak_per_blade"]), rel=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason="the fast solver's polish stops on the peak's value (ring_fast.POLISH_RTOL), "
-                   "not its frequency, and blades capped at the polished peak keep their Hermite frequencies, the "
-                   "first of equal peaks reported: 4 blades, H 1: 448.60 Hz against the tuned 448.87 Hz; 24 blades, "
-                   "H 3: 447.54 Hz against 447.75 Hz (--solver full: 447.7498 Hz)")
-def test_zero_scatter_reports_the_worst_blade_at_the_tuned_frequency(zero_scatter):
+def test_zero_scatter_reports_a_solved_point_as_the_worst_blade(zero_scatter):
+    """The worst blade's (frequency, peak) is a point of the tuned sector's curve.
+
+    Not its frequency against the tuned peak's: at H 1 the friction-damped amplitude
+    ripples by ~1e-4 across its top (the sampled stick-slip events; local maxima at 448.4
+    and 448.9 Hz within 2e-5 of each other), so the top's frequency is known to ~0.5 Hz
+    only, while every value there is within AMPLIFICATION_RTOL of the peak. The sample
+    reports the refined blade (a converged solve), not a blade capped to its value whose
+    frequency is a Hermite estimate (0.24 Hz away before)."""
+    import numpy as np
+
+    from damper.mistuning import Study
+    from harmonic_balance.bladed_disk.hb import SectorHB
+    from harmonic_balance.bladed_disk.sector import Sector
+    from harmonic_balance.bladed_disk.solve import solve_point, start_point
+
     s = zero_scatter["samples"][0]
-    assert s["frequency_hz"] == pytest.approx(zero_scatter["tuned_frequency_hz"], rel=FREQUENCY_RTOL)
+    study = Study(std=0, samples=1, blades=4, engine_order=1, harmonics=1)
+    hb = SectorHB(Sector(study.load()), 1, cf=study.cf, f0=study.f0)
+    w = 2 * np.pi * s["frequency_hz"]
+    a = hb.amplitude_h1(solve_point(hb, w, start_point(hb, w)))
+    # both converged to the solvers' residual tolerance (1e-10 of the loads): 1e-7 leaves
+    # room for the two paths' conditioning near the peak
+    assert a == pytest.approx(s["peak_per_blade"][s["worst_blade"]], rel=1e-7)
+    assert s["peak_per_blade"][s["worst_blade"]] == max(s["peak_per_blade"])
