@@ -150,7 +150,7 @@ class OptimalLoad(Kind):
         if opts.contacts == "surface":   # the walk of the condensed surface model (damper upd optimize's)
             from damper.upd_surface import optimize_record
 
-            out = optimize_record(sector, opts)
+            out = optimize_record(sector, opts, note=ctx.note)   # its estimate, then a line per load
         elif p.get("accuracy") is None:
             out = optimal_load(sector, p["cf_range"], p["points"], p["harmonics"], grid=p["grid"])
             out["truncation_error"] = optimum_truncation(sector, out, p["grid"], limits.MAX_UPD_HARMONICS)
@@ -170,9 +170,15 @@ class OptimalLoad(Kind):
 
     def lines(self, stage, result):
         o = result.data
-        return [f"optimum CF {o['optimum_cf']:.4g} N, peak {o['optimum_peak_amplitude']:.5e} m "
-                f"({o['method']}, H = {o['harmonics']}, {o['time_s']:.1f} s)"] + [
-                    f"   {line}" for line in truncation_lines(o)]
+        out = [f"optimum CF {o['optimum_cf']:.4g} N, peak {o['optimum_peak_amplitude']:.5e} m "
+               f"({o['method']}, H = {o['harmonics']}, {o['time_s']:.1f} s)"]
+        if "surface_model" in o:
+            from damper.upd_surface import optimize_line
+
+            out.append(f"   {optimize_line(o['surface_model'])}")
+        if "warning" in o:   # a surface walk that stopped above the range's low end (as upd optimize prints it)
+            out.append(f"   warning: {o['warning']}")
+        return out + [f"   {line}" for line in truncation_lines(o)]
 
     def scalars(self, stage, result):
         o = result.data

@@ -70,6 +70,16 @@ class Progress:
 
     __call__ = step
 
+    def note(self, text: str) -> None:
+        """A line from inside the running stage (a cost estimate, a step's summary) on ``stream``,
+        as the commands print theirs to standard error (above the bar on a terminal)."""
+        with self._lock:
+            if self.live:
+                self.stream.write("\r\033[K")
+            print(text, file=self.stream, flush=True)
+        if self.live and self.current:
+            self._draw()
+
     def echo(self, text: str) -> None:
         """Print a result line (above the bar on a terminal)."""
         with self._lock:

@@ -46,6 +46,9 @@ class Context:
     forced: set = field(default_factory=set)
     #: ``progress(done, total, label)`` for steps inside a stage (the libraries' callback), or None
     progress: object = None
+    #: ``note(line)`` for a line a stage prints while it runs (as its command prints it to
+    #: standard error: a cost estimate, a step's summary), or None
+    note: object = None
 
 
 @dataclass
@@ -92,7 +95,7 @@ def print_plan(plan: Plan, echo) -> None:
 def execute(scene, plan: Plan, store: Store, out: Path | None, progress: Progress) -> RunRecord:
     """Compute or load every stage of ``plan`` in order; write the output folder if ``out``."""
     rec = RunRecord(scene, plan, out=Path(out) if out is not None else None)
-    ctx = Context(store, scene, {s.name for s in plan.stages if s.forced}, progress.step)
+    ctx = Context(store, scene, {s.name for s in plan.stages if s.forced}, progress.step, progress.note)
     rec.provenance = record(scene=scene.source, scene_hash=scene.hash(), scene_content=scene.raw,
                             cache=None if store.memory else str(store.folder.resolve()))
     current = None

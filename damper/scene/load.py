@@ -163,7 +163,7 @@ def _validate(raw: dict, problems: list, base: Path) -> dict:
         _check_contacts(data, problems)
         _check_structure(data, problems, base)
         _check_upd(data, problems, base)
-        _check_wants(data, problems)
+        _check_wants(data, problems, raw)
     if not problems:   # what the stages would refuse only when they run
         checks.check_contacts(data, problems)
         checks.check_element(data, problems)
@@ -237,7 +237,8 @@ def _check_contacts(data: dict, problems: list) -> None:
         c.setdefault("nu2", c["nu"])
 
 
-def _check_wants(data: dict, problems: list) -> None:
+def _check_wants(data: dict, problems: list, raw: dict) -> None:
+    """The wanted results against the tables they need (``raw``: the scene as written)."""
     wants = data["want"]
     contacts = data.get("contact", {})
     for i, w in enumerate(wants):
@@ -286,7 +287,7 @@ def _check_wants(data: dict, problems: list) -> None:
             problems.append((("upd",), f"missing: needed for {w} (an empty [upd] table takes the "
                              "bundled UPD-24 model and its defaults)"))
     if "upd" in data:
-        _check_upd_contacts(data, problems)
+        _check_upd_contacts(data, problems, set(raw["upd"]))
     if "frf" in wants:
         for table in ("structure", "excitation", "sweep"):
             if table not in data:
@@ -347,11 +348,11 @@ def _check_upd(data: dict, problems: list, base: Path) -> None:
             problems.append((("upd", "cf_range"), str(err)))
 
 
-def _check_upd_contacts(data: dict, problems: list) -> None:
+def _check_upd_contacts(data: dict, problems: list, given: set) -> None:
     """[upd] contacts against the wanted results, as ``damper upd frf|optimize`` refuse them:
     the surface options only with surface contacts (their defaults filled in there, so the
-    stage key holds them), surfaces at a fixed H, optimal_load's with the condensed model; the CF
-    above its floor."""
+    stage key holds them), surfaces at a fixed H, optimal_load's with the condensed model and
+    no grid of its own (``given``: the keys the scene writes); the CF above its floor."""
     from damper import limits
     from damper.upd_frf import SURFACE_MODEL, SURFACE_NODES
 
@@ -371,6 +372,9 @@ def _check_upd_contacts(data: dict, problems: list) -> None:
         if "accuracy" in u:
             problems.append((("upd", "accuracy"), "contacts = \"surface\" runs at the fixed harmonics: "
                              "drop accuracy"))
+        if "grid" in given and "optimal_load" in wants and "upd_frf" not in wants:   # upd_frf's curve uses it
+            problems.append((("upd", "grid"), "optimal_load with contacts = \"surface\" searches each peak by "
+                             "Brent's method, not on a grid: drop grid"))
         from damper.upd_surface import MAX_OPTIMIZE_POINTS
 
         if "optimal_load" in wants and u["points"] > MAX_OPTIMIZE_POINTS:

@@ -214,8 +214,8 @@ UPD = {
     "contacts": Field("str", "contact laws: toml (the model's Jenkins points), geometry (computed by "
                       "contact_core from its [geometry] section), surface (the damper's faces as contact "
                       "surfaces of many 3D points on the condensed FE bodies; slower: optimal_load then walks "
-                      "the loads with the condensed model, a peak search of minutes per load, and ignores "
-                      "grid)",
+                      "the loads with the condensed model, a peak search of minutes per load, and refuses "
+                      "grid unless upd_frf is wanted too)",
                       default="toml", choices=("toml", "geometry", "surface")),
     "surface_nodes": Field("int", "contacts = surface: contact-zone nodes per side of each face "
                            "(default 5)", ge=MIN_NODES, le=MAX_NODES,

@@ -226,6 +226,7 @@ def scenes() -> dict[str, str | bytes]:
             "s_ufolsurf.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\naccuracy = 0.01\n',
             "s_ufolsurfpts.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\npoints = 41\n',
             "s_ufolsurfnodes.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\nsurface_model = "nodes"\n',
+            "s_ufolsurfgrid.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\ngrid = 20\n',
             "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
             "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
             "s_uff0tiny.toml": 'want = ["upd_frf"]\n[upd]\nf0 = 1e-300\npoints = 3\nharmonics = 1\n',

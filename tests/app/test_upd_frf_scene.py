@@ -97,13 +97,67 @@ def test_node_dof_surfaces_in_optimal_load_are_refused():
     assert "upd.surface_model: " in str(err.value) and 'surface_model = "condensed"' in str(err.value)
 
 
+#: The [upd] table of a surface optimal_load: UPD's keys but grid, which a surface walk refuses.
+OPTIMAL_SURFACE = (UPD.replace('["upd_frf"]', '["optimal_load"]').replace("grid = 5\n", "")
+                   + 'contacts = "surface"\n')
+
+
 def test_surface_optimal_load_stage_key_holds_the_node_count():
     from damper.run.backbone_stages import OptimalLoad
 
-    data = parse_scene(UPD.replace('["upd_frf"]', '["optimal_load"]') + 'contacts = "surface"\n').data
+    data = parse_scene(OPTIMAL_SURFACE).data
     (stage,) = OptimalLoad().instances(data)
     assert (stage.params["contacts"], stage.params["surface_nodes"], stage.params["surface_model"]) == \
         ("surface", 5, "condensed")
+
+
+def test_a_grid_in_a_surface_optimal_load_is_refused_unless_upd_frf_uses_it():
+    """The walk searches each peak by Brent's method (``upd optimize --contacts surface`` refuses
+    --grid); with upd_frf wanted too the grid is that curve's."""
+    with pytest.raises(SceneError) as err:
+        parse_scene(OPTIMAL_SURFACE + "grid = 20\n", "bad.toml")
+    assert "upd.grid: " in str(err.value) and "drop grid" in str(err.value), str(err.value)
+    both = parse_scene(OPTIMAL_SURFACE.replace('["optimal_load"]', '["optimal_load", "upd_frf"]') + "grid = 20\n")
+    assert both.data["upd"]["grid"] == 20
+    assert "grid" in parse_scene(OPTIMAL_SURFACE).data["upd"]   # the default, not written: accepted
+
+
+def _walk_that_stops(sector, surfaces_at, cf_range, points, H, f0=None, estimate=None, on_load=None, **kw):
+    """A stand-in for surface_peak.optimal_load_surface: its estimate, two loads, then the stop
+    warning (the walk's own text is tested in tests/upd/test_upd_surface_peak_search.py)."""
+    estimate(1234, 0.5)
+    loads = [{"cf": cf, "peak_hz": 470.0, "peak_amplitude_h1": a, "nodes": 60, "evaluations": 100,
+              "cpu_s": 10.0, "start": "stand-in"} for cf, a in ((3000.0, 5e-3), (1000.0, 4e-3))]
+    for r in loads:
+        on_load(r)
+    return {"cf": [1000.0, 3000.0], "peak_amplitude": [4e-3, 5e-3], "peak_frequency_hz": [470.0, 470.0],
+            "harmonics": H, "optimum_cf": 1000.0, "optimum_peak_amplitude": 4e-3, "method": "grid",
+            "interior": False, "time_s": 1.0, "warning": "the walk stopped at 300 N (stand-in)",
+            "surface_model": {"model": "condensed", "evaluations": 200, "cpu_s": 20.0, "time_s": 21.0,
+                              "first_guess_hz": 470.0, "loads": loads}}
+
+
+def test_surface_optimal_load_prints_the_estimate_the_loads_and_the_stop_warning(tmp_path, capsys, monkeypatch):
+    """As ``upd optimize --contacts surface`` prints them: the estimate and a line per load on
+    standard error while the stage runs, the stop warning among the stage's lines (again when
+    the result comes from the cache)."""
+    from harmonic_balance.bladed_disk import surface_peak
+
+    monkeypatch.setattr(surface_peak, "optimal_load_surface", _walk_that_stops)
+    scene = tmp_path / "s.toml"
+    scene.write_text(OPTIMAL_SURFACE.replace("cf = 150.0\n", "") + "cf_range = [300.0, 3000.0]\npoints = 3\n")
+    argv = ["run", str(scene), "--cache-dir", str(tmp_path / "cache"), "--out"]
+    assert main(argv + [str(tmp_path / "out")]) == 0
+    captured = capsys.readouterr()
+    err = captured.err.splitlines()
+    estimate = [i for i, line in enumerate(err) if "about 1234 residual evaluations" in line]
+    loads = [i for i, line in enumerate(err) if line.startswith("  CF 3000 N: peak 470.000 Hz")]
+    assert estimate and loads and estimate[0] < loads[0], captured.err
+    assert "   warning: the walk stopped at 300 N (stand-in)" in captured.out.splitlines(), captured.out
+    assert "2 loads searched, 200 evaluations" in captured.out
+    assert main(argv + [str(tmp_path / "again")]) == 0
+    again = capsys.readouterr()
+    assert "about 1234" not in again.err and "warning: the walk stopped at 300 N" in again.out
 
 
 def test_surface_defaults_are_filled_in_for_the_stage_key():
