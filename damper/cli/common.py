@@ -173,6 +173,8 @@ def check_out_file(path, flag: str) -> None:
     """Refuse, before any work, an output file that cannot be written (a folder, no permission)."""
     if path is None:
         return
+    if str(path).endswith(tuple(filter(None, (os.sep, os.altsep)))):   # Path() drops it: "x/" wrote a file x
+        raise ValueError(f"{flag} {path}: a name ending in {str(path)[-1]} is a folder; give a file name")
     path = Path(path)
     if path.is_dir():
         raise ValueError(f"{flag} {path}: that is a folder; give a file name")

@@ -208,12 +208,11 @@ def _print_samples(out: dict) -> None:
 
 def _run_worst(args, study) -> int:
     """``--worst``: the worst pattern, printed (and written to --out)."""
-    import json
     from pathlib import Path
 
     from damper.mistuning_worst import check_worst, run_worst
 
-    from .common import atomic_write, print_json, print_warnings
+    from .common import atomic_write, check_out_file, dumps, print_json, print_warnings
 
     if not args.worst:
         raise ValueError("--bound, --out and --max-evaluations go with --worst")
@@ -232,13 +231,10 @@ def _run_worst(args, study) -> int:
                          "--scheduler, --workers")
     study.check()
     check_worst(study, args.bound)
-    if args.out is not None:
-        out_path = Path(args.out)
-        if out_path.is_dir() or not out_path.parent.is_dir():
-            raise ValueError(f"--out {args.out}: give a file in an existing folder")
+    check_out_file(args.out, "--out")   # a folder, an unwritable one (/proc), before the search
     out = run_worst(study, args.bound, **friction)
-    if args.out is not None:
-        atomic_write(out_path, (json.dumps(out, indent=1) + "\n").encode())
+    if args.out is not None:   # dumps: a non-finite number refused (exit 3), not written as NaN
+        atomic_write(Path(args.out), dumps(out, indent=1) + "\n")
     if args.json:
         print_json(out)
     else:

@@ -104,6 +104,7 @@ def _normal() -> list[InputCase]:
         ("cylinder without length", "--body cylinder --radius 2.5e-3 --force 100"),
         ("p-design 0", f"{SPHERE} --force 100 --p-design 0"), ("body cube", "--body cube --radius 0.01 --force 1"),
         ("--out an existing folder", f"{SPHERE} --force 100 --out {{fx}}"),
+        ("--out ending in / (a folder; the file was written as res)", f"{SPHERE} --force 100 --grid 5 --out res/"),
         ("--out below a file", f"{SPHERE} --force 100 --out {{fx}}/a_file/r.json"),
         ("--plot a file", f"{SPHERE} --force 100 --plot {{fx}}/a_file"),
         ("--normal-curve an existing folder", f"{SPHERE} --force 100 --normal-curve {{fx}}"),
@@ -367,6 +368,10 @@ def _upd() -> list[InputCase]:
         ("mistuning worst with factors", "mistuning --worst --damper free --blades 4 --engine-order 1 "
          "--factors 1 1 1 1"),
         ("mistuning worst --out a folder", "mistuning --worst --damper free --out {fx}"),
+        ("mistuning worst --out ending in / (a folder)", "mistuning --worst --damper free --out worst/"),
+        # /proc: the write failed only after the search
+        ("mistuning worst --out in a folder that takes no writes",
+         "mistuning --worst --damper free --out /proc/damper_worst.json"),
         ("optimize surface with accuracy (fixed H)", "optimize --contacts surface --accuracy 0.01"),
         ("optimize surface with grid (Brent's peak search)", "optimize --contacts surface --grid 20 --json"),
         ("optimize surface with workers (one walk)", "optimize --contacts surface --workers 2"),

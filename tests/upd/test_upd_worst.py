@@ -82,3 +82,20 @@ def test_cli_worst_refusals_exit_2_nothing_written(tmp_path, capsys, extra, mess
     assert main(args) == 2
     assert message in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("out, message", [
+    ("/proc/damper_worst.json", "cannot write in /proc"),   # root's permission bits say yes, the write fails
+    ("worst/", "is a folder; give a file name"),            # Path() drops the /: a file "worst" was written
+])
+def test_cli_worst_out_that_cannot_be_written_is_refused_before_the_search(tmp_path, capsys, monkeypatch, out,
+                                                                          message):
+    import damper.mistuning_worst
+
+    searched = []
+    monkeypatch.setattr(damper.mistuning_worst, "run_worst", lambda *a, **kw: searched.append(a) or {})
+    monkeypatch.chdir(tmp_path)
+    assert main(["upd", "mistuning", "--blades", "4", "--engine-order", "1", "--damper", "free", "--worst",
+                 "--out", out]) == 2
+    assert message in capsys.readouterr().err and not searched
+    assert not list(tmp_path.iterdir())
