@@ -118,7 +118,8 @@ def check_upd_contacts(data: dict, problems: list) -> None:
     """Contacts other than the TOML's, checked on the model before any stage: its geometry
     (``damper.upd_geometry.geometry_params``: a [geometry] section, mu > 0), and for surfaces a
     planar sector, the faces' specifications and the node-DOF model's harmonic-balance unknowns
-    within their limit (``damper.upd_surface.check_unknowns``, counted on the faces' meshes)."""
+    within their limit (``damper.upd_surface.check_unknowns``, counted on the faces' meshes); for
+    optimal_load's walk the faces at both ends of ``cf_range``, as ``upd optimize`` checks them."""
     u = data.get("upd")
     if u is None or u["contacts"] == "toml" or any(path[:1] == ("upd",) for path, _ in problems):
         return
@@ -131,12 +132,17 @@ def check_upd_contacts(data: dict, problems: list) -> None:
     try:
         sector = upd_sector(options(config=u.get("config")))
         geometry_params(sector.cfg, u.get("cf"))
-        if u["contacts"] == "surface" and "upd_frf" in data["want"]:
+        if u["contacts"] == "surface" and {"upd_frf", "optimal_load"} & set(data["want"]):
             face_inputs(sector, "left")
+        if u["contacts"] == "surface" and "upd_frf" in data["want"]:
             face_specs(sector.cfg, u["surface_nodes"], u.get("cf"))
             key = "surface_nodes"
             if u["surface_model"] == "nodes":
                 check_unknowns(sector, u["surface_nodes"], u["harmonics"], u.get("cf"))
+        if u["contacts"] == "surface" and "optimal_load" in data["want"]:
+            key = "cf_range"
+            for cf in u["cf_range"]:   # damper.upd_surface.optimize_record's check, before the stage
+                face_specs(sector.cfg, u["surface_nodes"], cf)
     except ValueError as err:   # the command's message, its options named as the scene's keys
         msg = re.sub(r"--([a-z-]+) (\d+|nodes|condensed|toml|geometry|surface)\b",
                      lambda m: f"{m[1]} = {m[2]}", str(err))

@@ -429,7 +429,7 @@ def _run() -> list[InputCase]:
         "s_ufnodes.toml", "s_ufmodel.toml", "s_ufnodes4.toml", "s_ufnodes42.toml", "s_ufunknowns.toml",
         "s_ufacc.toml", "s_ufband.toml", "s_ufcflow.toml", "s_ufolsurf.toml", "s_ufnoupd.toml",
         "s_ufaxial.toml", "s_ufmu0.toml", "s_flatbig.toml", "s_uff0tiny.toml", "s_ufolsurfnodes.toml",
-        "s_ufolsurfpts.toml", "s_ufolsurfgrid.toml")]
+        "s_ufolsurfpts.toml", "s_ufolsurfgrid.toml", "s_ufolsurfcfhi.toml", "s_ufolsurfaxial.toml")]
     rows += [("dry run: loop amplitude 400", "{fx}/s_loopamp.toml --dry-run"),
              ("dry run: element DOF 7", "{fx}/s_dofs.toml --dry-run"),
              ("dry run: matrices with NaN", "{fx}/s_mnan.toml --dry-run"),

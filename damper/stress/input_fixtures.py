@@ -227,6 +227,9 @@ def scenes() -> dict[str, str | bytes]:
             "s_ufolsurfpts.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\npoints = 41\n',
             "s_ufolsurfnodes.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\nsurface_model = "nodes"\n',
             "s_ufolsurfgrid.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\ngrid = 20\n',
+            "s_ufolsurfcfhi.toml": 'want = ["optimal_load"]\n[upd]\ncontacts = "surface"\ncf_range = [300.0, 1e12]\n',
+            "s_ufolsurfaxial.toml": ('want = ["optimal_load"]\n[upd]\nconfig = "upd_axial.toml"\n'
+                                     'contacts = "surface"\n'),
             "s_ufnoupd.toml": 'want = ["upd_frf"]\n',
             "s_ufaxial.toml": 'want = ["upd_frf"]\n[upd]\nconfig = "upd_axial.toml"\ncontacts = "surface"\n',
             "s_uff0tiny.toml": 'want = ["upd_frf"]\n[upd]\nf0 = 1e-300\npoints = 3\nharmonics = 1\n',

@@ -122,6 +122,22 @@ def test_a_grid_in_a_surface_optimal_load_is_refused_unless_upd_frf_uses_it():
     assert "grid" in parse_scene(OPTIMAL_SURFACE).data["upd"]   # the default, not written: accepted
 
 
+@pytest.mark.parametrize("edit, key, words", [
+    ("cf_range = [300.0, 1e12]\n", "upd.cf_range", "outside [1e-06, 1e+09] N"),   # the geometry's load bound
+    ('config = "upd_axial.toml"\n', "upd.contacts", "contacts = toml or geometry"),
+])
+def test_surface_optimal_load_faces_are_checked_at_load(tmp_path, edit, key, words):
+    """The faces ``upd optimize --contacts surface`` checks before its walk (a planar sector, the
+    geometry at both ends of the range), refused with the scene's keys before any stage."""
+    from damper.stress.input_fixtures import upd_files
+
+    for name, content in upd_files().items():
+        (tmp_path / name).write_bytes(content if isinstance(content, bytes) else content.encode())
+    with pytest.raises(SceneError) as err:
+        parse_scene(OPTIMAL_SURFACE + edit, "bad.toml", base=tmp_path)
+    assert f"{key}: " in str(err.value) and words in str(err.value), str(err.value)
+
+
 def _walk_that_stops(sector, surfaces_at, cf_range, points, H, f0=None, estimate=None, on_load=None, **kw):
     """A stand-in for surface_peak.optimal_load_surface: its estimate, two loads, then the stop
     warning (the walk's own text is tested in tests/upd/test_upd_surface_peak_search.py)."""
