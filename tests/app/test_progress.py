@@ -33,3 +33,17 @@ def test_live_bar_shows_the_steps_inside_a_stage():
     p.step(3, 7, "assembly body 2")
     p.close()
     assert "condense:c:zx (compute)" in err.getvalue() and "3/7 assembly body 2" in err.getvalue()
+
+
+def test_a_stage_note_is_a_line_on_the_progress_stream_above_the_bar():
+    """A stage's own line (optimal_load's cost estimate) goes where the commands print theirs,
+    standard error, on a line of its own: the bar is cleared first and redrawn under it."""
+    for live in (False, True):
+        err, out = io.StringIO(), io.StringIO()
+        p = Progress(1, stream=err, out=out, live=live)
+        p.start("optimal_load", "compute")
+        p.note("about 1234 residual evaluations")
+        p.close()
+        assert out.getvalue() == ""
+        before, line, after = err.getvalue().partition("about 1234 residual evaluations\n")
+        assert line and (not live or (before.endswith("\r\033[K") and "optimal_load (compute)" in after))
