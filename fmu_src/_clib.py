@@ -163,6 +163,8 @@ FUNCTIONS = {
                                          DoubleArray, ct.POINTER(DoubleArray), _S, DoubleArray,
                                          DoubleArray, DoubleArray, DoubleArray, _I, _D,
                                          ct.POINTER(_S)]),
+    "iwan_periodic_many": (_STATUS, [ct.POINTER(_PM), _S, _S, DoubleArray, DoubleArray,
+                                     DoubleArray, DoubleArray, _I, _D, ct.POINTER(_S)]),
     "iwan_periodic_jac_terms": (_STATUS, [_PM, _S, DoubleArray, DoubleArray, _I, DoubleArray,
                                           DoubleArray, DoubleArray, _S, ct.POINTER(_S),
                                           SizeArray, SizeArray, DoubleArray, DoubleArray, _PD,

@@ -7,7 +7,9 @@ one numpy buffer of :data:`STATE_DTYPE` (the C ``iwan_state``), and
 code, so each state gets the bits ``IwanElement.step`` would give it alone. Reached
 through :meth:`IwanElement.initial_states`, :meth:`IwanElement.step_batch` and
 :meth:`IwanElement.batch_stepper`. Likewise :func:`periodic_jac_many` runs the
-periodic loops of many elements (e.g. a ring's contacts) in one C call. Symbols as
+periodic loops of many elements (e.g. a ring's contacts) with their Jacobians in one C
+call, :func:`periodic_many` without them, and :class:`PeriodicBatch` both on elements
+whose C pointers it resolves once. Symbols as
 in :mod:`fmu_src.element`. Only the ctypes layer (:mod:`fmu_src._clib`) is imported
 here: ``element`` imports this module, never the other way round; ``element``
 arguments are duck-typed (``._mp``, ``.N_ref``).
@@ -20,7 +22,8 @@ import numpy as np
 
 from ._clib import STATE_DTYPE, IwanInputError, State, StateArray, arr, check, lib, normal, vec
 
-__all__ = ["STATE_DTYPE", "BatchStepper", "initial_states", "periodic_jac_many", "step_batch"]
+__all__ = ["STATE_DTYPE", "BatchStepper", "PeriodicBatch", "initial_states", "periodic_jac_many",
+           "periodic_many", "step_batch"]
 
 
 def _check_states(states) -> int:
@@ -144,6 +147,72 @@ def step_batch(element, states: np.ndarray, u, N=None, out=None):
     return F, kt
 
 
+class PeriodicBatch:
+    """The periodic loops of many elements (e.g. a ring's contacts), one C call each
+    evaluation, with the elements' pointers resolved once.
+
+    Parameters
+    ----------
+    elements : sequence of n_e IwanElement (each its own law)
+    EN : sequence of n_e arrays, shape (n, nb), optional
+        Each element's normal-load basis (for :meth:`jac`); kept, not copied per call.
+    """
+
+    def __init__(self, elements, EN=None):
+        self.n_e = len(elements)
+        if self.n_e == 0:
+            raise IwanInputError("a batch needs at least one element")
+        self._models = (ct.POINTER(type(elements[0]._mp.contents)) * self.n_e)(
+            *[el._mp for el in elements])
+        self._EN = self._ens = None
+        if EN is not None:
+            self._EN = [np.ascontiguousarray(a, dtype=np.float64) for a in EN]
+            if len(self._EN) != self.n_e or any(a.shape != self._EN[0].shape for a in self._EN):
+                raise IwanInputError(f"EN must be {self.n_e} arrays of one shape (n, nb)")
+            self._ens = (ct.POINTER(ct.c_double) * self.n_e)(
+                *[a.ctypes.data_as(ct.POINTER(ct.c_double)) for a in self._EN])
+
+    def _samples(self, u, N):
+        u = np.ascontiguousarray(u, dtype=np.float64)
+        Nv = np.ascontiguousarray(N, dtype=np.float64)
+        if u.ndim != 2 or u.shape[0] != self.n_e or Nv.shape != u.shape:
+            raise IwanInputError(f"u and N must have shape ({self.n_e}, n), got {u.shape} "
+                                 f"and {Nv.shape}")
+        return u, Nv
+
+    def jac(self, u, Eu, N, max_periods: int = 100, tol: float = 1e-12):
+        """:func:`periodic_jac_many` of the batch (EN given at construction)."""
+        if self._ens is None:
+            raise IwanInputError("the batch was made without EN: no Jacobian")
+        u, Nv = self._samples(u, N)
+        n = u.shape[1]
+        Eu = np.ascontiguousarray(Eu, dtype=np.float64)
+        if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
+            raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
+        if self._EN[0].shape != Eu.shape:
+            raise IwanInputError(f"EN must be {self.n_e} arrays of shape {Eu.shape}")
+        n_e, nb = self.n_e, Eu.shape[1]
+        F, W = np.empty((n_e, n)), np.empty(n_e)
+        dFdX, dFdXN = np.empty((n_e, n, nb)), np.empty((n_e, n, nb))
+        failed = ct.c_size_t()
+        status = lib.iwan_periodic_jac_many(self._models, n_e, n, arr(u), arr(Nv), arr(Eu),
+                                            self._ens, nb, arr(F), arr(dFdX), arr(dFdXN), arr(W),
+                                            int(max_periods), float(tol), ct.byref(failed))
+        check(status, f"periodic_jac_many (element {failed.value})")
+        return F, dFdX, dFdXN, W
+
+    def loops(self, u, N, max_periods: int = 100, tol: float = 1e-12):
+        """:func:`periodic_many` of the batch: F (n_e, n) [N] and W_cycle (n_e,) [J]."""
+        u, Nv = self._samples(u, N)
+        n = u.shape[1]
+        F, W = np.empty((self.n_e, n)), np.empty(self.n_e)
+        failed = ct.c_size_t()
+        status = lib.iwan_periodic_many(self._models, self.n_e, n, arr(u), arr(Nv), arr(F),
+                                        arr(W), int(max_periods), float(tol), ct.byref(failed))
+        check(status, f"periodic_many (element {failed.value})")
+        return F, W
+
+
 def periodic_jac_many(elements, u, Eu, N, EN, max_periods: int = 100, tol: float = 1e-12):
     """:meth:`IwanElement.periodic_jac` of many elements in one C call (same numbers).
 
@@ -161,29 +230,28 @@ def periodic_jac_many(elements, u, Eu, N, EN, max_periods: int = 100, tol: float
     F : (n_e, n) [N];  dFdX, dFdXN : (n_e, n, nb);  W_cycle : (n_e,) [J].
 
     Raises the first failing element's error (IwanInputError, IwanNotConvergedError)
-    with its index.
+    with its index. Repeated calls on the same elements: :class:`PeriodicBatch`.
     """
-    n_e = len(elements)
-    u = np.ascontiguousarray(u, dtype=np.float64)
-    Eu = np.ascontiguousarray(Eu, dtype=np.float64)
-    Nv = np.ascontiguousarray(N, dtype=np.float64)
-    if n_e == 0 or u.ndim != 2 or u.shape[0] != n_e or Nv.shape != u.shape:
-        raise IwanInputError(f"u and N must have shape ({n_e}, n) with n_e >= 1, got {u.shape} "
-                             f"and {Nv.shape}")
-    n = u.shape[1]
-    if Eu.ndim != 2 or Eu.shape[0] != n or Eu.shape[1] == 0:
-        raise IwanInputError(f"Eu must have shape ({n}, nb), got {Eu.shape}")
-    nb = Eu.shape[1]
-    ENs = [np.ascontiguousarray(a, dtype=np.float64) for a in EN]
-    if len(ENs) != n_e or any(a.shape != Eu.shape for a in ENs):
-        raise IwanInputError(f"EN must be {n_e} arrays of shape {Eu.shape}")
-    F, W = np.empty((n_e, n)), np.empty(n_e)
-    dFdX, dFdXN = np.empty((n_e, n, nb)), np.empty((n_e, n, nb))
-    models = (ct.POINTER(type(elements[0]._mp.contents)) * n_e)(*[el._mp for el in elements])
-    ens = (ct.POINTER(ct.c_double) * n_e)(*[a.ctypes.data_as(ct.POINTER(ct.c_double)) for a in ENs])
-    failed = ct.c_size_t()
-    status = lib.iwan_periodic_jac_many(models, n_e, n, arr(u), arr(Nv), arr(Eu), ens, nb, arr(F),
-                                        arr(dFdX), arr(dFdXN), arr(W), int(max_periods), float(tol),
-                                        ct.byref(failed))
-    check(status, f"periodic_jac_many (element {failed.value})")
-    return F, dFdX, dFdXN, W
+    if len(elements) == 0:
+        raise IwanInputError("u and N must have shape (n_e, n) with n_e >= 1")
+    return PeriodicBatch(elements, EN).jac(u, Eu, N, max_periods, tol)
+
+
+def periodic_many(elements, u, N, max_periods: int = 100, tol: float = 1e-12):
+    """The periodic loops of many elements without their Jacobians, in one C call: the F
+    and W_cycle of each element's own :meth:`IwanElement.periodic_jac_terms` (the same
+    bits: the same march).
+
+    Parameters
+    ----------
+    elements : sequence of n_e IwanElement
+    u, N : array_like, shape (n_e, n)   displacement [m] and normal load [N] samples
+    max_periods, tol : as :meth:`IwanElement.periodic_jac`
+
+    Returns
+    -------
+    F : (n_e, n) [N];  W_cycle : (n_e,) [J].
+    """
+    if len(elements) == 0:
+        raise IwanInputError("u and N must have shape (n_e, n) with n_e >= 1")
+    return PeriodicBatch(elements).loops(u, N, max_periods, tol)

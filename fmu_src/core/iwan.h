@@ -200,6 +200,16 @@ iwan_status iwan_periodic_jac_many(const iwan_model *const *models, size_t n_el,
                                    double *dFdXN, double *W_cycle, int max_periods, double tol,
                                    size_t *failed);
 
+/* The periodic loops of n_el independent elements without their Jacobians, in one call
+ * (each its own model and samples): element e reads u[e*n ..], N[e*n ..] (N required)
+ * and writes F[e*n ..] and W_cycle[e], the same numbers as the F and W_cycle of its own
+ * iwan_periodic_jac, iwan_periodic_jac_rows or iwan_periodic_jac_terms call (the same
+ * closure and final pass). Stops at the first element that fails: its status, its
+ * index in *failed (n_el when all succeed). For a ring's residual without its Jacobian. */
+iwan_status iwan_periodic_many(const iwan_model *const *models, size_t n_el, size_t n,
+                               const double *u, const double *N, double *F, double *W_cycle,
+                               int max_periods, double tol, size_t *failed);
+
 /* iwan_periodic_jac's Jacobian as sparse terms in the samples, for any basis (same
  * numbers as the dense rows to round-off): row t of dF/dX is
  *   dX[t] Eu[t, :] + sum_i cX[i] Eu[col[i], :]     over the terms i with row[i] == t,

@@ -330,6 +330,42 @@ iwan_status iwan_periodic_jac_many(const iwan_model *const *models, size_t n_el,
     return IWAN_OK;
 }
 
+iwan_status iwan_periodic_many(const iwan_model *const *models, size_t n_el, size_t n,
+                               const double *u, const double *N, double *F, double *W_cycle,
+                               int max_periods, double tol, size_t *failed)
+{
+    if (!models || !u || !N || !F || !W_cycle || !failed || n == 0 || n > (size_t)INT32_MAX / 2)
+        return IWAN_ERR_BAD_PARAM;
+    for (size_t e = 0; e < n_el; ++e) {
+        const iwan_model *m = models[e];
+        const double *ue = u + e * n, *Ne = N + e * n;
+        double *Fe = F + e * n;
+        iwan_state s;
+        anchors an;
+        size_t tM;
+        int p = 0;
+        iwan_status st = check_periodic(m, n, ue, Ne, max_periods, tol);
+        if (st == IWAN_OK)
+            st = closed_start(m, n, ue, Ne, &s, &an, &tM, max_periods, tol, &p);
+        if (st != IWAN_OK) {
+            *failed = e;
+            return st;
+        }
+        /* the final pass of iwan_periodic_jac_terms without its Jacobian terms (the
+         * anchors are kept as there: the same steps, the same bits) */
+        const double w0 = s.w_diss;
+        for (size_t k = 1; k <= n; ++k) {
+            const size_t t = (tM + k) % n;
+            an.t = (int32_t)t;
+            iwanp_advance(m, &s, ue[t], Ne[t], &an);
+            Fe[t] = iwanp_force(m, &s);
+        }
+        W_cycle[e] = s.w_diss - w0;
+    }
+    *failed = n_el;
+    return IWAN_OK;
+}
+
 /* ------------------------------------------- exact loop of a monotone-piecewise input */
 
 iwan_status iwan_periodic_branches(const iwan_model *model, size_t n, const double *u_ext,

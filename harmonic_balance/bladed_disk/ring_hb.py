@@ -32,7 +32,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact import evaluate_many, frictionless_statics
+from ..contact import frictionless_statics
+from ..contact_many import LineContacts, _is_line, evaluate_many
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
@@ -123,6 +124,13 @@ class MistunedRingHB:
             groups.setdefault((el.m, d.size), []).append((e, gidx, np.asarray(kin.Q, dtype=float)))
         self._groups = [([e for e, _, _ in g], np.array([i for _, i, _ in g]),
                          np.array([q for _, _, q in g])) for g in groups.values()]
+        # each group's contacts for evaluate_many, their constants read once (the sliders'
+        # reference s_0 is set above, by the prestress state, and never changes)
+        self._contacts = []
+        for idx, _, _ in self._groups:
+            els = [self.points[e] for e in idx]
+            self._contacts.append(LineContacts(els, self.basis)
+                                  if all(_is_line(el) for el in els) else els)
 
     def _pattern(self) -> None:
         """Fixed CSC pattern of the Jacobian and each contribution's place in it."""
@@ -154,14 +162,19 @@ class MistunedRingHB:
             self._blk_pos.append(np.ascontiguousarray(pos))
             at += n
         self._cK0 = (None, None)
+        self._lin_w = (None, None, None)
 
     def _linear_values(self, w: float) -> np.ndarray:
         """A(omega)'s values on the Jacobian's pattern (nnz,), summed as the bincount of
-        :meth:`__call__` sums them (K, the scaled K0, M, C in turn; an absent part adds 0)."""
-        if self._cK0[0] != self.lam:
-            self._cK0 = (self.lam, self._c[self._indices] * self._lin_nnz[1])
-        K, _, M, C = self._lin_nnz
-        return K + self._cK0[1] + -w * w * M + w * C
+        :meth:`__call__` sums them (K, the scaled K0, M, C in turn; an absent part adds 0).
+        A new array each call (the caller adds the contacts' blocks into it); the sums
+        are kept for the last (omega, lam): Newton's iterations at one frequency copy them."""
+        if self._lin_w[:2] != (w, self.lam):
+            if self._cK0[0] != self.lam:
+                self._cK0 = (self.lam, self._c[self._indices] * self._lin_nnz[1])
+            K, _, M, C = self._lin_nnz
+            self._lin_w = (w, self.lam, K + self._cK0[1] + -w * w * M + w * C)
+        return self._lin_w[2].copy()
 
     # ------------------------------------------------------------ residual
     def __call__(self, x: np.ndarray, omega: float, jac: bool = True, rate: bool = False):
@@ -176,11 +189,11 @@ class MistunedRingHB:
         blocks, nb = [], self.nb
         compiled = jac and ring_lu_c.lib is not None
         data = self._linear_values(w) if compiled else None
-        for (idx, G, Q), pos in zip(self._groups, self._blk_pos):
+        for (_, G, Q), pos, els in zip(self._groups, self._blk_pos, self._contacts):
             n_e, m, d = Q.shape
             # U_e = (I (x) Q) x_e: local harmonics (n_e, n_b, m)
             U = np.einsum("eja,eca->ecj", Q, x[G].reshape(n_e, nb, d))
-            F, dF, dw = evaluate_many([self.points[e] for e in idx], U, self.basis, w, jac)
+            F, dF, dw = evaluate_many(els, U, self.basis, w, jac)
             np.add.at(R, G, _back(Q, F))
             if (jac or rate) and dw is not None:
                 np.add.at(Rw, G, _back(Q, dw))

@@ -11,8 +11,9 @@ the caller's ``surfaces_at(cf)``, sized at that load as for ``damper upd frf --c
 surface --cf CF``). Its unknowns are the sector's DOFs at every load and node count, so
 each load's search starts from the peak solution and frequency of the nearest load
 already solved; where Newton fails from there, the load step is halved in log CF
-(:func:`.load_path.warm_path`), and as a last resort the load is reached from its open
-load (:func:`.load_path.first_point`). The first load solved is the largest, where the
+(:func:`.load_path.warm_path`), and as a last resort, while fewer than
+:data:`MIN_WALKED` loads are solved, the load is reached from its open load
+(:func:`.load_path.first_point`). The first load solved is the largest, where the
 stuck start holds (the open load scales with the CF's own prestress).
 
 :func:`optimal_load_surface` walks ``points`` log-spaced loads from the largest down and
@@ -250,7 +251,8 @@ class SurfaceWalk:
 
     def _first(self, make, hb, cf: float, start: dict):
         """``first(omega)`` of the load's search: Newton from the nearest solved load's peak
-        solution, else that load step halved, else the path from the open load."""
+        solution, else that load step halved, else (fewer than MIN_WALKED loads solved) the
+        path from the open load."""
         def from_open_load(w):
             x, rec = load_path.first_point(make, w, cf)
             start["how"] = start["how"] or ("path from the open load" if len(rec["loads"]) > 1
@@ -273,6 +275,11 @@ class SurfaceWalk:
                 start["how"] = start["how"] or f"warm from {c0:.4g} N, step halved"
                 return x
             except SolverError:
+                # with the walk under way the open load's path retraces the loads already
+                # walked and fails where the halved steps did (UPD-24, 30 N: 17 of the
+                # walk's 24 min CPU spent so): the failure stops the walk (_walk_down)
+                if len(self.solved) >= MIN_WALKED:
+                    raise
                 return from_open_load(w)
         return first
 

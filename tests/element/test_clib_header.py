@@ -59,7 +59,7 @@ def _expected(c_type: str, name: str, position: int):
 
 def test_every_header_function_is_declared_once_with_matching_types():
     protos = prototypes()
-    assert len(protos) == 27 and set(protos) == set(_clib.FUNCTIONS)
+    assert len(protos) == 28 and set(protos) == set(_clib.FUNCTIONS)
     for name, (ret, params) in protos.items():
         restype, argtypes = _clib.FUNCTIONS[name]
         assert restype is (ct.c_char_p if ret == "constchar*" else _SCALARS[ret]), name

@@ -197,3 +197,25 @@ def test_many_elements_name_the_one_that_fails(el):
         periodic_jac_many([el] * 3, u, E, np.array([E @ XN] * 3), [E] * 3)
     with pytest.raises(IwanInputError):
         el.periodic_jac(u[1], E, E @ XN, E)
+
+
+def test_many_loops_without_jacobian_are_each_elements_own_terms_call(el):
+    """periodic_many (and a PeriodicBatch, reused on other samples): every element gets
+    the F and W_cycle bits of its own periodic_jac_terms call, the residual path it
+    replaces; varying N, lift-off; a NaN names its element."""
+    from fmu_src.element_batch import PeriodicBatch, periodic_many
+
+    E = basis()
+    els = [el, IwanElement.jenkins(2e5, 0.3 * N_SPHERE), IwanElement.from_curve(*cattaneo_table(6), N_ref=N_SPHERE)]
+    cases = [CASES[k] for k in ("varying N", "lift-off", "stuck, negative offset, varying N")]
+    u = np.array([E @ X for X, _ in cases])
+    N = np.array([E @ XN for _, XN in cases]) * np.array([1.0, 2.0, 0.5])[:, None]
+    batch = PeriodicBatch(els)
+    for scale in (1.0, 0.3):
+        for F, W in (periodic_many(els, scale * u, N), batch.loops(scale * u, N)):
+            for i, e in enumerate(els):
+                Fi, *_, Wi = e.periodic_jac_terms(scale * u[i], N[i])
+                assert np.array_equal(F[i], Fi) and W[i] == Wi
+    u[1, 5] = np.nan
+    with pytest.raises(IwanInputError, match=r"periodic_many \(element 1\)"):
+        batch.loops(u, N)

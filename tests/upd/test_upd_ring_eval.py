@@ -88,7 +88,7 @@ def test_contacts_with_different_tolerances_take_their_own_path_with_the_same_nu
     friction path inside evaluate_many, with its own evaluate's numbers."""
     import copy
 
-    from harmonic_balance.contact import evaluate_many
+    from harmonic_balance.contact_many import evaluate_many
 
     ring, w, states = ring_states
     (idx, G, Q), = ring._groups
@@ -103,3 +103,29 @@ def test_contacts_with_different_tolerances_take_their_own_path_with_the_same_nu
             if jac:
                 assert _rel(dF, dF0) < BATCH_RTOL
             assert (dw is None) == (dw0 is None) and (dw is None or _rel(dw, dw0) < BATCH_RTOL)
+
+
+def test_kept_contacts_and_linear_values_give_a_fresh_rings_bits(ring_states):
+    """The ring keeps its contacts' constants (LineContacts) and A(omega)'s values of the
+    last frequency and scale: after evaluations at another frequency and scale, R, J and
+    dR/domega equal a fresh ring's first evaluation bit for bit; each J owns its values;
+    the residual without the Jacobian is the Jacobian path's R (the same batched sums)."""
+    ring, w, states = ring_states
+    x = states[1]
+    for lam in (1.0, 0.5):
+        fresh = MistunedRingHB(ring.sector, PATTERN, 3)
+        fresh.set_scale(lam)
+        R0, J0, Rw0 = fresh(x, w)
+        ring.set_scale(1.0)
+        ring(x, 1.01 * w)
+        ring(x, w)
+        ring.set_scale(lam)
+        R, J, Rw = ring(x, w)
+        J2 = ring(x, w)[1]
+        assert np.array_equal(R, R0) and np.array_equal(Rw, Rw0)
+        assert np.array_equal(J.data, J0.data) and np.array_equal(J2.data, J0.data)
+        J2.data[:] = 0.0
+        assert np.array_equal(J.data, J0.data) and np.array_equal(ring(x, w)[1].data, J0.data)
+        R1, Rw1 = ring(x, w, jac=False, rate=True)
+        assert np.array_equal(R1, R) and np.array_equal(Rw1, Rw)
+    ring.set_scale(1.0)

@@ -78,3 +78,37 @@ def test_a_walk_stops_at_the_first_load_that_fails_after_enough_loads():
     assert _walk_down(_Walk(0.0), cfs, 450.0)[1] is None
     with pytest.raises(SolverError):
         _walk_down(_Walk(cfs[-MIN_WALKED] * 1.01), cfs, 450.0)
+
+
+@pytest.mark.parametrize("solved, open_path_tried", [(1, True), (2, False)])
+def test_the_open_load_path_is_the_last_resort_of_the_first_loads_only(monkeypatch, solved, open_path_tried):
+    """Once MIN_WALKED loads are solved, a load whose warm start and halved steps fail is
+    the walk's stop, not a path from its open load that retraces the loads walked."""
+    from harmonic_balance.bladed_disk import surface_peak
+    from harmonic_balance.newton import NewtonError
+
+    assert surface_peak.MIN_WALKED == 2
+    tried = []
+
+    def no_newton(*a, **k):
+        raise NewtonError("stand-in: no convergence", np.zeros(3), 40, 1.0)
+
+    def no_warm_path(*a, **k):
+        raise SolverError("stand-in: halved steps failed")
+
+    def open_path(make, w, cf):
+        tried.append(cf)
+        return np.zeros(3), {"loads": [cf]}
+
+    monkeypatch.setattr(surface_peak, "solve_point", no_newton)
+    monkeypatch.setattr(surface_peak.load_path, "warm_path", no_warm_path)
+    monkeypatch.setattr(surface_peak.load_path, "first_point", open_path)
+    walk = surface_peak.SurfaceWalk.__new__(surface_peak.SurfaceWalk)
+    walk.solved = {100.0 * 2 ** i: (2800.0, np.zeros(3)) for i in range(solved)}
+    first = walk._first(None, None, 30.0, {"how": None})
+    if open_path_tried:
+        assert first(2800.0).shape == (3,) and tried == [30.0]
+    else:
+        with pytest.raises(SolverError, match="halved steps failed"):
+            first(2800.0)
+        assert tried == []
