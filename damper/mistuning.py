@@ -161,10 +161,26 @@ class Study:
             limits.check_size("samples", self.samples, 1, limits.MAX_MISTUNING_SAMPLES,
                               "each sample is a ring curve (~20 s CPU at 24 blades, H = 7)")
             limits.check_size("seed", self.seed, 0, 2**63 - 1, "a 64-bit seed")
+            self._check_zero_std()
         if self.band_hz is not None:
             limits.check_omega_range("band", *self.band_hz, unit="Hz", scale=2 * np.pi)
             if not self.band_hz[0] < self.band_hz[1]:
                 raise ValueError(f"band {self.band_hz[0]:g} {self.band_hz[1]:g}: give LO < HI [Hz]")
+
+    def _check_zero_std(self) -> None:
+        """A zero std draws the tuned pattern (all factors 1) for every sample: more than one
+        sample, or sampling until an interval closes (~80 identical rings), repeats one
+        result, so only one sample (the tuned disk as a check) is run."""
+        if self.std != 0:
+            return
+        if self.until_ci is not None:
+            raise ValueError("--until-ci with --std 0: every sample is the tuned disk, so the interval closes "
+                             "only after ~80 identical samples; give --std > 0 (e.g. 0.02), or drop --until-ci "
+                             "and give --samples 1 for the tuned disk")
+        if self.samples > 1:
+            raise ValueError(f"--std 0 with {self.samples} samples: every sample is the tuned disk (all factors "
+                             "1), the same result each time; give --std > 0 (e.g. 0.02), or --samples 1 for "
+                             "the tuned disk")
 
     def patterns(self, n_blades: int) -> list[np.ndarray]:
         """Stiffness factors of every sample (all drawn and checked before any work)."""

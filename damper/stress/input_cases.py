@@ -328,6 +328,10 @@ def _upd() -> list[InputCase]:
         ("no action", ""),
         ("mistuning std -0.01", "mistuning --std=-0.01"), ("mistuning std nan", "mistuning --std nan"),
         ("mistuning std 0.6", "mistuning --std 0.6 --samples 50"),
+        ("mistuning std 0 until-ci (identical tuned samples)", "mistuning --std 0 --until-ci 0.01"),
+        ("mistuning std 0 samples 3 (identical tuned samples)", "mistuning --std 0 --samples 3 --blades 4 "
+         "--engine-order 1 --harmonics 1"),
+        ("mistuning std 0 at the default samples", "mistuning --std 0"),
         ("mistuning samples 0", "mistuning --samples 0"), ("mistuning samples 1e5", "mistuning --samples 100000"),
         ("mistuning blades 1e5", "mistuning --blades 100000"),
         ("mistuning engine order -1 (named as a config key)", "mistuning --engine-order=-1 --damper free --serial"),

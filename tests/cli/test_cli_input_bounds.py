@@ -51,6 +51,18 @@ def test_until_ci_wider_than_one_is_refused_and_one_is_accepted():
     Study(until_ci=limits.MAX_UNTIL_CI).check()
 
 
+def test_zero_std_runs_the_tuned_disk_once_and_refuses_repeating_it():
+    """std 0 draws all factors 1 for every sample: one sample is the tuned-disk check, more
+    (or --until-ci, ~80 before its interval closes) would repeat it."""
+    Study(std=0, samples=1).check()
+    with pytest.raises(ValueError, match=r"--std 0 with 3 samples: .*--samples 1"):
+        Study(std=0, samples=3).check()
+    with pytest.raises(ValueError, match=r"--until-ci with --std 0: .*give --std > 0"):
+        Study(std=0, samples=2000, until_ci=0.01).check()
+    Study(std=0.02, samples=3).check()
+    Study(std=0.02, samples=2000, until_ci=0.01).check()
+
+
 def test_max_step_too_small_for_the_point_limit_names_both_options(capsys):
     assert damper(["frf", *SDOF, "--omega", "0.9", "1.3", "--max-step", "1e-300"]) == 2
     line = _one_line(capsys.readouterr().err)
@@ -83,10 +95,10 @@ def test_tuned_study_std_zero_has_amplification_one(tmp_path, damper_kind):
     from damper.cache import Store
     from damper.mistuning import run_study
 
-    study = Study(blades=4, engine_order=1, std=0.0, samples=2, damper=damper_kind, harmonics=3)
+    study = Study(blades=4, engine_order=1, std=0.0, samples=1, damper=damper_kind, harmonics=3)
     out = run_study(study, Store(tmp_path / "c", max_bytes=10**9), serial=True, echo=lambda t: None)
     amps = [s["amplification"] for s in out["samples"]]
-    assert out["failed"] == 0 and len(amps) == 2
+    assert out["failed"] == 0 and len(amps) == 1
     assert all(abs(a - 1.0) < TUNED_AMPLIFICATION_TOL[damper_kind] for a in amps), amps
 
 
