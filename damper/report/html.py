@@ -23,6 +23,7 @@ td.num { text-align: right; font-family: monospace; }
 figure { display: inline-block; margin: 0.4em; vertical-align: top; }
 figure img { max-width: 44em; max-height: 22em; border: 1px solid #ddd; }
 figcaption { font-size: 0.85em; color: #555; } .meta { color: #555; font-size: 0.9em; }
+ul.warn { background: #fff4e0; border-left: 4px solid #c60; padding: 0.4em 0.4em 0.4em 2em; }
 """
 
 
@@ -53,6 +54,9 @@ def render(rec, out_dir: Path) -> str:
              f"<h1>{html.escape(title)}</h1>",
              f"<p class='meta'>scene {html.escape(scene.source)} (hash {scene.hash()}), code {html.escape(rev)}, "
              f"{html.escape(prov.get('created', ''))}; wanted: {html.escape(', '.join(plan.want))}</p>"]
+    warned = [s.name for s in plan.stages if s.name in rec.results and s.kind.warnings(s, rec.results[s.name])]
+    if warned:   # at the top as well: a warning deep in the results is easily missed
+        parts.append(f"<p class='meta'><b>warnings</b> in {html.escape(', '.join(warned))} (see Results)</p>")
     computed = [s for s in plan.stages if s.action == "compute"]
     cached = [s for s in plan.stages if s.action == "cached"]
     parts.append(f"<h2>Plan</h2><p>{len(computed)} stage(s) computed, {len(cached)} from the cache, "
@@ -67,8 +71,13 @@ def render(rec, out_dir: Path) -> str:
             continue
         result = rec.results[s.name]
         scal = s.kind.scalars(s, result)
-        if scal:
+        warns = s.kind.warnings(s, result)
+        if scal or warns:
             parts.append(f"<h3>{html.escape(s.name)}</h3>")
+        if warns:   # the texts the stage printed as "warning: ..." (its result's *warning* fields)
+            parts.append("<ul class='warn'>" + "".join(f"<li>warning: {html.escape(w)}</li>" for w in warns)
+                         + "</ul>")
+        if scal:
             parts.append(_table(["quantity", "value"], [[k, v] for k, v in scal.items()]))
         pngs = sorted(n for n in result.files if n.endswith(".png"))
         for name in pngs:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .graph import Kind, Result, Stage
+from .graph import Kind, Result, Stage, warning_texts
 
 #: Body fields of a scene contact that define the FE model (the condensation's inputs).
 BODY_KEYS = ("body", "radius", "length", "width", "height", "E", "nu", "E2", "nu2", "model", "grid", "p_design",
@@ -158,6 +158,14 @@ class Normal(Kind):
             out.append(f"{'':9s} " + under_resolved_warning("p_design", "grid"))
         return out
 
+
+    def warnings(self, stage, result):
+        out = super().warnings(stage, result)
+        if result.data.get("under_resolved"):
+            from contact_core.bodies import under_resolved_warning
+
+            out = warning_texts(out + [under_resolved_warning("p_design", "grid")])
+        return out
 
     def scalars(self, stage, result):
         r = result.data

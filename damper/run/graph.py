@@ -123,12 +123,37 @@ class Kind:
         """The stage's headline numbers (name -> float, SI units) for reports and sweep tables."""
         return {}
 
+    def warnings(self, stage: Stage, result: Result) -> list[str]:
+        """The warnings the stage's result carries, each one text without a ``warning:`` prefix.
+
+        Read from ``result.data``: its ``warning`` text, its ``warnings`` list and every
+        ``*_warning`` text (``truncation_warning``, ``lift_off_warning``, ...); an empty or
+        missing one is no warning. A kind whose result flags a warning otherwise (a
+        boolean) adds its text by overriding this.
+        """
+        data = result.data if isinstance(result.data, dict) else {}
+        texts = [data.get("warning")] + list(data.get("warnings") or [])
+        return warning_texts(texts + [v for k, v in sorted(data.items()) if k.endswith("_warning")])
+
     def folder(self, stage: Stage) -> str:
         """Output sub-folder of the stage."""
         return stage.name.replace(":", "_")
 
     def key(self, stage: Stage, dep_keys: list[str]) -> str:
         return make_key(self.name, self.version, stage.params, dep_keys, code_version(tuple(self.modules)))
+
+
+def warning_texts(texts) -> list[str]:
+    """The non-empty texts of ``texts`` (None and booleans dropped), each once, without a
+    leading ``warning:`` (the report and the printed lines add their own)."""
+    out = []
+    for t in texts:
+        if isinstance(t, str) and t.strip():
+            t = t.strip()
+            t = t[len("warning:"):].strip() if t.lower().startswith("warning:") else t
+            if t not in out:
+                out.append(t)
+    return out
 
 
 @dataclass
