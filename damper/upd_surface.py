@@ -295,8 +295,8 @@ def optimize_record(sector, args, note=None) -> dict:
     point-contact sweep, ``surface_model`` with the node count, and no truncation estimate (a
     peak search at more harmonics per load would double a run of minutes per load).
 
-    ``note(line)`` receives the cost estimate before the walk (evaluations expected x the
-    measured CPU time of the first one) and a line per load solved.
+    ``note(line)`` receives the cost estimate before the walk (evaluations expected of the walk
+    and of the refinement x the measured CPU time of the first one) and a line per load solved.
 
     Raises
     ------
@@ -310,6 +310,10 @@ def optimize_record(sector, args, note=None) -> dict:
     from harmonic_balance.bladed_disk.surface_hb import face_inputs
     from harmonic_balance.bladed_disk.surface_peak import optimal_load_surface
 
+    if note is not None:   # the faces' condensation and statics and the point model's peak come first (minutes)
+        note(f"upd optimize --contacts surface: building the faces at {args.surface_nodes} nodes per side and "
+             f"the point model's peak at H {args.harmonics} at CF {max(args.cf_range):g} N, then the "
+             "estimate of the walk")
     face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
     for cf in args.cf_range:      # the faces' inputs (mu, nominal loads) at both ends, before any solve
         face_specs(sector.cfg, args.surface_nodes, cf)
@@ -318,10 +322,11 @@ def optimize_record(sector, args, note=None) -> dict:
     def surfaces_at(cf):   # called once per load: the walk keeps each load's model
         return build_surfaces(sector.cfg, args.surface_nodes, cf, store)
 
-    def estimate(evaluations, seconds):
+    def estimate(walk, refine, seconds):
         if note is not None:
-            note(f"upd optimize --contacts surface: about {evaluations} residual evaluations at "
-                 f"{seconds:.2g} s CPU each (the first one measured): ~{evaluations * seconds / 60:.0f} min CPU")
+            note(f"upd optimize --contacts surface: about {walk} residual evaluations for the {args.points} loads "
+                 f"at {seconds:.2g} s CPU each (the first one measured): ~{walk * seconds / 60:.0f} min CPU, and "
+                 f"~{refine * seconds / 60:.0f} min more if the optimum lies inside the range (its refinement)")
 
     def on_load(r):
         if note is not None:

@@ -60,16 +60,20 @@ SURFACE_CF_XTOL = 0.02
 #: an error: two give the trend, the optimum then lies at the lowest solved (or between).
 MIN_WALKED = 2
 #: Residual evaluations expected per load (the cost estimate's, :func:`expected_evaluations`):
-#: a load warm-started from the last took 112-130 (UPD-24, 5 nodes per side, H 7, CF 1554 ...
-#: 417 N: ~12 frequencies of bracket and Brent, ~9 Newton evaluations each from the tangent
-#: predictor and one for the tangent).
-EVALUATIONS_PER_LOAD = 120
-#: Loads of the refinement expected: Brent's bounded search to SURFACE_CF_XTOL between the
-#: neighbours of the smallest walked peak.
+#: EVALUATIONS_BASE + EVALUATIONS_PER_H H. A load warm-started from the last took 112-130 at
+#: H 7 (UPD-24, 5 nodes per side, CF 1554 ... 417 N: ~12 frequencies of bracket and Brent,
+#: ~9 Newton evaluations each from the tangent predictor and one for the tangent); measured
+#: at 4b13a0a with ``damper upd optimize --contacts surface --cf-range 300 1200 --points 3``:
+#: 36 and 46 at H 1, 61 and 83 at H 3 (the Newton solves take more iterations with more
+#: harmonics). The line gives 43, 69 and 121; a constant 120 was 3x too high at H 1.
+EVALUATIONS_BASE, EVALUATIONS_PER_H = 30, 13
+#: Loads of the refinement expected when the smallest walked peak is interior: Brent's
+#: bounded search to SURFACE_CF_XTOL between its neighbours (none at a range's end).
 REFINE_LOADS = 6
-#: Evaluations of the first load's path from its open load, beyond a warm load's (UPD-24,
-#: H 7, CF 3000 N: 211 in all).
-PATH_EVALUATIONS = 90
+#: Evaluations of the first load's path from its open load beyond a warm load's, as a share
+#: of a warm load's: 90 of 120 at H 7 (CF 3000 N: 211 in all); at 4b13a0a (the command above,
+#: CF 1200 N) the first load took 72 at H 1 and 119 at H 3: 29 and 50 beyond a warm load's.
+PATH_SHARE = 0.75
 
 
 def bracket(neg, f0: float, step: float = BRACKET_STEP) -> tuple[float, float, float]:
@@ -284,10 +288,12 @@ class SurfaceWalk:
         return first
 
 
-def expected_evaluations(points: int) -> int:
-    """Residual evaluations a walk of ``points`` loads and its refinement is expected to take
-    (:data:`EVALUATIONS_PER_LOAD`, :data:`REFINE_LOADS`, :data:`PATH_EVALUATIONS`)."""
-    return PATH_EVALUATIONS + EVALUATIONS_PER_LOAD * (points + REFINE_LOADS)
+def expected_evaluations(points: int, H: int) -> tuple[int, int]:
+    """Residual evaluations expected at ``H`` harmonics: (the walk of ``points`` loads with the
+    first load's path, the refinement's :data:`REFINE_LOADS` loads when the optimum is interior)
+    (:data:`EVALUATIONS_BASE`, :data:`EVALUATIONS_PER_H`, :data:`PATH_SHARE`; measured at H 1 ... 7)."""
+    per_load = EVALUATIONS_BASE + EVALUATIONS_PER_H * H
+    return round(per_load * (points + PATH_SHARE)), per_load * REFINE_LOADS
 
 
 def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=None,
@@ -307,8 +313,9 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
     cf_xtol : float
         Tolerance of the optimum in log CF.
     estimate : callable, optional
-        ``estimate(evaluations, seconds)`` before the walk: the evaluations expected and
-        the measured CPU time [s] of one (with its Jacobian, at the first load's stuck start
+        ``estimate(walk, refine, seconds)`` before the walk: the evaluations expected of the
+        walk and of the refinement (:func:`expected_evaluations`) and the measured CPU time
+        [s] of one (with its Jacobian, at the first load's stuck start
         after its linear step: the first evaluation of a Newton solve).
     report, on_load : callable, optional
         As :class:`SurfaceWalk`'s.
@@ -334,7 +341,7 @@ def optimal_load_surface(sector, surfaces_at, cf_range, points: int, H: int, f0=
         x = hb.stuck_guess(w_guess)   # one evaluation at the prestress: every node stuck (cheap)
         c = time.process_time()
         hb(x, w_guess)                # Newton's first from the stuck start: nodes slip (typical)
-        estimate(expected_evaluations(points), time.process_time() - c)
+        estimate(*expected_evaluations(points, H), time.process_time() - c)
     peaks, stopped = _walk_down(walk, cfs, w_guess / (2 * np.pi))
     cfs = cfs[cfs.size - len(peaks):]
     t_grid, c_search = time.perf_counter() - t0, time.process_time()

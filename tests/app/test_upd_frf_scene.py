@@ -141,7 +141,7 @@ def test_surface_optimal_load_faces_are_checked_at_load(tmp_path, edit, key, wor
 def _walk_that_stops(sector, surfaces_at, cf_range, points, H, f0=None, estimate=None, on_load=None, **kw):
     """A stand-in for surface_peak.optimal_load_surface: its estimate, two loads, then the stop
     warning (the walk's own text is tested in tests/upd/test_upd_surface_peak_search.py)."""
-    estimate(1234, 0.5)
+    estimate(1234, 600, 0.5)
     loads = [{"cf": cf, "peak_hz": 470.0, "peak_amplitude_h1": a, "nodes": 60, "evaluations": 100,
               "cpu_s": 10.0, "start": "stand-in"} for cf, a in ((3000.0, 5e-3), (1000.0, 4e-3))]
     for r in loads:
@@ -166,9 +166,11 @@ def test_surface_optimal_load_prints_the_estimate_the_loads_and_the_stop_warning
     assert main(argv + [str(tmp_path / "out")]) == 0
     captured = capsys.readouterr()
     err = captured.err.splitlines()
-    estimate = [i for i, line in enumerate(err) if "about 1234 residual evaluations" in line]
+    first = [i for i, line in enumerate(err) if "building the faces at 5 nodes per side" in line]
+    estimate = [i for i, line in enumerate(err) if "about 1234 residual evaluations" in line
+                and "~5 min more if the optimum lies inside" in line]
     loads = [i for i, line in enumerate(err) if line.startswith("  CF 3000 N: peak 470.000 Hz")]
-    assert estimate and loads and estimate[0] < loads[0], captured.err
+    assert first and estimate and loads and first[0] < estimate[0] < loads[0], captured.err
     assert "   warning: the walk stopped at 300 N (stand-in)" in captured.out.splitlines(), captured.out
     assert "2 loads searched, 200 evaluations" in captured.out
     assert main(argv + [str(tmp_path / "again")]) == 0
