@@ -80,3 +80,49 @@ def test_ring_start_from_the_sector_dofs_alone_leaves_the_nodes_to_the_march(sur
     assert not np.any(part[:, n_s:n])
     with pytest.raises(ValueError, match="DOFs per harmonic"):
         ring_start(surface_hb, x[:, :n_s - 1].ravel())
+
+
+def _dense_statics(model, max_iter=100):
+    """The active-set statics with each contact's full (n, n) outer product (the plain form of
+    contact.frictionless_statics, which adds the products on the contact's DOFs only)."""
+    from harmonic_balance.contact import _static_parts
+
+    Klin, rows = _static_parts(model)
+    f0 = np.real(model.forcing.get(0, np.zeros(model.n))).astype(float)
+    active = np.ones(len(rows), dtype=bool)
+    for _ in range(max_iter):
+        A, b = Klin.copy(), f0.copy()
+        for on, (_, el, _, qn, tn) in zip(active, rows):
+            if on:
+                A += el.k_n * np.outer(tn, qn)
+                b -= el.k_n * el.preload * tn
+        x = np.linalg.solve(A, b)
+        new = np.array([el.preload + qn @ x > 0.0 for _, el, _, qn, _ in rows], dtype=bool)
+        if np.array_equal(new, active):
+            return x, active
+        active = new
+    raise AssertionError("no contact set")
+
+
+@pytest.mark.parametrize("which", ["sector", "ring"])
+def test_statics_on_the_contacts_dofs_equals_the_dense_assembly(surface_hb, which):
+    """Same matrix entries added in the same order: equal to round-off of the solve (1e-12),
+    and the same contacts closed (some open, so the active set is exercised)."""
+    model = surface_hb.model if which == "sector" else surface_ring_model(surface_hb)
+    x_ref, active = _dense_statics(model)
+    x, _ = frictionless_statics(model)
+    assert 0 < active.sum() <= active.size
+    assert np.allclose(x, x_ref, rtol=0, atol=1e-12 * np.abs(x_ref).max())
+
+
+def test_the_statics_solve_refuses_a_singular_matrix_and_solves_a_well_conditioned_one():
+    """The condition check of the statics (LAPACK's 1-norm estimate against SINGULAR_COND):
+    a rank-deficient matrix, an exactly zero one and cond 1e14 refused; cond 1e11 solved."""
+    from harmonic_balance.contact import SINGULAR_COND, _solve_checked
+
+    for A in (np.ones((2, 2)), np.zeros((3, 3)), np.diag([1.0, 1e-14])):
+        with pytest.raises(ValueError, match="frictionless statics is singular"):
+            _solve_checked(A, np.ones(len(A)))
+    A = np.diag([1.0, 1e-11])
+    assert np.linalg.cond(A) < SINGULAR_COND
+    assert np.allclose(_solve_checked(A, np.ones(2)), [1.0, 1e11], rtol=1e-15)
