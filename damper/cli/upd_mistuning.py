@@ -101,7 +101,8 @@ def run_mistuning(args) -> int:
           + ("" if out["damper"] != "nonlinear" else f" (H = {out['harmonics']}, every sample)")
           + "; amplification "
           f"max {out['max_amplification']:.4f} (Whitehead bound {out['whitehead_bound']:.3f}); "
-          f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s")
+          f"{out['failed']} failed, {out['cached']} from the cache, {out['time_s']:.1f} s"
+          + (f"; {out['widened']} searched on a band widened past a peak at its end" if out["widened"] else ""))
     for line in statistics_lines(out):
         print(line)
     for line in accuracy_lines(out):
