@@ -33,6 +33,7 @@ def test_a_peak_at_the_default_bands_end_is_searched_on_the_band_widened_there(m
     assert seen[0] == pytest.approx((400.0, 500.0))
     assert seen[1] == pytest.approx((400.0, 500.0 * m))          # only the upper end moves
     assert out["band_widened"] == 1 and out["band_hz"] == pytest.approx([400.0, 500.0 * m])
+    assert out["evaluations"] == 2   # both solves' (one each in the stand-in)
 
 
 def test_the_widening_stops_after_its_limit_with_the_bands_message(monkeypatch):
