@@ -310,13 +310,14 @@ def optimize_record(sector, args, note=None) -> dict:
     from harmonic_balance.bladed_disk.surface_hb import face_inputs
     from harmonic_balance.bladed_disk.surface_peak import optimal_load_surface
 
-    if note is not None:   # the faces' condensation and statics and the point model's peak come first (minutes)
-        note(f"upd optimize --contacts surface: building the faces at {args.surface_nodes} nodes per side and "
-             f"the point model's peak at H {args.harmonics} at CF {max(args.cf_range):g} N, then the "
-             "estimate of the walk")
     face_inputs(sector, "left")   # a sector with axial platform DOFs refused before any condensation
     for cf in args.cf_range:      # the faces' inputs (mu, nominal loads) at both ends, before any solve
         face_specs(sector.cfg, args.surface_nodes, cf)
+    if note is not None:   # after the refusals (one line each); the faces' condensation and statics
+        # and the point model's peak come first (minutes)
+        note(f"upd optimize --contacts surface: building the faces at {args.surface_nodes} nodes per side and "
+             f"the point model's peak at H {args.harmonics} at CF {max(args.cf_range):g} N, then the "
+             "estimate of the walk")
     store = store_of(args)
 
     def surfaces_at(cf):   # called once per load: the walk keeps each load's model
