@@ -36,7 +36,7 @@ class LineContacts:
         from fmu_src.element_batch import PeriodicBatch
 
         self.elements, self.basis = list(elements), basis
-        if not self.elements or not all(_is_line(el) for el in self.elements):
+        if not self.elements or not all(is_line_contact(el) for el in self.elements):
             raise ValueError("LineContacts needs one-tangent contact elements with friction")
         els = self.elements
         self.kn = np.array([el.k_n for el in els])
@@ -115,7 +115,9 @@ class LineContacts:
         return out
 
 
-def _is_line(el) -> bool:
+def is_line_contact(el) -> bool:
+    """Whether ``el`` is a one-tangent contact element with friction (what
+    :class:`LineContacts` takes)."""
     return isinstance(el, ContactElement) and el.m == 2 and el.friction is not None
 
 
@@ -148,7 +150,7 @@ def evaluate_many(elements, U, basis: FourierBasis, omega: float, jac: bool = Tr
     n_e, nb = U.shape[0], basis.nb
     terms = jac and nb * nb * basis.n_t >= TERMS_MIN_WORK
     lines = elements if isinstance(elements, LineContacts) and elements.basis is basis else None
-    if lines is None and not terms and all(_is_line(el) for el in elements):
+    if lines is None and not terms and all(is_line_contact(el) for el in elements):
         lines = LineContacts(elements, basis)
     if lines is None or terms:
         res = [el.evaluate(u, basis, omega, jac) for el, u in zip(elements, U)]

@@ -158,7 +158,6 @@ class Normal(Kind):
             out.append(f"{'':9s} " + under_resolved_warning("p_design", "grid"))
         return out
 
-
     def warnings(self, stage, result):
         out = super().warnings(stage, result)
         if result.data.get("under_resolved"):

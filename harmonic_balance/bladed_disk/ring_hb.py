@@ -33,7 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..contact import frictionless_statics
-from ..contact_many import LineContacts, _is_line, evaluate_many
+from ..contact_many import LineContacts, evaluate_many, is_line_contact
 from ..linear import LinearModel
 from ..model import Model
 from ..residual import FullResidual
@@ -130,7 +130,7 @@ class MistunedRingHB:
         for idx, _, _ in self._groups:
             els = [self.points[e] for e in idx]
             self._contacts.append(LineContacts(els, self.basis)
-                                  if all(_is_line(el) for el in els) else els)
+                                  if all(is_line_contact(el) for el in els) else els)
 
     def _pattern(self) -> None:
         """Fixed CSC pattern of the Jacobian and each contribution's place in it."""

@@ -366,7 +366,7 @@ def _walk_down(walk: SurfaceWalk, cfs, f_guess: float) -> tuple[list, tuple | No
     """The peaks of ``cfs`` (ascending) walked from the largest down, ascending; and (cf,
     message) of the load where a peak failed after MIN_WALKED loads solved (the walk stops
     there: the lowest loads, the damper near its floor, cost most and fail first; UPD-24 at
-    30 N = F0 failed after ~13 min CPU), else None. A failure before that is raised."""
+    30 N = F0 failed after ~7 min CPU at 0137a93), else None. A failure before that is raised."""
     peaks = []
     for c in cfs[::-1]:
         try:
